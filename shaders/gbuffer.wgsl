@@ -1,0 +1,68 @@
+// G-buffer pass: rasterise the scene from the camera.
+// Outputs (see src/renderer/frame.rs):
+//   0 position: Rgba32Float, xyz world position, w = material id + 1 (0 = no geometry)
+//   1 normal:   Rgba16Float, xyz unit shading normal facing the camera, w = 1
+//   2 albedo:   Rgba16Float, rgb linear diffuse albedo = baseColorFactor x texture, a = alpha
+#include "common/camera.wgsl"
+
+struct MaterialGpu {
+    base_color: vec4<f32>,
+    texture: vec4<i32>, // x = layer in `textures` or -1
+};
+
+@group(0) @binding(0) var<uniform> camera: Camera;
+@group(0) @binding(1) var<storage, read> materials: array<MaterialGpu>;
+@group(0) @binding(2) var textures: texture_2d_array<f32>;
+@group(0) @binding(3) var tex_sampler: sampler;
+
+struct VertexIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) material: u32,
+};
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) @interpolate(flat) material: u32,
+};
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    var o: VertexOut;
+    o.clip = camera.view_proj * vec4<f32>(v.position, 1.0);
+    o.world = v.position;
+    o.normal = v.normal;
+    o.uv = v.uv;
+    o.material = v.material;
+    return o;
+}
+
+struct GbufferOut {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) albedo: vec4<f32>,
+};
+
+@fragment
+fn fs_main(i: VertexOut, @builtin(front_facing) front: bool) -> GbufferOut {
+    let m = materials[i.material];
+    var albedo = m.base_color;
+    if m.texture.x >= 0 {
+        // Rgba8UnormSrgb layers: the sampler returns linear values.
+        albedo *= textureSample(textures, tex_sampler, i.uv, m.texture.x);
+    }
+    // Two-sided: shade the side the camera sees.
+    var n = normalize(i.normal);
+    if !front {
+        n = -n;
+    }
+    var o: GbufferOut;
+    o.position = vec4<f32>(i.world, f32(i.material + 1u));
+    o.normal = vec4<f32>(n, 1.0);
+    o.albedo = albedo;
+    return o;
+}

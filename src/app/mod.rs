@@ -1,0 +1,631 @@
+//! The eframe/egui workbench: viewport with camera controls, buffer selector, sun, shadow and
+//! display settings, status line. Only [`viewport_texture`] touches `egui_wgpu`'s textures.
+
+pub mod camera_control;
+pub mod viewport_texture;
+
+use std::{
+    path::PathBuf,
+    sync::{
+        Arc,
+        atomic::{AtomicBool, Ordering},
+    },
+};
+
+use glam::{Vec2, Vec3};
+
+use crate::{
+    renderer::{
+        FrameInput, Renderer,
+        context::{GpuContext, describe_adapter},
+        settings::{RenderSettings, Tonemap, ViewBuffer},
+        timing::PassTimings,
+    },
+    scene::{
+        Camera, DirectionalLight, Scene,
+        preset::{SceneSource, open_scene},
+    },
+};
+use camera_control::{CameraController, CameraMode};
+use viewport_texture::ViewportTexture;
+
+/// How the app was started.
+#[derive(Clone, Debug, Default)]
+pub struct AppOptions {
+    /// What `--scene` said (`default`, a glTF file or a preset).
+    pub scene: String,
+    pub camera: Option<String>,
+    /// Exit after this many rendered frames.
+    pub exit_after_frames: Option<u64>,
+    /// Save a window screenshot before exiting.
+    pub screenshot: Option<PathBuf>,
+}
+
+/// The sun as the UI edits it (light 0 of the scene).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SunControls {
+    pub azimuth_deg: f32,
+    pub elevation_deg: f32,
+    /// Irradiance E in W/m^2 on a perpendicular surface (of the brightest channel).
+    pub irradiance: f32,
+    /// Colour, brightest channel = 1.
+    pub color: [f32; 3],
+}
+
+impl SunControls {
+    pub fn from_light(l: &DirectionalLight) -> Self {
+        let (az, el) = l.angles_deg();
+        let e = l.irradiance.max_element().max(0.0);
+        let color = if e > 0.0 {
+            (l.irradiance / e).to_array()
+        } else {
+            [1.0; 3]
+        };
+        Self {
+            azimuth_deg: az,
+            elevation_deg: el,
+            irradiance: e,
+            color,
+        }
+    }
+    pub fn to_light(&self, name: &str) -> DirectionalLight {
+        DirectionalLight::from_angles(
+            name,
+            self.azimuth_deg,
+            self.elevation_deg,
+            Vec3::from(self.color) * self.irradiance,
+        )
+    }
+}
+
+/// Everything about the open scene.
+pub struct OpenScene {
+    pub scene: Scene,
+    pub source: String,
+    pub camera: Camera,
+    pub controller: CameraController,
+    pub camera_index: Option<usize>,
+}
+
+impl OpenScene {
+    fn new(scene: Scene, source: String, camera_name: Option<&str>) -> Result<Self, String> {
+        let camera = scene.camera_or_default(camera_name)?;
+        let camera_index = scene.cameras.iter().position(|c| c.name == camera.name);
+        let controller = CameraController::from_camera(&camera, &scene.bounds);
+        Ok(Self {
+            scene,
+            source,
+            camera,
+            controller,
+            camera_index,
+        })
+    }
+}
+
+pub struct WorkbenchApp {
+    render_state: Option<egui_wgpu::RenderState>,
+    renderer: Option<Renderer>,
+    open: Option<OpenScene>,
+    settings: RenderSettings,
+    view: ViewBuffer,
+    sun: Option<SunControls>,
+    /// Render resolution = viewport pixels x this.
+    render_scale: f32,
+    texture: ViewportTexture,
+    timings: Option<PassTimings>,
+    /// Messages shown in the error window until dismissed (each once).
+    errors: Vec<String>,
+    scene_path_input: String,
+    options: AppOptions,
+    frames: u64,
+    screenshot_done: Arc<AtomicBool>,
+    screenshot_requested: bool,
+    last_frame_time: Option<f64>,
+    frame_ms_smoothed: f64,
+    adapter: String,
+}
+
+impl WorkbenchApp {
+    pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
+        let mut app = Self {
+            render_state: cc.wgpu_render_state.clone(),
+            renderer: None,
+            open: None,
+            settings: RenderSettings::default(),
+            view: ViewBuffer::Final,
+            sun: None,
+            render_scale: 1.0,
+            texture: ViewportTexture::new(),
+            timings: None,
+            errors: Vec::new(),
+            scene_path_input: if options.scene == "default" {
+                String::new()
+            } else {
+                options.scene.clone()
+            },
+            options,
+            frames: 0,
+            screenshot_done: Arc::new(AtomicBool::new(false)),
+            screenshot_requested: false,
+            last_frame_time: None,
+            frame_ms_smoothed: 0.0,
+            adapter: String::new(),
+        };
+        let Some(rs) = app.render_state.clone() else {
+            app.errors.push(format!(
+                "The workbench needs the wgpu renderer and got none: {}",
+                crate::renderer::context::NO_ADAPTER_HELP
+            ));
+            return app;
+        };
+        let info = rs.adapter.get_info();
+        app.adapter = describe_adapter(&info);
+        if info.device_type == wgpu::DeviceType::Cpu {
+            // Software rasterisers: keep the viewport interactive.
+            app.render_scale = 0.5;
+        }
+        let source = app.options.scene.clone();
+        let camera = app.options.camera.clone();
+        if let Err(e) = app.open_scene(&source, camera.as_deref()) {
+            app.errors.push(e);
+            if source != "default"
+                && let Err(e) = app.open_scene("default", None)
+            {
+                app.errors.push(e);
+            }
+        }
+        app
+    }
+
+    /// Opens a scene; on failure the previous scene stays and the message is returned.
+    pub fn open_scene(&mut self, source: &str, camera: Option<&str>) -> Result<(), String> {
+        let Some(rs) = self.render_state.clone() else {
+            return Err("no GPU renderer".into());
+        };
+        let opened = open_scene(&SceneSource::from_arg(source))
+            .map_err(|e| format!("Could not open '{source}': {e}"))?;
+        let camera = camera.map(str::to_string).or(opened.camera_name.clone());
+        let open = OpenScene::new(opened.scene, source.to_string(), camera.as_deref())
+            .map_err(|e| format!("Could not open '{source}': {e}"))?;
+        for w in &open.scene.warnings {
+            log::warn!("{source}: {w}");
+        }
+        self.settings.display.exposure_ev = opened.exposure_ev;
+        match &mut self.renderer {
+            Some(r) => {
+                r.load_scene(&open.scene);
+                let _ = r.set_settings(self.settings.clone());
+            }
+            None => {
+                let ctx = GpuContext::from_parts(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info());
+                let r = Renderer::new(ctx, &open.scene, (64, 64), self.settings.clone())
+                    .map_err(|e| e.to_string())?;
+                self.renderer = Some(r);
+            }
+        }
+        self.sun = open.scene.lights.first().map(SunControls::from_light);
+        self.open = Some(open);
+        Ok(())
+    }
+
+    pub fn view(&self) -> ViewBuffer {
+        self.view
+    }
+    pub fn set_view(&mut self, v: ViewBuffer) {
+        self.view = v;
+    }
+    pub fn renderer(&self) -> Option<&Renderer> {
+        self.renderer.as_ref()
+    }
+    pub fn open(&self) -> Option<&OpenScene> {
+        self.open.as_ref()
+    }
+    pub fn errors(&self) -> &[String] {
+        &self.errors
+    }
+    pub fn frames(&self) -> u64 {
+        self.frames
+    }
+
+    /// The lights of the next frame (light 0 as the sun controls say).
+    pub fn lights(&self) -> Vec<DirectionalLight> {
+        self.open
+            .as_ref()
+            .map(|o| lights_with_sun(&o.scene, self.sun.as_ref()))
+            .unwrap_or_default()
+    }
+
+    fn side_panel(&mut self, ui: &mut egui::Ui) {
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            ui.heading("Scene");
+            ui.horizontal(|ui| {
+                ui.add(
+                    egui::TextEdit::singleline(&mut self.scene_path_input)
+                        .hint_text(".gltf / .glb / preset .toml")
+                        .desired_width(150.0),
+                );
+                if ui.button("Open").clicked() {
+                    let s = self.scene_path_input.trim().to_string();
+                    let s = if s.is_empty() { "default".to_string() } else { s };
+                    if let Err(e) = self.open_scene(&s, None) {
+                        self.errors.push(e);
+                    }
+                }
+            });
+            ui.horizontal_wrapped(|ui| {
+                let mut choice = None;
+                if ui.button("default").clicked() {
+                    choice = Some("default".to_string());
+                }
+                for p in preset_files() {
+                    let label = p
+                        .file_stem()
+                        .map(|s| s.to_string_lossy().to_string())
+                        .unwrap_or_default();
+                    if ui.button(label).on_hover_text(p.display().to_string()).clicked() {
+                        choice = Some(p.display().to_string());
+                    }
+                }
+                if let Some(c) = choice {
+                    self.scene_path_input = if c == "default" { String::new() } else { c.clone() };
+                    if let Err(e) = self.open_scene(&c, None) {
+                        self.errors.push(e);
+                    }
+                }
+            });
+            if let Some(open) = &mut self.open {
+                ui.label(format!(
+                    "{}: {} triangles, {} materials, {} textures",
+                    open.scene.name,
+                    open.scene.triangle_count(),
+                    open.scene.materials.len(),
+                    open.scene.textures.len()
+                ));
+                if !open.scene.warnings.is_empty() {
+                    ui.collapsing(format!("{} load warnings", open.scene.warnings.len()), |ui| {
+                        for w in &open.scene.warnings {
+                            ui.label(w);
+                        }
+                    });
+                }
+                ui.separator();
+                ui.heading("Camera");
+                let names: Vec<String> = open.scene.cameras.iter().map(|c| c.name.clone()).collect();
+                let current = open
+                    .camera_index
+                    .and_then(|i| names.get(i).cloned())
+                    .unwrap_or_else(|| "(free)".into());
+                egui::ComboBox::from_label("camera")
+                    .selected_text(current)
+                    .show_ui(ui, |ui| {
+                        for (i, n) in names.iter().enumerate() {
+                            if ui.selectable_label(open.camera_index == Some(i), n).clicked() {
+                                open.camera_index = Some(i);
+                                open.camera = open.scene.cameras[i].clone();
+                                open.controller =
+                                    CameraController::from_camera(&open.camera, &open.scene.bounds);
+                            }
+                        }
+                    });
+                ui.horizontal(|ui| {
+                    ui.radio_value(&mut open.controller.mode, CameraMode::Orbit, "orbit")
+                        .on_hover_text("left drag: orbit, right drag: pan, wheel: zoom");
+                    ui.radio_value(&mut open.controller.mode, CameraMode::Fly, "fly")
+                        .on_hover_text("drag: look, W/A/S/D/Q/E: move (Shift: faster), wheel: speed");
+                });
+                let mut fov = open.camera.yfov.to_degrees();
+                if ui
+                    .add(egui::Slider::new(&mut fov, 10.0..=120.0).text("vertical fov (deg)"))
+                    .changed()
+                {
+                    open.camera.yfov = fov.to_radians();
+                }
+            }
+            ui.separator();
+            ui.heading("View");
+            egui::ComboBox::from_label("buffer")
+                .selected_text(self.view.name())
+                .show_ui(ui, |ui| {
+                    for v in ViewBuffer::ALL {
+                        ui.selectable_value(&mut self.view, v, v.name());
+                    }
+                });
+            ui.add(
+                egui::Slider::new(&mut self.settings.display.exposure_ev, -10.0..=10.0).text("exposure (EV)"),
+            );
+            egui::ComboBox::from_label("tonemap")
+                .selected_text(self.settings.display.tonemap.name())
+                .show_ui(ui, |ui| {
+                    for t in Tonemap::ALL {
+                        ui.selectable_value(&mut self.settings.display.tonemap, t, t.name());
+                    }
+                });
+            ui.add(egui::Slider::new(&mut self.render_scale, 0.25..=1.0).text("render scale"))
+                .on_hover_text("render resolution relative to the viewport's pixels");
+            if let Some(sun) = &mut self.sun {
+                ui.separator();
+                ui.heading("Sun");
+                ui.add(egui::Slider::new(&mut sun.azimuth_deg, -180.0..=180.0).text("azimuth (deg)"));
+                ui.add(egui::Slider::new(&mut sun.elevation_deg, -10.0..=90.0).text("elevation (deg)"));
+                ui.add(
+                    egui::Slider::new(&mut sun.irradiance, 0.0..=100.0)
+                        .logarithmic(true)
+                        .text("irradiance (W/m²)"),
+                )
+                .on_hover_text("E on a surface perpendicular to the sun");
+                ui.horizontal(|ui| {
+                    ui.label("colour");
+                    ui.color_edit_button_rgb(&mut sun.color);
+                });
+            }
+            ui.separator();
+            ui.heading("Shadow map");
+            let s = &mut self.settings.shadow;
+            egui::ComboBox::from_label("resolution")
+                .selected_text(format!("{0}x{0}", s.resolution))
+                .show_ui(ui, |ui| {
+                    for r in [128, 256, 512, 1024, 2048, 4096] {
+                        ui.selectable_value(&mut s.resolution, r, format!("{r}x{r}"));
+                    }
+                });
+            ui.add(egui::Slider::new(&mut s.depth_bias, 0.0..=8.0).text("depth bias (texels)"));
+            ui.add(egui::Slider::new(&mut s.normal_offset, 0.0..=8.0).text("normal offset (texels)"));
+            ui.add(egui::Slider::new(&mut s.pcf_radius, 0..=4).text("PCF radius"));
+        });
+    }
+
+    fn status_bar(&self, ui: &mut egui::Ui) {
+        ui.horizontal_wrapped(|ui| {
+            ui.label(format!("GPU: {}", self.adapter));
+            ui.separator();
+            if let Some(r) = &self.renderer {
+                let (w, h) = r.size();
+                ui.label(format!("{w}x{h}"));
+                ui.separator();
+                if !r.timestamps_supported() {
+                    ui.label("timestamps not supported");
+                } else if let Some(t) = &self.timings {
+                    ui.label(t.summary());
+                } else {
+                    ui.label("GPU timings pending");
+                }
+                ui.separator();
+                ui.label(format!("frame {:.1} ms", self.frame_ms_smoothed));
+            }
+        });
+    }
+
+    fn viewport(&mut self, ui: &mut egui::Ui) {
+        let avail = ui.available_size();
+        let ppp = ui.ctx().pixels_per_point();
+        let (Some(rs), Some(open)) = (self.render_state.clone(), self.open.as_mut()) else {
+            ui.centered_and_justified(|ui| ui.label("No scene is open."));
+            return;
+        };
+        let Some(renderer) = self.renderer.as_mut() else {
+            return;
+        };
+        let w = ((avail.x * ppp * self.render_scale) as u32).clamp(16, 8192);
+        let h = ((avail.y * ppp * self.render_scale) as u32).clamp(16, 8192);
+        if let Err(e) = renderer.resize(w, h) {
+            self.errors.push(e.to_string());
+        }
+        if renderer.settings() != &self.settings
+            && let Err(e) = renderer.set_settings(self.settings.clone())
+        {
+            self.errors.push(e.to_string());
+            self.settings = renderer.settings().clone();
+        }
+
+        // Input -> camera.
+        let (rect, response) = ui.allocate_exact_size(avail, egui::Sense::click_and_drag());
+        let dt = ui.input(|i| i.stable_dt).min(0.1);
+        if response.dragged() {
+            let d = response.drag_delta();
+            let primary = response.dragged_by(egui::PointerButton::Primary);
+            open.controller.on_drag(Vec2::new(d.x, d.y), primary);
+            open.camera_index = None;
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                open.controller.on_scroll(scroll);
+                open.camera_index = None;
+            }
+        }
+        if open.controller.mode == CameraMode::Fly && response.hovered() {
+            let mv = ui.input(|i| {
+                let k = |key| if i.key_down(key) { 1.0 } else { 0.0 };
+                let fast = if i.modifiers.shift { 4.0 } else { 1.0 };
+                Vec3::new(
+                    k(egui::Key::D) - k(egui::Key::A),
+                    k(egui::Key::E) - k(egui::Key::Q),
+                    k(egui::Key::W) - k(egui::Key::S),
+                ) * fast
+            });
+            if mv != Vec3::ZERO {
+                open.controller.on_move(mv, dt);
+                open.camera_index = None;
+            }
+        }
+        if open.camera_index.is_none() {
+            open.controller.apply(&mut open.camera);
+        }
+
+        let lights = lights_with_sun(&open.scene, self.sun.as_ref());
+        renderer.render(&FrameInput {
+            camera: &open.camera,
+            lights: &lights,
+            view: self.view,
+        });
+        if let Some(t) = renderer.poll_timings() {
+            self.timings = Some(t);
+        }
+        for e in renderer.ctx.errors.take() {
+            if !self.errors.contains(&e) {
+                self.errors.push(e);
+            }
+        }
+        let (_, view, generation) = renderer.view_texture();
+        let id = self.texture.update(&rs, view, generation);
+        // Keep the image's aspect (the shadow map is square).
+        let (tw, th) = (
+            renderer.view_texture().0.width(),
+            renderer.view_texture().0.height(),
+        );
+        let img_aspect = tw as f32 / th.max(1) as f32;
+        let mut draw = rect;
+        if (rect.width() / rect.height() - img_aspect).abs() > 0.01 {
+            let size = if rect.width() / rect.height() > img_aspect {
+                egui::vec2(rect.height() * img_aspect, rect.height())
+            } else {
+                egui::vec2(rect.width(), rect.width() / img_aspect)
+            };
+            draw = egui::Rect::from_center_size(rect.center(), size);
+        }
+        ui.painter().image(
+            id,
+            draw,
+            egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+            egui::Color32::WHITE,
+        );
+        self.frames += 1;
+    }
+
+    fn error_window(&mut self, ctx: &egui::Context) {
+        if self.errors.is_empty() {
+            return;
+        }
+        let mut dismiss = false;
+        egui::Window::new("Problems")
+            .collapsible(false)
+            .default_width(420.0)
+            .show(ctx, |ui| {
+                for e in &self.errors {
+                    ui.label(egui::RichText::new(e).color(ui.visuals().warn_fg_color));
+                }
+                if ui.button("Dismiss").clicked() {
+                    dismiss = true;
+                }
+            });
+        if dismiss {
+            self.errors.clear();
+        }
+    }
+
+    fn handle_exit(&mut self, ctx: &egui::Context) {
+        let Some(n) = self.options.exit_after_frames else {
+            return;
+        };
+        if self.frames < n {
+            return;
+        }
+        match &self.options.screenshot {
+            Some(path) if !self.screenshot_done.load(Ordering::Acquire) => {
+                if !self.screenshot_requested {
+                    self.screenshot_requested = true;
+                    let path = path.clone();
+                    let done = self.screenshot_done.clone();
+                    let ctx2 = ctx.clone();
+                    ctx.request_screenshot(move |img| {
+                        let [w, h] = img.size;
+                        let bytes: Vec<u8> = img.pixels.iter().flat_map(|c| c.to_array()).collect();
+                        match crate::export::write_png(&path, w as u32, h as u32, &bytes) {
+                            Ok(()) => log::info!("screenshot written to {}", path.display()),
+                            Err(e) => log::error!("{e}"),
+                        }
+                        done.store(true, Ordering::Release);
+                        ctx2.request_repaint();
+                    });
+                }
+            }
+            _ => ctx.send_viewport_cmd(egui::ViewportCommand::Close),
+        }
+    }
+}
+
+fn lights_with_sun(scene: &Scene, sun: Option<&SunControls>) -> Vec<DirectionalLight> {
+    let mut lights = scene.lights.clone();
+    if let (Some(sun), Some(l0)) = (sun, lights.first_mut()) {
+        *l0 = sun.to_light(&l0.name);
+    }
+    lights
+}
+
+/// Preset files shipped under `scenes/` (next to the executable's working directory).
+pub fn preset_files() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir("scenes")
+        .map(|rd| {
+            rd.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+impl eframe::App for WorkbenchApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        let now = ctx.input(|i| i.time);
+        if let Some(prev) = self.last_frame_time {
+            let ms = (now - prev) * 1e3;
+            self.frame_ms_smoothed = if self.frame_ms_smoothed == 0.0 {
+                ms
+            } else {
+                0.9 * self.frame_ms_smoothed + 0.1 * ms
+            };
+        }
+        self.last_frame_time = Some(now);
+        egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
+        egui::Panel::left("controls")
+            .default_size(290.0)
+            .show(ui, |ui| self.side_panel(ui));
+        egui::CentralPanel::default().show(ui, |ui| self.viewport(ui));
+        self.error_window(&ctx);
+        self.handle_exit(&ctx);
+        ctx.request_repaint();
+    }
+}
+
+/// Runs the GUI (blocking). Fails with one clear message when no GPU adapter is usable.
+pub fn run_gui(options: AppOptions) -> anyhow::Result<()> {
+    let mut wgpu_setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
+    wgpu_setup.instance_descriptor.backends =
+        wgpu::Backends::from_env().unwrap_or(crate::renderer::context::BACKENDS);
+    wgpu_setup.device_descriptor = Arc::new(|adapter| {
+        let mut d = crate::renderer::context::device_descriptor(adapter);
+        // The window surface may need large textures.
+        d.required_limits.max_texture_dimension_2d = d
+            .required_limits
+            .max_texture_dimension_2d
+            .max(8192)
+            .min(adapter.limits().max_texture_dimension_2d);
+        d
+    });
+    let native = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("lightcut-workbench")
+            .with_inner_size([1280.0, 760.0]),
+        renderer: eframe::Renderer::Wgpu,
+        wgpu_options: egui_wgpu::WgpuConfiguration {
+            wgpu_setup: egui_wgpu::WgpuSetup::CreateNew(wgpu_setup),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    eframe::run_native(
+        "lightcut-workbench",
+        native,
+        Box::new(move |cc| Ok(Box::new(WorkbenchApp::new(cc, options)))),
+    )
+    .map_err(|e| {
+        let msg = e.to_string();
+        if msg.to_lowercase().contains("adapter") {
+            anyhow::anyhow!("{}", crate::renderer::context::NO_ADAPTER_HELP)
+        } else {
+            anyhow::anyhow!("could not start the window: {msg}")
+        }
+    })
+}

@@ -1,0 +1,87 @@
+//! Headless commands sharing the renderer with the app: `render` and `bench`.
+
+pub mod bench;
+pub mod render;
+
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+/// lightcut-workbench: real-time many-light GI research workbench.
+#[derive(Parser, Debug)]
+#[command(name = "lightcut-workbench", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// Scene to open in the GUI: `default`, a .gltf/.glb file, or a preset .toml under scenes/.
+    #[arg(long, default_value = "default")]
+    pub scene: String,
+    /// Camera name from the scene file (default: the preset's, else the first).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Exit after rendering this many frames (smoke tests, CI).
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// Save a screenshot of the whole window (PNG) just before exiting (with --frames).
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render headlessly and write linear EXRs, tonemapped PNGs and per-pass timings.
+    Render(render::RenderArgs),
+    /// Benchmarks (BVH shadow rays per second, ...).
+    Bench(bench::BenchArgs),
+}
+
+/// Settings flags shared by the commands (override a settings file, which overrides defaults).
+#[derive(Args, Debug, Clone, Default)]
+pub struct SettingsArgs {
+    /// TOML file with `RenderSettings` (see ARCHITECTURE.md for the fields).
+    #[arg(long)]
+    pub settings: Option<PathBuf>,
+    /// Shadow-map resolution per light.
+    #[arg(long)]
+    pub shadow_res: Option<u32>,
+    /// PCF radius in shadow-map texels (0 = hard).
+    #[arg(long)]
+    pub pcf: Option<u32>,
+    /// Exposure in EV for the PNGs (EXRs are never scaled).
+    #[arg(long)]
+    pub exposure: Option<f32>,
+    /// Largest base-colour texture size uploaded.
+    #[arg(long)]
+    pub max_texture: Option<u32>,
+}
+
+impl SettingsArgs {
+    pub fn resolve(&self, preset_exposure: f32) -> anyhow::Result<crate::renderer::settings::RenderSettings> {
+        let mut s = match &self.settings {
+            Some(p) => {
+                let text = std::fs::read_to_string(p)
+                    .map_err(|e| anyhow::anyhow!("cannot read settings file {}: {e}", p.display()))?;
+                toml::from_str(&text)
+                    .map_err(|e| anyhow::anyhow!("bad settings file {}: {}", p.display(), e.message()))?
+            }
+            None => {
+                let mut s = crate::renderer::settings::RenderSettings::default();
+                s.display.exposure_ev = preset_exposure;
+                s
+            }
+        };
+        if let Some(v) = self.shadow_res {
+            s.shadow.resolution = v;
+        }
+        if let Some(v) = self.pcf {
+            s.shadow.pcf_radius = v;
+        }
+        if let Some(v) = self.exposure {
+            s.display.exposure_ev = v;
+        }
+        if let Some(v) = self.max_texture {
+            s.textures.max_size = v;
+        }
+        s.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+        Ok(s)
+    }
+}

@@ -1,0 +1,341 @@
+//! `#[repr(C)]` parameter structs shared with WGSL. Each has a twin of the same name in
+//! `shaders/`; `tests::layouts_match_wgsl` checks sizes and member offsets against naga's
+//! layout of the WGSL struct, so the two cannot drift apart silently.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+
+use crate::scene::{Aabb, Camera, DirectionalLight};
+
+/// Most directional lights a frame shades (one shadow-map layer each).
+pub const MAX_LIGHTS: usize = 4;
+
+/// Twin: `Camera` in `shaders/common/camera.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuCamera {
+    pub view_proj: [[f32; 4]; 4],
+    /// xyz = eye position, w = near plane.
+    pub position: [f32; 4],
+    /// xyz = unit forward, w = far plane.
+    pub forward: [f32; 4],
+    /// xyz = right * tan(yfov/2) * aspect (pixel ray spans).
+    pub right: [f32; 4],
+    /// xyz = up * tan(yfov/2).
+    pub up: [f32; 4],
+    /// width, height, 1/width, 1/height.
+    pub resolution: [f32; 4],
+}
+
+impl GpuCamera {
+    pub fn new(cam: &Camera, width: u32, height: u32) -> Self {
+        let aspect = width as f32 / height.max(1) as f32;
+        let t = (0.5 * cam.yfov).tan();
+        Self {
+            view_proj: cam.view_projection(aspect).to_cols_array_2d(),
+            position: cam.position.extend(cam.znear).to_array(),
+            forward: cam.forward.extend(cam.zfar).to_array(),
+            right: (cam.right() * t * aspect).extend(0.0).to_array(),
+            up: (cam.up * t).extend(0.0).to_array(),
+            resolution: [
+                width as f32,
+                height as f32,
+                1.0 / width as f32,
+                1.0 / height as f32,
+            ],
+        }
+    }
+}
+
+/// Twin: `DirectionalLight` in `shaders/common/lights.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuDirectionalLight {
+    /// World -> light clip space (orthographic, covering the scene bounds), depth in [0, 1].
+    pub view_proj: [[f32; 4]; 4],
+    /// xyz = unit direction the light travels; w = shadow-map layer.
+    pub direction: [f32; 4],
+    /// rgb = irradiance E (W/m^2) on a perpendicular surface; w unused.
+    pub irradiance: [f32; 4],
+    /// x = world size of one shadow-map texel, y = depth range of the light frustum (m),
+    /// z = constant depth bias (texels), w = normal offset (texels).
+    pub shadow: [f32; 4],
+}
+
+/// Twin: `Lights` in `shaders/common/lights.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuLights {
+    /// x = light count, y = shadow-map resolution, z = PCF radius in texels (0 = one tap).
+    pub count: [u32; 4],
+    pub lights: [GpuDirectionalLight; MAX_LIGHTS],
+}
+
+/// The orthographic light frustum of a directional light that tightly covers `bounds`.
+/// Returns (view_proj, texel world size, depth range).
+pub fn light_frustum(direction: Vec3, bounds: &Aabb, resolution: u32) -> (Mat4, f32, f32) {
+    let dir = direction.normalize_or(Vec3::NEG_Y);
+    let (c, r) = if bounds.is_empty() {
+        (Vec3::ZERO, 1.0)
+    } else {
+        (bounds.center(), bounds.radius().max(1e-3))
+    };
+    let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    let eye = c - dir * (2.0 * r);
+    let view = Mat4::look_to_rh(eye, dir, up);
+    // Tight box of the 8 corners in light space.
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for i in 0..8 {
+        let p = Vec3::new(
+            if i & 1 == 0 { bounds.min.x } else { bounds.max.x },
+            if i & 2 == 0 { bounds.min.y } else { bounds.max.y },
+            if i & 4 == 0 { bounds.min.z } else { bounds.max.z },
+        );
+        let p = if bounds.is_empty() { c } else { p };
+        let q = view.transform_point3(p);
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    // Square texels: use the larger extent for both axes; pad half a texel each side.
+    let ext = (hi.x - lo.x).max(hi.y - lo.y).max(1e-3);
+    let pad = ext / resolution as f32;
+    let cx = 0.5 * (lo.x + hi.x);
+    let cy = 0.5 * (lo.y + hi.y);
+    let half = 0.5 * ext + pad;
+    // Right-handed view looks down -Z: near = -hi.z, far = -lo.z.
+    let near = -hi.z - pad;
+    let far = -lo.z + pad;
+    let proj = Mat4::orthographic_rh(cx - half, cx + half, cy - half, cy + half, near, far);
+    (proj * view, 2.0 * half / resolution as f32, far - near)
+}
+
+impl GpuLights {
+    pub fn new(
+        lights: &[DirectionalLight],
+        bounds: &Aabb,
+        resolution: u32,
+        depth_bias_texels: f32,
+        normal_offset_texels: f32,
+        pcf_radius: u32,
+    ) -> Self {
+        let mut out = GpuLights::zeroed();
+        let n = lights.len().min(MAX_LIGHTS);
+        out.count = [n as u32, resolution, pcf_radius, 0];
+        for (i, l) in lights.iter().take(n).enumerate() {
+            let (vp, texel, range) = light_frustum(l.direction, bounds, resolution);
+            out.lights[i] = GpuDirectionalLight {
+                view_proj: vp.to_cols_array_2d(),
+                direction: l.direction.normalize_or(Vec3::NEG_Y).extend(i as f32).to_array(),
+                irradiance: l.irradiance.extend(0.0).to_array(),
+                shadow: [texel, range, depth_bias_texels, normal_offset_texels],
+            };
+        }
+        out
+    }
+}
+
+/// Twin: `DisplayParams` in `shaders/display.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct DisplayParams {
+    /// Linear scale 2^EV applied before the tonemap.
+    pub exposure: f32,
+    /// 0 = clamp, 1 = Reinhard (luminance), 2 = ACES (Narkowicz fit).
+    pub tonemap: u32,
+    pub _pad: [u32; 2],
+}
+
+/// Twin: `VisParams` in `shaders/visualise.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct VisParams {
+    /// See `VisMode` in `visualise.rs`.
+    pub mode: u32,
+    /// Which channel/layer (shadow-map layer).
+    pub layer: u32,
+    pub _pad: [u32; 2],
+    /// Value range mapped to [0, 1] (depth, position).
+    pub range_min: [f32; 4],
+    pub range_max: [f32; 4],
+}
+
+/// Twin: `MaterialGpu` in `shaders/gbuffer.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// Linear RGBA base colour factor.
+    pub base_color: [f32; 4],
+    /// x = texture layer or -1 (as i32 bits), yzw unused.
+    pub texture: [i32; 4],
+}
+
+/// Twin: `Vertex` inputs of `shaders/gbuffer.wgsl` (vertex buffer, not a uniform).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuVertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub uv: [f32; 2],
+    pub material: u32,
+}
+
+/// Twin: `RayIn` in `shaders/bvh_rays.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuRay {
+    /// xyz = origin, w = tmin.
+    pub origin: [f32; 4],
+    /// xyz = direction (unnormalised is fine), w = tmax.
+    pub dir: [f32; 4],
+}
+
+/// Twin: `HitOut` in `shaders/bvh_rays.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuHit {
+    pub t: f32,
+    /// Original triangle id, or 0xffff_ffff for a miss.
+    pub triangle: u32,
+    pub u: f32,
+    pub v: f32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::renderer::shaders::{Embedded, preprocess, validate};
+
+    /// (size, member offsets) of WGSL struct `name` in shader `file`, from naga's layouter.
+    fn wgsl_layout(file: &str, name: &str) -> (u32, Vec<u32>) {
+        let text = preprocess(&Embedded, file).unwrap();
+        let module = validate(file, &text).unwrap();
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        for (handle, ty) in module.types.iter() {
+            if ty.name.as_deref() == Some(name)
+                && let naga::TypeInner::Struct { members, span } = &ty.inner
+            {
+                assert_eq!(layouter[handle].size, *span);
+                return (*span, members.iter().map(|m| m.offset).collect());
+            }
+        }
+        panic!("struct {name} not found in {file}");
+    }
+
+    #[test]
+    fn layouts_match_wgsl() {
+        use std::mem::{offset_of, size_of};
+        let cases: Vec<(&str, &str, usize, Vec<usize>)> = vec![
+            (
+                "direct.wgsl",
+                "Camera",
+                size_of::<GpuCamera>(),
+                vec![
+                    offset_of!(GpuCamera, view_proj),
+                    offset_of!(GpuCamera, position),
+                    offset_of!(GpuCamera, forward),
+                    offset_of!(GpuCamera, right),
+                    offset_of!(GpuCamera, up),
+                    offset_of!(GpuCamera, resolution),
+                ],
+            ),
+            (
+                "direct.wgsl",
+                "DirectionalLight",
+                size_of::<GpuDirectionalLight>(),
+                vec![
+                    offset_of!(GpuDirectionalLight, view_proj),
+                    offset_of!(GpuDirectionalLight, direction),
+                    offset_of!(GpuDirectionalLight, irradiance),
+                    offset_of!(GpuDirectionalLight, shadow),
+                ],
+            ),
+            (
+                "direct.wgsl",
+                "Lights",
+                size_of::<GpuLights>(),
+                vec![offset_of!(GpuLights, count), offset_of!(GpuLights, lights)],
+            ),
+            (
+                "display.wgsl",
+                "DisplayParams",
+                size_of::<DisplayParams>(),
+                vec![
+                    offset_of!(DisplayParams, exposure),
+                    offset_of!(DisplayParams, tonemap),
+                    offset_of!(DisplayParams, _pad),
+                ],
+            ),
+            (
+                "visualise.wgsl",
+                "VisParams",
+                size_of::<VisParams>(),
+                vec![
+                    offset_of!(VisParams, mode),
+                    offset_of!(VisParams, layer),
+                    offset_of!(VisParams, _pad),
+                    offset_of!(VisParams, range_min),
+                    offset_of!(VisParams, range_max),
+                ],
+            ),
+            (
+                "gbuffer.wgsl",
+                "MaterialGpu",
+                size_of::<GpuMaterial>(),
+                vec![
+                    offset_of!(GpuMaterial, base_color),
+                    offset_of!(GpuMaterial, texture),
+                ],
+            ),
+            (
+                "bvh_rays.wgsl",
+                "RayIn",
+                size_of::<GpuRay>(),
+                vec![offset_of!(GpuRay, origin), offset_of!(GpuRay, dir)],
+            ),
+            (
+                "bvh_rays.wgsl",
+                "HitOut",
+                size_of::<GpuHit>(),
+                vec![
+                    offset_of!(GpuHit, t),
+                    offset_of!(GpuHit, triangle),
+                    offset_of!(GpuHit, u),
+                    offset_of!(GpuHit, v),
+                ],
+            ),
+        ];
+        for (file, name, size, offsets) in cases {
+            let (wsize, woffsets) = wgsl_layout(file, name);
+            assert_eq!(wsize as usize, size, "size of {name} ({file})");
+            let woffsets: Vec<usize> = woffsets.into_iter().map(|o| o as usize).collect();
+            assert_eq!(woffsets, offsets, "member offsets of {name} ({file})");
+        }
+    }
+
+    #[test]
+    fn light_frustum_contains_bounds() {
+        let b = Aabb {
+            min: Vec3::new(-1.0, 0.0, -2.0),
+            max: Vec3::new(3.0, 2.0, 1.0),
+        };
+        let dir = Vec3::new(0.3, -1.0, 0.2).normalize();
+        let (vp, texel, range) = light_frustum(dir, &b, 512);
+        assert!(texel > 0.0 && range > 0.0);
+        for i in 0..8 {
+            let p = Vec3::new(
+                if i & 1 == 0 { b.min.x } else { b.max.x },
+                if i & 2 == 0 { b.min.y } else { b.max.y },
+                if i & 4 == 0 { b.min.z } else { b.max.z },
+            );
+            let q = vp.project_point3(p);
+            assert!(q.x.abs() < 1.0 && q.y.abs() < 1.0, "{q}");
+            assert!(q.z > 0.0 && q.z < 1.0, "{q}");
+        }
+        // Points further along the light direction are deeper.
+        let a = vp.project_point3(b.center());
+        let c = vp.project_point3(b.center() + 0.1 * dir);
+        assert!(c.z > a.z);
+    }
+}

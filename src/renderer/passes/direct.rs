@@ -1,0 +1,107 @@
+//! Direct light: rho/pi * E * max(0, n.l) * shadow-map visibility per directional light.
+//! Reads: camera, lights, shadow maps, G-buffer. Writes: the `direct` radiance buffer.
+
+use crate::renderer::{
+    frame::{GbufferTargets, ShadowTargets},
+    shaders,
+    timing::GpuTimer,
+};
+
+use super::{
+    compute_pipeline, float_texture_entry, groups_2d, storage_texture_entry, texture_entry, uniform_entry,
+};
+
+pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+pub struct DirectPass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl DirectPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let module = shaders::create_module(device, "direct.wgsl")?;
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("direct::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                uniform_entry(1, c),
+                texture_entry(
+                    2,
+                    c,
+                    wgpu::TextureSampleType::Depth,
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+                float_texture_entry(3),
+                float_texture_entry(4),
+                float_texture_entry(5),
+                storage_texture_entry(6, RADIANCE_FORMAT),
+            ],
+        });
+        let pipeline = compute_pipeline(device, "direct::pipeline", &[Some(&layout)], &module, "main");
+        Ok(Self { pipeline, layout })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        camera: &wgpu::Buffer,
+        lights: &wgpu::Buffer,
+        shadow: &ShadowTargets,
+        gbuffer: &GbufferTargets,
+        out: &wgpu::TextureView,
+        size: (u32, u32),
+    ) {
+        let tv = wgpu::BindingResource::TextureView;
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("direct::bind_group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: camera.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: lights.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: tv(&shadow.array_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: tv(&gbuffer.position_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: tv(&gbuffer.normal_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: tv(&gbuffer.albedo_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: tv(out),
+                },
+            ],
+        });
+        encoder.push_debug_group("direct");
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("direct::pass"),
+                timestamp_writes: timer.compute_pass("direct"),
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            let (gx, gy) = groups_2d(size.0, size.1);
+            pass.dispatch_workgroups(gx, gy, 1);
+        }
+        encoder.pop_debug_group();
+    }
+}

@@ -1,0 +1,134 @@
+//! One module per pass. Each pass owns its long-lived pipelines and layouts (`new`), declares
+//! what it reads and writes in its `record` signature (typed inputs, no global lookups), and
+//! builds its per-frame bind groups when it records.
+
+pub mod direct;
+pub mod display;
+pub mod gbuffer;
+pub mod shadow_map;
+pub mod visualise;
+
+/// Workgroup edge of the 2D image kernels (`@workgroup_size(8, 8, 1)` in their WGSL; checked
+/// by `tests::workgroup_sizes_match_wgsl`).
+pub const WG_2D: u32 = 8;
+/// Workgroup size of the 1D kernels (`@workgroup_size(64, 1, 1)`).
+pub const WG_1D: u32 = 64;
+
+/// Number of workgroups covering a `w` x `h` image.
+pub fn groups_2d(w: u32, h: u32) -> (u32, u32) {
+    (w.div_ceil(WG_2D), h.div_ceil(WG_2D))
+}
+
+pub(crate) fn uniform_entry(binding: u32, vis: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: vis,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+pub(crate) fn storage_entry(
+    binding: u32,
+    vis: wgpu::ShaderStages,
+    read_only: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: vis,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+pub(crate) fn texture_entry(
+    binding: u32,
+    vis: wgpu::ShaderStages,
+    sample_type: wgpu::TextureSampleType,
+    dim: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: vis,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: dim,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+pub(crate) fn float_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    texture_entry(
+        binding,
+        wgpu::ShaderStages::COMPUTE,
+        wgpu::TextureSampleType::Float { filterable: false },
+        wgpu::TextureViewDimension::D2,
+    )
+}
+
+pub(crate) fn storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
+pub(crate) fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layouts: &[Option<&wgpu::BindGroupLayout>],
+    module: &wgpu::ShaderModule,
+    entry: &str,
+) -> wgpu::ComputePipeline {
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: layouts,
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::renderer::shaders::{ENTRY_SHADERS, Embedded, preprocess, validate};
+
+    #[test]
+    fn workgroup_sizes_match_wgsl() {
+        for file in ENTRY_SHADERS {
+            let text = preprocess(&Embedded, file).unwrap();
+            let module = validate(file, &text).unwrap();
+            for ep in &module.entry_points {
+                if ep.stage != naga::ShaderStage::Compute {
+                    continue;
+                }
+                let ws = ep.workgroup_size;
+                let ok = ws == [WG_2D, WG_2D, 1] || ws == [WG_1D, 1, 1];
+                assert!(ok, "{file}::{} has workgroup size {ws:?}", ep.name);
+            }
+        }
+    }
+}

@@ -1,0 +1,324 @@
+//! The scene on the GPU: vertices, materials, the base-colour texture array, the BVH.
+
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use super::gpu_data::{GpuMaterial, GpuVertex};
+use crate::scene::{Aabb, Bvh, Scene, TextureImage};
+
+pub struct SceneGpu {
+    pub vertices: wgpu::Buffer,
+    pub indices: wgpu::Buffer,
+    pub index_count: u32,
+    pub materials: wgpu::Buffer,
+    pub textures: wgpu::Texture,
+    pub textures_view: wgpu::TextureView,
+    pub sampler: wgpu::Sampler,
+    pub bvh_nodes: wgpu::Buffer,
+    pub bvh_triangles: wgpu::Buffer,
+    pub bounds: Aabb,
+    pub triangle_count: usize,
+    pub bvh: Bvh,
+}
+
+/// Builds the GPU vertex list: one material id per vertex, duplicating a vertex where
+/// triangles of different materials share it.
+pub fn build_vertices(scene: &Scene) -> (Vec<GpuVertex>, Vec<u32>) {
+    let mut verts: Vec<GpuVertex> = scene
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| GpuVertex {
+            position: p.to_array(),
+            normal: scene.normals.get(i).copied().unwrap_or(Vec3::Y).to_array(),
+            uv: scene.uvs.get(i).map(|u| u.to_array()).unwrap_or([0.0; 2]),
+            material: u32::MAX,
+        })
+        .collect();
+    let mut indices = scene.indices.clone();
+    for t in 0..scene.triangle_count() {
+        let m = scene.triangle_materials.get(t).copied().unwrap_or(0);
+        for k in 0..3 {
+            let vi = indices[3 * t + k] as usize;
+            if verts[vi].material == u32::MAX {
+                verts[vi].material = m;
+            } else if verts[vi].material != m {
+                let mut v = verts[vi];
+                v.material = m;
+                indices[3 * t + k] = verts.len() as u32;
+                verts.push(v);
+            }
+        }
+    }
+    for v in &mut verts {
+        if v.material == u32::MAX {
+            v.material = 0;
+        }
+    }
+    (verts, indices)
+}
+
+fn srgb_to_linear(c: u8) -> f32 {
+    let x = c as f32 / 255.0;
+    if x <= 0.04045 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn linear_to_srgb8(x: f32) -> u8 {
+    let x = x.clamp(0.0, 1.0);
+    let s = if x <= 0.0031308 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// Resamples `tex` to `size` x `size` and builds its mip chain (box filter in linear space,
+/// alpha linear). Returns one RGBA8 (sRGB) buffer per level.
+pub fn texture_mips(tex: &TextureImage, size: u32) -> Vec<Vec<u8>> {
+    let base = if tex.width == size && tex.height == size {
+        tex.rgba8.clone()
+    } else {
+        match image::RgbaImage::from_raw(tex.width, tex.height, tex.rgba8.clone()) {
+            Some(img) => {
+                image::imageops::resize(&img, size, size, image::imageops::FilterType::Triangle).into_raw()
+            }
+            None => vec![255; (size * size * 4) as usize],
+        }
+    };
+    let mut levels = vec![base];
+    let mut s = size;
+    let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
+    while s > 1 {
+        let prev = levels.last().map(|v| v.as_slice()).unwrap_or(&[]);
+        let n = s / 2;
+        let mut next = vec![0u8; (n * n * 4) as usize];
+        for y in 0..n {
+            for x in 0..n {
+                let mut acc = [0f32; 4];
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let i = (((2 * y + dy) * s + 2 * x + dx) * 4) as usize;
+                    for c in 0..3 {
+                        acc[c] += lut[prev[i + c] as usize];
+                    }
+                    acc[3] += prev[i + 3] as f32;
+                }
+                let o = ((y * n + x) * 4) as usize;
+                for c in 0..3 {
+                    next[o + c] = linear_to_srgb8(acc[c] * 0.25);
+                }
+                next[o + 3] = (acc[3] * 0.25 + 0.5) as u8;
+            }
+        }
+        levels.push(next);
+        s = n;
+    }
+    levels
+}
+
+impl SceneGpu {
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, scene: &Scene, max_texture_size: u32) -> Self {
+        let (verts, indices) = build_vertices(scene);
+        let verts = if verts.is_empty() {
+            vec![bytemuck::Zeroable::zeroed()]
+        } else {
+            verts
+        };
+        let index_count = indices.len() as u32;
+        let indices = if indices.is_empty() {
+            vec![0u32; 3]
+        } else {
+            indices
+        };
+        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene::vertices"),
+            contents: bytemuck::cast_slice(&verts),
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::STORAGE,
+        });
+        let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene::indices"),
+            contents: bytemuck::cast_slice(&indices),
+            usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE,
+        });
+
+        // Texture array: every base-colour texture resampled to one power-of-two size.
+        let limit = device
+            .limits()
+            .max_texture_dimension_2d
+            .min(max_texture_size.max(1));
+        let largest = scene
+            .textures
+            .iter()
+            .map(|t| t.width.max(t.height))
+            .max()
+            .unwrap_or(1)
+            .max(1);
+        let size = largest
+            .min(limit)
+            .next_power_of_two()
+            .min(limit.next_power_of_two());
+        let size = if size > limit { size / 2 } else { size }.max(1);
+        let layers = scene.textures.len().max(1) as u32;
+        let mip_count = 32 - size.leading_zeros();
+        let textures = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("scene::base_color_textures"),
+            size: wgpu::Extent3d {
+                width: size,
+                height: size,
+                depth_or_array_layers: layers,
+            },
+            mip_level_count: mip_count,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let placeholder = TextureImage {
+            name: "white".into(),
+            width: 1,
+            height: 1,
+            rgba8: vec![255; 4],
+        };
+        let sources: Vec<&TextureImage> = if scene.textures.is_empty() {
+            vec![&placeholder]
+        } else {
+            scene.textures.iter().collect()
+        };
+        // Resample/mip in parallel (2 threads are common here), upload in order.
+        let all_mips: Vec<Vec<Vec<u8>>> = std::thread::scope(|s| {
+            let threads = std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(2)
+                .min(8);
+            let chunk = sources.len().div_ceil(threads).max(1);
+            let handles: Vec<_> = sources
+                .chunks(chunk)
+                .map(|c| s.spawn(move || c.iter().map(|t| texture_mips(t, size)).collect::<Vec<_>>()))
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().unwrap_or_default())
+                .collect()
+        });
+        for (layer, mips) in all_mips.iter().enumerate() {
+            for (level, data) in mips.iter().enumerate() {
+                let s = (size >> level).max(1);
+                queue.write_texture(
+                    wgpu::TexelCopyTextureInfo {
+                        texture: &textures,
+                        mip_level: level as u32,
+                        origin: wgpu::Origin3d {
+                            x: 0,
+                            y: 0,
+                            z: layer as u32,
+                        },
+                        aspect: wgpu::TextureAspect::All,
+                    },
+                    data,
+                    wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(4 * s),
+                        rows_per_image: Some(s),
+                    },
+                    wgpu::Extent3d {
+                        width: s,
+                        height: s,
+                        depth_or_array_layers: 1,
+                    },
+                );
+            }
+        }
+        let textures_view = textures.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("scene::base_color_textures_view"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("scene::sampler"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            address_mode_w: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            anisotropy_clamp: 8,
+            ..Default::default()
+        });
+
+        let mut mats: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .map(|m| GpuMaterial {
+                base_color: m.base_color_factor,
+                texture: [
+                    m.base_color_texture
+                        .filter(|&t| t < scene.textures.len())
+                        .map(|t| t as i32)
+                        .unwrap_or(-1),
+                    0,
+                    0,
+                    0,
+                ],
+            })
+            .collect();
+        if mats.is_empty() {
+            mats.push(GpuMaterial {
+                base_color: [0.8, 0.8, 0.8, 1.0],
+                texture: [-1, 0, 0, 0],
+            });
+        }
+        let materials = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene::materials"),
+            contents: bytemuck::cast_slice(&mats),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+
+        let bvh = Bvh::build(&scene.positions, &scene.indices);
+        let (bvh_nodes, bvh_triangles) = upload_bvh(device, &bvh);
+        SceneGpu {
+            vertices,
+            indices: index_buffer,
+            index_count,
+            materials,
+            textures,
+            textures_view,
+            sampler,
+            bvh_nodes,
+            bvh_triangles,
+            bounds: scene.bounds,
+            triangle_count: scene.triangle_count(),
+            bvh,
+        }
+    }
+}
+
+/// Uploads a BVH's nodes and triangles as storage buffers (never empty: wgpu forbids
+/// zero-sized bindings, so an empty BVH gets one inert element each).
+pub fn upload_bvh(device: &wgpu::Device, bvh: &Bvh) -> (wgpu::Buffer, wgpu::Buffer) {
+    let nodes: Vec<u8> = if bvh.nodes.is_empty() {
+        vec![0; std::mem::size_of::<crate::scene::bvh::GpuBvhNode>()]
+    } else {
+        bytemuck::cast_slice(&bvh.nodes).to_vec()
+    };
+    let tris: Vec<u8> = if bvh.triangles.is_empty() {
+        vec![0; std::mem::size_of::<crate::scene::bvh::GpuTriangle>()]
+    } else {
+        bytemuck::cast_slice(&bvh.triangles).to_vec()
+    };
+    let n = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("scene::bvh_nodes"),
+        contents: &nodes,
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let t = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("scene::bvh_triangles"),
+        contents: &tris,
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    (n, t)
+}

@@ -1,0 +1,223 @@
+//! WGSL sources and the one small include mechanism that joins them.
+//!
+//! A line `#include "common/camera.wgsl"` is replaced by that file's text (resolved
+//! recursively, each file at most once per shader, so diamond includes are fine). Sources are
+//! embedded in the binary; builds with debug assertions re-read them from `shaders/` on disk
+//! when they exist there (hot reload for shader work, see [`ShaderSource::reload_from_disk`]).
+
+use std::collections::HashSet;
+
+use thiserror::Error;
+
+/// Every WGSL file of the project, by its path under `shaders/`.
+pub const SHADER_FILES: &[(&str, &str)] = &[
+    ("common/bvh.wgsl", include_str!("../../shaders/common/bvh.wgsl")),
+    (
+        "common/camera.wgsl",
+        include_str!("../../shaders/common/camera.wgsl"),
+    ),
+    (
+        "common/color.wgsl",
+        include_str!("../../shaders/common/color.wgsl"),
+    ),
+    (
+        "common/lights.wgsl",
+        include_str!("../../shaders/common/lights.wgsl"),
+    ),
+    ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
+    ("shadow_map.wgsl", include_str!("../../shaders/shadow_map.wgsl")),
+    ("direct.wgsl", include_str!("../../shaders/direct.wgsl")),
+    ("display.wgsl", include_str!("../../shaders/display.wgsl")),
+    ("visualise.wgsl", include_str!("../../shaders/visualise.wgsl")),
+    ("bvh_rays.wgsl", include_str!("../../shaders/bvh_rays.wgsl")),
+];
+
+/// The shaders that are entry points (not include-only files).
+pub const ENTRY_SHADERS: &[&str] = &[
+    "gbuffer.wgsl",
+    "shadow_map.wgsl",
+    "direct.wgsl",
+    "display.wgsl",
+    "visualise.wgsl",
+    "bvh_rays.wgsl",
+];
+
+#[derive(Debug, Error, PartialEq)]
+pub enum ShaderError {
+    #[error("shader '{0}' not found")]
+    NotFound(String),
+    #[error("{file}:{line}: malformed #include (expected #include \"path\")")]
+    BadInclude { file: String, line: usize },
+    #[error("WGSL error in {file}: {message}")]
+    Parse { file: String, message: String },
+}
+
+/// Where shader text comes from: the embedded table, or files on disk for hot reload.
+pub trait ShaderSource {
+    fn get(&self, name: &str) -> Option<String>;
+}
+
+/// The sources compiled into the binary.
+pub struct Embedded;
+
+impl ShaderSource for Embedded {
+    fn get(&self, name: &str) -> Option<String> {
+        SHADER_FILES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, s)| s.to_string())
+    }
+}
+
+/// Reads `shaders/` from the source tree when it exists (debug builds), else the embedded copy.
+pub struct ShaderSourceDisk;
+
+impl ShaderSourceDisk {
+    fn dir() -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders")
+    }
+    /// True in builds with debug assertions when the source tree is present.
+    pub fn reload_from_disk() -> bool {
+        cfg!(debug_assertions) && Self::dir().is_dir()
+    }
+}
+
+impl ShaderSource for ShaderSourceDisk {
+    fn get(&self, name: &str) -> Option<String> {
+        std::fs::read_to_string(Self::dir().join(name))
+            .ok()
+            .or_else(|| Embedded.get(name))
+    }
+}
+
+/// Resolves `#include` lines of `name`, recursively, each file once.
+pub fn preprocess(source: &dyn ShaderSource, name: &str) -> Result<String, ShaderError> {
+    let mut seen = HashSet::new();
+    let mut out = String::new();
+    expand(source, name, &mut seen, &mut out)?;
+    Ok(out)
+}
+
+fn expand(
+    source: &dyn ShaderSource,
+    name: &str,
+    seen: &mut HashSet<String>,
+    out: &mut String,
+) -> Result<(), ShaderError> {
+    if !seen.insert(name.to_string()) {
+        return Ok(());
+    }
+    let text = source
+        .get(name)
+        .ok_or_else(|| ShaderError::NotFound(name.to_string()))?;
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim_start();
+        if let Some(rest) = t.strip_prefix("#include") {
+            let rest = rest.trim();
+            let inc = rest
+                .strip_prefix('"')
+                .and_then(|r| r.strip_suffix('"'))
+                .ok_or_else(|| ShaderError::BadInclude {
+                    file: name.to_string(),
+                    line: i + 1,
+                })?;
+            expand(source, inc, seen, out)?;
+        } else {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    Ok(())
+}
+
+/// Preprocesses and validates a shader with naga, returning the WGSL text.
+pub fn load_validated(source: &dyn ShaderSource, name: &str) -> Result<String, ShaderError> {
+    let text = preprocess(source, name)?;
+    validate(name, &text)?;
+    Ok(text)
+}
+
+/// Parses and validates WGSL with naga (all capabilities: the device decides what it accepts).
+pub fn validate(name: &str, text: &str) -> Result<naga::Module, ShaderError> {
+    let module = naga::front::wgsl::parse_str(text).map_err(|e| ShaderError::Parse {
+        file: name.to_string(),
+        message: e.emit_to_string(text),
+    })?;
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .map_err(|e| ShaderError::Parse {
+        file: name.to_string(),
+        message: e.emit_to_string(text),
+    })?;
+    Ok(module)
+}
+
+/// Creates a wgpu shader module from a (preprocessed) shader.
+pub fn create_module(device: &wgpu::Device, name: &str) -> Result<wgpu::ShaderModule, ShaderError> {
+    let text = if ShaderSourceDisk::reload_from_disk() {
+        load_validated(&ShaderSourceDisk, name)?
+    } else {
+        load_validated(&Embedded, name)?
+    };
+    Ok(device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(name),
+        source: wgpu::ShaderSource::Wgsl(text.into()),
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Mem(Vec<(&'static str, &'static str)>);
+    impl ShaderSource for Mem {
+        fn get(&self, name: &str) -> Option<String> {
+            self.0
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, s)| s.to_string())
+        }
+    }
+
+    #[test]
+    fn includes_resolve_once_and_recursively() {
+        let src = Mem(vec![
+            ("a.wgsl", "#include \"b.wgsl\"\n#include \"c.wgsl\"\nfn a() {}"),
+            ("b.wgsl", "#include \"c.wgsl\"\nfn b() {}"),
+            ("c.wgsl", "fn c() {}"),
+        ]);
+        let out = preprocess(&src, "a.wgsl").unwrap();
+        assert_eq!(out, "fn c() {}\nfn b() {}\nfn a() {}\n");
+    }
+
+    #[test]
+    fn include_errors_are_reported() {
+        let src = Mem(vec![
+            ("a.wgsl", "#include b.wgsl"),
+            ("m.wgsl", "#include \"x.wgsl\""),
+        ]);
+        assert_eq!(
+            preprocess(&src, "a.wgsl"),
+            Err(ShaderError::BadInclude {
+                file: "a.wgsl".into(),
+                line: 1
+            })
+        );
+        assert_eq!(
+            preprocess(&src, "m.wgsl"),
+            Err(ShaderError::NotFound("x.wgsl".into()))
+        );
+    }
+
+    #[test]
+    fn every_shader_passes_naga() {
+        for name in ENTRY_SHADERS {
+            if let Err(e) = load_validated(&Embedded, name) {
+                panic!("{e}");
+            }
+        }
+    }
+}

@@ -1,0 +1,1131 @@
+//! glTF 2.0 (`.gltf` / `.glb`) loading into a flattened, world-space [`Scene`].
+//!
+//! The loader is deliberately forgiving about things that do not change geometry or diffuse
+//! albedo (material extensions, DDS texture alternatives, missing images): those become
+//! entries in [`Scene::warnings`] (and `log::warn!`). Things that would make the geometry wrong
+//! (compressed/quantised geometry required by the file, unknown required extensions, missing
+//! or truncated buffers) are errors with a one-line message.
+//!
+//! All buffer and accessor reads are bounds-checked here (the `gltf` crate's own readers can
+//! panic on malformed files), so no user file can make the loader panic.
+
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use glam::{Mat3, Mat4, Vec2, Vec3};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::json::camera::Type as CameraType;
+use gltf::json::extensions::scene::khr_lights_punctual::Type as LightType;
+use gltf::json::validation::Checked;
+use gltf::mesh::Mode;
+
+use super::{Aabb, Camera, DirectionalLight, Material, Scene, TextureImage};
+
+/// Everything that can stop a scene from loading. Each variant displays as one line.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file (glTF, preset, ...) could not be opened or read.
+    #[error("cannot read {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not a glTF 2.0 asset the parser accepts (bad JSON, bad GLB header, invalid
+    /// references, ...).
+    #[error("{} is not a valid glTF file: {message}", path.display())]
+    InvalidGltf { path: PathBuf, message: String },
+    /// An external `.bin` buffer named by the file does not exist.
+    #[error("{}: buffer {index} file {} is missing", gltf.display(), buffer.display())]
+    MissingBuffer {
+        gltf: PathBuf,
+        index: usize,
+        buffer: PathBuf,
+    },
+    /// A buffer holds fewer bytes than its declared `byteLength`.
+    #[error(
+        "{}: buffer {index} ({name}) is truncated: {declared} bytes declared, only {actual} present",
+        path.display()
+    )]
+    TruncatedBuffer {
+        path: PathBuf,
+        index: usize,
+        name: String,
+        declared: usize,
+        actual: usize,
+    },
+    /// A buffer could not be loaded for another reason (bad data URI, unsupported URI scheme,
+    /// GLB without a BIN chunk, ...).
+    #[error("{}: buffer {index} cannot be loaded: {message}", path.display())]
+    BadBuffer {
+        path: PathBuf,
+        index: usize,
+        message: String,
+    },
+    /// The file requires an extension this loader cannot honour without getting the geometry
+    /// wrong.
+    #[error("{}: required glTF extension {name} is not supported ({reason})", path.display())]
+    UnsupportedExtension {
+        path: PathBuf,
+        name: String,
+        reason: String,
+    },
+    /// Nothing renderable is left after skipping unsupported primitives and bad triangles.
+    #[error("{}: no triangles left to render ({details})", path.display())]
+    NoTriangles { path: PathBuf, details: String },
+    /// A scene preset (`.toml`) is malformed or inconsistent.
+    #[error("bad scene preset {}: {message}", path.display())]
+    Preset { path: PathBuf, message: String },
+}
+
+/// What the loader does with a glTF extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ExtPolicy {
+    /// Fully or partly implemented (details are warned about where data is skipped).
+    Supported,
+    /// Does not change geometry or diffuse albedo: ignored with a warning.
+    Ignored(&'static str),
+    /// Changes how geometry is stored or placed: an error when required.
+    Geometry(&'static str),
+    /// Not known to this loader.
+    Unknown,
+}
+
+fn ext_policy(name: &str) -> ExtPolicy {
+    match name {
+        "KHR_lights_punctual" => ExtPolicy::Supported,
+        "MSFT_texture_dds" => ExtPolicy::Ignored(
+            "DDS texture alternatives are not loaded; each texture's PNG/JPG source is used",
+        ),
+        "AMD_split_roughnessMetallic" => ExtPolicy::Ignored(
+            "split roughness/metallic textures only affect specular shading, which is not rendered",
+        ),
+        "KHR_texture_transform" => ExtPolicy::Ignored(
+            "texture transforms are ignored: transformed base colour textures may look misplaced",
+        ),
+        "KHR_texture_basisu" | "EXT_texture_webp" | "EXT_texture_avif" => ExtPolicy::Ignored(
+            "only PNG/JPG texture sources are decoded; other textures fall back to the colour factor",
+        ),
+        "KHR_materials_variants" => {
+            ExtPolicy::Ignored("material variants are ignored; the default materials are used")
+        }
+        "KHR_xmp_json_ld" | "KHR_animation_pointer" => ExtPolicy::Ignored("metadata/animation is not used"),
+        "KHR_draco_mesh_compression" => ExtPolicy::Geometry("Draco-compressed geometry cannot be decoded"),
+        "EXT_meshopt_compression" => ExtPolicy::Geometry("meshopt-compressed buffers cannot be decoded"),
+        "KHR_mesh_quantization" => {
+            ExtPolicy::Geometry("quantised vertex attributes would change the geometry")
+        }
+        "EXT_mesh_gpu_instancing" => {
+            ExtPolicy::Geometry("GPU instancing would add mesh copies that are not loaded")
+        }
+        n if n.starts_with("KHR_materials_") => {
+            ExtPolicy::Ignored("only the base colour of materials is used")
+        }
+        _ => ExtPolicy::Unknown,
+    }
+}
+
+/// Loads a `.gltf` or `.glb` file (detected from its content) into a world-space [`Scene`].
+pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let invalid = |message: String| SceneError::InvalidGltf {
+        path: path.to_path_buf(),
+        message,
+    };
+
+    // Container: GLB or plain JSON.
+    let (json_bytes, blob): (Vec<u8>, Option<Vec<u8>>) = if bytes.starts_with(b"glTF") {
+        let glb = gltf::Glb::from_slice(&bytes).map_err(|e| invalid(format!("bad GLB: {e}")))?;
+        (glb.json.into_owned(), glb.bin.map(|b| b.into_owned()))
+    } else {
+        (bytes, None)
+    };
+    let mut root: gltf::json::Root =
+        gltf::json::deserialize::from_slice(&json_bytes).map_err(|e| invalid(one_line(&e.to_string())))?;
+    drop(json_bytes);
+
+    let mut warnings = Warnings::default();
+
+    // Extension policy. Required extensions are removed from the list before validation
+    // (the gltf crate rejects required extensions it does not know, even harmless ones).
+    let required = std::mem::take(&mut root.extensions_required);
+    for name in &required {
+        match ext_policy(name) {
+            ExtPolicy::Supported => {}
+            ExtPolicy::Ignored(why) => {
+                warnings.push(format!("glTF extension {name} (required) is ignored: {why}"))
+            }
+            ExtPolicy::Geometry(why) => {
+                return Err(SceneError::UnsupportedExtension {
+                    path: path.to_path_buf(),
+                    name: name.clone(),
+                    reason: why.to_string(),
+                });
+            }
+            ExtPolicy::Unknown => {
+                return Err(SceneError::UnsupportedExtension {
+                    path: path.to_path_buf(),
+                    name: name.clone(),
+                    reason: "unknown extension; it could change the geometry".into(),
+                });
+            }
+        }
+    }
+    for name in root.extensions_used.iter().filter(|n| !required.contains(n)) {
+        match ext_policy(name) {
+            ExtPolicy::Supported => {}
+            ExtPolicy::Ignored(why) => warnings.push(format!("glTF extension {name} is ignored: {why}")),
+            ExtPolicy::Geometry(why) => warnings.push(format!(
+                "glTF extension {name} is used but not required and is ignored ({why}); \
+                 the uncompressed fallback data is loaded"
+            )),
+            ExtPolicy::Unknown => warnings.push(format!("unknown glTF extension {name} is ignored")),
+        }
+    }
+
+    // Textures whose only image is given through an extension (e.g. MSFT_texture_dds without
+    // a plain `source`) are pointed at a placeholder image so validation passes, and are
+    // treated as "no texture" below.
+    let mut sourceless: HashSet<usize> = HashSet::new();
+    if root
+        .textures
+        .iter()
+        .any(|t| t.source.value() == u32::MAX as usize)
+    {
+        let placeholder: gltf::json::Image =
+            gltf::json::deserialize::from_str(r#"{"uri":"data:,","name":"placeholder"}"#)
+                .map_err(|e| invalid(e.to_string()))?;
+        let idx = root.images.len() as u32;
+        root.images.push(placeholder);
+        for (i, t) in root.textures.iter_mut().enumerate() {
+            if t.source.value() == u32::MAX as usize {
+                t.source = gltf::json::Index::new(idx);
+                sourceless.insert(i);
+            }
+        }
+    }
+
+    // POSITION min/max are required by the spec but unused here: do not reject files that
+    // lack them or get them wrong.
+    let position_accessors: Vec<usize> = root
+        .meshes
+        .iter()
+        .flat_map(|m| m.primitives.iter())
+        .flat_map(|p| p.attributes.iter())
+        .filter(|(sem, _)| matches!(sem, Checked::Valid(gltf::Semantic::Positions)))
+        .map(|(_, a)| a.value())
+        .collect();
+    for a in position_accessors {
+        // (the gltf crate's validation indexes POSITION accessors without a bounds check)
+        let acc = root
+            .accessors
+            .get_mut(a)
+            .ok_or_else(|| invalid(format!("a POSITION attribute names missing accessor {a}")))?;
+        let zero = gltf::json::Value::from(vec![0.0f32; 3]);
+        acc.min = Some(zero.clone());
+        acc.max = Some(zero);
+    }
+
+    // Last line of defence: a panic inside the parser's validation becomes an error.
+    let doc = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| gltf::Document::from_json(root)))
+        .map_err(|_| invalid("the glTF validator failed on this file".into()))?
+        .map_err(|e| invalid(validation_message(&e)))?;
+    let base_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+
+    let buffers = load_buffers(&doc, path, &base_dir, blob)?;
+
+    // Materials and their base colour images.
+    let (textures, image_to_texture) =
+        load_base_color_images(&doc, &buffers, &base_dir, &sourceless, &mut warnings);
+    let mut materials: Vec<Material> = Vec::new();
+    let mut material_uv_set: Vec<u32> = Vec::new();
+    for (i, m) in doc.materials().enumerate() {
+        let pbr = m.pbr_metallic_roughness();
+        let factor = pbr.base_color_factor();
+        let factor = if factor.iter().all(|c| c.is_finite()) {
+            factor
+        } else {
+            warnings.push(format!(
+                "material {i} has a non-finite baseColorFactor; using white"
+            ));
+            [1.0; 4]
+        };
+        let (tex, set) = match pbr.base_color_texture() {
+            Some(info) if sourceless.contains(&info.texture().index()) => {
+                warnings.push(format!(
+                    "material '{}': base colour texture {} has no PNG/JPG source; using the colour factor only",
+                    m.name().unwrap_or(""),
+                    info.texture().index()
+                ));
+                (None, info.tex_coord())
+            }
+            Some(info) => (
+                image_to_texture
+                    .get(&info.texture().source().index())
+                    .copied()
+                    .flatten(),
+                info.tex_coord(),
+            ),
+            None => (None, 0),
+        };
+        materials.push(Material {
+            name: m
+                .name()
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("material{i}")),
+            base_color_factor: factor,
+            base_color_texture: tex,
+        });
+        material_uv_set.push(set);
+    }
+    let mut default_material: Option<u32> = None;
+
+    let mut scene = Scene {
+        name: path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".into()),
+        textures,
+        ..Default::default()
+    };
+
+    // Walk the node hierarchy.
+    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(s) => s.nodes().collect(),
+        None => {
+            let mut is_child = vec![false; doc.nodes().len()];
+            for n in doc.nodes() {
+                for c in n.children() {
+                    is_child[c.index()] = true;
+                }
+            }
+            doc.nodes().filter(|n| !is_child[n.index()]).collect()
+        }
+    };
+
+    let mut stats = GeomStats::default();
+    let mut pending_cameras: Vec<(Camera, Option<f32>)> = Vec::new();
+    let mut visited = vec![false; doc.nodes().len()];
+    let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY)).collect();
+    let json = doc.as_json();
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut visited[node.index()], true) {
+            warnings.push(format!(
+                "node {} is reached twice (cycle or shared child); the repeat is skipped",
+                node.index()
+            ));
+            continue;
+        }
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+        let world = parent * local;
+        for c in node.children().collect::<Vec<_>>().into_iter().rev() {
+            stack.push((c, world));
+        }
+
+        if let Some(mesh) = node.mesh() {
+            for (pi, prim) in mesh.primitives().enumerate() {
+                if prim.mode() != Mode::Triangles {
+                    *stats
+                        .skipped_modes
+                        .entry(format!("{:?}", prim.mode()))
+                        .or_insert(0) += 1;
+                    continue;
+                }
+                let mat = match prim.material().index() {
+                    Some(m) => m as u32,
+                    None => *default_material.get_or_insert_with(|| {
+                        materials.push(Material::default());
+                        material_uv_set.push(0);
+                        (materials.len() - 1) as u32
+                    }),
+                };
+                let uv_set = material_uv_set.get(mat as usize).copied().unwrap_or(0);
+                let label = format!(
+                    "mesh {} ('{}') primitive {pi}",
+                    mesh.index(),
+                    mesh.name().unwrap_or("")
+                );
+                match read_primitive(&prim, &buffers, uv_set) {
+                    Ok((data, uv_missing)) => {
+                        if uv_missing {
+                            stats.uv_missing.insert(label.clone());
+                        }
+                        append_primitive(&mut scene, &data, &world, mat, &mut stats);
+                    }
+                    Err(e) => warnings.push(format!("{label} skipped: {e}")),
+                }
+            }
+        }
+
+        let node_json = json.nodes.get(node.index());
+        if let Some(ci) = node_json.and_then(|n| n.camera).map(|c| c.value()) {
+            match json.cameras.get(ci) {
+                Some(cam) => match (cam.type_, cam.perspective.as_ref()) {
+                    (Checked::Valid(CameraType::Perspective), Some(p)) => {
+                        let name = cam
+                            .name
+                            .clone()
+                            .or_else(|| node.name().map(str::to_string))
+                            .unwrap_or_else(|| format!("camera{ci}"));
+                        let c = make_camera(&name, &world, p.yfov, p.znear, &mut warnings);
+                        pending_cameras.push((c, p.zfar));
+                    }
+                    _ => warnings.push(format!(
+                        "camera {ci} ('{}') is not a perspective camera; skipped",
+                        cam.name.as_deref().unwrap_or("")
+                    )),
+                },
+                None => warnings.push(format!("node {} references missing camera {ci}", node.index())),
+            }
+        }
+
+        let light_index = node_json
+            .and_then(|n| n.extensions.as_ref())
+            .and_then(|e| e.khr_lights_punctual.as_ref())
+            .map(|l| l.light.value());
+        if let Some(li) = light_index {
+            let light = json
+                .extensions
+                .as_ref()
+                .and_then(|e| e.khr_lights_punctual.as_ref())
+                .and_then(|l| l.lights.get(li));
+            match light {
+                Some(l) => match l.type_ {
+                    Checked::Valid(LightType::Directional) => {
+                        let dir = Mat3::from_mat4(world) * Vec3::NEG_Z;
+                        let irr = l.intensity * Vec3::from_array(l.color);
+                        if dir.is_finite() && dir.length_squared() > 0.0 && irr.is_finite() {
+                            let name = l
+                                .name
+                                .clone()
+                                .or_else(|| node.name().map(str::to_string))
+                                .unwrap_or_else(|| format!("light{li}"));
+                            scene.lights.push(DirectionalLight {
+                                name,
+                                direction: dir.normalize(),
+                                irradiance: irr.max(Vec3::ZERO),
+                            });
+                        } else {
+                            warnings.push(format!(
+                                "directional light {li} has a degenerate direction or non-finite intensity; skipped"
+                            ));
+                        }
+                    }
+                    Checked::Valid(t) => {
+                        *stats.skipped_lights.entry(format!("{t:?}")).or_insert(0) += 1;
+                    }
+                    Checked::Invalid => warnings.push(format!("light {li} has an invalid type; skipped")),
+                },
+                None => warnings.push(format!("node {} references missing light {li}", node.index())),
+            }
+        }
+    }
+
+    // Summaries of skipped/dropped things, one warning each.
+    for (mode, n) in &stats.skipped_modes {
+        warnings.push(format!(
+            "{n} primitive(s) with mode {mode} skipped: only triangle lists are supported"
+        ));
+    }
+    for (kind, n) in &stats.skipped_lights {
+        warnings.push(format!(
+            "{n} {kind} light(s) skipped: only directional lights are supported"
+        ));
+    }
+    if stats.non_finite > 0 {
+        warnings.push(format!(
+            "{} triangle(s) with non-finite (NaN/inf) vertex positions dropped",
+            stats.non_finite
+        ));
+    }
+    if stats.degenerate > 0 {
+        warnings.push(format!("{} zero-area triangle(s) dropped", stats.degenerate));
+    }
+    if stats.bad_index > 0 {
+        warnings.push(format!(
+            "{} triangle(s) with out-of-range vertex indices dropped",
+            stats.bad_index
+        ));
+    }
+    if !stats.uv_missing.is_empty() {
+        let list: Vec<&str> = stats.uv_missing.iter().map(String::as_str).take(5).collect();
+        warnings.push(format!(
+            "{} textured primitive(s) lack the TEXCOORD set their material uses; zero UVs used (e.g. {})",
+            stats.uv_missing.len(),
+            list.join(", ")
+        ));
+    }
+
+    if scene.indices.is_empty() {
+        let mut details = String::new();
+        let _ = write!(
+            details,
+            "{} mesh(es); {} non-finite, {} zero-area, {} bad-index triangles dropped",
+            doc.meshes().len(),
+            stats.non_finite,
+            stats.degenerate,
+            stats.bad_index
+        );
+        if !stats.skipped_modes.is_empty() {
+            let modes: Vec<&str> = stats.skipped_modes.keys().map(String::as_str).collect();
+            let _ = write!(details, "; non-triangle primitives skipped: {}", modes.join(", "));
+        }
+        return Err(SceneError::NoTriangles {
+            path: path.to_path_buf(),
+            details,
+        });
+    }
+    if scene.positions.len() > u32::MAX as usize {
+        return Err(invalid("more than 2^32 vertices".into()));
+    }
+
+    scene.materials = materials;
+    scene.recompute_bounds();
+    let bounds = scene.bounds;
+    for (mut cam, zfar) in pending_cameras {
+        cam.zfar = match zfar {
+            Some(f) if f.is_finite() && f > cam.znear => f,
+            _ => finite_far(&cam, &bounds),
+        };
+        let mut name = cam.name.clone();
+        let mut k = 2;
+        while scene.cameras.iter().any(|c| c.name == name) {
+            name = format!("{}_{k}", cam.name);
+            k += 1;
+        }
+        cam.name = name;
+        scene.cameras.push(cam);
+    }
+
+    for w in &warnings.0 {
+        log::warn!("{}: {w}", path.display());
+    }
+    scene.warnings = warnings.0;
+    Ok(scene)
+}
+
+#[derive(Default)]
+struct Warnings(Vec<String>);
+
+impl Warnings {
+    fn push(&mut self, w: String) {
+        self.0.push(w);
+    }
+}
+
+#[derive(Default)]
+struct GeomStats {
+    non_finite: usize,
+    degenerate: usize,
+    bad_index: usize,
+    skipped_modes: BTreeMap<String, usize>,
+    skipped_lights: BTreeMap<String, usize>,
+    uv_missing: BTreeSet<String>,
+}
+
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+fn validation_message(e: &gltf::Error) -> String {
+    match e {
+        gltf::Error::Validation(errors) => {
+            let shown: Vec<String> = errors
+                .iter()
+                .take(3)
+                .map(|(p, err)| format!("{p}: {err}"))
+                .collect();
+            let more = if errors.len() > 3 {
+                format!(" (and {} more)", errors.len() - 3)
+            } else {
+                String::new()
+            };
+            format!("validation failed: {}{more}", shown.join("; "))
+        }
+        other => one_line(&other.to_string()),
+    }
+}
+
+/// Decodes `%XX` escapes of a relative URI (invalid escapes are kept as they are).
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' && i + 2 < b.len() {
+            let hex = |c: u8| (c as char).to_digit(16);
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Resolves a non-`data:` URI against the glTF file's folder.
+fn resolve_uri(base_dir: &Path, uri: &str) -> Result<PathBuf, String> {
+    if let Some(rest) = uri.strip_prefix("file://").or_else(|| uri.strip_prefix("file:")) {
+        return Ok(PathBuf::from(percent_decode(rest)));
+    }
+    if let Some(colon) = uri.find(':') {
+        // A scheme is letters before ':' (Windows drive letters are one letter long).
+        let scheme = &uri[..colon];
+        if scheme.len() > 1
+            && scheme
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c))
+        {
+            return Err(format!("unsupported URI scheme '{scheme}:'"));
+        }
+    }
+    Ok(base_dir.join(percent_decode(uri)))
+}
+
+fn decode_data_uri(uri: &str) -> Result<Vec<u8>, String> {
+    gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(uri), None)
+        .map(|d| d.0)
+        .map_err(|e| format!("bad data URI: {}", one_line(&e.to_string())))
+}
+
+fn load_buffers(
+    doc: &gltf::Document,
+    path: &Path,
+    base_dir: &Path,
+    mut blob: Option<Vec<u8>>,
+) -> Result<Vec<Vec<u8>>, SceneError> {
+    let mut out = Vec::new();
+    for buffer in doc.buffers() {
+        let index = buffer.index();
+        let bad = |message: String| SceneError::BadBuffer {
+            path: path.to_path_buf(),
+            index,
+            message,
+        };
+        let (data, name) = match buffer.source() {
+            gltf::buffer::Source::Bin => match blob.take() {
+                Some(b) => (b, "GLB BIN chunk".to_string()),
+                None => return Err(bad("the GLB file has no BIN chunk".into())),
+            },
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                (decode_data_uri(uri).map_err(bad)?, "data URI".to_string())
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                let file = resolve_uri(base_dir, uri).map_err(bad)?;
+                match std::fs::read(&file) {
+                    Ok(d) => (d, file.display().to_string()),
+                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                        return Err(SceneError::MissingBuffer {
+                            gltf: path.to_path_buf(),
+                            index,
+                            buffer: file,
+                        });
+                    }
+                    Err(source) => return Err(SceneError::Io { path: file, source }),
+                }
+            }
+        };
+        if data.len() < buffer.length() {
+            return Err(SceneError::TruncatedBuffer {
+                path: path.to_path_buf(),
+                index,
+                name,
+                declared: buffer.length(),
+                actual: data.len(),
+            });
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// An image's label (for messages) and its decoded texture or error.
+type DecodeResult = (String, Result<TextureImage, String>);
+
+/// Decodes every image used as a base colour texture (each once, in parallel). Returns the
+/// decoded textures and a map image index -> texture index (`None` when it failed).
+fn load_base_color_images(
+    doc: &gltf::Document,
+    buffers: &[Vec<u8>],
+    base_dir: &Path,
+    sourceless: &HashSet<usize>,
+    warnings: &mut Warnings,
+) -> (Vec<TextureImage>, HashMap<usize, Option<usize>>) {
+    // image index -> names of materials using it
+    let mut users: BTreeMap<usize, Vec<String>> = BTreeMap::new();
+    for (i, m) in doc.materials().enumerate() {
+        if let Some(info) = m.pbr_metallic_roughness().base_color_texture() {
+            if sourceless.contains(&info.texture().index()) {
+                continue;
+            }
+            let img = info.texture().source().index();
+            users.entry(img).or_default().push(
+                m.name()
+                    .map(str::to_string)
+                    .unwrap_or_else(|| format!("material{i}")),
+            );
+        }
+    }
+    let images: Vec<gltf::Image> = doc.images().collect();
+    let jobs: Vec<usize> = users.keys().copied().collect();
+    let results: Mutex<Vec<Option<DecodeResult>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
+    let next = AtomicUsize::new(0);
+    let threads = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(2)
+        .clamp(1, 8)
+        .min(jobs.len().max(1));
+
+    let work = || {
+        loop {
+            let j = next.fetch_add(1, Ordering::Relaxed);
+            let Some(&img_index) = jobs.get(j) else { break };
+            let Some(img) = images.get(img_index) else {
+                continue;
+            };
+            let (label, res) = decode_image(img, buffers, base_dir);
+            if let Ok(mut r) = results.lock() {
+                r[j] = Some((label, res));
+            }
+        }
+    };
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads).map(|_| s.spawn(work)).collect();
+        for h in handles {
+            // A decoder panic only loses that image (it is reported as a failure below).
+            let _ = h.join();
+        }
+    });
+    let results = results.into_inner().unwrap_or_else(|p| p.into_inner());
+
+    let mut textures = Vec::new();
+    let mut map = HashMap::new();
+    for (j, &img_index) in jobs.iter().enumerate() {
+        let user_list = users.get(&img_index).map(|u| u.join("', '")).unwrap_or_default();
+        match results.get(j).cloned().flatten() {
+            Some((_, Ok(t))) => {
+                map.insert(img_index, Some(textures.len()));
+                textures.push(t);
+            }
+            Some((label, Err(e))) => {
+                warnings.push(format!(
+                    "base colour image {label} not loaded ({e}); material(s) '{user_list}' use their colour factor only"
+                ));
+                map.insert(img_index, None);
+            }
+            None => {
+                warnings.push(format!(
+                    "base colour image {img_index} not loaded (decoder failure); material(s) '{user_list}' use their colour factor only"
+                ));
+                map.insert(img_index, None);
+            }
+        }
+    }
+    (textures, map)
+}
+
+fn decode_image(
+    img: &gltf::Image,
+    buffers: &[Vec<u8>],
+    base_dir: &Path,
+) -> (String, Result<TextureImage, String>) {
+    let (label, bytes): (String, Result<Vec<u8>, String>) = match img.source() {
+        gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => (
+            format!("{} (data URI)", img.name().unwrap_or("image")),
+            decode_data_uri(uri),
+        ),
+        gltf::image::Source::Uri { uri, .. } => match resolve_uri(base_dir, uri) {
+            Ok(p) => (
+                format!("'{}'", p.display()),
+                std::fs::read(&p).map_err(|e| e.to_string()),
+            ),
+            Err(e) => (format!("'{uri}'"), Err(e)),
+        },
+        gltf::image::Source::View { view, .. } => (
+            format!("{} (buffer view {})", img.name().unwrap_or("image"), view.index()),
+            view_slice(&view, buffers).map(<[u8]>::to_vec),
+        ),
+    };
+    let name = img
+        .name()
+        .map(str::to_string)
+        .unwrap_or_else(|| format!("image{}", img.index()));
+    let res = bytes.and_then(|b| {
+        let decoded = image::load_from_memory(&b).map_err(|e| one_line(&e.to_string()))?;
+        let rgba = decoded.into_rgba8();
+        Ok(TextureImage {
+            name,
+            width: rgba.width(),
+            height: rgba.height(),
+            rgba8: rgba.into_raw(),
+        })
+    });
+    (label, res)
+}
+
+fn view_slice<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) -> Result<&'b [u8], String> {
+    let buf = buffers
+        .get(view.buffer().index())
+        .ok_or_else(|| format!("buffer view {} names a missing buffer", view.index()))?;
+    let end = view
+        .offset()
+        .checked_add(view.length())
+        .ok_or("buffer view range overflows")?;
+    buf.get(view.offset()..end).ok_or_else(|| {
+        format!(
+            "buffer view {} (bytes {}..{end}) lies outside its buffer ({} bytes)",
+            view.index(),
+            view.offset(),
+            buf.len()
+        )
+    })
+}
+
+/// Geometry of one primitive in its local space.
+struct PrimData {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    uvs: Option<Vec<Vec2>>,
+    indices: Vec<u32>,
+}
+
+fn read_primitive(
+    prim: &gltf::Primitive,
+    buffers: &[Vec<u8>],
+    uv_set: u32,
+) -> Result<(PrimData, bool), String> {
+    let pos_acc = prim
+        .get(&gltf::Semantic::Positions)
+        .ok_or("no POSITION attribute")?;
+    if pos_acc.dimensions() != Dimensions::Vec3 {
+        return Err("POSITION is not a VEC3 accessor".into());
+    }
+    let positions: Vec<Vec3> = read_floats(&pos_acc, buffers)
+        .map_err(|e| format!("POSITION: {e}"))?
+        .chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect();
+    let n = positions.len();
+
+    let normals = match prim.get(&gltf::Semantic::Normals) {
+        Some(acc) if acc.dimensions() == Dimensions::Vec3 && acc.count() == n => {
+            let v = read_floats(&acc, buffers).map_err(|e| format!("NORMAL: {e}"))?;
+            Some(v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect())
+        }
+        _ => None,
+    };
+    let (uvs, uv_missing) = match prim.get(&gltf::Semantic::TexCoords(uv_set)) {
+        Some(acc) if acc.dimensions() == Dimensions::Vec2 && acc.count() == n => {
+            let v = read_floats(&acc, buffers).map_err(|e| format!("TEXCOORD_{uv_set}: {e}"))?;
+            let uvs: Vec<Vec2> = v
+                .chunks_exact(2)
+                .map(|c| {
+                    let uv = Vec2::new(c[0], c[1]);
+                    if uv.is_finite() { uv } else { Vec2::ZERO }
+                })
+                .collect();
+            (Some(uvs), false)
+        }
+        _ => (
+            None,
+            prim.material()
+                .pbr_metallic_roughness()
+                .base_color_texture()
+                .is_some(),
+        ),
+    };
+    let indices = match prim.indices() {
+        Some(acc) => read_indices(&acc, buffers).map_err(|e| format!("indices: {e}"))?,
+        None => (0..n as u32).collect(),
+    };
+    Ok((
+        PrimData {
+            positions,
+            normals,
+            uvs,
+            indices,
+        },
+        uv_missing,
+    ))
+}
+
+fn component_size(t: DataType) -> usize {
+    match t {
+        DataType::I8 | DataType::U8 => 1,
+        DataType::I16 | DataType::U16 => 2,
+        DataType::U32 | DataType::F32 => 4,
+    }
+}
+
+/// Upper bound on elements of an accessor that has no buffer view (all zeros).
+const MAX_VIEWLESS_COUNT: usize = 1 << 26;
+
+/// Reads all components of an accessor (including sparse substitution) through `conv`,
+/// which turns the bytes of one component into a value. Every range is checked.
+fn read_accessor<T: Copy + Default>(
+    acc: &gltf::Accessor,
+    buffers: &[Vec<u8>],
+    conv: &dyn Fn(&[u8], DataType) -> T,
+) -> Result<Vec<T>, String> {
+    let comps = match acc.dimensions() {
+        Dimensions::Scalar => 1,
+        Dimensions::Vec2 => 2,
+        Dimensions::Vec3 => 3,
+        Dimensions::Vec4 => 4,
+        d => return Err(format!("unsupported accessor type {d:?}")),
+    };
+    let ct = acc.data_type();
+    let csize = component_size(ct);
+    let elem = comps * csize;
+    let count = acc.count();
+    let total = count.checked_mul(comps).ok_or("accessor count overflows")?;
+    let mut out: Vec<T>;
+    match acc.view() {
+        Some(view) => {
+            let data = view_slice(&view, buffers)?;
+            let stride = view.stride().unwrap_or(elem);
+            if stride < elem {
+                return Err(format!(
+                    "byteStride {stride} is smaller than the element size {elem}"
+                ));
+            }
+            if count > 0 {
+                let end = (count - 1)
+                    .checked_mul(stride)
+                    .and_then(|x| x.checked_add(acc.offset()))
+                    .and_then(|x| x.checked_add(elem))
+                    .ok_or("accessor range overflows")?;
+                if end > data.len() {
+                    return Err(format!(
+                        "accessor {} needs {end} bytes but its buffer view has {}",
+                        acc.index(),
+                        data.len()
+                    ));
+                }
+            }
+            out = Vec::with_capacity(total);
+            for i in 0..count {
+                let start = acc.offset() + i * stride;
+                for c in 0..comps {
+                    let s = start + c * csize;
+                    out.push(conv(&data[s..s + csize], ct));
+                }
+            }
+        }
+        None => {
+            if count > MAX_VIEWLESS_COUNT {
+                return Err(format!(
+                    "accessor {} without buffer view has count {count}",
+                    acc.index()
+                ));
+            }
+            out = vec![T::default(); total];
+        }
+    }
+
+    if let Some(sparse) = acc.sparse() {
+        let sc = sparse.count();
+        let idx = sparse.indices();
+        let idx_data = view_slice(&idx.view(), buffers)?;
+        let isize_ = idx.index_type().size();
+        let idx_end = sc
+            .checked_mul(isize_)
+            .and_then(|x| x.checked_add(idx.offset()))
+            .ok_or("sparse index range overflows")?;
+        let vals = sparse.values();
+        let val_data = view_slice(&vals.view(), buffers)?;
+        let val_end = sc
+            .checked_mul(elem)
+            .and_then(|x| x.checked_add(vals.offset()))
+            .ok_or("sparse value range overflows")?;
+        if idx_end > idx_data.len() || val_end > val_data.len() {
+            return Err("sparse accessor data lies outside its buffer views".into());
+        }
+        for k in 0..sc {
+            let s = idx.offset() + k * isize_;
+            let b = &idx_data[s..s + isize_];
+            let target = match isize_ {
+                1 => b[0] as usize,
+                2 => u16::from_le_bytes([b[0], b[1]]) as usize,
+                _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
+            };
+            if target >= count {
+                return Err(format!("sparse index {target} out of range (count {count})"));
+            }
+            let vs = vals.offset() + k * elem;
+            for c in 0..comps {
+                let s = vs + c * csize;
+                out[target * comps + c] = conv(&val_data[s..s + csize], ct);
+            }
+        }
+    }
+    Ok(out)
+}
+
+fn read_floats(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<f32>, String> {
+    let norm = acc.normalized();
+    read_accessor(acc, buffers, &|b: &[u8], t: DataType| match t {
+        DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+        DataType::U8 => {
+            let v = b[0] as f32;
+            if norm { v / 255.0 } else { v }
+        }
+        DataType::I8 => {
+            let v = b[0] as i8 as f32;
+            if norm { (v / 127.0).max(-1.0) } else { v }
+        }
+        DataType::U16 => {
+            let v = u16::from_le_bytes([b[0], b[1]]) as f32;
+            if norm { v / 65535.0 } else { v }
+        }
+        DataType::I16 => {
+            let v = i16::from_le_bytes([b[0], b[1]]) as f32;
+            if norm { (v / 32767.0).max(-1.0) } else { v }
+        }
+        DataType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+    })
+}
+
+fn read_indices(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>, String> {
+    if acc.dimensions() != Dimensions::Scalar {
+        return Err("index accessor is not SCALAR".into());
+    }
+    match acc.data_type() {
+        DataType::U8 | DataType::U16 | DataType::U32 => {}
+        t => return Err(format!("index component type {t:?} is not unsigned")),
+    }
+    read_accessor(acc, buffers, &|b: &[u8], t: DataType| match t {
+        DataType::U8 => b[0] as u32,
+        DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as u32,
+        _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+    })
+}
+
+/// Appends one world-space instance of a primitive, dropping bad triangles.
+fn append_primitive(scene: &mut Scene, p: &PrimData, world: &Mat4, material: u32, stats: &mut GeomStats) {
+    let m3 = Mat3::from_mat4(*world);
+    let flip = m3.determinant() < 0.0;
+    let normal_matrix = m3.inverse().transpose();
+    let wpos: Vec<Vec3> = p.positions.iter().map(|&v| world.transform_point3(v)).collect();
+    let n = wpos.len();
+    let mut remap = vec![u32::MAX; if p.normals.is_some() { n } else { 0 }];
+
+    for tri in p.indices.chunks_exact(3) {
+        let (a, mut b, mut c) = (tri[0] as usize, tri[1] as usize, tri[2] as usize);
+        if a >= n || b >= n || c >= n {
+            stats.bad_index += 1;
+            continue;
+        }
+        if flip {
+            std::mem::swap(&mut b, &mut c);
+        }
+        let (pa, pb, pc) = (wpos[a], wpos[b], wpos[c]);
+        if !(pa.is_finite() && pb.is_finite() && pc.is_finite()) {
+            stats.non_finite += 1;
+            continue;
+        }
+        let cross = (pb - pa).cross(pc - pa);
+        let max_edge2 = (pb - pa)
+            .length_squared()
+            .max((pc - pa).length_squared())
+            .max((pc - pb).length_squared());
+        let area2 = cross.length_squared();
+        if area2.is_nan()
+            || area2 <= f32::MIN_POSITIVE
+            || !area2.is_finite()
+            || area2 <= 1e-14 * max_edge2 * max_edge2
+        {
+            stats.degenerate += 1;
+            continue;
+        }
+        let face_n = cross / area2.sqrt();
+        let uv = |i: usize| {
+            p.uvs
+                .as_ref()
+                .and_then(|u| u.get(i).copied())
+                .unwrap_or(Vec2::ZERO)
+        };
+        match &p.normals {
+            None => {
+                for &v in &[a, b, c] {
+                    scene.indices.push(scene.positions.len() as u32);
+                    scene.positions.push(wpos[v]);
+                    scene.normals.push(face_n);
+                    scene.uvs.push(uv(v));
+                }
+            }
+            Some(normals) => {
+                for &v in &[a, b, c] {
+                    if remap[v] == u32::MAX {
+                        remap[v] = scene.positions.len() as u32;
+                        let wn = normal_matrix * normals[v];
+                        let wn = if wn.is_finite() && wn.length_squared() > 1e-20 {
+                            wn.normalize()
+                        } else {
+                            face_n
+                        };
+                        scene.positions.push(wpos[v]);
+                        scene.normals.push(wn);
+                        scene.uvs.push(uv(v));
+                    }
+                    scene.indices.push(remap[v]);
+                }
+            }
+        }
+        scene.triangle_materials.push(material);
+    }
+}
+
+fn make_camera(name: &str, world: &Mat4, yfov: f32, znear: f32, warnings: &mut Warnings) -> Camera {
+    let m3 = Mat3::from_mat4(*world);
+    let position = world.transform_point3(Vec3::ZERO);
+    let forward = (m3 * Vec3::NEG_Z).normalize_or(Vec3::NEG_Z);
+    let up = (m3 * Vec3::Y).normalize_or(Vec3::Y);
+    let yfov = if yfov.is_finite() && yfov > 1e-3 && yfov < std::f32::consts::PI - 1e-3 {
+        yfov
+    } else {
+        warnings.push(format!(
+            "camera '{name}' has an invalid yfov {yfov}; using 50 degrees"
+        ));
+        50f32.to_radians()
+    };
+    let znear = if znear.is_finite() && znear > 0.0 {
+        znear
+    } else {
+        0.01
+    };
+    let mut cam = Camera {
+        name: name.to_string(),
+        position: if position.is_finite() {
+            position
+        } else {
+            Vec3::ZERO
+        },
+        forward,
+        up,
+        yfov,
+        znear,
+        zfar: f32::INFINITY,
+    };
+    cam.orthonormalize();
+    if !(cam.forward.is_finite() && cam.up.is_finite()) {
+        cam.forward = Vec3::NEG_Z;
+        cam.up = Vec3::Y;
+    }
+    cam
+}
+
+/// A finite far plane that covers the whole scene from the camera.
+fn finite_far(cam: &Camera, bounds: &Aabb) -> f32 {
+    let d = (cam.position - bounds.center()).length() + bounds.radius();
+    (2.0 * d).max(cam.znear * 1000.0).max(1.0)
+}

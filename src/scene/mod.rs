@@ -1,0 +1,199 @@
+//! Scene data on the CPU: glTF loading, the embedded default scene, presets, the BVH, cameras.
+//!
+//! Everything here is plain Rust (no wgpu, no egui) so that tests and CPU references can use it.
+//! Geometry is flattened to world space at load time: every node that references a mesh
+//! contributes its own transformed copy of the mesh's triangles (instancing is resolved here).
+
+pub mod bvh;
+pub mod camera;
+pub mod default_scene;
+pub mod gltf_load;
+pub mod preset;
+
+#[cfg(test)]
+mod loader_tests;
+
+use glam::{Vec2, Vec3};
+
+pub use bvh::Bvh;
+pub use camera::Camera;
+pub use gltf_load::SceneError;
+
+/// Axis-aligned bounding box. An empty box has `min > max` (min = +inf, max = -inf).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Default for Aabb {
+    fn default() -> Self {
+        Self::EMPTY
+    }
+}
+
+impl Aabb {
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
+
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
+    }
+    pub fn grow(&mut self, p: Vec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+    pub fn union(&self, o: &Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
+    }
+    pub fn center(&self) -> Vec3 {
+        0.5 * (self.min + self.max)
+    }
+    pub fn extent(&self) -> Vec3 {
+        if self.is_empty() {
+            Vec3::ZERO
+        } else {
+            self.max - self.min
+        }
+    }
+    /// Half the diagonal: radius of the bounding sphere around `center()`.
+    pub fn radius(&self) -> f32 {
+        0.5 * self.extent().length()
+    }
+    pub fn surface_area(&self) -> f32 {
+        let e = self.extent();
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+    }
+}
+
+/// A diffuse material: albedo = `base_color_factor` x texture(uv) (texture sRGB-decoded).
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub name: String,
+    /// Linear RGBA factor (glTF `baseColorFactor`).
+    pub base_color_factor: [f32; 4],
+    /// Index into [`Scene::textures`], if the material has a base colour texture that loaded.
+    pub base_color_texture: Option<usize>,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self {
+            name: "default".into(),
+            base_color_factor: [0.8, 0.8, 0.8, 1.0],
+            base_color_texture: None,
+        }
+    }
+}
+
+/// An 8-bit RGBA image whose RGB is sRGB-encoded (as stored in PNG/JPG files).
+#[derive(Clone, Debug)]
+pub struct TextureImage {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    /// `width * height * 4` bytes, row-major, top row first.
+    pub rgba8: Vec<u8>,
+}
+
+/// A directional light (sun).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DirectionalLight {
+    pub name: String,
+    /// Unit vector in the direction the light *travels* (glTF: the node's local -Z in world
+    /// space). The direction towards the light is `-direction`.
+    pub direction: Vec3,
+    /// Irradiance E in W/m^2 on a surface perpendicular to the light, per RGB channel
+    /// (glTF `intensity` x `color`; no photometric conversion).
+    pub irradiance: Vec3,
+}
+
+impl DirectionalLight {
+    /// Builds a sun from azimuth/elevation in degrees (elevation above the horizon, azimuth
+    /// measured from +X towards +Z around +Y) and a scalar irradiance times colour.
+    pub fn from_angles(name: &str, azimuth_deg: f32, elevation_deg: f32, irradiance: Vec3) -> Self {
+        let (az, el) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
+        let to_light = Vec3::new(el.cos() * az.cos(), el.sin(), el.cos() * az.sin());
+        Self {
+            name: name.into(),
+            direction: -to_light.normalize(),
+            irradiance,
+        }
+    }
+    /// (azimuth, elevation) in degrees of the direction towards the light; inverse of
+    /// [`DirectionalLight::from_angles`].
+    pub fn angles_deg(&self) -> (f32, f32) {
+        let l = -self.direction.normalize_or(Vec3::Y);
+        let el = l.y.clamp(-1.0, 1.0).asin();
+        let az = l.z.atan2(l.x);
+        (az.to_degrees(), el.to_degrees())
+    }
+}
+
+/// A loaded scene: world-space triangles, materials, textures, cameras and lights.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    pub name: String,
+    /// World-space vertex positions.
+    pub positions: Vec<Vec3>,
+    /// World-space unit vertex normals (computed flat when the file has none).
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates (zero when the file has none).
+    pub uvs: Vec<Vec2>,
+    /// Three indices per triangle into the vertex arrays.
+    pub indices: Vec<u32>,
+    /// Material index per triangle (into `materials`).
+    pub triangle_materials: Vec<u32>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<TextureImage>,
+    pub cameras: Vec<Camera>,
+    pub lights: Vec<DirectionalLight>,
+    /// Bounds of all triangles.
+    pub bounds: Aabb,
+    /// Non-fatal problems met while loading (unsupported extensions, missing images, ...).
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+    /// The three world-space corners of triangle `t`.
+    pub fn triangle(&self, t: usize) -> [Vec3; 3] {
+        let i = &self.indices[3 * t..3 * t + 3];
+        [
+            self.positions[i[0] as usize],
+            self.positions[i[1] as usize],
+            self.positions[i[2] as usize],
+        ]
+    }
+    pub fn recompute_bounds(&mut self) {
+        let mut b = Aabb::EMPTY;
+        for &p in &self.positions {
+            b.grow(p);
+        }
+        self.bounds = b;
+    }
+    /// The camera named `name`, or the first one, or one framing the bounds.
+    pub fn camera_or_default(&self, name: Option<&str>) -> Result<Camera, String> {
+        match name {
+            Some(n) => self.cameras.iter().find(|c| c.name == n).cloned().ok_or_else(|| {
+                let names: Vec<&str> = self.cameras.iter().map(|c| c.name.as_str()).collect();
+                format!(
+                    "no camera named '{n}' in the scene (it has: {})",
+                    names.join(", ")
+                )
+            }),
+            None => Ok(self
+                .cameras
+                .first()
+                .cloned()
+                .unwrap_or_else(|| Camera::framing(&self.bounds))),
+        }
+    }
+}

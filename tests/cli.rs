@@ -1,0 +1,89 @@
+//! The headless `render` command end to end, and clear one-line errors for bad input.
+
+mod common;
+
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_lightcut-workbench"))
+}
+
+#[test]
+fn render_default_scene_writes_exrs_pngs_and_timings() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = std::env::temp_dir().join(format!("lightcut-cli-{}", std::process::id()));
+    let o = bin()
+        .args([
+            "render", "--scene", "default", "--width", "96", "--height", "64", "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "stdout: {stdout}\nstderr: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(stdout.contains("adapter:"));
+    assert!(
+        stdout.contains("gbuffer") || stdout.contains("timestamps not supported"),
+        "{stdout}"
+    );
+    for f in [
+        "direct.exr",
+        "final.exr",
+        "position.exr",
+        "normal.exr",
+        "albedo.exr",
+        "depth.exr",
+        "final.png",
+        "direct.png",
+        "normal.png",
+        "albedo.png",
+        "depth.png",
+        "shadow_map.png",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let direct = lightcut::export::read_exr(&out.join("direct.exr")).unwrap();
+    assert_eq!((direct.width, direct.height), (96, 64));
+    let mean = direct.mean_rgb();
+    assert!(mean[0] > 0.0 && mean.iter().all(|v| v.is_finite()), "{mean:?}");
+    let fin = lightcut::export::read_exr(&out.join("final.exr")).unwrap();
+    assert_eq!(fin, direct, "final = direct until GI exists");
+    let png = image::open(out.join("final.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (96, 64));
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+fn one_line_error(args: &[&str]) -> String {
+    let o = bin().args(args).output().unwrap();
+    assert!(!o.status.success(), "{args:?} should fail");
+    let err = String::from_utf8_lossy(&o.stderr);
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(lines.len(), 1, "expected one error line, got: {err}");
+    lines[0].to_string()
+}
+
+#[test]
+fn bad_input_gives_one_clear_line() {
+    let e = one_line_error(&["render", "--scene", "/nonexistent/scene.gltf", "--out", "/tmp/x"]);
+    assert!(e.contains("/nonexistent/scene.gltf"), "{e}");
+    let e = one_line_error(&[
+        "render",
+        "--scene",
+        "default",
+        "--shadow-res",
+        "3",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("shadow.resolution"), "{e}");
+    let e = one_line_error(&[
+        "render", "--scene", "default", "--camera", "Nope", "--out", "/tmp/x",
+    ]);
+    assert!(e.contains("Nope"), "{e}");
+}

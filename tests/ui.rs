@@ -1,0 +1,85 @@
+//! The workbench UI, headless (egui_kittest + wgpu): switching the buffer selector changes the
+//! shown texture; a snapshot of the main window.
+
+mod common;
+
+use std::sync::Arc;
+
+use egui::accesskit::Role;
+use egui_kittest::{Harness, kittest::Queryable};
+use lightcut::{
+    app::{AppOptions, WorkbenchApp},
+    renderer::settings::ViewBuffer,
+};
+
+fn setup() -> egui_wgpu::WgpuSetup {
+    let mut s = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
+    s.instance_descriptor.backends = lightcut::renderer::context::BACKENDS;
+    s.device_descriptor = Arc::new(lightcut::renderer::context::device_descriptor);
+    egui_wgpu::WgpuSetup::CreateNew(s)
+}
+
+fn harness() -> Option<Harness<'static, WorkbenchApp>> {
+    common::gpu()?;
+    Some(
+        Harness::builder()
+            .with_size(egui::vec2(1100.0, 700.0))
+            .wgpu_setup(setup())
+            .build_eframe(|cc| {
+                WorkbenchApp::new(
+                    cc,
+                    AppOptions {
+                        scene: "default".into(),
+                        ..Default::default()
+                    },
+                )
+            }),
+    )
+}
+
+fn shown_pixels(h: &Harness<'_, WorkbenchApp>) -> Vec<u8> {
+    let r = h.state().renderer().expect("renderer");
+    r.read_view_rgba8().expect("readback").2
+}
+
+#[test]
+fn buffer_selector_changes_the_shown_texture() {
+    let Some(mut h) = harness() else { return };
+    h.run_steps(3);
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+    assert_eq!(h.state().view(), ViewBuffer::Final);
+    let final_px = shown_pixels(&h);
+    assert!(final_px.chunks(4).any(|p| p[0] > 20), "final image is black");
+
+    // Open the buffer combo box and pick "normal".
+    h.get_by_role_and_label(Role::ComboBox, "buffer").click();
+    h.run_steps(2);
+    h.get_by_label("normal").click();
+    h.run_steps(3);
+    assert_eq!(h.state().view(), ViewBuffer::Normal);
+    let normal_px = shown_pixels(&h);
+    assert_ne!(final_px, normal_px, "the shown texture did not change");
+
+    // And the shadow map (a square texture of the shadow-map resolution).
+    h.get_by_role_and_label(Role::ComboBox, "buffer").click();
+    h.run_steps(2);
+    h.get_by_label("shadow map").click();
+    h.run_steps(3);
+    assert_eq!(h.state().view(), ViewBuffer::ShadowMap);
+    let (w, hh, _) = h.state().renderer().unwrap().read_view_rgba8().unwrap();
+    assert_eq!((w, hh), (512, 512));
+    assert!(h.state().frames() >= 8);
+}
+
+#[test]
+fn main_window_snapshot() {
+    let Some(mut h) = harness() else { return };
+    h.run_steps(4);
+    // The status line holds GPU timings, which change from run to run: mask it.
+    let status = h.get_by_label_contains("GPU: ").rect();
+    h.mask(egui::Rect::from_min_max(
+        egui::pos2(0.0, status.min.y - 4.0),
+        egui::pos2(1100.0, 700.0),
+    ));
+    h.snapshot("main_window");
+}
