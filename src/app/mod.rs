@@ -187,9 +187,6 @@ impl WorkbenchApp {
         let camera = camera.map(str::to_string).or(opened.camera_name.clone());
         let open = OpenScene::new(opened.scene, source.to_string(), camera.as_deref())
             .map_err(|e| format!("Could not open '{source}': {e}"))?;
-        for w in &open.scene.warnings {
-            log::warn!("{source}: {w}");
-        }
         self.settings.display.exposure_ev = opened.exposure_ev;
         match &mut self.renderer {
             Some(r) => {
@@ -467,7 +464,12 @@ impl WorkbenchApp {
             }
         }
         let (_, view, generation) = renderer.view_texture();
-        let id = self.texture.update(&rs, view, generation);
+        let filter = if self.render_scale < 1.0 {
+            wgpu::FilterMode::Linear
+        } else {
+            wgpu::FilterMode::Nearest
+        };
+        let id = self.texture.update(&rs, view, generation, filter);
         // Keep the image's aspect (the shadow map is square).
         let (tw, th) = (
             renderer.view_texture().0.width(),
@@ -591,6 +593,9 @@ impl eframe::App for WorkbenchApp {
 
 /// Runs the GUI (blocking). Fails with one clear message when no GPU adapter is usable.
 pub fn run_gui(options: AppOptions) -> anyhow::Result<()> {
+    // Fail early with the fix named, rather than with eframe's surface error.
+    let info = GpuContext::probe_adapter()?;
+    log::info!("GPU adapter: {}", describe_adapter(&info));
     let mut wgpu_setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
     wgpu_setup.instance_descriptor.backends =
         wgpu::Backends::from_env().unwrap_or(crate::renderer::context::BACKENDS);

@@ -4,6 +4,7 @@
 pub struct ViewportTexture {
     id: Option<egui::TextureId>,
     generation: u64,
+    filter: wgpu::FilterMode,
 }
 
 impl Default for ViewportTexture {
@@ -17,34 +18,34 @@ impl ViewportTexture {
         Self {
             id: None,
             generation: u64::MAX,
+            filter: wgpu::FilterMode::Nearest,
         }
     }
 
-    /// The egui texture id showing `view` (registering or updating it when `generation` changed).
+    /// The egui texture id showing `view` (registering or updating it when `generation` or the
+    /// filter changed). Nearest filtering shows render pixels as they are; linear smooths an
+    /// upscaled low-resolution render.
     pub fn update(
         &mut self,
         render_state: &egui_wgpu::RenderState,
         view: &wgpu::TextureView,
         generation: u64,
+        filter: wgpu::FilterMode,
     ) -> egui::TextureId {
         let mut renderer = render_state.renderer.write();
         match self.id {
-            Some(id) if self.generation == generation => id,
+            Some(id) if self.generation == generation && self.filter == filter => id,
             Some(id) => {
-                renderer.update_egui_texture_from_wgpu_texture(
-                    &render_state.device,
-                    view,
-                    wgpu::FilterMode::Nearest,
-                    id,
-                );
+                renderer.update_egui_texture_from_wgpu_texture(&render_state.device, view, filter, id);
                 self.generation = generation;
+                self.filter = filter;
                 id
             }
             None => {
-                let id =
-                    renderer.register_native_texture(&render_state.device, view, wgpu::FilterMode::Nearest);
+                let id = renderer.register_native_texture(&render_state.device, view, filter);
                 self.id = Some(id);
                 self.generation = generation;
+                self.filter = filter;
                 id
             }
         }

@@ -56,9 +56,6 @@ fn linear_depth(position: &ImageF32, eye: glam::Vec3, fwd: glam::Vec3) -> ImageF
 
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
-    for w in &opened.scene.warnings {
-        eprintln!("warning: {w}");
-    }
     let settings = args.settings.resolve(opened.exposure_ev)?;
     let cam_name = args.camera.clone().or(opened.camera_name.clone());
     let camera = opened

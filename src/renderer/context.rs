@@ -129,6 +129,17 @@ impl GpuContext {
         Self::from_adapter(&adapter)
     }
 
+    /// The adapter a headless context would use, without creating a device.
+    pub fn probe_adapter() -> Result<wgpu::AdapterInfo, GpuError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+            backends: wgpu::Backends::from_env().unwrap_or(BACKENDS),
+            ..wgpu::InstanceDescriptor::new_without_display_handle()
+        });
+        pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))
+            .map(|a| a.get_info())
+            .map_err(|_| GpuError::NoAdapter)
+    }
+
     pub fn from_adapter(adapter: &wgpu::Adapter) -> Result<Self, GpuError> {
         let info = adapter.get_info();
         let (device, queue) = pollster::block_on(adapter.request_device(&device_descriptor(adapter)))
