@@ -19,8 +19,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let c = textureLoad(src, vec2<i32>(gid.xy), 0).rgb * params.exposure;
-    // NaN/inf shows as magenta so it cannot hide.
-    if any(c != c) || any(abs(c) > vec3<f32>(3.0e38)) {
+    // NaN/inf shows as magenta so it cannot hide (tested on the bits: compilers may fold
+    // `x != x` away).
+    let exp_bits = bitcast<vec3<u32>>(c) & vec3<u32>(0x7f800000u);
+    if any(exp_bits == vec3<u32>(0x7f800000u)) {
         textureStore(dst, vec2<i32>(gid.xy), vec4<f32>(1.0, 0.0, 1.0, 1.0));
         return;
     }

@@ -4,5 +4,7 @@
 pub mod app;
 pub mod cli;
 pub mod export;
+#[doc(hidden)]
+pub mod reference;
 pub mod renderer;
 pub mod scene;

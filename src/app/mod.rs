@@ -367,6 +367,7 @@ impl WorkbenchApp {
                 });
             ui.add(egui::Slider::new(&mut s.depth_bias, 0.0..=8.0).text("depth bias (texels)"));
             ui.add(egui::Slider::new(&mut s.normal_offset, 0.0..=8.0).text("normal offset (texels)"));
+            ui.add(egui::Slider::new(&mut s.slope_bias, 0.0..=4.0).text("slope bias"));
             ui.add(egui::Slider::new(&mut s.pcf_radius, 0..=4).text("PCF radius"));
         });
     }

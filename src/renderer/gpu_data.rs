@@ -66,7 +66,8 @@ pub struct GpuDirectionalLight {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuLights {
-    /// x = light count, y = shadow-map resolution, z = PCF radius in texels (0 = one tap).
+    /// x = light count, y = shadow-map resolution, z = PCF radius in texels (0 = one tap),
+    /// w = slope-scaled bias factor (f32 bits).
     pub count: [u32; 4],
     pub lights: [GpuDirectionalLight; MAX_LIGHTS],
 }
@@ -117,11 +118,12 @@ impl GpuLights {
         resolution: u32,
         depth_bias_texels: f32,
         normal_offset_texels: f32,
+        slope_bias: f32,
         pcf_radius: u32,
     ) -> Self {
         let mut out = GpuLights::zeroed();
         let n = lights.len().min(MAX_LIGHTS);
-        out.count = [n as u32, resolution, pcf_radius, 0];
+        out.count = [n as u32, resolution, pcf_radius, slope_bias.to_bits()];
         for (i, l) in lights.iter().take(n).enumerate() {
             let (vp, texel, range) = light_frustum(l.direction, bounds, resolution);
             out.lights[i] = GpuDirectionalLight {

@@ -194,6 +194,7 @@ impl Renderer {
             s.shadow.resolution,
             s.shadow.depth_bias,
             s.shadow.normal_offset,
+            s.shadow.slope_bias,
             s.shadow.pcf_radius,
         );
         queue.write_buffer(

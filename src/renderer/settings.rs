@@ -23,9 +23,14 @@ pub struct ShadowSettings {
     /// Constant depth bias in texels of light-space depth. Raise if surfaces shadow themselves
     /// (acne stripes); lower if shadows detach from their casters (peter-panning).
     pub depth_bias: f32,
-    /// Offset of the lookup point along the surface normal, in texels. Raise against acne at
-    /// grazing light; lower if thin occluders leak light.
+    /// Offset of the lookup point along the surface normal, in texels, scaled by sin(theta)
+    /// of the light's incidence. Raise against acne at grazing light; lower if thin occluders
+    /// leak light.
     pub normal_offset: f32,
+    /// Slope-scaled depth bias: tan(theta) x (PCF radius + 1/2) texels times this factor
+    /// (receiver-plane bound for the PCF taps). Raise if tilted surfaces shadow themselves in
+    /// stripes; lower if contact shadows detach.
+    pub slope_bias: f32,
     /// Percentage-closer filter radius in texels: 0 = one hard tap, 1 = 3x3, 2 = 5x5. Raising it
     /// softens (and antialiases) shadow edges at more cost per pixel.
     pub pcf_radius: u32,
@@ -35,8 +40,9 @@ impl Default for ShadowSettings {
     fn default() -> Self {
         Self {
             resolution: 512,
-            depth_bias: 1.5,
+            depth_bias: 1.0,
             normal_offset: 1.0,
+            slope_bias: 1.0,
             pcf_radius: 1,
         }
     }
@@ -127,6 +133,12 @@ impl RenderSettings {
             return Err(format!(
                 "shadow.normal_offset {} is out of range (0..=64)",
                 s.normal_offset
+            ));
+        }
+        if !(0.0..=16.0).contains(&s.slope_bias) {
+            return Err(format!(
+                "shadow.slope_bias {} is out of range (0..=16)",
+                s.slope_bias
             ));
         }
         if s.pcf_radius > 4 {
