@@ -324,3 +324,25 @@ fn direct_pass_matches_ray_traced_reference_away_from_shadow_edges() {
     );
     assert!(r.ctx.errors.take().is_empty());
 }
+
+#[test]
+fn shader_reload_rebuilds_pipelines_and_rendering_continues() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = default_scene::build();
+    let cam = scene.camera_or_default(None).unwrap();
+    let mut r = Renderer::new(ctx, &scene, (48, 32), RenderSettings::default()).unwrap();
+    r.render(&FrameInput {
+        camera: &cam,
+        lights: &scene.lights,
+        view: ViewBuffer::Final,
+    });
+    let before = r.read(Buffer::Direct).unwrap();
+    r.reload_shaders().expect("reload");
+    r.render(&FrameInput {
+        camera: &cam,
+        lights: &scene.lights,
+        view: ViewBuffer::Final,
+    });
+    assert_eq!(before, r.read(Buffer::Direct).unwrap());
+    assert!(r.ctx.errors.take().is_empty());
+}

@@ -337,6 +337,17 @@ impl WorkbenchApp {
                         ui.selectable_value(&mut self.settings.display.tonemap, t, t.name());
                     }
                 });
+            let hint = if crate::renderer::shaders::ShaderSourceDisk::reload_from_disk() {
+                "rebuild the pipelines from shaders/ on disk (the last good ones stay on error)"
+            } else {
+                "release build: rebuilds the pipelines from the embedded shaders"
+            };
+            if ui.button("Reload shaders").on_hover_text(hint).clicked()
+                && let Some(r) = &mut self.renderer
+                && let Err(e) = r.reload_shaders()
+            {
+                self.errors.push(e.to_string());
+            }
             ui.add(egui::Slider::new(&mut self.render_scale, 0.25..=1.0).text("render scale"))
                 .on_hover_text("render resolution relative to the viewport's pixels");
             if let Some(sun) = &mut self.sun {

@@ -41,6 +41,8 @@ pub enum RenderError {
     Gpu(#[from] GpuError),
     #[error("invalid setting: {0}")]
     Settings(String),
+    #[error("{0}")]
+    Pipeline(String),
     #[error("invalid frame size {0}x{1} (1..=8192 each)")]
     Size(u32, u32),
 }
@@ -122,6 +124,33 @@ impl Renderer {
             frames: 0,
             ctx,
         })
+    }
+
+    /// Rebuilds every pass's pipelines from the shader sources (from `shaders/` on disk in
+    /// debug builds: edit WGSL while the workbench runs). If any shader fails to compile, the
+    /// error is returned and the last good pipelines stay in use.
+    pub fn reload_shaders(&mut self) -> Result<(), RenderError> {
+        let device = &self.ctx.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let passes = (
+            GbufferPass::new(device),
+            ShadowMapPass::new(device),
+            DirectPass::new(device),
+            DisplayPass::new(device),
+            VisualisePass::new(device),
+        );
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
+        }
+        let (g, s, d, disp, v) = passes;
+        (
+            self.gbuffer,
+            self.shadow,
+            self.direct,
+            self.display,
+            self.visualise,
+        ) = (g?, s?, d?, disp?, v?);
+        Ok(())
     }
 
     /// Replaces the scene (geometry, materials, textures, BVH).

@@ -16,14 +16,29 @@ use super::{Scene, default_scene};
 // Fixture helpers
 // ---------------------------------------------------------------------------------------
 
-/// A fresh, empty temporary folder for one test.
-fn temp_dir(tag: &str) -> PathBuf {
+/// A fresh, empty temporary folder for one test, removed when dropped.
+struct TempDir(PathBuf);
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn temp_dir(tag: &str) -> TempDir {
     static COUNTER: AtomicUsize = AtomicUsize::new(0);
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
     let dir = std::env::temp_dir().join(format!("lightcut_loader_tests_{}_{tag}_{n}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    dir
+    TempDir(dir)
 }
 
 /// Builds a binary buffer plus the matching `bufferViews` / `accessors` JSON.
