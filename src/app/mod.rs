@@ -348,6 +348,8 @@ impl WorkbenchApp {
             {
                 self.errors.push(e.to_string());
             }
+            ui.add(egui::Slider::new(&mut self.settings.textures.anisotropy, 1..=16).text("anisotropy"))
+                .on_hover_text("anisotropic texture filtering (1 = trilinear)");
             ui.add(egui::Slider::new(&mut self.render_scale, 0.25..=1.0).text("render scale"))
                 .on_hover_text("render resolution relative to the viewport's pixels");
             if let Some(sun) = &mut self.sun {

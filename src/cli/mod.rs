@@ -52,6 +52,9 @@ pub struct SettingsArgs {
     /// Largest base-colour texture size uploaded.
     #[arg(long)]
     pub max_texture: Option<u32>,
+    /// Anisotropic texture filtering, 1..=16.
+    #[arg(long)]
+    pub anisotropy: Option<u16>,
 }
 
 impl SettingsArgs {
@@ -80,6 +83,9 @@ impl SettingsArgs {
         }
         if let Some(v) = self.max_texture {
             s.textures.max_size = v;
+        }
+        if let Some(v) = self.anisotropy {
+            s.textures.anisotropy = v;
         }
         s.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
         Ok(s)

@@ -110,7 +110,13 @@ impl Renderer {
         };
         let lights = scene.lights.len().clamp(1, MAX_LIGHTS) as u32;
         Ok(Self {
-            scene: SceneGpu::new(device, &ctx.queue, scene, settings.textures.max_size),
+            scene: SceneGpu::new(
+                device,
+                &ctx.queue,
+                scene,
+                settings.textures.max_size,
+                settings.textures.anisotropy,
+            ),
             targets: FrameTargets::new(device, size, settings.shadow.resolution, lights),
             gbuffer: GbufferPass::new(device)?,
             shadow: ShadowMapPass::new(device)?,
@@ -160,6 +166,7 @@ impl Renderer {
             &self.ctx.queue,
             scene,
             self.settings.textures.max_size,
+            self.settings.textures.anisotropy,
         );
     }
 
@@ -181,6 +188,9 @@ impl Renderer {
                 settings.shadow.resolution,
                 self.targets.shadow.layers(),
             );
+        }
+        if settings.textures.anisotropy != self.settings.textures.anisotropy {
+            self.scene.sampler = scene_gpu::texture_sampler(&self.ctx.device, settings.textures.anisotropy);
         }
         self.settings = settings;
         Ok(())

@@ -121,7 +121,13 @@ pub fn texture_mips(tex: &TextureImage, size: u32) -> Vec<Vec<u8>> {
 }
 
 impl SceneGpu {
-    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, scene: &Scene, max_texture_size: u32) -> Self {
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        max_texture_size: u32,
+        anisotropy: u16,
+    ) -> Self {
         let (verts, indices) = build_vertices(scene);
         let verts = if verts.is_empty() {
             vec![bytemuck::Zeroable::zeroed()]
@@ -238,17 +244,7 @@ impl SceneGpu {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("scene::sampler"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            address_mode_w: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            anisotropy_clamp: 8,
-            ..Default::default()
-        });
+        let sampler = texture_sampler(device, anisotropy);
 
         let mut mats: Vec<GpuMaterial> = scene
             .materials
@@ -295,6 +291,21 @@ impl SceneGpu {
             bvh,
         }
     }
+}
+
+/// The base-colour sampler: repeat, trilinear, `anisotropy`x anisotropic (1..=16).
+pub fn texture_sampler(device: &wgpu::Device, anisotropy: u16) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("scene::sampler"),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        address_mode_w: wgpu::AddressMode::Repeat,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        anisotropy_clamp: anisotropy.clamp(1, 16),
+        ..Default::default()
+    })
 }
 
 /// Uploads a BVH's nodes and triangles as storage buffers (never empty: wgpu forbids
