@@ -113,9 +113,11 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     let mean = direct.mean_rgb();
     println!(
-        "scene: {} ({} triangles), camera '{}', {}x{}",
+        "scene: {} ({} triangles, {} materials, {} textures), camera '{}', {}x{}",
         opened.scene.name,
         opened.scene.triangle_count(),
+        opened.scene.materials.len(),
+        opened.scene.textures.len(),
         camera.name,
         args.width,
         args.height
