@@ -4,11 +4,7 @@
 //   1 normal:   Rgba16Float, xyz unit shading normal facing the camera, w = 1
 //   2 albedo:   Rgba16Float, rgb linear diffuse albedo = baseColorFactor x texture, a = alpha
 #include "common/camera.wgsl"
-
-struct MaterialGpu {
-    base_color: vec4<f32>,
-    texture: vec4<i32>, // x = layer in `textures` or -1
-};
+#include "common/material.wgsl"
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> materials: array<MaterialGpu>;
@@ -49,12 +45,7 @@ struct GbufferOut {
 
 @fragment
 fn fs_main(i: VertexOut, @builtin(front_facing) front: bool) -> GbufferOut {
-    let m = materials[i.material];
-    var albedo = m.base_color;
-    if m.texture.x >= 0 {
-        // Rgba8UnormSrgb layers: the sampler returns linear values.
-        albedo *= textureSample(textures, tex_sampler, i.uv, m.texture.x);
-    }
+    let albedo = material_albedo(i.material, i.uv);
     // Two-sided: shade the side the camera sees.
     var n = normalize(i.normal);
     if !front {

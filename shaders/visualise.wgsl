@@ -6,6 +6,11 @@
 //   5 depth texture layer (shadow map; range -> grey)
 //   6 unsigned integer ids (hash colour; 0 = black)
 //   7 unsigned integer heat (range -> false colour)
+//   8 array layer, colour x range_max.x (RSM flux / (E x texel area) ~ albedo), sRGB
+//   9 array layer, normal (n * 0.5 + 0.5)
+//  10 scalar buffer, log heat relative to its mean: t = (log10(v / mean) + 3) / 5, i.e.
+//     1/1000 of the mean -> 0, 100x the mean -> 1; zero -> black.
+//     The mean is range_min.x (a pyramid's top / texel count, read on the GPU).
 #include "common/color.wgsl"
 
 struct VisParams {
@@ -22,6 +27,9 @@ struct VisParams {
 @group(1) @binding(1) var src_aux: texture_2d<f32>;
 @group(2) @binding(0) var src_depth: texture_depth_2d_array;
 @group(3) @binding(0) var src_uint: texture_2d<u32>;
+@group(1) @binding(2) var src_array: texture_2d_array<f32>;
+@group(1) @binding(3) var<storage, read> src_scalar: array<f32>;
+@group(1) @binding(4) var<storage, read> src_pyramid: array<f32>;
 
 fn in_bounds(gid: vec3<u32>) -> bool {
     let size = textureDimensions(dst);
@@ -102,4 +110,41 @@ fn vis_uint(@builtin(global_invocation_id) gid: vec3<u32>) {
         c = id_color(v);
     }
     textureStore(dst, px, vec4<f32>(c, 1.0));
+}
+
+// Array texture layers (RSM), sampled nearest to the destination size.
+@compute @workgroup_size(8, 8, 1)
+fn vis_array(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if !in_bounds(gid) {
+        return;
+    }
+    let src_size = textureDimensions(src_array);
+    let dst_size = textureDimensions(dst);
+    let sp = vec2<u32>((vec2<f32>(gid.xy) + 0.5) * vec2<f32>(src_size) / vec2<f32>(dst_size));
+    let v = textureLoad(src_array, vec2<i32>(sp), i32(params.layer), 0);
+    var c = vec3<f32>(0.0);
+    if params.mode == 9u {
+        c = select(vec3<f32>(0.0), v.xyz * 0.5 + 0.5, dot(v.xyz, v.xyz) > 0.0);
+    } else {
+        c = linear_to_srgb(v.rgb * params.range_max.x);
+    }
+    textureStore(dst, vec2<i32>(gid.xy), vec4<f32>(c, 1.0));
+}
+
+// Scalar buffers over a square map (res = range_max.y, layer offset = range_max.z texels).
+@compute @workgroup_size(8, 8, 1)
+fn vis_scalar(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if !in_bounds(gid) {
+        return;
+    }
+    let res = u32(params.range_max.y);
+    let dst_size = textureDimensions(dst);
+    let sp = vec2<u32>((vec2<f32>(gid.xy) + 0.5) * f32(res) / vec2<f32>(dst_size));
+    let v = src_scalar[u32(params.range_max.z) + sp.y * res + sp.x];
+    let mean = src_pyramid[u32(params.range_min.y)] / f32(res * res);
+    var c = vec3<f32>(0.0);
+    if v > 0.0 && mean > 0.0 {
+        c = false_color((log2(v / mean) * 0.30103 + 3.0) / 5.0);
+    }
+    textureStore(dst, vec2<i32>(gid.xy), vec4<f32>(c, 1.0));
 }

@@ -3,7 +3,7 @@
 use clap::Parser;
 use lightcut::{
     app::{AppOptions, run_gui},
-    cli::{Cli, Command, bench, render},
+    cli::{Cli, Command, bench, export_scene, render},
 };
 
 fn main() {
@@ -16,6 +16,7 @@ fn main() {
     let result = match &cli.command {
         Some(Command::Render(args)) => render::run(args),
         Some(Command::Bench(args)) => bench::run(args),
+        Some(Command::ExportScene(args)) => export_scene::run(args),
         None => run_gui(AppOptions {
             scene: cli.scene.clone(),
             camera: cli.camera.clone(),

@@ -60,12 +60,12 @@ fn buffer_selector_changes_the_shown_texture() {
     let normal_px = shown_pixels(&h);
     assert_ne!(final_px, normal_px, "the shown texture did not change");
 
-    // And the shadow map (a square texture of the shadow-map resolution).
+    // And the RSM flux (a square texture of the shadow-map resolution).
     h.get_by_role_and_label(Role::ComboBox, "buffer").click();
     h.run_steps(2);
-    h.get_by_label("shadow map").click();
+    h.get_by_label("RSM flux").click();
     h.run_steps(3);
-    assert_eq!(h.state().view(), ViewBuffer::ShadowMap);
+    assert_eq!(h.state().view(), ViewBuffer::RsmFlux);
     let (w, hh, _) = h.state().renderer().unwrap().read_view_rgba8().unwrap();
     assert_eq!((w, hh), (512, 512));
     assert!(h.state().frames() >= 8);

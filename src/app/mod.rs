@@ -18,7 +18,7 @@ use crate::{
     renderer::{
         FrameInput, Renderer,
         context::{GpuContext, describe_adapter},
-        settings::{RenderSettings, Tonemap, ViewBuffer},
+        settings::{GiMethod, RenderSettings, Tonemap, ViewBuffer, VplMode},
         timing::PassTimings,
     },
     scene::{
@@ -369,6 +369,61 @@ impl WorkbenchApp {
                 });
             }
             ui.separator();
+            ui.heading("Global illumination");
+            let g = &mut self.settings.gi;
+            egui::ComboBox::from_label("method")
+                .selected_text(g.method.name())
+                .show_ui(ui, |ui| {
+                    for m in GiMethod::ALL {
+                        ui.selectable_value(&mut g.method, m, m.name());
+                    }
+                });
+            if let Some(p) = self.renderer.as_ref().and_then(|r| r.gi_progress()) {
+                ui.add(
+                    egui::ProgressBar::new(p.fraction())
+                        .text(format!("{} / {} VPLs", p.done, p.total))
+                        .show_percentage(),
+                );
+            }
+            ui.add(
+                egui::Slider::new(&mut g.distance_epsilon, 0.001..=1.0)
+                    .logarithmic(true)
+                    .text("distance bound ε (m)"),
+            )
+            .on_hover_text("1/d² is bounded by 1/max(d², ε²)");
+            let v = &mut self.settings.vpl;
+            ui.add(
+                egui::Slider::new(&mut v.count, 16..=65536)
+                    .logarithmic(true)
+                    .text("VPLs"),
+            );
+            egui::ComboBox::from_label("VPL selection")
+                .selected_text(v.mode.name())
+                .show_ui(ui, |ui| {
+                    for m in VplMode::ALL {
+                        ui.selectable_value(&mut v.mode, m, m.name());
+                    }
+                });
+            ui.add(egui::Slider::new(&mut v.samples_per_texel, 1..=32).text("BRSM samples / texel"));
+            ui.add(
+                egui::Slider::new(&mut v.sample_radius, 0.005..=1.0)
+                    .logarithmic(true)
+                    .text("sample radius (× scene)"),
+            );
+            ui.add(egui::Slider::new(&mut v.filter_radius, 0..=8).text("filter radius (texels)"));
+            ui.add(egui::Slider::new(&mut v.n_min, -1.0..=1.0).text("n_min"));
+            ui.add(
+                egui::Slider::new(&mut v.d_max, 0.001..=1.0)
+                    .logarithmic(true)
+                    .text("d_max (× scene)"),
+            );
+            ui.add(egui::Slider::new(&mut v.flux_mix, 0.0..=1.0).text("flux mix"))
+                .on_hover_text("share of the PDF that follows flux: > 0 keeps the VPLs unbiased");
+            ui.horizontal(|ui| {
+                ui.add(egui::DragValue::new(&mut v.seed).prefix("seed "));
+                ui.checkbox(&mut v.animate, "new VPLs every frame");
+            });
+            ui.separator();
             ui.heading("Shadow map");
             let s = &mut self.settings.shadow;
             egui::ComboBox::from_label("resolution")
@@ -400,6 +455,8 @@ impl WorkbenchApp {
                 } else {
                     ui.label("GPU timings pending");
                 }
+                ui.separator();
+                ui.label(format!("VPLs {}", r.vpl_frame().count));
                 ui.separator();
                 ui.label(format!("frame {:.1} ms", self.frame_ms_smoothed));
             }

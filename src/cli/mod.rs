@@ -1,6 +1,7 @@
 //! Headless commands sharing the renderer with the app: `render` and `bench`.
 
 pub mod bench;
+pub mod export_scene;
 pub mod render;
 
 use clap::{Args, Parser, Subcommand};
@@ -32,6 +33,9 @@ pub enum Command {
     Render(render::RenderArgs),
     /// Benchmarks (BVH shadow rays per second, ...).
     Bench(bench::BenchArgs),
+    /// Write a scene as PLY meshes + JSON (camera, sun, albedos) for independent renderers
+    /// (scripts/mitsuba_check.py).
+    ExportScene(export_scene::ExportSceneArgs),
 }
 
 /// Settings flags shared by the commands (override a settings file, which overrides defaults).

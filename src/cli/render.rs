@@ -5,12 +5,45 @@ use std::path::PathBuf;
 use anyhow::{Context, anyhow};
 use clap::Args;
 
+use clap::ValueEnum;
+
 use super::SettingsArgs;
 use crate::{
     export::{write_exr, write_png},
-    renderer::{Buffer, FrameInput, Renderer, context::GpuContext, readback::ImageF32, settings::ViewBuffer},
+    renderer::{
+        Buffer, FrameInput, Renderer,
+        context::GpuContext,
+        readback::ImageF32,
+        settings::{GiMethod, ViewBuffer},
+    },
     scene::preset::{SceneSource, open_scene},
 };
+
+/// The indirect-light method of a headless render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Method {
+    /// Direct light only (indirect.exr is black).
+    Off,
+    /// Every VPL of the frame at every pixel with a shadow ray (the thesis's ground truth).
+    GroundTruth,
+}
+
+/// Groups of files `render` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Output {
+    /// Everything below.
+    All,
+    /// final.exr (direct + indirect).
+    Final,
+    /// direct.exr.
+    Direct,
+    /// indirect.exr (GI only).
+    Indirect,
+    /// position/normal/albedo/depth.exr.
+    Gbuffer,
+    /// Tonemapped PNGs of the views.
+    Png,
+}
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -30,6 +63,21 @@ pub struct RenderArgs {
     /// Frames to render before reading timings (the first frames include pipeline warm-up).
     #[arg(long, default_value_t = 3)]
     pub timing_frames: u32,
+    /// Indirect-light method.
+    #[arg(long, value_enum, default_value = "off")]
+    pub method: Method,
+    /// What to write (comma-separated).
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "all")]
+    pub output: Vec<Output>,
+    /// Number of VPLs (overrides the settings file).
+    #[arg(long)]
+    pub vpls: Option<u32>,
+    /// Randomisation seed of the VPLs.
+    #[arg(long)]
+    pub seed: Option<u32>,
+    /// Lower bound of the VPL distance in 1/d^2 (metres).
+    #[arg(long)]
+    pub epsilon: Option<f32>,
     #[command(flatten)]
     pub settings: SettingsArgs,
 }
@@ -56,7 +104,24 @@ fn linear_depth(position: &ImageF32, eye: glam::Vec3, fwd: glam::Vec3) -> ImageF
 
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
-    let settings = args.settings.resolve(opened.exposure_ev)?;
+    let mut settings = args.settings.resolve(opened.exposure_ev)?;
+    settings.gi.method = match args.method {
+        Method::Off => GiMethod::Off,
+        Method::GroundTruth => GiMethod::GroundTruth,
+    };
+    if let Some(v) = args.vpls {
+        settings.vpl.count = v;
+    }
+    if let Some(v) = args.seed {
+        settings.vpl.seed = v;
+    }
+    if let Some(v) = args.epsilon {
+        settings.gi.distance_epsilon = v;
+    }
+    // Headless: large GI steps (each submit still splits into bounded dispatches).
+    settings.gi.rays_per_frame = 1 << 26;
+    settings.validate().map_err(|e| anyhow!("{e}"))?;
+    let wants = |o: Output| args.output.contains(&Output::All) || args.output.contains(&o);
     let cam_name = args.camera.clone().or(opened.camera_name.clone());
     let camera = opened
         .scene
@@ -79,34 +144,82 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         r.ctx.wait_idle()?;
     }
     let timings = r.wait_timings();
+    // Progressive GI: keep rendering the same frame until it has seen every VPL.
+    let gi_start = std::time::Instant::now();
+    let mut gi_ms = 0.0;
+    while let Some(p) = r.gi_progress() {
+        if p.finished() {
+            break;
+        }
+        frame(&mut r, ViewBuffer::Final);
+        r.ctx.wait_idle()?;
+        if let Some(t) = r.wait_timings() {
+            gi_ms += t.get("ground_truth").unwrap_or(0.0);
+        }
+        if let Some(p) = r.gi_progress() {
+            eprint!(
+                "\rground truth: {:5.1}% of {} VPLs",
+                100.0 * p.fraction(),
+                p.total
+            );
+        }
+    }
+    if r.gi_progress().is_some() {
+        eprintln!();
+        println!(
+            "ground truth: {} VPLs x {}x{} pixels in {:.2} s wall, {:.1} ms GPU",
+            r.vpl_frame().count,
+            args.width,
+            args.height,
+            gi_start.elapsed().as_secs_f64(),
+            gi_ms
+        );
+    }
     if let Some(e) = r.ctx.errors.take().into_iter().next() {
         return Err(anyhow!("GPU error: {e}"));
     }
 
     let out = &args.out;
     let direct = r.read(Buffer::Direct)?;
-    write_exr(&out.join("direct.exr"), &direct)?;
-    write_exr(&out.join("final.exr"), &r.read(Buffer::Final)?)?;
-    let position = r.read(Buffer::Position)?;
-    write_exr(&out.join("position.exr"), &position)?;
-    write_exr(&out.join("normal.exr"), &r.read(Buffer::Normal)?)?;
-    write_exr(&out.join("albedo.exr"), &r.read(Buffer::Albedo)?)?;
-    write_exr(
-        &out.join("depth.exr"),
-        &linear_depth(&position, camera.position, camera.forward),
-    )?;
-    let pngs = [
-        (ViewBuffer::Final, "final.png"),
-        (ViewBuffer::Direct, "direct.png"),
-        (ViewBuffer::Albedo, "albedo.png"),
-        (ViewBuffer::Normal, "normal.png"),
-        (ViewBuffer::Depth, "depth.png"),
-        (ViewBuffer::ShadowMap, "shadow_map.png"),
-    ];
-    for (view, name) in pngs {
-        frame(&mut r, view);
-        let (w, h, bytes) = r.read_view_rgba8()?;
-        write_png(&out.join(name), w, h, &bytes)?;
+    let indirect = r.read(Buffer::Indirect)?;
+    if wants(Output::Direct) {
+        write_exr(&out.join("direct.exr"), &direct)?;
+    }
+    if wants(Output::Indirect) {
+        write_exr(&out.join("indirect.exr"), &indirect)?;
+    }
+    if wants(Output::Final) {
+        write_exr(&out.join("final.exr"), &r.read(Buffer::Final)?)?;
+    }
+    if wants(Output::Gbuffer) {
+        let position = r.read(Buffer::Position)?;
+        write_exr(&out.join("position.exr"), &position)?;
+        write_exr(&out.join("normal.exr"), &r.read(Buffer::Normal)?)?;
+        write_exr(&out.join("albedo.exr"), &r.read(Buffer::Albedo)?)?;
+        write_exr(
+            &out.join("depth.exr"),
+            &linear_depth(&position, camera.position, camera.forward),
+        )?;
+    }
+    if wants(Output::Png) {
+        let pngs = [
+            (ViewBuffer::Final, "final.png"),
+            (ViewBuffer::Direct, "direct.png"),
+            (ViewBuffer::Indirect, "indirect.png"),
+            (ViewBuffer::Albedo, "albedo.png"),
+            (ViewBuffer::Normal, "normal.png"),
+            (ViewBuffer::Depth, "depth.png"),
+            (ViewBuffer::ShadowMap, "shadow_map.png"),
+            (ViewBuffer::RsmFlux, "rsm_flux.png"),
+            (ViewBuffer::ImportanceRaw, "brsm_importance_raw.png"),
+            (ViewBuffer::ImportanceFiltered, "brsm_importance_filtered.png"),
+        ];
+        // Views re-render the frame; the finished GI keeps its key, so nothing restarts.
+        for (view, name) in pngs {
+            frame(&mut r, view);
+            let (w, h, bytes) = r.read_view_rgba8()?;
+            write_png(&out.join(name), w, h, &bytes)?;
+        }
     }
     if let Some(e) = r.ctx.errors.take().into_iter().next() {
         return Err(anyhow!("GPU error: {e}"));

@@ -13,3 +13,4 @@ pub mod direct;
 pub mod display;
 pub mod gbuffer;
 pub mod visualise;
+pub mod vpl;

@@ -66,44 +66,78 @@ impl GbufferTargets {
     }
 }
 
-/// Shadow maps: a depth texture array, one layer per light.
+/// Reflective shadow maps: one array layer per light of depth (the shadow map), world
+/// position, normal and reflected flux (see `shaders/rsm.wgsl`).
 pub struct ShadowTargets {
     pub texture: wgpu::Texture,
     pub array_view: wgpu::TextureView,
     pub layer_views: Vec<wgpu::TextureView>,
+    pub position: wgpu::Texture,
+    pub position_array: wgpu::TextureView,
+    pub position_layers: Vec<wgpu::TextureView>,
+    pub normal: wgpu::Texture,
+    pub normal_array: wgpu::TextureView,
+    pub normal_layers: Vec<wgpu::TextureView>,
+    pub flux: wgpu::Texture,
+    pub flux_array: wgpu::TextureView,
+    pub flux_layers: Vec<wgpu::TextureView>,
     pub resolution: u32,
+}
+
+pub const RSM_POSITION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+pub const RSM_NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const RSM_FLUX_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+fn array_and_layers(
+    tex: &wgpu::Texture,
+    label: &str,
+    layers: u32,
+) -> (wgpu::TextureView, Vec<wgpu::TextureView>) {
+    let array = tex.create_view(&wgpu::TextureViewDescriptor {
+        label: Some(label),
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    let per_layer = (0..layers)
+        .map(|l| {
+            tex.create_view(&wgpu::TextureViewDescriptor {
+                label: Some(label),
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: l,
+                array_layer_count: Some(1),
+                ..Default::default()
+            })
+        })
+        .collect();
+    (array, per_layer)
 }
 
 impl ShadowTargets {
     pub fn new(device: &wgpu::Device, resolution: u32, layers: u32) -> Self {
         let layers = layers.max(1);
-        let tex = texture(
-            device,
-            "shadow_map::depth",
-            (resolution, resolution),
-            layers,
-            DEPTH_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | READABLE,
-        );
-        let layer_views = (0..layers)
-            .map(|l| {
-                tex.create_view(&wgpu::TextureViewDescriptor {
-                    label: Some("shadow_map::layer"),
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: l,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                })
-            })
-            .collect();
+        let size = (resolution, resolution);
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | READABLE;
+        let depth = texture(device, "rsm::depth", size, layers, DEPTH_FORMAT, usage);
+        let position = texture(device, "rsm::position", size, layers, RSM_POSITION_FORMAT, usage);
+        let normal = texture(device, "rsm::normal", size, layers, RSM_NORMAL_FORMAT, usage);
+        let flux = texture(device, "rsm::flux", size, layers, RSM_FLUX_FORMAT, usage);
+        let (array_view, layer_views) = array_and_layers(&depth, "rsm::depth_view", layers);
+        let (position_array, position_layers) = array_and_layers(&position, "rsm::position_view", layers);
+        let (normal_array, normal_layers) = array_and_layers(&normal, "rsm::normal_view", layers);
+        let (flux_array, flux_layers) = array_and_layers(&flux, "rsm::flux_view", layers);
         Self {
-            array_view: tex.create_view(&wgpu::TextureViewDescriptor {
-                label: Some("shadow_map::array"),
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            }),
-            texture: tex,
+            texture: depth,
+            array_view,
             layer_views,
+            position,
+            position_array,
+            position_layers,
+            normal,
+            normal_array,
+            normal_layers,
+            flux,
+            flux_array,
+            flux_layers,
             resolution,
         }
     }
@@ -116,15 +150,37 @@ impl ShadowTargets {
 pub struct LightingTargets {
     pub direct: wgpu::Texture,
     pub direct_view: wgpu::TextureView,
+    /// Indirect (one-bounce) radiance of the selected GI method.
+    pub indirect: wgpu::Texture,
+    pub indirect_view: wgpu::TextureView,
+    /// direct + indirect.
+    pub final_: wgpu::Texture,
+    pub final_view: wgpu::TextureView,
+    /// Per-pixel rgb sums the GI method accumulates (vec4 per pixel).
+    pub gi_accum: wgpu::Buffer,
 }
 
 impl LightingTargets {
     pub fn new(device: &wgpu::Device, size: (u32, u32)) -> Self {
         let usage = wgpu::TextureUsages::STORAGE_BINDING | READABLE;
         let direct = texture(device, "direct::radiance", size, 1, RADIANCE_FORMAT, usage);
+        let indirect = texture(device, "composite::indirect", size, 1, RADIANCE_FORMAT, usage);
+        let final_ = texture(device, "composite::final", size, 1, RADIANCE_FORMAT, usage);
         Self {
             direct_view: direct.create_view(&Default::default()),
             direct,
+            indirect_view: indirect.create_view(&Default::default()),
+            indirect,
+            final_view: final_.create_view(&Default::default()),
+            final_,
+            gi_accum: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("gi::accum"),
+                size: 16 * (size.0.max(1) as u64) * (size.1.max(1) as u64),
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
         }
     }
 }

@@ -203,6 +203,62 @@ pub struct GpuHit {
     pub v: f32,
 }
 
+/// Twin: `VplParams` in `shaders/vpl_gen.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuVplParams {
+    pub res: u32,
+    pub levels: u32,
+    pub light_count: u32,
+    pub vpl_count: u32,
+    pub samples: u32,
+    pub filter_radius: u32,
+    /// 0 = BRSM, 1 = RSM (uniform).
+    pub mode: u32,
+    pub seed: u32,
+    /// Metres.
+    pub sample_radius: f32,
+    pub n_min: f32,
+    /// Metres.
+    pub d_max: f32,
+    pub flux_mix: f32,
+    pub epsilon: f32,
+    pub per_layer: u32,
+    pub _pad: [u32; 2],
+    /// Per light: x = first VPL, y = VPL count.
+    pub ranges: [[u32; 4]; 4],
+    /// Offset of pyramid level l within a layer at [l / 4][l % 4].
+    pub level_offsets: [[u32; 4]; 4],
+}
+
+/// Twin: `Vpl` in `shaders/common/vpl.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuVpl {
+    /// xyz = position, w = pmf of its texel.
+    pub position: [f32; 4],
+    pub normal: [f32; 3],
+    /// light layer << 24 | texel index, or `VPL_NONE`.
+    pub id: u32,
+    /// rgb = flux (W), w = 1 when valid.
+    pub flux: [f32; 4],
+}
+
+pub const VPL_NONE: u32 = u32::MAX;
+
+/// Twin: `GtParams` in `shaders/ground_truth.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuGtParams {
+    pub begin: u32,
+    pub end: u32,
+    pub width: u32,
+    pub height: u32,
+    pub epsilon: f32,
+    pub ray_offset: f32,
+    pub _pad: [u32; 2],
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -288,6 +344,57 @@ mod tests {
                 vec![
                     offset_of!(GpuMaterial, base_color),
                     offset_of!(GpuMaterial, texture),
+                ],
+            ),
+            (
+                "vpl_gen.wgsl",
+                "VplParams",
+                size_of::<GpuVplParams>(),
+                vec![
+                    offset_of!(GpuVplParams, res),
+                    offset_of!(GpuVplParams, levels),
+                    offset_of!(GpuVplParams, light_count),
+                    offset_of!(GpuVplParams, vpl_count),
+                    offset_of!(GpuVplParams, samples),
+                    offset_of!(GpuVplParams, filter_radius),
+                    offset_of!(GpuVplParams, mode),
+                    offset_of!(GpuVplParams, seed),
+                    offset_of!(GpuVplParams, sample_radius),
+                    offset_of!(GpuVplParams, n_min),
+                    offset_of!(GpuVplParams, d_max),
+                    offset_of!(GpuVplParams, flux_mix),
+                    offset_of!(GpuVplParams, epsilon),
+                    offset_of!(GpuVplParams, per_layer),
+                    offset_of!(GpuVplParams, _pad),
+                    offset_of!(GpuVplParams, _pad) + 4,
+                    offset_of!(GpuVplParams, ranges),
+                    offset_of!(GpuVplParams, level_offsets),
+                ],
+            ),
+            (
+                "vpl_gen.wgsl",
+                "Vpl",
+                size_of::<GpuVpl>(),
+                vec![
+                    offset_of!(GpuVpl, position),
+                    offset_of!(GpuVpl, normal),
+                    offset_of!(GpuVpl, id),
+                    offset_of!(GpuVpl, flux),
+                ],
+            ),
+            (
+                "ground_truth.wgsl",
+                "GtParams",
+                size_of::<GpuGtParams>(),
+                vec![
+                    offset_of!(GpuGtParams, begin),
+                    offset_of!(GpuGtParams, end),
+                    offset_of!(GpuGtParams, width),
+                    offset_of!(GpuGtParams, height),
+                    offset_of!(GpuGtParams, epsilon),
+                    offset_of!(GpuGtParams, ray_offset),
+                    offset_of!(GpuGtParams, _pad),
+                    offset_of!(GpuGtParams, _pad) + 4,
                 ],
             ),
             (

@@ -20,17 +20,20 @@ use thiserror::Error;
 use crate::scene::{Camera, DirectionalLight, Scene};
 use context::{GpuContext, GpuError};
 use frame::{FrameTargets, ShadowTargets, ViewTarget};
-use gpu_data::{GpuCamera, GpuLights, MAX_LIGHTS};
+use gpu_data::{GpuCamera, GpuGtParams, GpuLights, GpuVpl, MAX_LIGHTS};
 use passes::{
+    composite::CompositePass,
     direct::DirectPass,
     display::DisplayPass,
     gbuffer::GbufferPass,
-    shadow_map::ShadowMapPass,
+    ground_truth::GroundTruthPass,
+    rsm::RsmPass,
     visualise::{VisMode, VisSource, VisualisePass},
+    vpl_gen::{VplBuffers, VplFrame, VplGenPass},
 };
 use readback::ImageF32;
 use scene_gpu::SceneGpu;
-use settings::{RenderSettings, ViewBuffer};
+use settings::{GiMethod, RenderSettings, ViewBuffer};
 use timing::{GpuTimer, PassTimings};
 
 #[derive(Debug, Error)]
@@ -59,11 +62,44 @@ pub struct FrameInput<'a> {
 pub enum Buffer {
     Final,
     Direct,
+    Indirect,
     Position,
     Normal,
     Albedo,
     Depth,
     ShadowMap(u32),
+    RsmPosition(u32),
+    RsmNormal(u32),
+    RsmFlux(u32),
+}
+
+/// Progress of the progressive GI method (ground truth).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GiProgress {
+    /// VPLs evaluated at every pixel so far.
+    pub done: u32,
+    pub total: u32,
+}
+
+impl GiProgress {
+    pub fn fraction(&self) -> f32 {
+        if self.total == 0 {
+            1.0
+        } else {
+            self.done as f32 / self.total as f32
+        }
+    }
+    pub fn finished(&self) -> bool {
+        self.done >= self.total
+    }
+}
+
+/// State of the ground truth between frames: a snapshot of the VPLs it evaluates, and how far
+/// it got. Any change of view, lights or settings (`key`) restarts it.
+struct GtState {
+    key: u64,
+    progress: GiProgress,
+    snapshot: wgpu::Buffer,
 }
 
 pub struct Renderer {
@@ -72,10 +108,19 @@ pub struct Renderer {
     scene: SceneGpu,
     targets: FrameTargets,
     gbuffer: GbufferPass,
-    shadow: ShadowMapPass,
+    rsm: RsmPass,
     direct: DirectPass,
     display: DisplayPass,
     visualise: VisualisePass,
+    vpl_gen: VplGenPass,
+    ground_truth: GroundTruthPass,
+    composite: CompositePass,
+    vpl_buffers: VplBuffers,
+    vpl_frame: VplFrame,
+    gt: Option<GtState>,
+    /// Luminance of each light's irradiance and light 0's shadow texel size, last frame.
+    lights_cache: Vec<f32>,
+    lights_texel: f32,
     camera_buf: wgpu::Buffer,
     lights_buf: wgpu::Buffer,
     timer: GpuTimer,
@@ -119,10 +164,18 @@ impl Renderer {
             ),
             targets: FrameTargets::new(device, size, settings.shadow.resolution, lights),
             gbuffer: GbufferPass::new(device)?,
-            shadow: ShadowMapPass::new(device)?,
+            rsm: RsmPass::new(device)?,
             direct: DirectPass::new(device)?,
             display: DisplayPass::new(device)?,
             visualise: VisualisePass::new(device)?,
+            vpl_gen: VplGenPass::new(device)?,
+            ground_truth: GroundTruthPass::new(device)?,
+            composite: CompositePass::new(device)?,
+            vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
+            vpl_frame: VplFrame::default(),
+            gt: None,
+            lights_cache: Vec::new(),
+            lights_texel: 0.0,
             camera_buf: uniform("frame::camera", std::mem::size_of::<GpuCamera>()),
             lights_buf: uniform("frame::lights", std::mem::size_of::<GpuLights>()),
             timer: GpuTimer::new(device, &ctx.queue),
@@ -140,22 +193,31 @@ impl Renderer {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let passes = (
             GbufferPass::new(device),
-            ShadowMapPass::new(device),
+            RsmPass::new(device),
             DirectPass::new(device),
             DisplayPass::new(device),
             VisualisePass::new(device),
+            (
+                VplGenPass::new(device),
+                GroundTruthPass::new(device),
+                CompositePass::new(device),
+            ),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
         }
-        let (g, s, d, disp, v) = passes;
+        let (g, s, d, disp, v, (vg, gt, c)) = passes;
+        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?);
         (
             self.gbuffer,
-            self.shadow,
+            self.rsm,
             self.direct,
             self.display,
             self.visualise,
-        ) = (g?, s?, d?, disp?, v?);
+            self.vpl_gen,
+            self.ground_truth,
+            self.composite,
+        ) = new;
         Ok(())
     }
 
@@ -242,22 +304,23 @@ impl Renderer {
             bytemuck::bytes_of(&GpuCamera::new(input.camera, size.0, size.1)),
         );
         queue.write_buffer(&self.lights_buf, 0, bytemuck::bytes_of(&gpu_lights));
-        let light_matrices: Vec<glam::Mat4> = gpu_lights.lights[..lights.len()]
+        self.lights_cache = lights
             .iter()
-            .map(|l| glam::Mat4::from_cols_array_2d(&l.view_proj))
+            .map(|l| l.irradiance.dot(Vec3::new(0.2126, 0.7152, 0.0722)))
             .collect();
+        self.lights_texel = gpu_lights.lights[0].shadow[0];
 
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("frame::encoder"),
         });
         self.timer.begin_frame();
         let t = &self.targets;
-        self.shadow.record(
+        self.rsm.record(
             &device,
             &queue,
             &mut enc,
             &mut self.timer,
-            &light_matrices,
+            &gpu_lights,
             &self.scene,
             &t.shadow,
         );
@@ -280,6 +343,52 @@ impl Renderer {
             &t.lighting.direct_view,
             size,
         );
+        // VPLs (thesis 4.1): resources follow the RSM resolution, light count and VPL budget.
+        let vb = &self.vpl_buffers;
+        if vb.res != s.shadow.resolution || vb.layers != layers || vb.capacity != s.vpl.count {
+            self.vpl_buffers = VplBuffers::new(&device, s.shadow.resolution, layers, s.vpl.count);
+            self.gt = None;
+        }
+        let seed = s
+            .vpl
+            .seed
+            .wrapping_add(if s.vpl.animate { self.frames as u32 } else { 0 });
+        let t = &self.targets;
+        self.vpl_frame = self.vpl_gen.record(
+            &device,
+            &queue,
+            &mut enc,
+            &mut self.timer,
+            &s.vpl,
+            &s.gi,
+            seed,
+            self.scene.bounds.radius().max(1e-3),
+            lights,
+            &self.camera_buf,
+            &t.shadow,
+            &t.gbuffer,
+            &self.vpl_buffers,
+        );
+        let indirect_scale = match s.gi.method {
+            GiMethod::Off => 0.0,
+            GiMethod::GroundTruth => {
+                self.step_ground_truth(&mut enc, input, lights, size);
+                1.0
+            }
+        };
+        let t = &self.targets;
+        self.composite.record(
+            &device,
+            &queue,
+            &mut enc,
+            &mut self.timer,
+            size,
+            indirect_scale,
+            &t.lighting.direct_view,
+            &t.lighting.gi_accum,
+            &t.lighting.indirect_view,
+            &t.lighting.final_view,
+        );
         self.record_view(&mut enc, input.view, input.camera);
         self.timer.resolve(&mut enc);
         queue.submit([enc.finish()]);
@@ -287,11 +396,136 @@ impl Renderer {
         self.frames += 1;
     }
 
+    /// Fingerprint of everything the ground truth depends on (not the animated seed).
+    fn gt_key(&self, input: &FrameInput<'_>, lights: &[DirectionalLight], size: (u32, u32)) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        let c = input.camera;
+        for v in [c.position, c.forward, c.up] {
+            v.to_array().map(f32::to_bits).hash(&mut h);
+        }
+        c.yfov.to_bits().hash(&mut h);
+        for l in lights {
+            l.direction.to_array().map(f32::to_bits).hash(&mut h);
+            l.irradiance.to_array().map(f32::to_bits).hash(&mut h);
+        }
+        size.hash(&mut h);
+        let mut s = self.settings.clone();
+        s.display = Default::default();
+        s.gi.rays_per_frame = 0;
+        s.vpl.animate = false;
+        format!("{s:?}").hash(&mut h);
+        h.finish()
+    }
+
+    /// Ground truth: restart on any change (snapshot this frame's VPLs, clear the sums), then
+    /// evaluate as many VPL batches as `gi.rays_per_frame` allows.
+    fn step_ground_truth(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        input: &FrameInput<'_>,
+        lights: &[DirectionalLight],
+        size: (u32, u32),
+    ) {
+        let device = self.ctx.device.clone();
+        let queue = self.ctx.queue.clone();
+        let key = self.gt_key(input, lights, size);
+        let total = self.vpl_frame.count;
+        if self.gt.as_ref().is_none_or(|g| g.key != key) {
+            let bytes = (std::mem::size_of::<GpuVpl>() as u64) * self.vpl_buffers.capacity as u64;
+            let snapshot = match self.gt.take() {
+                Some(g) if g.snapshot.size() == bytes => g.snapshot,
+                _ => device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("ground_truth::vpl_snapshot"),
+                    size: bytes,
+                    usage: wgpu::BufferUsages::STORAGE
+                        | wgpu::BufferUsages::COPY_DST
+                        | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                }),
+            };
+            enc.copy_buffer_to_buffer(&self.vpl_buffers.vpls, 0, &snapshot, 0, bytes);
+            enc.clear_buffer(&self.targets.lighting.gi_accum, 0, None);
+            self.gt = Some(GtState {
+                key,
+                progress: GiProgress { done: 0, total },
+                snapshot,
+            });
+        }
+        let Some(gt) = self.gt.as_mut() else { return };
+        if gt.progress.finished() {
+            return;
+        }
+        let pixels = (size.0 as u64 * size.1 as u64).max(1);
+        let budget_vpls = (self.settings.gi.rays_per_frame as u64 / pixels).max(1);
+        let batch = budget_vpls
+            .div_ceil(passes::ground_truth::MAX_BATCHES as u64)
+            .max(1) as u32;
+        let end = (gt.progress.done as u64 + budget_vpls).min(gt.progress.total as u64) as u32;
+        let base = GpuGtParams {
+            begin: gt.progress.done,
+            end,
+            width: size.0,
+            height: size.1,
+            epsilon: self.settings.gi.distance_epsilon,
+            ray_offset: self.settings.gi.ray_offset,
+            _pad: [0; 2],
+        };
+        let reached = self.ground_truth.record(
+            &device,
+            &queue,
+            enc,
+            &mut self.timer,
+            base,
+            batch,
+            &self.scene,
+            &gt.snapshot,
+            &self.targets.gbuffer,
+            &self.targets.lighting.gi_accum,
+        );
+        gt.progress.done = reached;
+    }
+
+    /// Progress of the ground truth (None when the GI method is not progressive).
+    pub fn gi_progress(&self) -> Option<GiProgress> {
+        match self.settings.gi.method {
+            GiMethod::GroundTruth => self.gt.as_ref().map(|g| g.progress),
+            GiMethod::Off => None,
+        }
+    }
+
+    /// The VPLs of the last frame (count and per-light ranges).
+    pub fn vpl_frame(&self) -> &VplFrame {
+        &self.vpl_frame
+    }
+
+    pub fn vpl_buffers(&self) -> &VplBuffers {
+        &self.vpl_buffers
+    }
+
+    /// Reads a storage buffer of f32 back (pyramids, importance).
+    pub fn read_f32_buffer(&self, buffer: &wgpu::Buffer) -> Result<Vec<f32>, GpuError> {
+        let bytes = readback::read_storage_buffer(&self.ctx, buffer)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+
+    /// Reads the last frame's VPLs back.
+    pub fn read_vpls(&self) -> Result<Vec<GpuVpl>, GpuError> {
+        let bytes = readback::read_storage_buffer(&self.ctx, &self.vpl_buffers.vpls)?;
+        let all: &[GpuVpl] = bytemuck::cast_slice(&bytes);
+        Ok(all[..(self.vpl_frame.count as usize).min(all.len())].to_vec())
+    }
+
     fn record_view(&mut self, enc: &mut wgpu::CommandEncoder, view: ViewBuffer, camera: &Camera) {
         let device = self.ctx.device.clone();
         let queue = self.ctx.queue.clone();
+        let rsm_res = self.targets.shadow.resolution;
         let want = match view {
-            ViewBuffer::ShadowMap => (self.targets.shadow.resolution, self.targets.shadow.resolution),
+            ViewBuffer::ShadowMap
+            | ViewBuffer::RsmFlux
+            | ViewBuffer::RsmNormal
+            | ViewBuffer::ImportanceRaw
+            | ViewBuffer::ImportanceFiltered => (rsm_res, rsm_res),
             _ => self.targets.size,
         };
         if self.targets.view.size != want {
@@ -307,18 +541,58 @@ impl Renderer {
             (b.min, b.max)
         };
         let (mode, src, lo, hi) = match view {
-            ViewBuffer::Final | ViewBuffer::Direct => {
+            ViewBuffer::Final | ViewBuffer::Direct | ViewBuffer::Indirect => {
+                let src = match view {
+                    ViewBuffer::Final => &t.lighting.final_view,
+                    ViewBuffer::Direct => &t.lighting.direct_view,
+                    _ => &t.lighting.indirect_view,
+                };
                 self.display.record(
                     &device,
                     &queue,
                     enc,
                     &mut self.timer,
                     &self.settings.display,
-                    &t.lighting.direct_view,
+                    src,
                     dst,
                     want,
                 );
                 return;
+            }
+            ViewBuffer::RsmFlux => {
+                // Flux / (E x texel area) is the albedo the light saw: a readable image.
+                let l0 = self.lights_cache.first().copied().unwrap_or(1.0);
+                let texel = self.lights_texel;
+                let scale = 1.0 / (l0 * texel * texel).max(1e-30);
+                (
+                    VisMode::ArrayColor,
+                    VisSource::Array(&t.shadow.flux_array, 0),
+                    [0.0; 4],
+                    [scale, 0.0, 0.0, 0.0],
+                )
+            }
+            ViewBuffer::RsmNormal => (
+                VisMode::ArrayNormal,
+                VisSource::Array(&t.shadow.normal_array, 0),
+                [0.0; 4],
+                [0.0; 4],
+            ),
+            ViewBuffer::ImportanceRaw | ViewBuffer::ImportanceFiltered => {
+                let vb = &self.vpl_buffers;
+                let (per_layer, offsets) = passes::vpl_gen::pyramid_layout(vb.res);
+                let _ = per_layer;
+                let top = *offsets.last().unwrap_or(&0) as f32;
+                let values = if view == ViewBuffer::ImportanceRaw {
+                    &vb.importance_raw
+                } else {
+                    &vb.importance_pyramid
+                };
+                (
+                    VisMode::ScalarLogHeat,
+                    VisSource::Scalar(values, &vb.importance_pyramid),
+                    [0.0, top, 0.0, 0.0],
+                    [0.0, vb.res as f32, 0.0, 0.0],
+                )
             }
             ViewBuffer::Albedo => (
                 VisMode::Albedo,
@@ -406,12 +680,17 @@ impl Renderer {
     pub fn read(&self, buffer: Buffer) -> Result<ImageF32, GpuError> {
         let t = &self.targets;
         match buffer {
-            Buffer::Final | Buffer::Direct => readback::read_texture_f32(&self.ctx, &t.lighting.direct, 0),
+            Buffer::Final => readback::read_texture_f32(&self.ctx, &t.lighting.final_, 0),
+            Buffer::Direct => readback::read_texture_f32(&self.ctx, &t.lighting.direct, 0),
+            Buffer::Indirect => readback::read_texture_f32(&self.ctx, &t.lighting.indirect, 0),
             Buffer::Position => readback::read_texture_f32(&self.ctx, &t.gbuffer.position, 0),
             Buffer::Normal => readback::read_texture_f32(&self.ctx, &t.gbuffer.normal, 0),
             Buffer::Albedo => readback::read_texture_f32(&self.ctx, &t.gbuffer.albedo, 0),
             Buffer::Depth => readback::read_texture_f32(&self.ctx, &t.gbuffer.depth, 0),
             Buffer::ShadowMap(layer) => readback::read_texture_f32(&self.ctx, &t.shadow.texture, layer),
+            Buffer::RsmPosition(layer) => readback::read_texture_f32(&self.ctx, &t.shadow.position, layer),
+            Buffer::RsmNormal(layer) => readback::read_texture_f32(&self.ctx, &t.shadow.normal, layer),
+            Buffer::RsmFlux(layer) => readback::read_texture_f32(&self.ctx, &t.shadow.flux, layer),
         }
     }
 

@@ -8,6 +8,8 @@ use serde::{Deserialize, Serialize};
 #[serde(default, deny_unknown_fields)]
 pub struct RenderSettings {
     pub shadow: ShadowSettings,
+    pub vpl: VplSettings,
+    pub gi: GiSettings,
     pub display: DisplaySettings,
     pub textures: TextureSettings,
 }
@@ -44,6 +46,129 @@ impl Default for ShadowSettings {
             normal_offset: 1.0,
             slope_bias: 1.0,
             pcf_radius: 1,
+        }
+    }
+}
+
+/// How VPLs are chosen among the reflective-shadow-map texels (potential VPLs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum VplMode {
+    /// Bidirectional RSM (Ritschel et al. 2011; thesis 4.1): texels are chosen in proportion to
+    /// their estimated contribution to the image (filtered BRSM importance), mixed with their
+    /// flux by `flux_mix`.
+    #[default]
+    Brsm,
+    /// Plain RSM (Dachsbacher & Stamminger 2005): every texel equally likely.
+    Rsm,
+}
+
+impl VplMode {
+    pub const ALL: [VplMode; 2] = [VplMode::Brsm, VplMode::Rsm];
+    pub fn name(self) -> &'static str {
+        match self {
+            VplMode::Brsm => "BRSM",
+            VplMode::Rsm => "RSM (uniform)",
+        }
+    }
+}
+
+/// VPL generation (thesis 4.1 and chapter 6): reflective shadow map, BRSM importance, its
+/// edge-aware filter, the PDF pyramid and hierarchical warping of a Hammersley set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VplSettings {
+    /// VPLs per frame over all lights (split by relative brightness). More VPLs: less
+    /// structured noise, more cost for every later stage. Thesis: 4096.
+    pub count: u32,
+    pub mode: VplMode,
+    /// G-buffer samples per RSM texel for the BRSM importance. More: a less noisy PDF.
+    /// Thesis: 8-16.
+    pub samples_per_texel: u32,
+    /// Scale of the 1/r^2 radius distribution of the importance sample points around a texel,
+    /// as a fraction of the scene's bounding radius (radius = r x scale x scene radius, r with
+    /// density min(1, 1/r^2) / 2). Larger reaches farther surfaces; smaller concentrates on
+    /// the texel's surroundings.
+    pub sample_radius: f32,
+    /// Radius of the edge-aware Gaussian filter of the importance, in texels (0 = off).
+    pub filter_radius: u32,
+    /// Similarity S (thesis eq. 5.3): two texels are similar if their normals' dot product
+    /// exceeds `n_min` ...
+    pub n_min: f32,
+    /// ... and their distance is below `d_max` (a fraction of the scene's bounding radius).
+    /// Lowering `n_min` or raising `d_max` blurs across edges.
+    pub d_max: f32,
+    /// Fraction of the selection PDF that follows the texels' flux instead of the importance.
+    /// Above 0 every texel with flux can be chosen, which keeps the VPL set an unbiased
+    /// estimate of the reflected light; 0 is the thesis's pure BRSM.
+    pub flux_mix: f32,
+    /// Randomisation seed of the Hammersley set; with `animate` the frame index is added.
+    pub seed: u32,
+    /// New VPLs every frame (a fresh random rotation of the Hammersley set).
+    pub animate: bool,
+}
+
+impl Default for VplSettings {
+    fn default() -> Self {
+        Self {
+            count: 4096,
+            mode: VplMode::Brsm,
+            samples_per_texel: 8,
+            sample_radius: 0.1,
+            filter_radius: 2,
+            n_min: 0.9,
+            d_max: 0.05,
+            flux_mix: 0.1,
+            seed: 1,
+            animate: false,
+        }
+    }
+}
+
+/// Which indirect (one-bounce) light the frame computes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum GiMethod {
+    /// Direct light only.
+    #[default]
+    Off,
+    /// The thesis's ground truth: every VPL of the frame at every pixel with a shadow ray,
+    /// accumulated over frames in VPL batches (progressive; restarts when the view changes).
+    GroundTruth,
+}
+
+impl GiMethod {
+    pub const ALL: [GiMethod; 2] = [GiMethod::Off, GiMethod::GroundTruth];
+    pub fn name(self) -> &'static str {
+        match self {
+            GiMethod::Off => "off (direct only)",
+            GiMethod::GroundTruth => "ground truth (all VPLs)",
+        }
+    }
+}
+
+/// Shading of VPLs (shared by every GI method and the references).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GiSettings {
+    pub method: GiMethod,
+    /// Shadow rays the ground truth may trace per frame in the GUI (it continues next frame).
+    /// Higher finishes sooner but makes frames slower.
+    pub rays_per_frame: u32,
+    /// Lower bound of the VPL-to-surface distance (metres) in the 1/d^2 term:
+    /// 1 / max(d^2, epsilon^2) (the SST paper bounds d from below the same way). It removes
+    /// the singularity next to VPLs at the price of darkening corners, where d < epsilon.
+    /// Raise it against bright VPL splotches; lower it for accuracy in corners.
+    pub distance_epsilon: f32,
+    /// Offset of shadow-ray end points along their surfaces' normals (metres).
+    pub ray_offset: f32,
+}
+
+impl Default for GiSettings {
+    fn default() -> Self {
+        Self {
+            method: GiMethod::Off,
+            rays_per_frame: 1 << 20,
+            distance_epsilon: 0.05,
+            ray_offset: 1e-3,
         }
     }
 }
@@ -124,9 +249,9 @@ impl RenderSettings {
     /// Checks every value's range; the message names the setting and its valid range.
     pub fn validate(&self) -> Result<(), String> {
         let s = &self.shadow;
-        if !(16..=8192).contains(&s.resolution) {
+        if !(16..=4096).contains(&s.resolution) || !s.resolution.is_power_of_two() {
             return Err(format!(
-                "shadow.resolution {} is out of range (16..=8192)",
+                "shadow.resolution {} must be a power of two in 16..=4096 (the VPL pyramid halves it)",
                 s.resolution
             ));
         }
@@ -166,6 +291,53 @@ impl RenderSettings {
                 self.textures.max_size
             ));
         }
+        let v = &self.vpl;
+        if !(1..=1 << 20).contains(&v.count) {
+            return Err(format!("vpl.count {} is out of range (1..=1048576)", v.count));
+        }
+        if !(1..=64).contains(&v.samples_per_texel) {
+            return Err(format!(
+                "vpl.samples_per_texel {} is out of range (1..=64)",
+                v.samples_per_texel
+            ));
+        }
+        if !(v.sample_radius > 0.0 && v.sample_radius <= 10.0) {
+            return Err(format!(
+                "vpl.sample_radius {} is out of range (0..=10, > 0)",
+                v.sample_radius
+            ));
+        }
+        if v.filter_radius > 8 {
+            return Err(format!(
+                "vpl.filter_radius {} is out of range (0..=8)",
+                v.filter_radius
+            ));
+        }
+        if !(-1.0..=1.0).contains(&v.n_min) {
+            return Err(format!("vpl.n_min {} is out of range (-1..=1)", v.n_min));
+        }
+        if !(v.d_max > 0.0 && v.d_max <= 10.0) {
+            return Err(format!("vpl.d_max {} is out of range (0..=10, > 0)", v.d_max));
+        }
+        if !(0.0..=1.0).contains(&v.flux_mix) {
+            return Err(format!("vpl.flux_mix {} is out of range (0..=1)", v.flux_mix));
+        }
+        let g = &self.gi;
+        if g.rays_per_frame == 0 {
+            return Err("gi.rays_per_frame must be at least 1".into());
+        }
+        if !(g.distance_epsilon > 0.0 && g.distance_epsilon <= 100.0) {
+            return Err(format!(
+                "gi.distance_epsilon {} is out of range (0..=100 m, > 0)",
+                g.distance_epsilon
+            ));
+        }
+        if !(0.0..=1.0).contains(&g.ray_offset) {
+            return Err(format!(
+                "gi.ray_offset {} is out of range (0..=1 m)",
+                g.ray_offset
+            ));
+        }
         if !(1..=16).contains(&self.textures.anisotropy) {
             return Err(format!(
                 "textures.anisotropy {} is out of range (1..=16)",
@@ -184,6 +356,16 @@ pub enum ViewBuffer {
     Final,
     /// Direct light only.
     Direct,
+    /// Indirect (one-bounce GI) only, from the selected GI method.
+    Indirect,
+    /// Reflected flux of the reflective shadow map of light 0.
+    RsmFlux,
+    /// Normals of the reflective shadow map of light 0.
+    RsmNormal,
+    /// BRSM importance of light 0's texels, raw (log heat map).
+    ImportanceRaw,
+    /// BRSM importance after the edge-aware filter (log heat map).
+    ImportanceFiltered,
     /// Diffuse albedo from the G-buffer.
     Albedo,
     /// Shading normals from the G-buffer.
@@ -199,9 +381,14 @@ pub enum ViewBuffer {
 }
 
 impl ViewBuffer {
-    pub const ALL: [ViewBuffer; 8] = [
+    pub const ALL: [ViewBuffer; 13] = [
         ViewBuffer::Final,
         ViewBuffer::Direct,
+        ViewBuffer::Indirect,
+        ViewBuffer::RsmFlux,
+        ViewBuffer::RsmNormal,
+        ViewBuffer::ImportanceRaw,
+        ViewBuffer::ImportanceFiltered,
         ViewBuffer::Albedo,
         ViewBuffer::Normal,
         ViewBuffer::Depth,
@@ -213,6 +400,11 @@ impl ViewBuffer {
         match self {
             ViewBuffer::Final => "final",
             ViewBuffer::Direct => "direct only",
+            ViewBuffer::Indirect => "GI only",
+            ViewBuffer::RsmFlux => "RSM flux",
+            ViewBuffer::RsmNormal => "RSM normal",
+            ViewBuffer::ImportanceRaw => "BRSM importance (raw)",
+            ViewBuffer::ImportanceFiltered => "BRSM importance (filtered)",
             ViewBuffer::Albedo => "albedo",
             ViewBuffer::Normal => "normal",
             ViewBuffer::Depth => "depth",
@@ -223,7 +415,10 @@ impl ViewBuffer {
     }
     /// True for linear-radiance buffers (shown through exposure + tonemap).
     pub fn is_radiance(self) -> bool {
-        matches!(self, ViewBuffer::Final | ViewBuffer::Direct)
+        matches!(
+            self,
+            ViewBuffer::Final | ViewBuffer::Direct | ViewBuffer::Indirect
+        )
     }
 }
 

@@ -24,8 +24,23 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         "common/lights.wgsl",
         include_str!("../../shaders/common/lights.wgsl"),
     ),
+    (
+        "common/material.wgsl",
+        include_str!("../../shaders/common/material.wgsl"),
+    ),
+    (
+        "common/random.wgsl",
+        include_str!("../../shaders/common/random.wgsl"),
+    ),
+    ("common/vpl.wgsl", include_str!("../../shaders/common/vpl.wgsl")),
+    ("vpl_gen.wgsl", include_str!("../../shaders/vpl_gen.wgsl")),
+    (
+        "ground_truth.wgsl",
+        include_str!("../../shaders/ground_truth.wgsl"),
+    ),
+    ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),
     ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
-    ("shadow_map.wgsl", include_str!("../../shaders/shadow_map.wgsl")),
+    ("rsm.wgsl", include_str!("../../shaders/rsm.wgsl")),
     ("direct.wgsl", include_str!("../../shaders/direct.wgsl")),
     ("display.wgsl", include_str!("../../shaders/display.wgsl")),
     ("visualise.wgsl", include_str!("../../shaders/visualise.wgsl")),
@@ -35,11 +50,14 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
 /// The shaders that are entry points (not include-only files).
 pub const ENTRY_SHADERS: &[&str] = &[
     "gbuffer.wgsl",
-    "shadow_map.wgsl",
+    "rsm.wgsl",
     "direct.wgsl",
     "display.wgsl",
     "visualise.wgsl",
     "bvh_rays.wgsl",
+    "vpl_gen.wgsl",
+    "ground_truth.wgsl",
+    "composite.wgsl",
 ];
 
 #[derive(Debug, Error, PartialEq)]

@@ -2,11 +2,14 @@
 //! what it reads and writes in its `record` signature (typed inputs, no global lookups), and
 //! builds its per-frame bind groups when it records.
 
+pub mod composite;
 pub mod direct;
 pub mod display;
 pub mod gbuffer;
-pub mod shadow_map;
+pub mod ground_truth;
+pub mod rsm;
 pub mod visualise;
+pub mod vpl_gen;
 
 /// Workgroup edge of the 2D image kernels (`@workgroup_size(8, 8, 1)` in their WGSL; checked
 /// by `tests::workgroup_sizes_match_wgsl`).

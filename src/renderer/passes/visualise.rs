@@ -19,6 +19,9 @@ pub enum VisMode {
     DepthTexture = 5,
     UintIds = 6,
     UintHeat = 7,
+    ArrayColor = 8,
+    ArrayNormal = 9,
+    ScalarLogHeat = 10,
 }
 
 /// What to visualise.
@@ -29,12 +32,21 @@ pub enum VisSource<'a> {
     Depth(&'a wgpu::TextureView, u32),
     /// An unsigned-integer buffer (mode UintIds or UintHeat).
     Uint(&'a wgpu::TextureView),
+    /// A layer of a float array texture (mode ArrayColor / ArrayNormal).
+    Array(&'a wgpu::TextureView, u32),
+    /// A square map of f32 in a buffer (mode ScalarLogHeat) and the pyramid whose top holds
+    /// its sum (index in the pyramid buffer given in range_min.y by the caller).
+    Scalar(&'a wgpu::Buffer, &'a wgpu::Buffer),
 }
 
 pub struct VisualisePass {
     float_pipeline: wgpu::ComputePipeline,
     depth_pipeline: wgpu::ComputePipeline,
     uint_pipeline: wgpu::ComputePipeline,
+    array_pipeline: wgpu::ComputePipeline,
+    scalar_pipeline: wgpu::ComputePipeline,
+    array_layout: wgpu::BindGroupLayout,
+    scalar_layout: wgpu::BindGroupLayout,
     common_layout: wgpu::BindGroupLayout,
     float_layout: wgpu::BindGroupLayout,
     depth_layout: wgpu::BindGroupLayout,
@@ -78,6 +90,33 @@ impl VisualisePass {
                 wgpu::TextureViewDimension::D2,
             )],
         );
+        let array_layout = bgl(
+            "visualise::array_layout",
+            &[texture_entry(
+                2,
+                c,
+                wgpu::TextureSampleType::Float { filterable: false },
+                wgpu::TextureViewDimension::D2Array,
+            )],
+        );
+        let scalar_layout = bgl(
+            "visualise::scalar_layout",
+            &[super::storage_entry(3, c, true), super::storage_entry(4, c, true)],
+        );
+        let array_pipeline = compute_pipeline(
+            device,
+            "visualise::array_pipeline",
+            &[Some(&common_layout), Some(&array_layout)],
+            &module,
+            "vis_array",
+        );
+        let scalar_pipeline = compute_pipeline(
+            device,
+            "visualise::scalar_pipeline",
+            &[Some(&common_layout), Some(&scalar_layout)],
+            &module,
+            "vis_scalar",
+        );
         let float_pipeline = compute_pipeline(
             device,
             "visualise::float_pipeline",
@@ -109,6 +148,10 @@ impl VisualisePass {
             float_pipeline,
             depth_pipeline,
             uint_pipeline,
+            array_pipeline,
+            scalar_pipeline,
+            array_layout,
+            scalar_layout,
             common_layout,
             float_layout,
             depth_layout,
@@ -134,7 +177,7 @@ impl VisualisePass {
         size: (u32, u32),
     ) {
         let layer = match src {
-            VisSource::Depth(_, l) => l,
+            VisSource::Depth(_, l) | VisSource::Array(_, l) => l,
             _ => 0,
         };
         let p = VisParams {
@@ -189,6 +232,36 @@ impl VisualisePass {
                         binding: 0,
                         resource: tv(view),
                     }],
+                }),
+            ),
+            VisSource::Array(view, _) => (
+                &self.array_pipeline,
+                1,
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("visualise::array_source"),
+                    layout: &self.array_layout,
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: tv(view),
+                    }],
+                }),
+            ),
+            VisSource::Scalar(values, pyramid) => (
+                &self.scalar_pipeline,
+                1,
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("visualise::scalar_source"),
+                    layout: &self.scalar_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: values.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 4,
+                            resource: pyramid.as_entire_binding(),
+                        },
+                    ],
                 }),
             ),
             VisSource::Uint(view) => (

@@ -1,0 +1,12 @@
+// A virtual point light. Twin of `GpuVpl` in src/renderer/gpu_data.rs.
+// It is a diffuse emitter of total flux `flux`: radiant intensity flux / pi x cos(angle to
+// its normal), so a surface point x (albedo rho, normal n_x) at distance d receives radiance
+// rho / pi x flux / pi x cos_x x cos_v / max(d^2, eps^2) from it (unoccluded).
+const VPL_NONE: u32 = 0xffffffffu;
+
+struct Vpl {
+    position: vec4<f32>, // xyz world position, w = pmf of the texel it was chosen from
+    normal: vec3<f32>,   // unit normal (the side its surface was lit on)
+    id: u32,             // light layer << 24 | RSM texel index; VPL_NONE for an empty VPL
+    flux: vec4<f32>,     // rgb flux in W (texel flux / (N_light x pmf)), w = 1 if valid
+};

@@ -1,0 +1,366 @@
+//! `export-scene`: the scene as world-space PLY meshes (one per material) plus a JSON file with
+//! the camera, the sun and the materials, for independent renderers (scripts/mitsuba_check.py).
+//!
+//! Output folder layout:
+//! - `mesh_<i>.ply`: binary little-endian PLY with the triangles of material `i` (world space;
+//!   `x y z nx ny nz u v` per vertex). UVs are written exactly as the scene holds them (glTF
+//!   convention: v = 0 is the top row of the image). Mitsuba 3 needs no flip: its `bitmap`
+//!   texture also puts v = 0 at the first (top) row and its PLY loader keeps v (checked, see
+//!   docs/mitsuba_check.md); a consumer with v = 0 at the bottom row uses 1 - v.
+//! - `textures/tex_<i>.png`: the base-colour textures that some exported material uses, as the
+//!   scene holds them (sRGB-encoded RGBA8, top row first).
+//! - `scene.json`: camera, suns, materials and bounds (see [`scene_json`]).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, anyhow};
+use clap::Args;
+use glam::Vec3;
+
+use crate::export::write_png;
+use crate::scene::preset::{SceneSource, open_scene};
+use crate::scene::{Camera, Scene};
+
+#[derive(Args, Debug)]
+pub struct ExportSceneArgs {
+    /// `default`, a .gltf/.glb file, or a preset .toml.
+    #[arg(long, default_value = "default")]
+    pub scene: String,
+    /// Camera name (default: the preset's, else the first).
+    #[arg(long)]
+    pub camera: Option<String>,
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// One material's triangles with their own compact vertex list.
+struct MeshPart {
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    uvs: Vec<[f32; 2]>,
+    faces: Vec<[u32; 3]>,
+}
+
+/// Splits the scene's triangles by material; vertices are shared within a part. Triangles with
+/// an out-of-range index or material are skipped and counted.
+fn split_by_material(scene: &Scene) -> (Vec<MeshPart>, usize) {
+    let mut parts: Vec<MeshPart> = (0..scene.materials.len())
+        .map(|_| MeshPart {
+            positions: Vec::new(),
+            normals: Vec::new(),
+            uvs: Vec::new(),
+            faces: Vec::new(),
+        })
+        .collect();
+    // remap[v] = (material + 1, local index) of the last part vertex v was copied into.
+    let mut remap: Vec<(u32, u32)> = vec![(0, 0); scene.positions.len()];
+    let mut skipped = 0usize;
+    for t in 0..scene.triangle_count() {
+        let m = scene.triangle_materials.get(t).copied().unwrap_or(0) as usize;
+        let ids = &scene.indices[3 * t..3 * t + 3];
+        if m >= parts.len() || ids.iter().any(|&i| i as usize >= scene.positions.len()) {
+            skipped += 1;
+            continue;
+        }
+        let part = &mut parts[m];
+        let mut face = [0u32; 3];
+        for (k, &vi) in ids.iter().enumerate() {
+            let v = vi as usize;
+            let (tag, local) = remap[v];
+            if tag == m as u32 + 1 {
+                face[k] = local;
+                continue;
+            }
+            // A vertex shared by several materials is copied once per material; when the
+            // materials alternate, a duplicate may be written (harmless).
+            let local = part.positions.len() as u32;
+            let p = scene.positions[v];
+            // A missing or degenerate normal becomes the triangle's geometric normal (consumers
+            // normalise normals; a zero one would give them NaNs).
+            let n = scene
+                .normals
+                .get(v)
+                .copied()
+                .filter(|n| n.is_finite() && n.length_squared() > 1e-12)
+                .unwrap_or_else(|| {
+                    let [a, b, c] = scene.triangle(t);
+                    (b - a).cross(c - a).normalize_or(Vec3::Y)
+                });
+            let uv = scene
+                .uvs
+                .get(v)
+                .copied()
+                .filter(|u| u.is_finite())
+                .unwrap_or_default();
+            part.positions.push(p.to_array());
+            part.normals.push(n.to_array());
+            part.uvs.push(uv.to_array());
+            remap[v] = (m as u32 + 1, local);
+            face[k] = local;
+        }
+        part.faces.push(face);
+    }
+    (parts, skipped)
+}
+
+/// Binary little-endian PLY with `x y z nx ny nz u v` vertices and triangle faces.
+fn ply_bytes(part: &MeshPart) -> Vec<u8> {
+    let header = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment lightcut-workbench export-scene (world space)\n\
+         element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+         property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n\
+         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        part.positions.len(),
+        part.faces.len()
+    );
+    let mut out = Vec::with_capacity(header.len() + part.positions.len() * 32 + part.faces.len() * 13);
+    out.extend_from_slice(header.as_bytes());
+    for i in 0..part.positions.len() {
+        for x in part.positions[i]
+            .iter()
+            .chain(&part.normals[i])
+            .chain(&part.uvs[i])
+        {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    for f in &part.faces {
+        out.push(3u8);
+        for &i in f {
+            out.extend_from_slice(&(i as i32).to_le_bytes());
+        }
+    }
+    out
+}
+
+/// A finite f32 as a JSON number (non-finite values are rejected earlier; 0 as a fallback).
+fn num(x: f32) -> String {
+    if x.is_finite() { format!("{x}") } else { "0".into() }
+}
+
+fn vec3(v: [f32; 3]) -> String {
+    format!("[{}, {}, {}]", num(v[0]), num(v[1]), num(v[2]))
+}
+
+/// A JSON string literal.
+fn jstr(s: &str) -> String {
+    let mut o = String::with_capacity(s.len() + 2);
+    o.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => o.push_str("\\\""),
+            '\\' => o.push_str("\\\\"),
+            '\n' => o.push_str("\\n"),
+            '\r' => o.push_str("\\r"),
+            '\t' => o.push_str("\\t"),
+            c if (c as u32) < 0x20 => {
+                let _ = write!(o, "\\u{:04x}", c as u32);
+            }
+            c => o.push(c),
+        }
+    }
+    o.push('"');
+    o
+}
+
+/// Material entry for the JSON: (name, linear albedo factor, texture path, mesh file).
+struct MaterialEntry {
+    name: String,
+    albedo: [f32; 3],
+    texture: Option<String>,
+    mesh: Option<String>,
+    triangles: usize,
+}
+
+/// The JSON document:
+/// `{ "format", "scene", "camera": {name, position, forward, up, yfov_deg},
+///    "sun": [{name, direction (travel), irradiance [r,g,b] W/m^2}],
+///    "materials": [{name, albedo, texture, mesh, triangles}], "bounds": {min, max},
+///    "uv_origin": "top-left" }`.
+fn scene_json(scene: &Scene, cam: &Camera, materials: &[MaterialEntry]) -> String {
+    let mut j = String::new();
+    j.push_str("{\n");
+    let _ = writeln!(j, "  \"format\": \"lightcut-export-scene/1\",");
+    let _ = writeln!(j, "  \"scene\": {},", jstr(&scene.name));
+    let _ = writeln!(
+        j,
+        "  \"uv_origin\": \"top-left\",\n  \"uv_note\": \"PLY u,v as in glTF: v = 0 is the first (top) row of the texture image (as in Mitsuba 3's bitmap: no flip)\","
+    );
+    let _ = writeln!(
+        j,
+        "  \"camera\": {{\"name\": {}, \"position\": {}, \"forward\": {}, \"up\": {}, \"yfov_deg\": {}}},",
+        jstr(&cam.name),
+        vec3(cam.position.to_array()),
+        vec3(cam.forward.to_array()),
+        vec3(cam.up.to_array()),
+        num(cam.yfov.to_degrees())
+    );
+    j.push_str("  \"sun\": [");
+    for (i, l) in scene.lights.iter().enumerate() {
+        let _ = write!(
+            j,
+            "{}\n    {{\"name\": {}, \"direction\": {}, \"irradiance\": {}}}",
+            if i == 0 { "" } else { "," },
+            jstr(&l.name),
+            vec3(l.direction.normalize_or_zero().to_array()),
+            vec3(l.irradiance.to_array())
+        );
+    }
+    j.push_str(if scene.lights.is_empty() {
+        "],\n"
+    } else {
+        "\n  ],\n"
+    });
+    j.push_str("  \"materials\": [");
+    for (i, m) in materials.iter().enumerate() {
+        let opt = |s: &Option<String>| s.as_deref().map(jstr).unwrap_or_else(|| "null".into());
+        let _ = write!(
+            j,
+            "{}\n    {{\"name\": {}, \"albedo\": {}, \"texture\": {}, \"mesh\": {}, \"triangles\": {}}}",
+            if i == 0 { "" } else { "," },
+            jstr(&m.name),
+            vec3(m.albedo),
+            opt(&m.texture),
+            opt(&m.mesh),
+            m.triangles
+        );
+    }
+    j.push_str(if materials.is_empty() { "],\n" } else { "\n  ],\n" });
+    let b = scene.bounds;
+    let (bmin, bmax) = if b.is_empty() {
+        ([0.0; 3], [0.0; 3])
+    } else {
+        (b.min.to_array(), b.max.to_array())
+    };
+    let _ = writeln!(
+        j,
+        "  \"bounds\": {{\"min\": {}, \"max\": {}}}",
+        vec3(bmin),
+        vec3(bmax)
+    );
+    j.push_str("}\n");
+    j
+}
+
+fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    std::fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))
+}
+
+pub fn run(args: &ExportSceneArgs) -> anyhow::Result<()> {
+    let opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
+    let scene = &opened.scene;
+    let cam_name = args.camera.clone().or(opened.camera_name.clone());
+    let cam = scene
+        .camera_or_default(cam_name.as_deref())
+        .map_err(|e| anyhow!("{e}"))?;
+
+    // Everything written as a JSON number must be finite.
+    let cam_ok = cam.position.is_finite()
+        && cam.forward.is_finite()
+        && cam.up.is_finite()
+        && cam.yfov.is_finite()
+        && cam.forward.length_squared() > 0.0;
+    if !cam_ok {
+        return Err(anyhow!(
+            "camera '{}' has a non-finite or degenerate pose",
+            cam.name
+        ));
+    }
+    for l in &scene.lights {
+        if !l.direction.is_finite() || !l.irradiance.is_finite() || l.direction.length_squared() == 0.0 {
+            return Err(anyhow!(
+                "light '{}' has a non-finite direction or irradiance",
+                l.name
+            ));
+        }
+    }
+    if let Some(i) = scene.positions.iter().position(|p| !p.is_finite()) {
+        return Err(anyhow!("vertex {i} has a non-finite position"));
+    }
+    if scene.triangle_count() == 0 {
+        return Err(anyhow!("the scene '{}' has no triangles to export", scene.name));
+    }
+
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let (parts, skipped) = split_by_material(scene);
+
+    let mut entries = Vec::with_capacity(scene.materials.len());
+    let mut written: Vec<usize> = Vec::new();
+    for (i, (m, part)) in scene.materials.iter().zip(&parts).enumerate() {
+        let f = m.base_color_factor;
+        let albedo = [f[0], f[1], f[2]];
+        if albedo.iter().any(|x| !x.is_finite()) {
+            return Err(anyhow!(
+                "material '{}' has a non-finite base colour factor",
+                m.name
+            ));
+        }
+        let used = !part.faces.is_empty();
+        let mesh = if used {
+            let name = format!("mesh_{i}.ply");
+            write_file(&args.out.join(&name), &ply_bytes(part))?;
+            Some(name)
+        } else {
+            None
+        };
+        let texture = match m.base_color_texture {
+            Some(t) if used => {
+                let tex = scene.textures.get(t).ok_or_else(|| {
+                    anyhow!(
+                        "material '{}' refers to texture {t}, which the scene lacks",
+                        m.name
+                    )
+                })?;
+                let rel = format!("textures/tex_{t}.png");
+                if !written.contains(&t) {
+                    let dir = args.out.join("textures");
+                    std::fs::create_dir_all(&dir)
+                        .with_context(|| format!("cannot create {}", dir.display()))?;
+                    if tex.rgba8.len() != (tex.width as usize) * (tex.height as usize) * 4 {
+                        return Err(anyhow!(
+                            "texture '{}' has {} bytes for {}x{} RGBA8",
+                            tex.name,
+                            tex.rgba8.len(),
+                            tex.width,
+                            tex.height
+                        ));
+                    }
+                    write_png(&args.out.join(&rel), tex.width, tex.height, &tex.rgba8)
+                        .map_err(|e| anyhow!("{e}"))?;
+                    written.push(t);
+                }
+                Some(rel)
+            }
+            _ => None,
+        };
+        entries.push(MaterialEntry {
+            name: m.name.clone(),
+            albedo,
+            texture,
+            mesh,
+            triangles: part.faces.len(),
+        });
+    }
+    write_file(
+        &args.out.join("scene.json"),
+        scene_json(scene, &cam, &entries).as_bytes(),
+    )?;
+
+    let meshes = entries.iter().filter(|e| e.mesh.is_some()).count();
+    println!(
+        "scene: {} ({} triangles, {} materials -> {} meshes, {} texture file(s), {} sun(s)), camera '{}'",
+        scene.name,
+        scene.triangle_count(),
+        scene.materials.len(),
+        meshes,
+        written.len(),
+        scene.lights.len(),
+        cam.name
+    );
+    if skipped > 0 {
+        println!("warning: skipped {skipped} triangle(s) with an invalid material or vertex index");
+    }
+    println!("wrote {}", args.out.display());
+    Ok(())
+}

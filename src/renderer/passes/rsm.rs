@@ -1,0 +1,220 @@
+//! Reflective shadow map: an orthographic raster per directional light into one layer of
+//! [`ShadowTargets`]: depth (the shadow map), world position, normal and reflected flux per
+//! texel. Reads: scene vertices, materials, textures, the lights' view-projections.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::renderer::{
+    frame::{RSM_FLUX_FORMAT, RSM_NORMAL_FORMAT, RSM_POSITION_FORMAT, ShadowTargets},
+    gpu_data::{GpuLights, MAX_LIGHTS},
+    scene_gpu::SceneGpu,
+    shaders,
+    timing::GpuTimer,
+};
+
+use super::{
+    gbuffer::{DEPTH_FORMAT, vertex_layout},
+    storage_entry, texture_entry,
+};
+
+/// Uniform stride per light (dynamic offsets must be 256-byte aligned).
+const STRIDE: u64 = 256;
+
+/// Twin: `RsmLight` in `shaders/rsm.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuRsmLight {
+    pub view_proj: [[f32; 4]; 4],
+    /// rgb = irradiance E (W/m^2), w = texel area perpendicular to the light (m^2).
+    pub irradiance: [f32; 4],
+}
+
+pub struct RsmPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    uniforms: wgpu::Buffer,
+}
+
+impl RsmPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let module = shaders::create_module(device, "rsm.wgsl")?;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("rsm::layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<GpuRsmLight>() as u64),
+                    },
+                    count: None,
+                },
+                storage_entry(1, wgpu::ShaderStages::FRAGMENT, true),
+                texture_entry(
+                    2,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::TextureSampleType::Float { filterable: true },
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("rsm::pipeline_layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let targets = [RSM_POSITION_FORMAT, RSM_NORMAL_FORMAT, RSM_FLUX_FORMAT].map(|format| {
+            Some(wgpu::ColorTargetState {
+                format,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("rsm::pipeline"),
+            layout: Some(&pl),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(vertex_layout())],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("rsm::lights"),
+            size: STRIDE * MAX_LIGHTS as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            pipeline,
+            layout,
+            uniforms,
+        })
+    }
+
+    /// Renders one layer per light of `lights` (its first `count` entries).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        lights: &GpuLights,
+        scene: &SceneGpu,
+        out: &ShadowTargets,
+    ) {
+        let count = (lights.count[0] as usize).min(MAX_LIGHTS);
+        for (i, l) in lights.lights.iter().take(count).enumerate() {
+            let texel = l.shadow[0];
+            let u = GpuRsmLight {
+                view_proj: l.view_proj,
+                irradiance: [l.irradiance[0], l.irradiance[1], l.irradiance[2], texel * texel],
+            };
+            queue.write_buffer(&self.uniforms, i as u64 * STRIDE, bytemuck::bytes_of(&u));
+        }
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("rsm::bind_group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.uniforms,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<GpuRsmLight>() as u64),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: scene.materials.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&scene.textures_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::Sampler(&scene.sampler),
+                },
+            ],
+        });
+        encoder.push_debug_group("rsm");
+        let clear = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        for i in 0..out.layers() as usize {
+            let name = if i == 0 {
+                "rsm".to_string()
+            } else {
+                format!("rsm[{i}]")
+            };
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("rsm::pass"),
+                color_attachments: &[
+                    clear(&out.position_layers[i]),
+                    clear(&out.normal_layers[i]),
+                    clear(&out.flux_layers[i]),
+                ],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &out.layer_views[i],
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: timer.render_pass(&name),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            if i < count && scene.index_count > 0 {
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &bind, &[(i as u64 * STRIDE) as u32]);
+                pass.set_vertex_buffer(0, scene.vertices.slice(..));
+                pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..scene.index_count, 0, 0..1);
+            }
+        }
+        encoder.pop_debug_group();
+    }
+}

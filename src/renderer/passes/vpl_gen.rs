@@ -1,0 +1,399 @@
+//! VPL generation (thesis 4.1, chapter 6): BRSM importance per RSM texel, edge-aware filter,
+//! importance and flux pyramids, hierarchical warping of a randomized Hammersley set.
+//! Reads: camera, RSM, G-buffer. Writes: [`VplBuffers`] (pyramids and the VPL array).
+
+use glam::Vec3;
+
+use crate::{
+    renderer::{
+        frame::{GbufferTargets, ShadowTargets},
+        gpu_data::{GpuVpl, GpuVplParams, MAX_LIGHTS},
+        settings::{GiSettings, VplMode, VplSettings},
+        shaders,
+        timing::GpuTimer,
+    },
+    scene::DirectionalLight,
+};
+
+use super::{
+    WG_1D, compute_pipeline, float_texture_entry, groups_2d, storage_entry, texture_entry, uniform_entry,
+};
+
+/// Dynamic-offset stride of the per-level uniforms.
+const LEVEL_STRIDE: u64 = 256;
+/// Most pyramid levels (4096 -> 13 levels).
+pub const MAX_LEVELS: u32 = 16;
+
+/// Floats per light layer of a pyramid over a `res` x `res` map, and each level's offset.
+pub fn pyramid_layout(res: u32) -> (u32, Vec<u32>) {
+    let levels = res.trailing_zeros() + 1;
+    let mut offsets = Vec::with_capacity(levels as usize);
+    let mut total = 0;
+    for l in 0..levels {
+        offsets.push(total);
+        let r = res >> l;
+        total += r * r;
+    }
+    (total, offsets)
+}
+
+/// VPLs per light: proportional to the luminance of each light's irradiance (thesis ch. 6,
+/// "Multiple Lights"), the rounding remainder going to the brightest; returns (first, count).
+pub fn split_budget(lights: &[DirectionalLight], total: u32) -> Vec<(u32, u32)> {
+    let lum: Vec<f32> = lights
+        .iter()
+        .map(|l| l.irradiance.dot(Vec3::new(0.2126, 0.7152, 0.0722)).max(0.0))
+        .collect();
+    let sum: f32 = lum.iter().sum();
+    if lights.is_empty() || sum <= 0.0 {
+        return lights.iter().map(|_| (0, 0)).collect();
+    }
+    let mut counts: Vec<u32> = lum
+        .iter()
+        .map(|l| ((l / sum) * total as f32).floor() as u32)
+        .collect();
+    let assigned: u32 = counts.iter().sum();
+    let brightest = lum
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(i, _)| i)
+        .unwrap_or(0);
+    counts[brightest] += total - assigned;
+    let mut first = 0;
+    counts
+        .into_iter()
+        .map(|c| {
+            let r = (first, c);
+            first += c;
+            r
+        })
+        .collect()
+}
+
+/// GPU buffers of the VPL stage.
+pub struct VplBuffers {
+    pub importance_raw: wgpu::Buffer,
+    pub importance_pyramid: wgpu::Buffer,
+    pub flux_pyramid: wgpu::Buffer,
+    pub vpls: wgpu::Buffer,
+    pub res: u32,
+    pub layers: u32,
+    pub capacity: u32,
+}
+
+impl VplBuffers {
+    pub fn new(device: &wgpu::Device, res: u32, layers: u32, capacity: u32) -> Self {
+        let (per_layer, _) = pyramid_layout(res);
+        let storage = |label, bytes: u64| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let layers = layers.max(1);
+        Self {
+            importance_raw: storage("vpl::importance_raw", 4 * (res * res * layers) as u64),
+            importance_pyramid: storage("vpl::importance_pyramid", 4 * (per_layer * layers) as u64),
+            flux_pyramid: storage("vpl::flux_pyramid", 4 * (per_layer * layers) as u64),
+            vpls: storage(
+                "vpl::vpls",
+                (std::mem::size_of::<GpuVpl>() as u32 * capacity.max(1)) as u64,
+            ),
+            res,
+            layers,
+            capacity: capacity.max(1),
+        }
+    }
+}
+
+/// What one VPL frame produced.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct VplFrame {
+    /// (first, count) per light.
+    pub ranges: Vec<(u32, u32)>,
+    pub count: u32,
+    pub seed: u32,
+}
+
+pub struct VplGenPass {
+    importance: wgpu::ComputePipeline,
+    filter: wgpu::ComputePipeline,
+    reduce: wgpu::ComputePipeline,
+    warp: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    level_layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+    level_params: wgpu::Buffer,
+}
+
+impl VplGenPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let module = shaders::create_module(device, "vpl_gen.wgsl")?;
+        let c = wgpu::ShaderStages::COMPUTE;
+        let array_tex = |b| {
+            texture_entry(
+                b,
+                c,
+                wgpu::TextureSampleType::Float { filterable: false },
+                wgpu::TextureViewDimension::D2Array,
+            )
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("vpl_gen::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                uniform_entry(1, c),
+                array_tex(2),
+                array_tex(3),
+                array_tex(4),
+                float_texture_entry(5),
+                float_texture_entry(6),
+                float_texture_entry(7),
+                storage_entry(8, c, false),
+                storage_entry(9, c, false),
+                storage_entry(10, c, false),
+                storage_entry(11, c, false),
+            ],
+        });
+        let level_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("vpl_gen::level_layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: c,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(4),
+                },
+                count: None,
+            }],
+        });
+        let one = [Some(&layout)];
+        let two = [Some(&layout), Some(&level_layout)];
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("vpl_gen::params"),
+            size: std::mem::size_of::<GpuVplParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let level_params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("vpl_gen::level_params"),
+            size: LEVEL_STRIDE * MAX_LEVELS as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            importance: compute_pipeline(device, "vpl_gen::importance", &one, &module, "importance"),
+            filter: compute_pipeline(device, "vpl_gen::filter", &one, &module, "filter_importance"),
+            reduce: compute_pipeline(device, "vpl_gen::reduce", &two, &module, "reduce"),
+            warp: compute_pipeline(device, "vpl_gen::warp", &one, &module, "warp_vpls"),
+            layout,
+            level_layout,
+            params,
+            level_params,
+        })
+    }
+
+    /// Records the whole VPL stage for `lights` (at most MAX_LIGHTS, one RSM layer each).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        settings: &VplSettings,
+        gi: &GiSettings,
+        seed: u32,
+        scene_radius: f32,
+        lights: &[DirectionalLight],
+        camera: &wgpu::Buffer,
+        rsm: &ShadowTargets,
+        gbuffer: &GbufferTargets,
+        out: &VplBuffers,
+    ) -> VplFrame {
+        let lights = &lights[..lights.len().min(MAX_LIGHTS)];
+        let count = settings.count.min(out.capacity);
+        let ranges = split_budget(lights, count);
+        let res = out.res;
+        let (per_layer, offsets) = pyramid_layout(res);
+        let mut p = GpuVplParams {
+            res,
+            levels: offsets.len() as u32,
+            light_count: lights.len() as u32,
+            vpl_count: if lights.is_empty() { 0 } else { count },
+            samples: settings.samples_per_texel,
+            filter_radius: settings.filter_radius,
+            mode: match settings.mode {
+                VplMode::Brsm => 0,
+                VplMode::Rsm => 1,
+            },
+            seed,
+            sample_radius: settings.sample_radius * scene_radius,
+            n_min: settings.n_min,
+            d_max: settings.d_max * scene_radius,
+            flux_mix: settings.flux_mix,
+            epsilon: gi.distance_epsilon,
+            per_layer,
+            _pad: [0; 2],
+            ranges: [[0; 4]; 4],
+            level_offsets: [[0; 4]; 4],
+        };
+        for (i, (first, n)) in ranges.iter().enumerate() {
+            p.ranges[i] = [*first, *n, 0, 0];
+        }
+        for (l, o) in offsets.iter().enumerate() {
+            p.level_offsets[l / 4][l % 4] = *o;
+        }
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        for l in 0..offsets.len() as u64 {
+            queue.write_buffer(
+                &self.level_params,
+                l * LEVEL_STRIDE,
+                bytemuck::bytes_of(&(l as u32)),
+            );
+        }
+        let tv = wgpu::BindingResource::TextureView;
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("vpl_gen::bind_group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: camera.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: tv(&rsm.position_array),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: tv(&rsm.normal_array),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: tv(&rsm.flux_array),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: tv(&gbuffer.position_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: tv(&gbuffer.normal_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: tv(&gbuffer.albedo_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 8,
+                    resource: out.importance_raw.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 9,
+                    resource: out.importance_pyramid.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 10,
+                    resource: out.flux_pyramid.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 11,
+                    resource: out.vpls.as_entire_binding(),
+                },
+            ],
+        });
+        let level_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("vpl_gen::level_bind_group"),
+            layout: &self.level_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &self.level_params,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(4),
+                }),
+            }],
+        });
+        let layers = lights.len().max(1) as u32;
+        let (gx, gy) = groups_2d(res, res);
+        encoder.push_debug_group("vpl_gen");
+        for (name, pipeline) in [
+            ("brsm_importance", &self.importance),
+            ("brsm_filter", &self.filter),
+        ] {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(name),
+                timestamp_writes: timer.compute_pass(name),
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.dispatch_workgroups(gx, gy, layers);
+        }
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("pdf_pyramid"),
+                timestamp_writes: timer.compute_pass("pdf_pyramid"),
+            });
+            pass.set_pipeline(&self.reduce);
+            pass.set_bind_group(0, &bind, &[]);
+            for l in 1..offsets.len() as u32 {
+                let r = res >> l;
+                let (gx, gy) = groups_2d(r, r);
+                pass.set_bind_group(1, &level_bind, &[(l as u64 * LEVEL_STRIDE) as u32]);
+                pass.dispatch_workgroups(gx, gy, layers);
+            }
+        }
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("vpl_warp"),
+                timestamp_writes: timer.compute_pass("vpl_warp"),
+            });
+            pass.set_pipeline(&self.warp);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.dispatch_workgroups(p.vpl_count.div_ceil(WG_1D).max(1), 1, 1);
+        }
+        encoder.pop_debug_group();
+        VplFrame {
+            ranges,
+            count: p.vpl_count,
+            seed,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pyramid_layout_sums_levels() {
+        let (total, offsets) = pyramid_layout(8);
+        assert_eq!(offsets, vec![0, 64, 80, 84]);
+        assert_eq!(total, 85);
+    }
+
+    #[test]
+    fn budget_split_by_brightness_sums_to_total() {
+        let l = |e: f32| DirectionalLight {
+            name: "l".into(),
+            direction: Vec3::NEG_Y,
+            irradiance: Vec3::splat(e),
+        };
+        let r = split_budget(&[l(1.0), l(3.0)], 4096);
+        assert_eq!(r, vec![(0, 1024), (1024, 3072)]);
+        let r = split_budget(&[l(1.0), l(1.0), l(1.0)], 100);
+        assert_eq!(r.iter().map(|x| x.1).sum::<u32>(), 100);
+        assert_eq!(split_budget(&[l(0.0)], 10), vec![(0, 0)]);
+    }
+}

@@ -1,0 +1,292 @@
+//! VPL generation and the ground truth on the GPU against the CPU references and statistics.
+
+mod common;
+
+use glam::Vec3;
+use lightcut::{
+    reference,
+    renderer::{
+        Buffer, FrameInput, Renderer,
+        gpu_data::{GpuVpl, VPL_NONE},
+        passes::vpl_gen::pyramid_layout,
+        settings::{GiMethod, RenderSettings, ViewBuffer, VplMode},
+    },
+    scene::{Bvh, Scene, bvh::Ray, default_scene},
+};
+
+fn lum(c: [f32; 3]) -> f64 {
+    (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]) as f64
+}
+
+fn setup(settings: RenderSettings, size: (u32, u32)) -> Option<(Renderer, Scene)> {
+    let ctx = common::gpu()?;
+    let scene = default_scene::build();
+    let r = Renderer::new(ctx, &scene, size, settings).expect("renderer");
+    Some((r, scene))
+}
+
+fn frame(r: &mut Renderer, scene: &Scene) {
+    let cam = scene.camera_or_default(None).unwrap();
+    r.render(&FrameInput {
+        camera: &cam,
+        lights: &scene.lights,
+        view: ViewBuffer::Final,
+    });
+}
+
+/// The mean over frames of the VPLs' total flux equals the RSM's total reflected flux.
+fn check_unbiased(mode: VplMode) {
+    let mut settings = RenderSettings::default();
+    settings.vpl.mode = mode;
+    settings.vpl.count = 1024;
+    settings.shadow.resolution = 256;
+    let Some((mut r, scene)) = setup(settings.clone(), (96, 64)) else {
+        return;
+    };
+    frame(&mut r, &scene);
+    let rsm = r.read(Buffer::RsmFlux(0)).unwrap();
+    let pos = r.read(Buffer::RsmPosition(0)).unwrap();
+    let total: f64 = rsm
+        .pixels
+        .iter()
+        .zip(&pos.pixels)
+        .filter(|(_, p)| p[3] > 0.0)
+        .map(|(f, _)| lum([f[0], f[1], f[2]]))
+        .sum();
+    assert!(total > 0.0);
+    let frames = 40;
+    let mut sums = Vec::new();
+    for seed in 0..frames {
+        settings.vpl.seed = 1000 + seed;
+        r.set_settings(settings.clone()).unwrap();
+        frame(&mut r, &scene);
+        let vpls = r.read_vpls().unwrap();
+        assert_eq!(vpls.len(), 1024);
+        sums.push(
+            vpls.iter()
+                .map(|v| lum([v.flux[0], v.flux[1], v.flux[2]]))
+                .sum::<f64>(),
+        );
+    }
+    let mean = sums.iter().sum::<f64>() / frames as f64;
+    let var = sums.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (frames as f64 - 1.0);
+    let se = (var / frames as f64).sqrt();
+    eprintln!(
+        "{mode:?}: RSM total {total:.6}, VPL mean {mean:.6} +- {se:.6} (per-frame sd {:.6})",
+        var.sqrt()
+    );
+    // 4 standard errors, plus f32 rounding of the per-VPL division.
+    assert!(
+        (mean - total).abs() < 4.0 * se + 1e-4 * total,
+        "mean {mean} vs total {total} (se {se})"
+    );
+    assert!(r.ctx.errors.take().is_empty());
+}
+
+#[test]
+fn vpl_flux_is_unbiased_with_brsm_selection() {
+    check_unbiased(VplMode::Brsm);
+}
+
+#[test]
+fn vpl_flux_is_unbiased_with_uniform_rsm_selection() {
+    check_unbiased(VplMode::Rsm);
+}
+
+#[test]
+fn gpu_filter_pyramid_and_warping_match_the_cpu_reference() {
+    let mut settings = RenderSettings::default();
+    settings.shadow.resolution = 128;
+    settings.vpl.count = 20_000;
+    let Some((mut r, scene)) = setup(settings.clone(), (160, 100)) else {
+        return;
+    };
+    frame(&mut r, &scene);
+    let res = 128u32;
+    let n = (res * res) as usize;
+    let bufs = r.vpl_buffers();
+    let raw = r.read_f32_buffer(&bufs.importance_raw).unwrap();
+    let imp = r.read_f32_buffer(&bufs.importance_pyramid).unwrap();
+    let flux = r.read_f32_buffer(&bufs.flux_pyramid).unwrap();
+    let pos = r.read(Buffer::RsmPosition(0)).unwrap();
+    let nrm = r.read(Buffer::RsmNormal(0)).unwrap();
+    let nrm: Vec<Vec3> = nrm
+        .pixels
+        .iter()
+        .map(|p| Vec3::new(p[0], p[1], p[2]).normalize_or_zero())
+        .collect();
+    // Filter: GPU level 0 = CPU filter of the GPU's raw importance.
+    let radius = scene.bounds.radius();
+    let cpu = reference::vpl::filter(
+        &raw[..n],
+        &pos.pixels,
+        &nrm,
+        res,
+        settings.vpl.filter_radius,
+        settings.vpl.n_min,
+        settings.vpl.d_max * radius,
+    );
+    // A neighbour whose similarity sits exactly at n_min / d_max may be decided differently
+    // after float rounding: allow a handful of texels, not more.
+    let mut nonzero = 0;
+    let mut differ = 0;
+    for k in 0..n {
+        let tol = 1e-4 * cpu[k].abs().max(1e-12);
+        differ += ((imp[k] - cpu[k]).abs() > tol) as usize;
+        nonzero += (cpu[k] > 0.0) as usize;
+    }
+    assert!(
+        differ * 1000 <= nonzero,
+        "{differ} of {nonzero} filtered texels differ from the CPU filter"
+    );
+    assert!(
+        nonzero > 50,
+        "importance is zero almost everywhere ({nonzero} texels)"
+    );
+    // Pyramids: the GPU's levels equal the CPU's sums of the GPU's level 0.
+    let (_, offsets) = pyramid_layout(res);
+    for (pyr_gpu, name) in [(&imp, "importance"), (&flux, "flux")] {
+        let cpu = reference::vpl::pyramid(&pyr_gpu[..n], res);
+        for (l, level) in cpu.iter().enumerate() {
+            let o = offsets[l] as usize;
+            for (k, v) in level.iter().enumerate() {
+                let g = pyr_gpu[o + k];
+                assert!(
+                    (g - v).abs() <= 1e-5 * v.abs().max(1e-12),
+                    "{name} level {l} node {k}: {g} vs {v}"
+                );
+            }
+        }
+    }
+    // Warping: each VPL's pmf is its texel's share of the mixed PDF, and the CPU warp of the
+    // same Hammersley point picks the same texel (division rounding may differ at a few
+    // cell boundaries).
+    let m = settings.vpl.flux_mix;
+    let top = *offsets.last().unwrap() as usize;
+    let (it, ft) = (imp[top], flux[top]);
+    let mixed: Vec<f32> = (0..n)
+        .map(|k| (1.0 - m) / it * imp[k] + m / ft * flux[k])
+        .collect();
+    let pyr = reference::vpl::pyramid(&mixed, res);
+    let vpls: Vec<GpuVpl> = r.read_vpls().unwrap();
+    let count = vpls.len() as u32;
+    let seed = settings.vpl.seed;
+    let rot = [
+        reference::vpl::u01(reference::vpl::pcg_hash(seed * 2)),
+        reference::vpl::u01(reference::vpl::pcg_hash(seed * 2 + 1)),
+    ];
+    let mut same = 0;
+    for (i, v) in vpls.iter().enumerate() {
+        assert_ne!(v.id, VPL_NONE, "VPL {i} is empty");
+        let texel = (v.id & 0xff_ffff) as usize;
+        let want_pmf = mixed[texel] / pyr.last().unwrap()[0];
+        assert!(
+            (v.position[3] - want_pmf).abs() <= 1e-3 * want_pmf,
+            "VPL {i}: pmf {} vs {want_pmf}",
+            v.position[3]
+        );
+        let (x, y, _) = reference::vpl::warp(&pyr, res, reference::vpl::hammersley(i as u32, count, rot));
+        same += ((y * res + x) as usize == texel) as usize;
+    }
+    assert!(
+        same as f64 >= 0.995 * count as f64,
+        "only {same}/{count} VPLs on the CPU warp's texel"
+    );
+    // Chi-square of the chosen texels against the mixed PDF (coarse 16x16 cells).
+    let cells = 16u32;
+    let mut counts = vec![0f64; (cells * cells) as usize];
+    let mut expected = vec![0f64; (cells * cells) as usize];
+    let total: f64 = mixed.iter().map(|&v| v as f64).sum();
+    for (k, &w) in mixed.iter().enumerate() {
+        let (x, y) = (k as u32 % res, k as u32 / res);
+        expected[((y * cells / res) * cells + x * cells / res) as usize] += w as f64 / total * count as f64;
+    }
+    for v in &vpls {
+        let k = v.id & 0xff_ffff;
+        let (x, y) = (k % res, k / res);
+        counts[((y * cells / res) * cells + x * cells / res) as usize] += 1.0;
+    }
+    let (mut chi2, mut dof) = (0.0, 0);
+    for (c, e) in counts.iter().zip(&expected) {
+        if *e >= 5.0 {
+            chi2 += (c - e).powi(2) / e;
+            dof += 1;
+        }
+    }
+    let limit = dof as f64 + 4.4 * (2.0 * dof as f64).sqrt();
+    assert!(chi2 < limit, "chi2 {chi2:.1} with {dof} cells (limit {limit:.1})");
+}
+
+#[test]
+fn ground_truth_on_the_gpu_equals_a_cpu_evaluation_of_the_same_vpls() {
+    let mut settings = RenderSettings::default();
+    settings.vpl.count = 256;
+    settings.shadow.resolution = 256;
+    settings.gi.method = GiMethod::GroundTruth;
+    let (w, h) = (64u32, 40u32);
+    let Some((mut r, scene)) = setup(settings.clone(), (w, h)) else {
+        return;
+    };
+    for _ in 0..4 {
+        frame(&mut r, &scene);
+        if r.gi_progress().is_some_and(|p| p.finished()) {
+            break;
+        }
+    }
+    assert!(r.gi_progress().unwrap().finished());
+    let ind = r.read(Buffer::Indirect).unwrap();
+    let pos = r.read(Buffer::Position).unwrap();
+    let nrm = r.read(Buffer::Normal).unwrap();
+    let alb = r.read(Buffer::Albedo).unwrap();
+    let vpls = r.read_vpls().unwrap();
+    let bvh = Bvh::build(&scene.positions, &scene.indices);
+    let eps = settings.gi.distance_epsilon;
+    let off = settings.gi.ray_offset;
+    let (mut checked, mut lit) = (0, 0);
+    for k in (0..(w * h) as usize).step_by(7) {
+        let p = pos.pixels[k];
+        if p[3] == 0.0 {
+            continue;
+        }
+        let x = Vec3::new(p[0], p[1], p[2]);
+        let nx = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
+        let a = Vec3::from_slice(&alb.pixels[k][..3]);
+        let mut sum = Vec3::ZERO;
+        for v in &vpls {
+            if v.id == VPL_NONE {
+                continue;
+            }
+            let vp = Vec3::from_slice(&v.position[..3]);
+            let vn = Vec3::from_array(v.normal);
+            let d = vp - x;
+            let dist2 = d.length_squared();
+            let wdir = d / dist2.sqrt();
+            let (cx, cv) = (nx.dot(wdir), -vn.dot(wdir));
+            if cx <= 0.0 || cv <= 0.0 {
+                continue;
+            }
+            let o = x + nx * off;
+            let e = vp + vn * off;
+            if bvh.any_hit(&Ray {
+                origin: o,
+                dir: e - o,
+                tmin: 1e-4,
+                tmax: 1.0 - 1e-4,
+            }) {
+                continue;
+            }
+            sum += Vec3::from_slice(&v.flux[..3]) / std::f32::consts::PI * (cx * cv / dist2.max(eps * eps));
+        }
+        let want = a / std::f32::consts::PI * sum;
+        let got = Vec3::from_slice(&ind.pixels[k][..3]);
+        let tol = 1e-3 * want.max_element().max(1e-6);
+        assert!(
+            (got - want).abs().max_element() <= tol,
+            "pixel {k}: GPU {got} CPU {want}"
+        );
+        checked += 1;
+        lit += (want.max_element() > 0.0) as usize;
+    }
+    assert!(checked > 100 && lit > 50, "checked {checked}, lit {lit}");
+    assert!(r.ctx.errors.take().is_empty());
+}
