@@ -1,0 +1,622 @@
+#!/usr/bin/env python3
+"""Independent check of lightcut-workbench's direct (and one-bounce indirect) light with Mitsuba 3.
+
+Inputs:
+  --scene-dir  output of `lightcut-workbench export-scene` (scene.json, mesh_*.ply, textures/)
+  --ours       output of `lightcut-workbench render` (direct.exr, optionally indirect.exr)
+
+Mitsuba renders the same scene (two-sided diffuse BSDFs with the exported albedos x sRGB-decoded
+textures, a `directional` emitter with the exported travel direction and irradiance, a
+`look_at` pinhole sensor, box pixel filter, `path` integrator):
+  direct   = path(max_depth=2)
+  indirect = path(max_depth=3) - path(max_depth=2), same seed  (only with --indirect)
+The image is rendered in --splits independent parts (different seeds, spp/splits each) whose
+spread gives the standard error of Mitsuba's image mean and region means.
+
+Outputs in --out: mitsuba_direct.exr (+ mitsuba_indirect.exr), compare_<part>.png
+(ours | Mitsuba | relative difference, false colour), report.md, report.json; a short summary
+on stdout. Needs only `mitsuba` and `numpy` (pip install mitsuba numpy).
+
+See docs/mitsuba_check.md for the commands and the measured numbers.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def parse_args(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--scene-dir", required=True, type=Path, help="export-scene output folder")
+    p.add_argument("--ours", required=True, type=Path, help="render output folder (direct.exr, indirect.exr)")
+    p.add_argument("--width", type=int, required=True)
+    p.add_argument("--height", type=int, required=True)
+    p.add_argument("--spp", type=int, default=256, help="samples per pixel for the direct render (total over splits)")
+    p.add_argument("--indirect-spp", type=int, default=None,
+                   help="samples per pixel for the two indirect renders (default: --spp)")
+    p.add_argument("--indirect", action="store_true", help="also compare one-bounce indirect (needs ours/indirect.exr)")
+    p.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (scalar_rgb, llvm_ad_rgb, ...)")
+    p.add_argument("--sampler", default="ldsampler", choices=["ldsampler", "independent", "stratified", "multijitter"])
+    p.add_argument("--splits", type=int, default=4,
+                   help="independent renders (different seeds) averaged; their spread estimates Mitsuba's noise")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--grid", type=int, default=4, help="region grid (N x N blocks) for region means")
+    p.add_argument("--flip-v", action="store_true",
+                   help="use v' = 1 - v for textures (not needed: Mitsuba 3's bitmap puts v = 0 at the top "
+                        "row and its PLY loader keeps v, like glTF)")
+    p.add_argument("--reuse-mitsuba", type=Path, default=None,
+                   help="take Mitsuba's split renders from an earlier --out folder (same scene, size, spp, "
+                        "splits, seed, variant, sampler) instead of rendering again")
+    p.add_argument("--out", required=True, type=Path)
+    return p.parse_args(argv)
+
+
+# ----------------------------------------------------------------------------------------------
+# Scene construction
+
+
+def srgb_to_linear(c8: np.ndarray) -> np.ndarray:
+    """The exact sRGB EOTF (IEC 61966-2-1), as the renderer's Rgba8UnormSrgb sampling does."""
+    x = c8.astype(np.float64) / 255.0
+    return np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
+
+
+def load_texture(mi, path: Path, factor, flip_v: bool):
+    """Linear RGB albedo texture = factor x sRGB-decoded image, as a raw float mi.Bitmap."""
+    bmp = mi.Bitmap(str(path))
+    arr = np.array(bmp)
+    if arr.dtype != np.uint8:
+        raise SystemExit(f"error: texture {path} is not 8-bit (got {arr.dtype}); export-scene writes RGBA8 PNGs")
+    if arr.ndim == 2:
+        arr = arr[:, :, None]
+    if arr.shape[2] == 1 or arr.shape[2] == 2:  # grey or grey+alpha
+        arr = np.repeat(arr[:, :, :1], 3, axis=2)
+    rgb = srgb_to_linear(arr[:, :, :3]) * np.asarray(factor, dtype=np.float64)[None, None, :]
+    if flip_v:
+        rgb = rgb[::-1]
+    return mi.Bitmap(np.ascontiguousarray(rgb.astype(np.float32)), mi.Bitmap.PixelFormat.RGB)
+
+
+def build_scene_dict(mi, scene_dir: Path, meta: dict, width: int, height: int, sampler: str, spp: int,
+                     flip_v: bool) -> dict:
+    cam = meta["camera"]
+    eye = np.asarray(cam["position"], dtype=float)
+    fwd = np.asarray(cam["forward"], dtype=float)
+    up = np.asarray(cam["up"], dtype=float)
+    fwd = fwd / np.linalg.norm(fwd)
+    d = {
+        "type": "scene",
+        "sensor": {
+            "type": "perspective",
+            "fov_axis": "y",
+            "fov": float(cam["yfov_deg"]),
+            "near_clip": 1e-3,
+            "far_clip": 1e4,
+            # Mitsuba cameras look down local +Z with +X image-left: build from look_at, never
+            # from the glTF node matrix (see /work/shared/docs/mitsuba-notes.md).
+            "to_world": mi.ScalarTransform4f().look_at(origin=eye.tolist(), target=(eye + fwd).tolist(),
+                                                        up=up.tolist()),
+            "film": {
+                "type": "hdrfilm",
+                "width": width,
+                "height": height,
+                "pixel_format": "rgb",
+                "component_format": "float32",
+                "rfilter": {"type": "box"},
+            },
+            "sampler": {"type": sampler, "sample_count": spp},
+        },
+    }
+    n_mesh = 0
+    for i, m in enumerate(meta["materials"]):
+        if not m.get("mesh"):
+            continue
+        albedo = [float(x) for x in m["albedo"]]
+        if m.get("texture"):
+            refl = {
+                "type": "bitmap",
+                "bitmap": load_texture(mi, scene_dir / m["texture"], albedo, flip_v),
+                "raw": True,  # already linear
+                "filter_type": "bilinear",
+                "wrap_mode": "repeat",
+            }
+        else:
+            refl = {"type": "rgb", "value": albedo}
+        d[f"mesh_{i}"] = {
+            "type": "ply",
+            "filename": str(scene_dir / m["mesh"]),
+            "face_normals": False,  # use the exported vertex normals as shading normals
+            "bsdf": {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": refl}},
+        }
+        n_mesh += 1
+    if n_mesh == 0:
+        raise SystemExit("error: scene.json lists no meshes")
+    for k, s in enumerate(meta.get("sun", [])):
+        d[f"sun_{k}"] = {
+            "type": "directional",
+            "direction": [float(x) for x in s["direction"]],  # travel direction
+            "irradiance": {"type": "rgb", "value": [float(x) for x in s["irradiance"]]},
+        }
+    if not meta.get("sun"):
+        print("warning: scene.json has no sun; Mitsuba's image will be black", file=sys.stderr)
+    return d
+
+
+MAX_PASS_SPP = 64  # the JIT variants trace all of a pass's samples at once: bound the memory
+
+
+def render(mi, scene, max_depth: int, spp: int, seed: int) -> np.ndarray:
+    """Average of ceil(spp / MAX_PASS_SPP) passes with seeds derived from `seed` (deterministic,
+    so two calls with the same seed and spp use the same samples)."""
+    integ = mi.load_dict({"type": "path", "max_depth": max_depth, "rr_depth": max_depth + 100,
+                          "hide_emitters": False})
+    passes = max(1, -(-spp // MAX_PASS_SPP))
+    per = spp // passes
+    acc = None
+    for k in range(passes):
+        img = np.array(mi.render(scene, integrator=integ, spp=per, seed=seed * 1009 + k), dtype=np.float64)[:, :, :3]
+        acc = img if acc is None else acc + img
+    return acc / passes
+
+
+# ----------------------------------------------------------------------------------------------
+# Comparison
+
+
+def read_exr_rgb(mi, path: Path) -> np.ndarray:
+    bmp = mi.Bitmap(str(path))
+    arr = np.array(bmp, dtype=np.float64)
+    if arr.ndim == 2:
+        arr = np.repeat(arr[:, :, None], 3, axis=2)
+    return arr[:, :, :3]
+
+
+def region_means(img: np.ndarray, n: int) -> np.ndarray:
+    """Mean (over pixels and RGB) of each of n x n blocks: shape (n, n)."""
+    h, w = img.shape[:2]
+    ys = np.linspace(0, h, n + 1).round().astype(int)
+    xs = np.linspace(0, w, n + 1).round().astype(int)
+    out = np.zeros((n, n))
+    for a in range(n):
+        for b in range(n):
+            out[a, b] = img[ys[a]:ys[a + 1], xs[b]:xs[b + 1]].mean()
+    return out
+
+
+def rel(a, b):
+    b = np.asarray(b, dtype=np.float64)
+    return np.where(np.abs(b) > 0, (np.asarray(a) - b) / np.where(np.abs(b) > 0, b, 1.0), np.nan)
+
+
+def compare(ours: np.ndarray, mts_splits: list[np.ndarray], grid: int, albedo: np.ndarray | None = None,
+            mat_id: np.ndarray | None = None, mat_names: list[str] | None = None) -> dict:
+    k = len(mts_splits)
+    mts = np.mean(mts_splits, axis=0)
+    diff = ours - mts
+    mean_o = ours.reshape(-1, 3).mean(axis=0)
+    mean_m = mts.reshape(-1, 3).mean(axis=0)
+    split_means = np.array([s.reshape(-1, 3).mean(axis=0) for s in mts_splits])  # (k, 3)
+    se_chan = split_means.std(axis=0, ddof=1) / math.sqrt(k) if k > 1 else np.full(3, np.nan)
+    split_overall = split_means.mean(axis=1)
+    se_overall = split_overall.std(ddof=1) / math.sqrt(k) if k > 1 else float("nan")
+    rmse = float(np.sqrt(np.mean(diff ** 2)))
+    # Mitsuba's own per-pixel noise (standard error of the averaged image), from the splits.
+    if k > 1:
+        pix_var = np.var(np.stack(mts_splits), axis=0, ddof=1) / k
+        mts_noise_rms = float(np.sqrt(pix_var.mean()))
+    else:
+        mts_noise_rms = float("nan")
+    # RMSE with Mitsuba's noise removed in expectation: E[diff^2] = bias^2 + noise var.
+    rmse_debiased = float(np.sqrt(max(rmse ** 2 - mts_noise_rms ** 2, 0.0))) if k > 1 else float("nan")
+
+    reg_o = region_means(ours, grid)
+    reg_m = region_means(mts, grid)
+    reg_splits = np.array([region_means(s, grid) for s in mts_splits])
+    reg_se = reg_splits.std(axis=0, ddof=1) / math.sqrt(k) if k > 1 else np.full((grid, grid), np.nan)
+    reg_rel = rel(reg_o, reg_m)
+
+    # Pixel-level error distribution (relative to the Mitsuba mean, so dark pixels do not dominate).
+    lum_o = ours.mean(axis=2)
+    lum_m = mts.mean(axis=2)
+    ad = np.abs(lum_o - lum_m)
+    scale = max(float(lum_m.mean()), 1e-30)
+    frac_big = float(np.mean(ad > 0.25 * scale))
+    # Share of the absolute error carried by the worst 5% of the lit pixels (non-zero in either).
+    lit_any = (lum_o != 0) | (lum_m != 0)
+    srt = np.sort(ad[lit_any])[::-1] if lit_any.any() else np.zeros(1)
+    top = max(1, int(0.05 * srt.size))
+    top_share = float(srt[:top].sum() / max(srt.sum(), 1e-30))
+
+    # Smooth-interior vs edge pixels, from our (noise-free) image divided by our albedo buffer
+    # when given (so texture edges do not count): a pixel is "edge" when the range of its 3x3
+    # neighbourhood exceeds 25% of that neighbourhood's maximum (shadow boundaries,
+    # silhouettes). Interior pixels test irradiance, cosine, albedo and texture decoding; edge
+    # pixels also test shadow-map and rasterisation effects.
+    h, w = lum_o.shape
+    shade = lum_o
+    if albedo is not None:
+        al = albedo.mean(axis=2)
+        shade = np.where(al > 1e-6, lum_o / np.maximum(al, 1e-6), 0.0)
+    pad = np.pad(shade, 1, mode="edge")
+    win = np.stack([pad[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)])
+    lo_, hi_ = win.min(axis=0), win.max(axis=0)
+    edge = (hi_ - lo_) > 0.25 * np.maximum(hi_, 1e-30)
+    lit = lum_o + lum_m > 0
+    interior = lit & ~edge
+    edge_lit = lit & edge
+
+    def masked(mask):
+        if not mask.any():
+            return {"pixels": 0}
+        so, sm = float(lum_o[mask].sum()), float(lum_m[mask].sum())
+        return {
+            "pixels": int(mask.sum()),
+            "fraction_of_image": float(mask.mean()),
+            "sum_ours": so,
+            "sum_mitsuba": sm,
+            "rel_err": (so - sm) / sm if sm > 0 else None,
+            "share_of_mitsuba_total": sm / max(float(lum_m.sum()), 1e-30),
+        }
+
+    # Region errors: only blocks holding at least 10% of the image mean are ranked.
+    sig = reg_m > 0.1 * max(float(mean_m.mean()), 1e-30)
+    reg_max = float(np.nanmax(np.abs(reg_rel[sig]))) if sig.any() else None
+
+    # Per material, from our G-buffer's material id (pixels where our rasteriser saw material m;
+    # Mitsuba's value at the same pixels, so silhouettes mix in a little of the neighbours).
+    per_mat = []
+    if mat_id is not None:
+        for m in range(int(mat_id.max()) + 1 if mat_id.size else 0):
+            mask = mat_id == m
+            if not mask.any():
+                continue
+            so = ours[mask].sum(axis=0)
+            sm = mts[mask].sum(axis=0)
+            per_mat.append({
+                "material": m,
+                "name": mat_names[m] if mat_names and m < len(mat_names) else str(m),
+                "pixels": int(mask.sum()),
+                "share_of_mitsuba_total": float(sm.sum() / max(float(mts.sum()), 1e-30)),
+                "rel_err_rgb": [float((so[c] - sm[c]) / sm[c]) if sm[c] > 0 else None for c in range(3)],
+                "rel_err": float((so.sum() - sm.sum()) / sm.sum()) if sm.sum() > 0 else None,
+                "abs_err_share_of_image_mean_err": float((so.sum() - sm.sum()) / (ours.sum() - mts.sum()))
+                if ours.sum() != mts.sum() else None,
+            })
+
+    return {
+        "per_material": per_mat,
+        "interior_pixels": masked(interior),
+        "edge_pixels": masked(edge_lit),
+        "mean_ours_rgb": mean_o.tolist(),
+        "mean_mitsuba_rgb": mean_m.tolist(),
+        "mean_rel_err_rgb": rel(mean_o, mean_m).tolist(),
+        "mean_ours": float(mean_o.mean()),
+        "mean_mitsuba": float(mean_m.mean()),
+        "mean_rel_err": float(rel(mean_o.mean(), mean_m.mean())),
+        "mitsuba_mean_stderr_rgb": np.asarray(se_chan).tolist(),
+        "mitsuba_mean_rel_stderr": float(se_overall / mean_m.mean()) if mean_m.mean() > 0 else float("nan"),
+        "rmse": rmse,
+        "rmse_rel_to_mean": rmse / scale,
+        "mitsuba_pixel_noise_rms": mts_noise_rms,
+        "rmse_without_mitsuba_noise": rmse_debiased,
+        "pixels_off_by_more_than_25pct_of_mean": frac_big,
+        "abs_error_share_of_worst_5pct_lit_pixels": top_share,
+        "grid": grid,
+        "region_mean_ours": reg_o.tolist(),
+        "region_mean_mitsuba": reg_m.tolist(),
+        "region_mitsuba_stderr": np.asarray(reg_se).tolist(),
+        "region_rel_err": np.where(np.isnan(reg_rel), None, reg_rel).tolist(),
+        "region_max_abs_rel_err": reg_max,
+        "region_significant": sig.tolist(),
+    }
+
+
+# ----------------------------------------------------------------------------------------------
+# Images
+
+
+def tonemap(img: np.ndarray, scale: float) -> np.ndarray:
+    x = np.clip(img * scale, 0, None)
+    x = x / (1.0 + x)  # Reinhard, then sRGB OETF
+    s = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+    return np.clip(s * 255 + 0.5, 0, 255).astype(np.uint8)
+
+
+def diff_colour(ours: np.ndarray, mts: np.ndarray, limit: float = 0.5) -> np.ndarray:
+    """Relative difference (ours - Mitsuba) / Mitsuba-mean-scale: blue = ours darker, red = brighter,
+    white = equal; saturates at +-limit. Normalised by max(pixel, 10% of the image mean)."""
+    lo, lm = ours.mean(axis=2), mts.mean(axis=2)
+    denom = np.maximum(lm, 0.1 * max(float(lm.mean()), 1e-30))
+    r = np.clip((lo - lm) / denom / limit, -1, 1)
+    out = np.ones(r.shape + (3,))
+    pos, neg = np.clip(r, 0, 1), np.clip(-r, 0, 1)
+    out[:, :, 1] -= pos + neg
+    out[:, :, 2] -= pos
+    out[:, :, 0] -= neg
+    return np.clip(np.clip(out, 0, 1) * 255 + 0.5, 0, 255).astype(np.uint8)
+
+
+def write_png(mi, path: Path, rgb8: np.ndarray):
+    mi.Bitmap(np.ascontiguousarray(rgb8), mi.Bitmap.PixelFormat.RGB).write(str(path))
+
+
+def write_exr(mi, path: Path, rgb: np.ndarray):
+    mi.Bitmap(np.ascontiguousarray(rgb.astype(np.float32)), mi.Bitmap.PixelFormat.RGB).write(str(path))
+
+
+# ----------------------------------------------------------------------------------------------
+# Report
+
+
+def fmt_pct(x):
+    return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{100 * x:+.2f}%"
+
+
+def part_md(name: str, r: dict) -> str:
+    g = r["grid"]
+    lines = [
+        f"### {name}",
+        "",
+        "| | R | G | B | all |",
+        "|---|---|---|---|---|",
+        "| ours mean | " + " | ".join(f"{v:.5f}" for v in r["mean_ours_rgb"]) + f" | {r['mean_ours']:.5f} |",
+        "| Mitsuba mean | " + " | ".join(f"{v:.5f}" for v in r["mean_mitsuba_rgb"]) + f" | {r['mean_mitsuba']:.5f} |",
+        "| relative error | " + " | ".join(fmt_pct(v) for v in r["mean_rel_err_rgb"]) + f" | {fmt_pct(r['mean_rel_err'])} |",
+        "| Mitsuba std. error of mean | " + " | ".join(f"{v:.2e}" for v in r["mitsuba_mean_stderr_rgb"])
+        + f" | {100 * r['mitsuba_mean_rel_stderr']:.3f}% (relative) |",
+        "",
+        f"- RMSE (per pixel and channel): {r['rmse']:.5f} = {100 * r['rmse_rel_to_mean']:.1f}% of the Mitsuba mean; "
+        f"Mitsuba's own pixel noise (RMS std. error): {r['mitsuba_pixel_noise_rms']:.5f}; "
+        f"RMSE with that noise removed: {r['rmse_without_mitsuba_noise']:.5f}",
+        f"- pixels whose |difference| exceeds 25% of the image mean: {100 * r['pixels_off_by_more_than_25pct_of_mean']:.2f}%; "
+        f"the worst 5% of the lit pixels carry {100 * r['abs_error_share_of_worst_5pct_lit_pixels']:.0f}% of the absolute error",
+        "",
+        f"Region means ({g}x{g} blocks, row 0 = top; ours / Mitsuba / relative error):",
+        "",
+        "| row | " + " | ".join(f"col {b}" for b in range(g)) + " |",
+        "|---|" + "---|" * g,
+    ]
+    for a in range(g):
+        cells = []
+        for b in range(g):
+            re_ = r["region_rel_err"][a][b]
+            cells.append(f"{r['region_mean_ours'][a][b]:.4f} / {r['region_mean_mitsuba'][a][b]:.4f} / {fmt_pct(re_)}")
+        lines.append(f"| {a} | " + " | ".join(cells) + " |")
+    lines.append("")
+    lines.append(f"Largest region |relative error| (blocks with at least 10% of the image mean): "
+                 f"{fmt_pct(r['region_max_abs_rel_err'])}")
+    lines.append("")
+    if r.get("per_material"):
+        lines += ["Per material (pixels where our G-buffer sees it):", "",
+                  "| material | pixels | share of Mitsuba total | rel. error R | G | B | all | share of the image-mean error |",
+                  "|---|---|---|---|---|---|---|---|"]
+        for m in r["per_material"]:
+            sh = m["abs_err_share_of_image_mean_err"]
+            lines.append(f"| {m['name']} | {m['pixels']} | {100 * m['share_of_mitsuba_total']:.1f}% | "
+                         + " | ".join(fmt_pct(v) for v in m["rel_err_rgb"])
+                         + f" | {fmt_pct(m['rel_err'])} | {'n/a' if sh is None else f'{100 * sh:.0f}%'} |")
+        lines.append("")
+    for key, label in (("interior_pixels", "smooth interior"), ("edge_pixels", "edge")):
+        m = r[key]
+        if m.get("pixels"):
+            lines.append(f"- {label} pixels (lit, {100 * m['fraction_of_image']:.1f}% of the image, "
+                         f"{100 * m['share_of_mitsuba_total']:.0f}% of Mitsuba's energy): "
+                         f"sum relative error {fmt_pct(m['rel_err'])}")
+    lines.append("")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    a = parse_args(argv)
+    meta_path = a.scene_dir / "scene.json"
+    try:
+        meta = json.loads(meta_path.read_text())
+    except (OSError, json.JSONDecodeError) as e:
+        raise SystemExit(f"error: cannot read {meta_path}: {e}")
+    ours_direct_path = a.ours / "direct.exr"
+    ours_ind_path = a.ours / "indirect.exr"
+    if not ours_direct_path.exists():
+        raise SystemExit(f"error: {ours_direct_path} not found (run `lightcut-workbench render --out {a.ours}`)")
+    if a.indirect and not ours_ind_path.exists():
+        raise SystemExit(f"error: --indirect given but {ours_ind_path} does not exist (indirect not rendered yet)")
+    if a.splits < 1 or a.spp < a.splits:
+        raise SystemExit("error: need --splits >= 1 and --spp >= --splits")
+
+    if a.variant.startswith("llvm") and "DRJIT_LIBLLVM_PATH" not in os.environ:
+        # Debian 12's LLVM 15 crashes Dr.Jit ("Cannot select fminimum"); `apt-get install libllvm19`.
+        for cand in ("/usr/lib/x86_64-linux-gnu/libLLVM-19.so.1", "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1",
+                     "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"):
+            if os.path.exists(cand):
+                os.environ["DRJIT_LIBLLVM_PATH"] = cand
+                break
+    import mitsuba as mi
+
+    try:
+        mi.set_variant(a.variant)
+    except Exception as e:  # noqa: BLE001 - mitsuba raises plain exceptions
+        raise SystemExit(f"error: Mitsuba variant {a.variant!r} unavailable: {e}")
+
+    # Ours may be rendered at k x the size (k integer): it is then box-filtered down, which is
+    # what Mitsuba's box pixel filter does, so pixel-centre aliasing drops out of the comparison.
+    def load_ours(path: Path, what: str):
+        img = read_exr_rgb(mi, path) if what != "position" else np.array(mi.Bitmap(str(path)), dtype=np.float64)
+        h, w = img.shape[:2]
+        k = h // a.height
+        if k < 1 or h != k * a.height or w != k * a.width:
+            raise SystemExit(f"error: {path} is {w}x{h}, but --width/--height say {a.width}x{a.height} "
+                             "(or an integer multiple)")
+        if k == 1:
+            return img, 1
+        if what == "position":  # material ids cannot be averaged: take the sample nearest the centre
+            return img[k // 2::k, k // 2::k], k
+        return img.reshape(a.height, k, a.width, k, img.shape[2]).mean(axis=(1, 3)), k
+
+    ours_direct, ours_ss = load_ours(ours_direct_path, "direct")
+    a.out.mkdir(parents=True, exist_ok=True)
+    ours_albedo = None
+    if (a.ours / "albedo.exr").exists():
+        ours_albedo, _ = load_ours(a.ours / "albedo.exr", "albedo")
+    mat_id, mat_names = None, [m.get("name", str(i)) for i, m in enumerate(meta["materials"])]
+    if (a.ours / "position.exr").exists():
+        pos, _ = load_ours(a.ours / "position.exr", "position")
+        if pos.ndim == 3 and pos.shape[2] >= 4:
+            mat_id = np.rint(pos[:, :, 3]).astype(np.int64) - 1  # w = material id + 1, 0 = none
+
+    def spp_split(total):
+        per = max(1, total // a.splits)
+        if a.sampler == "ldsampler" and per & (per - 1):
+            per = 1 << (per.bit_length() - 1)  # ldsampler wants a power of two
+        return per
+
+    t0 = time.time()
+    per = spp_split(a.spp)
+    scene = mi.load_dict(build_scene_dict(mi, a.scene_dir, meta, a.width, a.height, a.sampler, per, a.flip_v))
+    t_load = time.time() - t0
+
+    report = {
+        "mitsuba_version": mi.__version__,
+        "variant": a.variant,
+        "sampler": a.sampler,
+        "splits": a.splits,
+        "scene_dir": str(a.scene_dir),
+        "ours": str(a.ours),
+        "width": a.width,
+        "height": a.height,
+        "camera": meta["camera"],
+        "sun": meta.get("sun", []),
+        "flip_v": a.flip_v,
+        "seed": a.seed,
+        "ours_supersampling": ours_ss,
+        "scene_load_s": t_load,
+        "parts": {},
+    }
+
+    def cached(part: str, spp_total: int):
+        """Split images of `part` from --reuse-mitsuba, or None when absent or made differently."""
+        if a.reuse_mitsuba is None:
+            return None
+        try:
+            old = json.loads((a.reuse_mitsuba / "report.json").read_text())
+        except (OSError, json.JSONDecodeError):
+            return None
+        same = (old.get("variant") == a.variant and old.get("sampler") == a.sampler
+                and old.get("splits") == a.splits and old.get("seed") == a.seed
+                and old.get("width") == a.width and old.get("height") == a.height
+                and old.get("camera") == meta["camera"] and old.get("sun") == meta.get("sun", [])
+                and old.get("flip_v") == a.flip_v
+                and old.get("parts", {}).get(part, {}).get("spp") == spp_total)
+        files = [a.reuse_mitsuba / f"mitsuba_{part}_split{k}.exr" for k in range(a.splits)]
+        if not same or not all(f.exists() for f in files):
+            print(f"note: --reuse-mitsuba {a.reuse_mitsuba} does not match for {part}; rendering", file=sys.stderr)
+            return None
+        old_part = old["parts"][part]
+        return [read_exr_rgb(mi, f) for f in files], old_part.get("render_s", 0.0)
+
+    def save_splits(part: str, splits):
+        for k, img in enumerate(splits):
+            write_exr(mi, a.out / f"mitsuba_{part}_split{k}.exr", img)
+
+    # Direct: path max_depth = 2.
+    t0 = time.time()
+    hit = cached("direct", per * a.splits)
+    reused_direct = bool(hit)
+    if hit:
+        d_splits, t_direct = hit
+        report["reused_mitsuba_from"] = str(a.reuse_mitsuba)
+    else:
+        d_splits = [render(mi, scene, 2, per, a.seed + 1000 * s) for s in range(a.splits)]
+        t_direct = time.time() - t0
+    save_splits("direct", d_splits)
+    mts_direct = np.mean(d_splits, axis=0)
+    write_exr(mi, a.out / "mitsuba_direct.exr", mts_direct)
+    r = compare(ours_direct, d_splits, a.grid, ours_albedo, mat_id, mat_names)
+    r.update({"spp": per * a.splits, "render_s": t_direct, "max_depth": 2, "reused": reused_direct})
+    report["parts"]["direct"] = r
+    scale = 1.0 / max(float(np.percentile(mts_direct, 99.5)), 1e-30)
+    strip = np.concatenate([tonemap(ours_direct, scale), tonemap(mts_direct, scale),
+                            diff_colour(ours_direct, mts_direct)], axis=1)
+    write_png(mi, a.out / "compare_direct.png", strip)
+
+    if a.indirect:
+        ours_ind, _ = load_ours(ours_ind_path, "indirect")
+        per_i = spp_split(a.indirect_spp or a.spp)
+        scene_i = scene
+        if per_i != per:
+            scene_i = mi.load_dict(build_scene_dict(mi, a.scene_dir, meta, a.width, a.height, a.sampler, per_i,
+                                                    a.flip_v))
+        t0 = time.time()
+        hit = cached("indirect", per_i * a.splits)
+        reused_ind = bool(hit)
+        if hit:
+            i_splits, t_ind = hit
+        else:
+            i_splits = []
+            for s in range(a.splits):
+                seed = a.seed + 7919 + 1000 * s
+                # Same seed for both depths so the direct part cancels in the difference.
+                i_splits.append(render(mi, scene_i, 3, per_i, seed) - render(mi, scene_i, 2, per_i, seed))
+            t_ind = time.time() - t0
+        save_splits("indirect", i_splits)
+        mts_ind = np.mean(i_splits, axis=0)
+        write_exr(mi, a.out / "mitsuba_indirect.exr", mts_ind)
+        r = compare(ours_ind, i_splits, a.grid, ours_albedo, mat_id, mat_names)
+        r.update({"spp": per_i * a.splits, "render_s": t_ind, "max_depth": "3 minus 2", "reused": reused_ind})
+        report["parts"]["indirect"] = r
+        scale = 1.0 / max(float(np.percentile(mts_ind, 99.5)), 1e-30)
+        strip = np.concatenate([tonemap(ours_ind, scale), tonemap(mts_ind, scale),
+                                diff_colour(ours_ind, mts_ind)], axis=1)
+        write_png(mi, a.out / "compare_indirect.png", strip)
+
+    def clean(o):
+        if isinstance(o, float) and not math.isfinite(o):
+            return None
+        if isinstance(o, dict):
+            return {k: clean(v) for k, v in o.items()}
+        if isinstance(o, list):
+            return [clean(v) for v in o]
+        return o
+
+    (a.out / "report.json").write_text(json.dumps(clean(report), indent=2) + "\n")
+
+    md = [
+        "# Mitsuba 3 check",
+        "",
+        f"- scene: `{a.scene_dir}` (camera '{meta['camera'].get('name', '?')}'), ours: `{a.ours}`, {a.width}x{a.height}"
+        + (f" (ours rendered at {ours_ss}x and box-filtered down)" if ours_ss > 1 else " (ours: one sample at each pixel centre)"),
+        f"- Mitsuba {mi.__version__}, variant `{a.variant}`, sampler `{a.sampler}`, {a.splits} independent splits, "
+        "box pixel filter, `path` integrator (rr_depth > max_depth), two-sided diffuse",
+        f"- images: `compare_<part>.png` = ours | Mitsuba | (ours - Mitsuba) / Mitsuba "
+        "(blue: ours darker, red: ours brighter, saturating at 50%)",
+        "",
+    ]
+    for name, r in report["parts"].items():
+        md.append(f"_{name}: {r['spp']} spp, {r['render_s']:.1f} s{' (Mitsuba images reused from ' + str(a.reuse_mitsuba) + ')' if r.get('reused') else ''}_")
+        md.append("")
+        md.append(part_md(name, r))
+    if not a.indirect:
+        md.append("Indirect: not compared (run with `--indirect` once `indirect.exr` exists).")
+        md.append("")
+    (a.out / "report.md").write_text("\n".join(md))
+
+    for name, r in report["parts"].items():
+        print(f"{name}: ours {r['mean_ours']:.5f}  Mitsuba {r['mean_mitsuba']:.5f}  "
+              f"rel.err {fmt_pct(r['mean_rel_err'])} (R {fmt_pct(r['mean_rel_err_rgb'][0])}, "
+              f"G {fmt_pct(r['mean_rel_err_rgb'][1])}, B {fmt_pct(r['mean_rel_err_rgb'][2])}); "
+              f"Mitsuba std.err {100 * r['mitsuba_mean_rel_stderr']:.3f}%; RMSE {r['rmse']:.5f} "
+              f"({100 * r['rmse_rel_to_mean']:.1f}% of mean); worst region {fmt_pct(r['region_max_abs_rel_err'])}; "
+              f"interior {fmt_pct(r['interior_pixels'].get('rel_err'))}, edges {fmt_pct(r['edge_pixels'].get('rel_err'))}; "
+              f"{r['spp']} spp in {r['render_s']:.1f} s ({a.variant}{', reused' if r.get('reused') else ''})")
+    print(f"wrote {a.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
