@@ -53,7 +53,7 @@ fn render_default_scene_writes_exrs_pngs_and_timings() {
     let mean = direct.mean_rgb();
     assert!(mean[0] > 0.0 && mean.iter().all(|v| v.is_finite()), "{mean:?}");
     let fin = lightcut::export::read_exr(&out.join("final.exr")).unwrap();
-    assert_eq!(fin, direct, "final = direct until GI exists");
+    assert_eq!(fin, direct, "with GI off, final = direct");
     let png = image::open(out.join("final.png")).unwrap();
     assert_eq!((png.width(), png.height()), (96, 64));
     let _ = std::fs::remove_dir_all(&out);
@@ -86,4 +86,90 @@ fn bad_input_gives_one_clear_line() {
         "render", "--scene", "default", "--camera", "Nope", "--out", "/tmp/x",
     ]);
     assert!(e.contains("Nope"), "{e}");
+}
+
+#[test]
+fn export_scene_writes_every_triangle_and_the_camera_and_sun() {
+    let out = std::env::temp_dir().join(format!("lightcut-export-{}", std::process::id()));
+    let o = bin()
+        .args(["export-scene", "--scene", "default", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json = std::fs::read_to_string(out.join("scene.json")).unwrap();
+    for key in [
+        "\"camera\"",
+        "\"sun\"",
+        "\"materials\"",
+        "\"yfov_deg\"",
+        "\"irradiance\"",
+    ] {
+        assert!(json.contains(key), "scene.json lacks {key}");
+    }
+    let mut faces = 0usize;
+    for e in std::fs::read_dir(&out).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "ply") {
+            let bytes = std::fs::read(&p).unwrap();
+            let end = bytes
+                .windows(10)
+                .position(|w| w == b"end_header")
+                .expect("PLY header");
+            let header = String::from_utf8_lossy(&bytes[..end]);
+            let line = header
+                .lines()
+                .find(|l| l.starts_with("element face"))
+                .expect("face element");
+            faces += line.split_whitespace().last().unwrap().parse::<usize>().unwrap();
+        }
+    }
+    let scene = lightcut::scene::default_scene::build();
+    assert_eq!(faces, scene.triangle_count());
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn render_ground_truth_writes_indirect_and_final_is_direct_plus_indirect() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = std::env::temp_dir().join(format!("lightcut-gt-{}", std::process::id()));
+    let o = bin()
+        .args([
+            "render",
+            "--scene",
+            "default",
+            "--width",
+            "48",
+            "--height",
+            "32",
+            "--method",
+            "ground-truth",
+        ])
+        .args(["--vpls", "64", "--output", "direct,indirect,final", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(stdout.contains("ground truth: 64 VPLs"), "{stdout}");
+    assert!(!out.join("normal.exr").exists(), "--output limits the files");
+    let read = |f: &str| lightcut::export::read_exr(&out.join(f)).unwrap();
+    let (d, i, f) = (read("direct.exr"), read("indirect.exr"), read("final.exr"));
+    assert!(i.mean_rgb()[0] > 0.0, "no indirect light");
+    for k in 0..f.pixels.len() {
+        for c in 0..3 {
+            let want = d.pixels[k][c] + i.pixels[k][c];
+            assert!(
+                (f.pixels[k][c] - want).abs() <= 1e-6 * want.abs().max(1.0),
+                "pixel {k}"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&out);
 }
