@@ -8,28 +8,10 @@
 
 const PI_V: f32 = 3.14159265358979;
 
-struct VplParams {
-    res: u32,             // RSM resolution (power of two)
-    levels: u32,          // pyramid levels (log2(res) + 1)
-    light_count: u32,
-    vpl_count: u32,
-    samples: u32,         // importance samples per texel
-    filter_radius: u32,
-    mode: u32,            // 0 BRSM, 1 RSM (uniform)
-    seed: u32,
-    sample_radius: f32,   // metres
-    n_min: f32,
-    d_max: f32,           // metres
-    flux_mix: f32,
-    epsilon: f32,         // distance bound (metres)
-    per_layer: u32,       // pyramid floats per light layer
-    _pad0: u32,
-    _pad1: u32,
-    ranges: array<vec4<u32>, 4>,       // per light: x first VPL, y VPL count
-    level_offsets: array<vec4<u32>, 4>, // offset of pyramid level l in a layer: [l / 4][l % 4]
-};
+
 
 #include "common/vpl.wgsl"
+#include "common/rsm_pyramid.wgsl"
 
 
 struct LevelParams {
@@ -48,16 +30,12 @@ struct LevelParams {
 @group(0) @binding(9) var<storage, read_write> importance_pyramid: array<f32>;
 @group(0) @binding(10) var<storage, read_write> flux_pyramid: array<f32>;
 @group(0) @binding(11) var<storage, read_write> vpls: array<Vpl>;
+// Bounding box of each pyramid node's texel positions for levels >= 1 (see bounds_index):
+// [2 k] = min, [2 k + 1] = max (empty: min = +big, max = -big). Used by the converged
+// reference's geometric bound.
+@group(0) @binding(12) var<storage, read_write> bounds_pyramid: array<vec4<f32>>;
 @group(1) @binding(0) var<uniform> level_params: LevelParams;
 
-fn level_offset(l: u32) -> u32 {
-    return params.level_offsets[l / 4u][l % 4u];
-}
-
-fn pyr_index(layer: u32, level: u32, x: u32, y: u32) -> u32 {
-    let r = params.res >> level;
-    return layer * params.per_layer + level_offset(level) + y * r + x;
-}
 
 // Radius with density min(1, 1/r^2) / 2 on (0, inf) (the thesis's 1/r^2 falloff capped at 1):
 // half the mass uniform on [0, 1), half on [1, inf) with density 1/(2 r^2).
@@ -185,6 +163,27 @@ fn reduce(@builtin(global_invocation_id) gid: vec3<u32>) {
     let o = pyr_index(layer, l, gid.x, gid.y);
     importance_pyramid[o] = (importance_pyramid[a] + importance_pyramid[a + 1u]) + (importance_pyramid[c] + importance_pyramid[c + 1u]);
     flux_pyramid[o] = (flux_pyramid[a] + flux_pyramid[a + 1u]) + (flux_pyramid[c] + flux_pyramid[c + 1u]);
+    var lo = vec4<f32>(3.0e38, 3.0e38, 3.0e38, 0.0);
+    var hi = -lo;
+    for (var k = 0u; k < 4u; k++) {
+        let cx = x + (k & 1u);
+        let cy = y + (k >> 1u);
+        if l == 1u {
+            // Level-0 boxes are the texels' positions.
+            let p = textureLoad(rsm_position, vec2<i32>(vec2<u32>(cx, cy)), i32(layer), 0);
+            if p.w > 0.0 {
+                lo = min(lo, vec4<f32>(p.xyz, 0.0));
+                hi = max(hi, vec4<f32>(p.xyz, 0.0));
+            }
+        } else {
+            let b = bounds_index(layer, l - 1u, cx, cy);
+            lo = min(lo, bounds_pyramid[2u * b]);
+            hi = max(hi, bounds_pyramid[2u * b + 1u]);
+        }
+    }
+    let ob = bounds_index(layer, l, gid.x, gid.y);
+    bounds_pyramid[2u * ob] = lo;
+    bounds_pyramid[2u * ob + 1u] = hi;
 }
 
 // Selection weight of a pyramid node: (1 - m) importance share + m flux share.

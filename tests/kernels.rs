@@ -346,3 +346,30 @@ fn shader_reload_rebuilds_pipelines_and_rendering_continues() {
     assert_eq!(before, r.read(Buffer::Direct).unwrap());
     assert!(r.ctx.errors.take().is_empty());
 }
+
+#[test]
+fn settings_the_device_cannot_bind_are_refused_with_a_message() {
+    let Some(ctx) = common::gpu() else { return };
+    let limit = ctx.device.limits().max_storage_buffer_binding_size;
+    let scene = default_scene::build();
+    let mut r = Renderer::new(ctx, &scene, (32, 32), RenderSettings::default()).unwrap();
+    let mut s = RenderSettings::default();
+    s.shadow.resolution = 4096;
+    let need = lightcut::renderer::passes::vpl_gen::VplBuffers::largest_binding(4096, 1, s.vpl.count);
+    match r.set_settings(s) {
+        Err(e) => {
+            assert!(need > limit, "refused although it fits: {e}");
+            assert!(e.to_string().contains("MiB"), "{e}");
+            // The previous settings stay and frames still render.
+            assert_eq!(r.settings().shadow.resolution, 512);
+            let cam = scene.camera_or_default(None).unwrap();
+            r.render(&FrameInput {
+                camera: &cam,
+                lights: &scene.lights,
+                view: ViewBuffer::Final,
+            });
+            assert!(r.ctx.errors.take().is_empty());
+        }
+        Ok(()) => assert!(need <= limit),
+    }
+}

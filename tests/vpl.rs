@@ -290,3 +290,83 @@ fn ground_truth_on_the_gpu_equals_a_cpu_evaluation_of_the_same_vpls() {
     assert!(checked > 100 && lit > 50, "checked {checked}, lit {lit}");
     assert!(r.ctx.errors.take().is_empty());
 }
+
+#[test]
+fn converged_reference_converges_to_the_exact_sum_over_all_texels() {
+    // A small RSM (64 x 64 texels) so that the exact CPU sum is affordable.
+    let mut settings = RenderSettings::default();
+    settings.shadow.resolution = 64;
+    settings.gi.method = GiMethod::Reference;
+    settings.gi.reference_samples = 256;
+    settings.gi.reference_spp_per_frame = 64;
+    let (w, h) = (48u32, 32u32);
+    let Some((mut r, scene)) = setup(settings.clone(), (w, h)) else {
+        return;
+    };
+    // Independent estimates: different seeds (the importance changes too; the estimator is
+    // unbiased for any importance because the PDF keeps a flux share).
+    let seeds = 6;
+    let mut means = Vec::new();
+    let mut image = vec![Vec3::ZERO; (w * h) as usize];
+    for seed in 0..seeds {
+        settings.vpl.seed = 100 + seed;
+        r.set_settings(settings.clone()).unwrap();
+        for _ in 0..8 {
+            frame(&mut r, &scene);
+            if r.gi_progress().is_some_and(|p| p.finished()) {
+                break;
+            }
+        }
+        assert!(r.gi_progress().unwrap().finished());
+        let ind = r.read(Buffer::Indirect).unwrap();
+        let lum_sum: f64 = ind.pixels.iter().map(|p| lum([p[0], p[1], p[2]])).sum();
+        means.push(lum_sum / ind.pixels.len() as f64);
+        for (k, p) in ind.pixels.iter().enumerate() {
+            image[k] += Vec3::new(p[0], p[1], p[2]) / seeds as f32;
+        }
+    }
+    let mean = means.iter().sum::<f64>() / seeds as f64;
+    let se =
+        (means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (seeds as f64 - 1.0) / seeds as f64).sqrt();
+    // Exact: every texel of the (seed-independent) RSM at every pixel.
+    let pos = r.read(Buffer::Position).unwrap();
+    let nrm = r.read(Buffer::Normal).unwrap();
+    let alb = r.read(Buffer::Albedo).unwrap();
+    let rp = r.read(Buffer::RsmPosition(0)).unwrap();
+    let rn = r.read(Buffer::RsmNormal(0)).unwrap();
+    let rf = r.read(Buffer::RsmFlux(0)).unwrap();
+    let texels: Vec<reference::gi::Texel> = (0..rp.pixels.len())
+        .filter(|&k| rp.pixels[k][3] > 0.0)
+        .map(|k| reference::gi::Texel {
+            position: Vec3::from_slice(&rp.pixels[k][..3]),
+            normal: Vec3::from_slice(&rn.pixels[k][..3]).normalize(),
+            flux: Vec3::from_slice(&rf.pixels[k][..3]),
+        })
+        .collect();
+    let bvh = Bvh::build(&scene.positions, &scene.indices);
+    let mut exact_sum = 0.0;
+    for k in 0..(w * h) as usize {
+        let p = pos.pixels[k];
+        if p[3] == 0.0 {
+            continue;
+        }
+        let e = reference::gi::exact_indirect(
+            &bvh,
+            Vec3::from_slice(&p[..3]),
+            Vec3::from_slice(&nrm.pixels[k][..3]).normalize(),
+            Vec3::from_slice(&alb.pixels[k][..3]),
+            &texels,
+            settings.gi.distance_epsilon,
+            settings.gi.ray_offset,
+        );
+        exact_sum += lum(e.to_array());
+    }
+    let exact = exact_sum / (w * h) as f64;
+    eprintln!("reference image mean {mean:.6} +- {se:.6} (6 x 256 spp), exact {exact:.6}");
+    assert!(exact > 0.0);
+    assert!(
+        (mean - exact).abs() < 4.0 * se + 1e-3 * exact,
+        "reference {mean} +- {se} vs exact {exact}"
+    );
+    assert!(r.ctx.errors.take().is_empty());
+}

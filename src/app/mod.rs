@@ -381,7 +381,10 @@ impl WorkbenchApp {
             if let Some(p) = self.renderer.as_ref().and_then(|r| r.gi_progress()) {
                 ui.add(
                     egui::ProgressBar::new(p.fraction())
-                        .text(format!("{} / {} VPLs", p.done, p.total))
+                        .text(match g.method {
+                            GiMethod::Reference => format!("{} / {} samples per pixel", p.done, p.total),
+                            _ => format!("{} / {} VPLs", p.done, p.total),
+                        })
                         .show_percentage(),
                 );
             }

@@ -26,6 +26,8 @@ pub enum Method {
     Off,
     /// Every VPL of the frame at every pixel with a shadow ray (the thesis's ground truth).
     GroundTruth,
+    /// Every RSM texel as a VPL, per-pixel Monte Carlo (converged reference).
+    Reference,
 }
 
 /// Groups of files `render` writes.
@@ -78,8 +80,18 @@ pub struct RenderArgs {
     /// Lower bound of the VPL distance in 1/d^2 (metres).
     #[arg(long)]
     pub epsilon: Option<f32>,
+    /// Samples per pixel of the converged reference.
+    #[arg(long)]
+    pub samples: Option<u32>,
     #[command(flatten)]
     pub settings: SettingsArgs,
+}
+
+fn gi_label(m: Method) -> &'static str {
+    match m {
+        Method::Reference => "converged reference (samples per pixel)",
+        _ => "ground truth (VPLs)",
+    }
 }
 
 /// Linear view depth (metres along the camera forward; 0 where there is no geometry).
@@ -108,7 +120,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     settings.gi.method = match args.method {
         Method::Off => GiMethod::Off,
         Method::GroundTruth => GiMethod::GroundTruth,
+        Method::Reference => GiMethod::Reference,
     };
+    if let Some(v) = args.samples {
+        settings.gi.reference_samples = v;
+    }
+    settings.gi.reference_spp_per_frame = settings.gi.reference_samples.min(16);
     if let Some(v) = args.vpls {
         settings.vpl.count = v;
     }
@@ -139,14 +156,17 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             view,
         })
     };
+    let render_start = std::time::Instant::now();
     for _ in 0..args.timing_frames.max(1) {
         frame(&mut r, ViewBuffer::Final);
         r.ctx.wait_idle()?;
     }
     let timings = r.wait_timings();
-    // Progressive GI: keep rendering the same frame until it has seen every VPL.
-    let gi_start = std::time::Instant::now();
-    let mut gi_ms = 0.0;
+    // Progressive GI: keep rendering the same frame until it has seen every VPL / sample.
+    let mut gi_ms = timings
+        .as_ref()
+        .and_then(|t| t.get("ground_truth").or(t.get("reference")))
+        .unwrap_or(0.0);
     while let Some(p) = r.gi_progress() {
         if p.finished() {
             break;
@@ -154,24 +174,28 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         frame(&mut r, ViewBuffer::Final);
         r.ctx.wait_idle()?;
         if let Some(t) = r.wait_timings() {
-            gi_ms += t.get("ground_truth").unwrap_or(0.0);
+            gi_ms += t.get("ground_truth").or(t.get("reference")).unwrap_or(0.0);
         }
         if let Some(p) = r.gi_progress() {
             eprint!(
-                "\rground truth: {:5.1}% of {} VPLs",
+                "\r{}: {:5.1}% of {}",
+                gi_label(args.method),
                 100.0 * p.fraction(),
                 p.total
             );
         }
     }
-    if r.gi_progress().is_some() {
+    if let Some(p) = r.gi_progress() {
         eprintln!();
+        let what = match args.method {
+            Method::Reference => format!("converged reference: {} samples per pixel", p.total),
+            _ => format!("ground truth: {} VPLs", r.vpl_frame().count),
+        };
         println!(
-            "ground truth: {} VPLs x {}x{} pixels in {:.2} s wall, {:.1} ms GPU",
-            r.vpl_frame().count,
+            "{what} x {}x{} pixels in {:.2} s wall (from the first frame), {:.1} ms GPU",
             args.width,
             args.height,
-            gi_start.elapsed().as_secs_f64(),
+            render_start.elapsed().as_secs_f64(),
             gi_ms
         );
     }

@@ -12,5 +12,6 @@
 pub mod direct;
 pub mod display;
 pub mod gbuffer;
+pub mod gi;
 pub mod visualise;
 pub mod vpl;

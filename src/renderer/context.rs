@@ -93,6 +93,15 @@ impl ErrorSink {
             }
         }));
     }
+    /// Records a message (shown like a GPU error, once).
+    pub fn report(&self, msg: String) {
+        if let Ok(mut v) = self.inner.lock()
+            && !v.contains(&msg)
+        {
+            v.push(msg);
+        }
+    }
+
     /// Takes the errors gathered since the last call.
     pub fn take(&self) -> Vec<String> {
         self.inner

@@ -27,6 +27,7 @@ use passes::{
     display::DisplayPass,
     gbuffer::GbufferPass,
     ground_truth::GroundTruthPass,
+    reference::{GpuRefParams, ReferencePass},
     rsm::RsmPass,
     visualise::{VisMode, VisSource, VisualisePass},
     vpl_gen::{VplBuffers, VplFrame, VplGenPass},
@@ -115,9 +116,11 @@ pub struct Renderer {
     vpl_gen: VplGenPass,
     ground_truth: GroundTruthPass,
     composite: CompositePass,
+    reference: ReferencePass,
     vpl_buffers: VplBuffers,
     vpl_frame: VplFrame,
     gt: Option<GtState>,
+    reference_state: Option<(u64, GiProgress)>,
     /// Luminance of each light's irradiance and light 0's shadow texel size, last frame.
     lights_cache: Vec<f32>,
     lights_texel: f32,
@@ -125,6 +128,22 @@ pub struct Renderer {
     lights_buf: wgpu::Buffer,
     timer: GpuTimer,
     frames: u64,
+}
+
+/// Refuses settings whose buffers the device cannot bind (instead of failing every frame).
+fn check_device_limits(device: &wgpu::Device, s: &RenderSettings, layers: u32) -> Result<(), RenderError> {
+    let limit = device.limits().max_storage_buffer_binding_size;
+    let need = VplBuffers::largest_binding(s.shadow.resolution, layers.max(1), s.vpl.count);
+    if need > limit {
+        return Err(RenderError::Settings(format!(
+            "shadow.resolution {} with {} VPLs needs a {} MiB storage buffer; this device binds at most {} MiB",
+            s.shadow.resolution,
+            s.vpl.count,
+            need >> 20,
+            limit >> 20
+        )));
+    }
+    Ok(())
 }
 
 fn check_size(w: u32, h: u32) -> Result<(), RenderError> {
@@ -144,6 +163,11 @@ impl Renderer {
     ) -> Result<Self, RenderError> {
         settings.validate().map_err(RenderError::Settings)?;
         check_size(size.0, size.1)?;
+        check_device_limits(
+            &ctx.device,
+            &settings,
+            scene.lights.len().clamp(1, MAX_LIGHTS) as u32,
+        )?;
         let device = &ctx.device;
         let uniform = |label, size: usize| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -171,9 +195,11 @@ impl Renderer {
             vpl_gen: VplGenPass::new(device)?,
             ground_truth: GroundTruthPass::new(device)?,
             composite: CompositePass::new(device)?,
+            reference: ReferencePass::new(device)?,
             vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
             vpl_frame: VplFrame::default(),
             gt: None,
+            reference_state: None,
             lights_cache: Vec::new(),
             lights_texel: 0.0,
             camera_buf: uniform("frame::camera", std::mem::size_of::<GpuCamera>()),
@@ -201,13 +227,14 @@ impl Renderer {
                 VplGenPass::new(device),
                 GroundTruthPass::new(device),
                 CompositePass::new(device),
+                ReferencePass::new(device),
             ),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
         }
-        let (g, s, d, disp, v, (vg, gt, c)) = passes;
-        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?);
+        let (g, s, d, disp, v, (vg, gt, c, rf)) = passes;
+        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?);
         (
             self.gbuffer,
             self.rsm,
@@ -217,6 +244,7 @@ impl Renderer {
             self.vpl_gen,
             self.ground_truth,
             self.composite,
+            self.reference,
         ) = new;
         Ok(())
     }
@@ -244,6 +272,7 @@ impl Renderer {
     /// are refused with a message and the previous settings stay.
     pub fn set_settings(&mut self, settings: RenderSettings) -> Result<(), RenderError> {
         settings.validate().map_err(RenderError::Settings)?;
+        check_device_limits(&self.ctx.device, &settings, self.targets.shadow.layers())?;
         if settings.shadow.resolution != self.targets.shadow.resolution {
             self.targets.shadow = ShadowTargets::new(
                 &self.ctx.device,
@@ -345,35 +374,53 @@ impl Renderer {
         );
         // VPLs (thesis 4.1): resources follow the RSM resolution, light count and VPL budget.
         let vb = &self.vpl_buffers;
+        let mut vpl_ok = true;
         if vb.res != s.shadow.resolution || vb.layers != layers || vb.capacity != s.vpl.count {
-            self.vpl_buffers = VplBuffers::new(&device, s.shadow.resolution, layers, s.vpl.count);
-            self.gt = None;
+            match check_device_limits(&device, &s, layers) {
+                // More lights than the buffers fit: say so and keep the frame direct-only.
+                Err(e) => {
+                    self.ctx.errors.report(e.to_string());
+                    vpl_ok = false;
+                }
+                Ok(()) => {
+                    self.vpl_buffers = VplBuffers::new(&device, s.shadow.resolution, layers, s.vpl.count);
+                    self.gt = None;
+                    self.reference_state = None;
+                }
+            }
         }
         let seed = s
             .vpl
             .seed
             .wrapping_add(if s.vpl.animate { self.frames as u32 } else { 0 });
-        let t = &self.targets;
-        self.vpl_frame = self.vpl_gen.record(
-            &device,
-            &queue,
-            &mut enc,
-            &mut self.timer,
-            &s.vpl,
-            &s.gi,
-            seed,
-            self.scene.bounds.radius().max(1e-3),
-            lights,
-            &self.camera_buf,
-            &t.shadow,
-            &t.gbuffer,
-            &self.vpl_buffers,
-        );
+        if vpl_ok {
+            let t = &self.targets;
+            self.vpl_frame = self.vpl_gen.record(
+                &device,
+                &queue,
+                &mut enc,
+                &mut self.timer,
+                &s.vpl,
+                &s.gi,
+                seed,
+                self.scene.bounds.radius().max(1e-3),
+                lights,
+                &self.camera_buf,
+                &t.shadow,
+                &t.gbuffer,
+                &self.vpl_buffers,
+            );
+        }
         let indirect_scale = match s.gi.method {
+            _ if !vpl_ok => 0.0,
             GiMethod::Off => 0.0,
             GiMethod::GroundTruth => {
                 self.step_ground_truth(&mut enc, input, lights, size);
                 1.0
+            }
+            GiMethod::Reference => {
+                let n = self.step_reference(&mut enc, input, lights, size);
+                if n == 0 { 0.0 } else { 1.0 / n as f32 }
             }
         };
         let t = &self.targets;
@@ -486,10 +533,67 @@ impl Renderer {
         gt.progress.done = reached;
     }
 
-    /// Progress of the ground truth (None when the GI method is not progressive).
+    /// Converged reference: restart on any change (clear the sums), then add
+    /// `reference_spp_per_frame` samples per pixel up to `reference_samples`. Returns the
+    /// samples per pixel accumulated after this frame.
+    fn step_reference(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        input: &FrameInput<'_>,
+        lights: &[DirectionalLight],
+        size: (u32, u32),
+    ) -> u32 {
+        let key = self.gt_key(input, lights, size) ^ 0x005e_ed0f_7e7e_7e7e;
+        let total = self.settings.gi.reference_samples;
+        if self.reference_state.is_none_or(|(k, _)| k != key) {
+            enc.clear_buffer(&self.targets.lighting.gi_accum, 0, None);
+            self.reference_state = Some((key, GiProgress { done: 0, total }));
+        }
+        let Some((_, progress)) = self.reference_state.as_mut() else {
+            return 0;
+        };
+        let n = self
+            .settings
+            .gi
+            .reference_spp_per_frame
+            .min(progress.total - progress.done.min(progress.total));
+        if n > 0 {
+            let p = GpuRefParams {
+                width: size.0,
+                height: size.1,
+                samples: n,
+                first_sample: progress.done,
+                epsilon: self.settings.gi.distance_epsilon,
+                ray_offset: self.settings.gi.ray_offset,
+                flux_mix: self.settings.gi.reference_flux_mix,
+                seed: self.settings.vpl.seed,
+            };
+            let device = self.ctx.device.clone();
+            let queue = self.ctx.queue.clone();
+            self.reference.record(
+                &device,
+                &queue,
+                enc,
+                &mut self.timer,
+                p,
+                self.vpl_gen.params_buffer(),
+                &self.vpl_buffers,
+                &self.targets.shadow,
+                &self.targets.gbuffer,
+                &self.scene,
+                &self.targets.lighting.gi_accum,
+            );
+            progress.done += n;
+        }
+        progress.done
+    }
+
+    /// Progress of the progressive GI method: VPLs done (ground truth) or samples per pixel
+    /// (reference); None when GI is off.
     pub fn gi_progress(&self) -> Option<GiProgress> {
         match self.settings.gi.method {
             GiMethod::GroundTruth => self.gt.as_ref().map(|g| g.progress),
+            GiMethod::Reference => self.reference_state.map(|(_, p)| p),
             GiMethod::Off => None,
         }
     }
@@ -579,8 +683,7 @@ impl Renderer {
             ),
             ViewBuffer::ImportanceRaw | ViewBuffer::ImportanceFiltered => {
                 let vb = &self.vpl_buffers;
-                let (per_layer, offsets) = passes::vpl_gen::pyramid_layout(vb.res);
-                let _ = per_layer;
+                let (_, offsets) = passes::vpl_gen::pyramid_layout(vb.res);
                 let top = *offsets.last().unwrap_or(&0) as f32;
                 let values = if view == ViewBuffer::ImportanceRaw {
                     &vb.importance_raw

@@ -133,14 +133,18 @@ pub enum GiMethod {
     /// The thesis's ground truth: every VPL of the frame at every pixel with a shadow ray,
     /// accumulated over frames in VPL batches (progressive; restarts when the view changes).
     GroundTruth,
+    /// Converged reference: every RSM texel as a VPL, per-pixel Monte Carlo over the RSM
+    /// pyramids, accumulated over frames until `reference_samples` per pixel.
+    Reference,
 }
 
 impl GiMethod {
-    pub const ALL: [GiMethod; 2] = [GiMethod::Off, GiMethod::GroundTruth];
+    pub const ALL: [GiMethod; 3] = [GiMethod::Off, GiMethod::GroundTruth, GiMethod::Reference];
     pub fn name(self) -> &'static str {
         match self {
             GiMethod::Off => "off (direct only)",
             GiMethod::GroundTruth => "ground truth (all VPLs)",
+            GiMethod::Reference => "converged reference (all texels)",
         }
     }
 }
@@ -153,6 +157,14 @@ pub struct GiSettings {
     /// Shadow rays the ground truth may trace per frame in the GUI (it continues next frame).
     /// Higher finishes sooner but makes frames slower.
     pub rays_per_frame: u32,
+    /// Samples per pixel the converged reference accumulates before it stops.
+    pub reference_samples: u32,
+    /// Samples per pixel the reference adds per frame (GUI; the CLI uses larger steps).
+    pub reference_spp_per_frame: u32,
+    /// Share of the reference's texel PDF that follows flux rather than BRSM importance.
+    /// Must be above 0 (every texel that can contribute stays selectable, so the reference
+    /// is unbiased); higher is more robust to a poor importance estimate, noisier otherwise.
+    pub reference_flux_mix: f32,
     /// Lower bound of the VPL-to-surface distance (metres) in the 1/d^2 term:
     /// 1 / max(d^2, epsilon^2) (the SST paper bounds d from below the same way). It removes
     /// the singularity next to VPLs at the price of darkening corners, where d < epsilon.
@@ -167,6 +179,9 @@ impl Default for GiSettings {
         Self {
             method: GiMethod::Off,
             rays_per_frame: 1 << 20,
+            reference_samples: 4096,
+            reference_spp_per_frame: 1,
+            reference_flux_mix: 0.25,
             distance_epsilon: 0.05,
             ray_offset: 1e-3,
         }
@@ -323,6 +338,17 @@ impl RenderSettings {
             return Err(format!("vpl.flux_mix {} is out of range (0..=1)", v.flux_mix));
         }
         let g = &self.gi;
+        if !(g.reference_flux_mix > 0.0 && g.reference_flux_mix <= 1.0) {
+            return Err(format!(
+                "gi.reference_flux_mix {} is out of range (0..=1, > 0)",
+                g.reference_flux_mix
+            ));
+        }
+        if g.reference_samples == 0 || !(1..=4096).contains(&g.reference_spp_per_frame) {
+            return Err(
+                "gi.reference_samples must be >= 1 and gi.reference_spp_per_frame in 1..=4096".into(),
+            );
+        }
         if g.rays_per_frame == 0 {
             return Err("gi.rays_per_frame must be at least 1".into());
         }

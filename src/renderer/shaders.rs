@@ -33,12 +33,17 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         include_str!("../../shaders/common/random.wgsl"),
     ),
     ("common/vpl.wgsl", include_str!("../../shaders/common/vpl.wgsl")),
+    (
+        "common/rsm_pyramid.wgsl",
+        include_str!("../../shaders/common/rsm_pyramid.wgsl"),
+    ),
     ("vpl_gen.wgsl", include_str!("../../shaders/vpl_gen.wgsl")),
     (
         "ground_truth.wgsl",
         include_str!("../../shaders/ground_truth.wgsl"),
     ),
     ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),
+    ("reference.wgsl", include_str!("../../shaders/reference.wgsl")),
     ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
     ("rsm.wgsl", include_str!("../../shaders/rsm.wgsl")),
     ("direct.wgsl", include_str!("../../shaders/direct.wgsl")),
@@ -58,6 +63,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "vpl_gen.wgsl",
     "ground_truth.wgsl",
     "composite.wgsl",
+    "reference.wgsl",
 ];
 
 #[derive(Debug, Error, PartialEq)]

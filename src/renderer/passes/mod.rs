@@ -7,6 +7,7 @@ pub mod direct;
 pub mod display;
 pub mod gbuffer;
 pub mod ground_truth;
+pub mod reference;
 pub mod rsm;
 pub mod visualise;
 pub mod vpl_gen;

@@ -77,12 +77,29 @@ pub struct VplBuffers {
     pub importance_pyramid: wgpu::Buffer,
     pub flux_pyramid: wgpu::Buffer,
     pub vpls: wgpu::Buffer,
+    /// Per pyramid node of level >= 1: min and max of its texels' positions (2 x vec4).
+    pub bounds_pyramid: wgpu::Buffer,
     pub res: u32,
     pub layers: u32,
     pub capacity: u32,
 }
 
 impl VplBuffers {
+    /// Bytes of the largest buffer the stage binds for an RSM of `res` and `layers` layers.
+    pub fn largest_binding(res: u32, layers: u32, capacity: u32) -> u64 {
+        let (per_layer, _) = pyramid_layout(res);
+        let layers = layers.max(1) as u64;
+        [
+            4 * (res as u64 * res as u64) * layers,
+            4 * per_layer as u64 * layers,
+            32 * (per_layer as u64 - res as u64 * res as u64) * layers,
+            std::mem::size_of::<GpuVpl>() as u64 * capacity.max(1) as u64,
+        ]
+        .into_iter()
+        .max()
+        .unwrap_or(0)
+    }
+
     pub fn new(device: &wgpu::Device, res: u32, layers: u32, capacity: u32) -> Self {
         let (per_layer, _) = pyramid_layout(res);
         let storage = |label, bytes: u64| {
@@ -103,6 +120,10 @@ impl VplBuffers {
             vpls: storage(
                 "vpl::vpls",
                 (std::mem::size_of::<GpuVpl>() as u32 * capacity.max(1)) as u64,
+            ),
+            bounds_pyramid: storage(
+                "vpl::bounds_pyramid",
+                32 * ((per_layer - res * res) * layers) as u64,
             ),
             res,
             layers,
@@ -158,6 +179,7 @@ impl VplGenPass {
                 storage_entry(9, c, false),
                 storage_entry(10, c, false),
                 storage_entry(11, c, false),
+                storage_entry(12, c, false),
             ],
         });
         let level_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -197,6 +219,11 @@ impl VplGenPass {
             params,
             level_params,
         })
+    }
+
+    /// The uniform with this frame's `VplParams` (the reference reads the same pyramids).
+    pub fn params_buffer(&self) -> &wgpu::Buffer {
+        &self.params
     }
 
     /// Records the whole VPL stage for `lights` (at most MAX_LIGHTS, one RSM layer each).
@@ -310,6 +337,10 @@ impl VplGenPass {
                 wgpu::BindGroupEntry {
                     binding: 11,
                     resource: out.vpls.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 12,
+                    resource: out.bounds_pyramid.as_entire_binding(),
                 },
             ],
         });

@@ -1,0 +1,188 @@
+// Converged reference (stage 19): one-bounce indirect light with EVERY RSM texel as a VPL,
+// estimated per pixel by Monte Carlo and accumulated over frames:
+//   L(x) = sum_t rho_x / pi x flux_t / pi x cos_x x cos_t / max(d^2, eps^2) x V(x, t)
+// Each sample picks a light (in proportion to its flux), then descends that light's RSM
+// pyramid from the top, choosing among the 4 children in proportion to
+//   W(child) = [(1 - m) importance share + m flux share] x B(child, x),
+// B = 1 / max(d_min^2, eps^2) if any corner of the child's position box lies in front of x's
+// tangent plane, else 0 (then every texel below has cos_x <= 0). With m > 0 every texel that
+// can contribute has a non-zero probability, so the estimator f / pmf is unbiased.
+// CPU twin: src/reference/gi.rs (exact sum over all texels).
+#include "common/bvh.wgsl"
+#include "common/color.wgsl"
+#include "common/random.wgsl"
+#include "common/vpl.wgsl"
+#include "common/rsm_pyramid.wgsl"
+
+const PI_R: f32 = 3.14159265358979;
+
+struct RefParams {
+    width: u32,
+    height: u32,
+    samples: u32,       // samples per pixel in this dispatch
+    first_sample: u32,  // index of the first (for the random numbers)
+    epsilon: f32,
+    ray_offset: f32,
+    flux_mix: f32,      // m above (> 0)
+    seed: u32,
+};
+
+@group(0) @binding(0) var<uniform> params: VplParams;
+@group(0) @binding(1) var<uniform> rp: RefParams;
+@group(0) @binding(2) var rsm_position: texture_2d_array<f32>;
+@group(0) @binding(3) var rsm_normal: texture_2d_array<f32>;
+@group(0) @binding(4) var rsm_flux: texture_2d_array<f32>;
+@group(0) @binding(5) var gb_position: texture_2d<f32>;
+@group(0) @binding(6) var gb_normal: texture_2d<f32>;
+@group(0) @binding(7) var gb_albedo: texture_2d<f32>;
+@group(0) @binding(8) var<storage, read> importance_pyramid: array<f32>;
+@group(0) @binding(9) var<storage, read> flux_pyramid: array<f32>;
+@group(0) @binding(10) var<storage, read> bounds_pyramid: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(12) var<storage, read> bvh_triangles: array<BvhTriangle>;
+@group(0) @binding(13) var<storage, read_write> accum: array<vec4<f32>>;
+
+// Geometric bound B of a pyramid node's box for surface point x with normal n.
+fn box_bound(layer: u32, level: u32, nx: u32, ny: u32, x: vec3<f32>, n: vec3<f32>) -> f32 {
+    var lo = vec3<f32>(0.0);
+    var hi = vec3<f32>(0.0);
+    if level == 0u {
+        let p = textureLoad(rsm_position, vec2<i32>(vec2<u32>(nx, ny)), i32(layer), 0);
+        if p.w == 0.0 {
+            return 0.0;
+        }
+        lo = p.xyz;
+        hi = p.xyz;
+    } else {
+        let b = bounds_index(layer, level, nx, ny);
+        lo = bounds_pyramid[2u * b].xyz;
+        hi = bounds_pyramid[2u * b + 1u].xyz;
+    }
+    if lo.x > hi.x {
+        return 0.0;
+    }
+    var front = false;
+    for (var c = 0u; c < 8u; c++) {
+        let p = select(lo, hi, vec3<bool>((c & 1u) != 0u, (c & 2u) != 0u, (c & 4u) != 0u));
+        front = front || dot(n, p - x) > 0.0;
+    }
+    if !front {
+        return 0.0;
+    }
+    let q = clamp(x, lo, hi);
+    let d2 = dot(q - x, q - x);
+    return 1.0 / max(d2, rp.epsilon * rp.epsilon);
+}
+
+fn node_w(layer: u32, level: u32, x: u32, y: u32, wi: f32, wf: f32, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let k = pyr_index(layer, level, x, y);
+    return (wi * importance_pyramid[k] + wf * flux_pyramid[k]) * box_bound(layer, level, x, y, p, n);
+}
+
+// One sample: returns f / pmf (rgb, without rho/pi).
+fn sample_once(rng: ptr<function, Rng>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    // Light choice in proportion to its flux.
+    var total = 0.0;
+    for (var l = 0u; l < params.light_count; l++) {
+        total += flux_pyramid[pyr_index(l, params.levels - 1u, 0u, 0u)];
+    }
+    if !(total > 0.0) {
+        return vec3<f32>(0.0);
+    }
+    var u = rng_next(rng) * total;
+    var layer = 0u;
+    var p_light = 0.0;
+    for (var l = 0u; l < params.light_count; l++) {
+        let f = flux_pyramid[pyr_index(l, params.levels - 1u, 0u, 0u)];
+        if u < f || l + 1u == params.light_count {
+            layer = l;
+            p_light = f / total;
+            break;
+        }
+        u -= f;
+    }
+    let top = pyr_index(layer, params.levels - 1u, 0u, 0u);
+    let ti = importance_pyramid[top];
+    let tf = flux_pyramid[top];
+    var m = rp.flux_mix;
+    if !(ti > 0.0) {
+        m = 1.0;
+    }
+    let wi = select(0.0, (1.0 - m) / ti, ti > 0.0);
+    let wf = m / tf;
+    var x = 0u;
+    var y = 0u;
+    var pmf = p_light;
+    for (var lv = params.levels - 1u; lv > 0u; lv--) {
+        let cl = lv - 1u;
+        let w0 = node_w(layer, cl, 2u * x, 2u * y, wi, wf, p, n);
+        let w1 = node_w(layer, cl, 2u * x + 1u, 2u * y, wi, wf, p, n);
+        let w2 = node_w(layer, cl, 2u * x, 2u * y + 1u, wi, wf, p, n);
+        let w3 = node_w(layer, cl, 2u * x + 1u, 2u * y + 1u, wi, wf, p, n);
+        let sum = w0 + w1 + w2 + w3;
+        if !(sum > 0.0) {
+            return vec3<f32>(0.0);
+        }
+        let r = rng_next(rng) * sum;
+        var c = 3u;
+        var wc = w3;
+        if r < w0 {
+            c = 0u;
+            wc = w0;
+        } else if r < w0 + w1 {
+            c = 1u;
+            wc = w1;
+        } else if r < w0 + w1 + w2 {
+            c = 2u;
+            wc = w2;
+        }
+        if !(wc > 0.0) {
+            return vec3<f32>(0.0);
+        }
+        pmf *= wc / sum;
+        x = 2u * x + (c & 1u);
+        y = 2u * y + (c >> 1u);
+    }
+    let t = vec2<i32>(vec2<u32>(x, y));
+    let tp = textureLoad(rsm_position, t, i32(layer), 0);
+    if tp.w == 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let tn = normalize(textureLoad(rsm_normal, t, i32(layer), 0).xyz);
+    let flux = textureLoad(rsm_flux, t, i32(layer), 0).rgb;
+    let d = tp.xyz - p;
+    let dist2 = dot(d, d);
+    let w = d * inverseSqrt(max(dist2, 1e-30));
+    let cx = dot(n, w);
+    let cv = -dot(tn, w);
+    if cx <= 0.0 || cv <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let o = p + n * rp.ray_offset;
+    let e = tp.xyz + tn * rp.ray_offset;
+    if bvh_any_hit(o, e - o, 1e-4, 1.0 - 1e-4) {
+        return vec3<f32>(0.0);
+    }
+    return flux / PI_R * (cx * cv / max(dist2, rp.epsilon * rp.epsilon)) / pmf;
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= rp.width || gid.y >= rp.height {
+        return;
+    }
+    let px = vec2<i32>(gid.xy);
+    let g = textureLoad(gb_position, px, 0);
+    if g.w == 0.0 {
+        return;
+    }
+    let n = normalize(textureLoad(gb_normal, px, 0).xyz);
+    let albedo = textureLoad(gb_albedo, px, 0).rgb;
+    let k = gid.y * rp.width + gid.x;
+    var sum = vec3<f32>(0.0);
+    for (var s = 0u; s < rp.samples; s++) {
+        var rng = rng_new(k, rp.first_sample + s, rp.seed ^ 0x5bd1e995u);
+        sum += sample_once(&rng, g.xyz, n);
+    }
+    accum[k] += vec4<f32>(albedo / PI_R * sum, 0.0);
+}

@@ -1,0 +1,52 @@
+//! References of the one-bounce GI kernels: the exact sum over every RSM texel (what the
+//! converged reference `shaders/reference.wgsl` estimates) at one surface point.
+
+use glam::Vec3;
+
+use crate::scene::bvh::{Bvh, Ray};
+
+/// One RSM texel as a VPL.
+#[derive(Clone, Copy, Debug)]
+pub struct Texel {
+    pub position: Vec3,
+    pub normal: Vec3,
+    pub flux: Vec3,
+}
+
+/// rho/pi x sum over texels of flux/pi x cos_x x cos_t / max(d^2, eps^2) x V.
+pub fn exact_indirect(
+    bvh: &Bvh,
+    x: Vec3,
+    n: Vec3,
+    albedo: Vec3,
+    texels: &[Texel],
+    eps: f32,
+    offset: f32,
+) -> Vec3 {
+    let pi = std::f32::consts::PI;
+    let mut sum = Vec3::ZERO;
+    for t in texels {
+        let d = t.position - x;
+        let dist2 = d.length_squared();
+        if dist2 <= 0.0 {
+            continue;
+        }
+        let w = d / dist2.sqrt();
+        let (cx, ct) = (n.dot(w), -t.normal.dot(w));
+        if cx <= 0.0 || ct <= 0.0 {
+            continue;
+        }
+        let o = x + n * offset;
+        let e = t.position + t.normal * offset;
+        if bvh.any_hit(&Ray {
+            origin: o,
+            dir: e - o,
+            tmin: 1e-4,
+            tmax: 1.0 - 1e-4,
+        }) {
+            continue;
+        }
+        sum += t.flux / pi * (cx * ct / dist2.max(eps * eps));
+    }
+    albedo / pi * sum
+}

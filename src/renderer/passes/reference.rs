@@ -1,0 +1,144 @@
+//! Converged reference (stage 19): every RSM texel as a VPL, estimated per pixel by Monte
+//! Carlo through the RSM pyramids and accumulated over frames (see `shaders/reference.wgsl`).
+//! Reads: VPL-stage pyramids and parameters, RSM, G-buffer, BVH. Writes: the GI accumulation.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::renderer::{
+    frame::{GbufferTargets, ShadowTargets},
+    scene_gpu::SceneGpu,
+    shaders,
+    timing::GpuTimer,
+};
+
+use super::{
+    compute_pipeline, float_texture_entry, groups_2d, storage_entry, texture_entry, uniform_entry,
+    vpl_gen::VplBuffers,
+};
+
+/// Twin: `RefParams` in `shaders/reference.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuRefParams {
+    pub width: u32,
+    pub height: u32,
+    pub samples: u32,
+    pub first_sample: u32,
+    pub epsilon: f32,
+    pub ray_offset: f32,
+    pub flux_mix: f32,
+    pub seed: u32,
+}
+
+pub struct ReferencePass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+}
+
+impl ReferencePass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let module = shaders::create_module(device, "reference.wgsl")?;
+        let c = wgpu::ShaderStages::COMPUTE;
+        let array_tex = |b| {
+            texture_entry(
+                b,
+                c,
+                wgpu::TextureSampleType::Float { filterable: false },
+                wgpu::TextureViewDimension::D2Array,
+            )
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("reference::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                uniform_entry(1, c),
+                array_tex(2),
+                array_tex(3),
+                array_tex(4),
+                float_texture_entry(5),
+                float_texture_entry(6),
+                float_texture_entry(7),
+                storage_entry(8, c, true),
+                storage_entry(9, c, true),
+                storage_entry(10, c, true),
+                storage_entry(11, c, true),
+                storage_entry(12, c, true),
+                storage_entry(13, c, false),
+            ],
+        });
+        let pipeline = compute_pipeline(device, "reference::pipeline", &[Some(&layout)], &module, "main");
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("reference::params"),
+            size: std::mem::size_of::<GpuRefParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            pipeline,
+            layout,
+            params,
+        })
+    }
+
+    /// Records `p.samples` more samples per pixel into `accum`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: GpuRefParams,
+        vpl_params: &wgpu::Buffer,
+        vpl: &VplBuffers,
+        rsm: &ShadowTargets,
+        gbuffer: &GbufferTargets,
+        scene: &SceneGpu,
+        accum: &wgpu::Buffer,
+    ) {
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let tv = wgpu::BindingResource::TextureView;
+        let entries = [
+            vpl_params.as_entire_binding(),
+            self.params.as_entire_binding(),
+            tv(&rsm.position_array),
+            tv(&rsm.normal_array),
+            tv(&rsm.flux_array),
+            tv(&gbuffer.position_view),
+            tv(&gbuffer.normal_view),
+            tv(&gbuffer.albedo_view),
+            vpl.importance_pyramid.as_entire_binding(),
+            vpl.flux_pyramid.as_entire_binding(),
+            vpl.bounds_pyramid.as_entire_binding(),
+            scene.bvh_nodes.as_entire_binding(),
+            scene.bvh_triangles.as_entire_binding(),
+            accum.as_entire_binding(),
+        ];
+        let entries: Vec<wgpu::BindGroupEntry<'_>> = entries
+            .into_iter()
+            .enumerate()
+            .map(|(i, resource)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource,
+            })
+            .collect();
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("reference::bind_group"),
+            layout: &self.layout,
+            entries: &entries,
+        });
+        encoder.push_debug_group("reference");
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("reference::pass"),
+                timestamp_writes: timer.compute_pass("reference"),
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            let (gx, gy) = groups_2d(p.width, p.height);
+            pass.dispatch_workgroups(gx, gy, 1);
+        }
+        encoder.pop_debug_group();
+    }
+}
