@@ -100,6 +100,7 @@ fn display_pass_matches_reference_within_one_lsb() {
             let settings = DisplaySettings {
                 exposure_ev: ev,
                 tonemap,
+                ..Default::default()
             };
             let mut enc = ctx.device.create_command_encoder(&Default::default());
             let sv = src.create_view(&Default::default());

@@ -122,6 +122,8 @@ pub struct WorkbenchApp {
     screenshot_requested: bool,
     last_frame_time: Option<f64>,
     frame_ms_smoothed: f64,
+    /// RSM reflected flux (luminance, W), refreshed every 30 frames.
+    flux_total: Option<f32>,
     adapter: String,
 }
 
@@ -149,6 +151,7 @@ impl WorkbenchApp {
             screenshot_requested: false,
             last_frame_time: None,
             frame_ms_smoothed: 0.0,
+            flux_total: None,
             adapter: String::new(),
         };
         let Some(rs) = app.render_state.clone() else {
@@ -321,6 +324,7 @@ impl WorkbenchApp {
             ui.separator();
             ui.heading("View");
             egui::ComboBox::from_label("buffer")
+                .height(600.0)
                 .selected_text(self.view.name())
                 .show_ui(ui, |ui| {
                     for v in ViewBuffer::ALL {
@@ -330,6 +334,17 @@ impl WorkbenchApp {
             ui.add(
                 egui::Slider::new(&mut self.settings.display.exposure_ev, -10.0..=10.0).text("exposure (EV)"),
             );
+            if self.view == ViewBuffer::PdfPyramid {
+                ui.add(
+                    egui::Slider::new(&mut self.settings.display.pyramid_level, 0..=12).text("pyramid level"),
+                );
+            }
+            ui.horizontal(|ui| {
+                ui.checkbox(&mut self.settings.display.vpl_overlay, "show VPLs");
+                ui.add(
+                    egui::Slider::new(&mut self.settings.display.vpl_point_size, 0..=6).text("point size"),
+                );
+            });
             egui::ComboBox::from_label("tonemap")
                 .selected_text(self.settings.display.tonemap.name())
                 .show_ui(ui, |ui| {
@@ -459,7 +474,14 @@ impl WorkbenchApp {
                     ui.label("GPU timings pending");
                 }
                 ui.separator();
-                ui.label(format!("VPLs {}", r.vpl_frame().count));
+                match self.flux_total {
+                    Some(f) => ui.label(format!(
+                        "VPLs {} · reflected flux {:.4} W (lum.)",
+                        r.vpl_frame().count,
+                        f
+                    )),
+                    None => ui.label(format!("VPLs {}", r.vpl_frame().count)),
+                };
                 ui.separator();
                 ui.label(format!("frame {:.1} ms", self.frame_ms_smoothed));
             }
@@ -565,6 +587,16 @@ impl WorkbenchApp {
             egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
             egui::Color32::WHITE,
         );
+        if self.view.is_log_heat() {
+            legend(ui, draw, "importance / mean (log)", -3.0, 2.0);
+        } else if self.settings.display.vpl_overlay {
+            legend(ui, draw, "VPL flux / mean (log)", -2.0, 2.0);
+        }
+        if self.frames.is_multiple_of(30)
+            && let Some(r) = &self.renderer
+        {
+            self.flux_total = r.rsm_flux_total().ok();
+        }
         self.frames += 1;
     }
 
@@ -617,6 +649,60 @@ impl WorkbenchApp {
             }
             _ => ctx.send_viewport_cmd(egui::ViewportCommand::Close),
         }
+    }
+}
+
+/// A false-colour scale bar in the lower left of `rect`, labelled in powers of ten.
+fn legend(ui: &egui::Ui, rect: egui::Rect, title: &str, lo: f32, hi: f32) {
+    let w = 220.0;
+    let bar = egui::Rect::from_min_size(rect.left_bottom() + egui::vec2(12.0, -34.0), egui::vec2(w, 12.0));
+    let painter = ui.painter();
+    painter.rect_filled(
+        bar.expand2(egui::vec2(6.0, 22.0))
+            .translate(egui::vec2(0.0, -8.0)),
+        4.0,
+        egui::Color32::from_black_alpha(170),
+    );
+    let steps = 64;
+    for k in 0..steps {
+        let t = (k as f32 + 0.5) / steps as f32;
+        let c = crate::reference::visualise::false_color(t);
+        let [r, g, b] = c.map(|v| (v * 255.0) as u8);
+        let x0 = bar.left() + w * k as f32 / steps as f32;
+        painter.rect_filled(
+            egui::Rect::from_min_max(
+                egui::pos2(x0, bar.top()),
+                egui::pos2(x0 + w / steps as f32 + 0.5, bar.bottom()),
+            ),
+            0.0,
+            egui::Color32::from_rgb(r, g, b),
+        );
+    }
+    let font = egui::FontId::proportional(11.0);
+    let text = egui::Color32::from_gray(230);
+    painter.text(
+        bar.left_top() - egui::vec2(0.0, 3.0),
+        egui::Align2::LEFT_BOTTOM,
+        title,
+        font.clone(),
+        text,
+    );
+    let decades = (hi - lo).round() as i32;
+    for d in 0..=decades {
+        let x = bar.left() + w * d as f32 / decades as f32;
+        let e = lo as i32 + d;
+        let label = match e {
+            0 => "1".to_string(),
+            e if e > 0 => format!("{}", 10i64.pow(e as u32)),
+            e => format!("1e{e}"),
+        };
+        painter.text(
+            egui::pos2(x, bar.bottom() + 2.0),
+            egui::Align2::CENTER_TOP,
+            label,
+            font.clone(),
+            text,
+        );
     }
 }
 

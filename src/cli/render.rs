@@ -244,6 +244,21 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             let (w, h, bytes) = r.read_view_rgba8()?;
             write_png(&out.join(name), w, h, &bytes)?;
         }
+        // The VPLs over the RSM and in the camera view, and a coarse PDF-pyramid level.
+        let mut s2 = r.settings().clone();
+        s2.display.vpl_overlay = true;
+        s2.display.vpl_point_size = 1;
+        s2.display.pyramid_level = 4;
+        r.set_settings(s2)?;
+        for (view, name) in [
+            (ViewBuffer::RsmFlux, "vpls_over_rsm.png"),
+            (ViewBuffer::Final, "vpls_in_view.png"),
+            (ViewBuffer::PdfPyramid, "pdf_pyramid_level4.png"),
+        ] {
+            frame(&mut r, view);
+            let (w, h, bytes) = r.read_view_rgba8()?;
+            write_png(&out.join(name), w, h, &bytes)?;
+        }
     }
     if let Some(e) = r.ctx.errors.take().into_iter().next() {
         return Err(anyhow!("GPU error: {e}"));

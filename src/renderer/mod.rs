@@ -31,6 +31,7 @@ use passes::{
     rsm::RsmPass,
     visualise::{VisMode, VisSource, VisualisePass},
     vpl_gen::{VplBuffers, VplFrame, VplGenPass},
+    vpl_splat::{GpuSplatParams, VplSplatPass},
 };
 use readback::ImageF32;
 use scene_gpu::SceneGpu;
@@ -117,6 +118,7 @@ pub struct Renderer {
     ground_truth: GroundTruthPass,
     composite: CompositePass,
     reference: ReferencePass,
+    vpl_splat: VplSplatPass,
     vpl_buffers: VplBuffers,
     vpl_frame: VplFrame,
     gt: Option<GtState>,
@@ -196,6 +198,7 @@ impl Renderer {
             ground_truth: GroundTruthPass::new(device)?,
             composite: CompositePass::new(device)?,
             reference: ReferencePass::new(device)?,
+            vpl_splat: VplSplatPass::new(device)?,
             vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
             vpl_frame: VplFrame::default(),
             gt: None,
@@ -228,13 +231,14 @@ impl Renderer {
                 GroundTruthPass::new(device),
                 CompositePass::new(device),
                 ReferencePass::new(device),
+                VplSplatPass::new(device),
             ),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
         }
-        let (g, s, d, disp, v, (vg, gt, c, rf)) = passes;
-        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?);
+        let (g, s, d, disp, v, (vg, gt, c, rf, sp)) = passes;
+        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?);
         (
             self.gbuffer,
             self.rsm,
@@ -245,6 +249,7 @@ impl Renderer {
             self.ground_truth,
             self.composite,
             self.reference,
+            self.vpl_splat,
         ) = new;
         Ok(())
     }
@@ -437,6 +442,9 @@ impl Renderer {
             &t.lighting.final_view,
         );
         self.record_view(&mut enc, input.view, input.camera);
+        if self.settings.display.vpl_overlay && vpl_ok {
+            self.record_vpl_overlay(&mut enc, input.view);
+        }
         self.timer.resolve(&mut enc);
         queue.submit([enc.finish()]);
         self.timer.after_submit();
@@ -613,11 +621,60 @@ impl Renderer {
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
 
+    /// Total reflected flux of the RSMs (luminance, W) = the expected total VPL flux; read from
+    /// the flux pyramids' tops (a small blocking readback).
+    pub fn rsm_flux_total(&self) -> Result<f32, GpuError> {
+        let vb = &self.vpl_buffers;
+        let (per_layer, offsets) = passes::vpl_gen::pyramid_layout(vb.res);
+        let top = *offsets.last().unwrap_or(&0) as u64;
+        let mut total = 0.0;
+        for l in 0..self.vpl_frame.ranges.len() as u64 {
+            let b = readback::read_buffer_range(
+                &self.ctx,
+                &vb.flux_pyramid,
+                4 * (l * per_layer as u64 + top),
+                4,
+            )?;
+            total += f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+        }
+        Ok(total)
+    }
+
     /// Reads the last frame's VPLs back.
     pub fn read_vpls(&self) -> Result<Vec<GpuVpl>, GpuError> {
         let bytes = readback::read_storage_buffer(&self.ctx, &self.vpl_buffers.vpls)?;
         let all: &[GpuVpl] = bytemuck::cast_slice(&bytes);
         Ok(all[..(self.vpl_frame.count as usize).min(all.len())].to_vec())
+    }
+
+    /// The frame's VPLs as discs over the view texture.
+    fn record_vpl_overlay(&mut self, enc: &mut wgpu::CommandEncoder, view: ViewBuffer) {
+        let device = self.ctx.device.clone();
+        let queue = self.ctx.queue.clone();
+        let vb = &self.vpl_buffers;
+        let (per_layer, offsets) = passes::vpl_gen::pyramid_layout(vb.res);
+        let p = GpuSplatParams {
+            count: self.vpl_frame.count,
+            space: view.is_rsm_space() as u32,
+            radius: self.settings.display.vpl_point_size,
+            layer: 0,
+            rsm_res: vb.res,
+            light_count: self.vpl_frame.ranges.len() as u32,
+            per_layer,
+            top_offset: *offsets.last().unwrap_or(&0),
+        };
+        self.vpl_splat.record(
+            &device,
+            &queue,
+            enc,
+            &mut self.timer,
+            p,
+            &self.camera_buf,
+            &vb.vpls,
+            &vb.flux_pyramid,
+            &self.targets.gbuffer.position_view,
+            &self.targets.view.view,
+        );
     }
 
     fn record_view(&mut self, enc: &mut wgpu::CommandEncoder, view: ViewBuffer, camera: &Camera) {
@@ -630,6 +687,12 @@ impl Renderer {
             | ViewBuffer::RsmNormal
             | ViewBuffer::ImportanceRaw
             | ViewBuffer::ImportanceFiltered => (rsm_res, rsm_res),
+            ViewBuffer::PdfPyramid => {
+                let r = (rsm_res >> self.settings.display.pyramid_level.min(rsm_res.trailing_zeros())).max(1);
+                // Small levels are shown enlarged (nearest) so they stay visible.
+                let s = (256 / r).max(1);
+                (r * s, r * s)
+            }
             _ => self.targets.size,
         };
         if self.targets.view.size != want {
@@ -681,6 +744,18 @@ impl Renderer {
                 [0.0; 4],
                 [0.0; 4],
             ),
+            ViewBuffer::PdfPyramid => {
+                let vb = &self.vpl_buffers;
+                let (_, offsets) = passes::vpl_gen::pyramid_layout(vb.res);
+                let l = (self.settings.display.pyramid_level as usize).min(offsets.len() - 1);
+                let top = *offsets.last().unwrap_or(&0) as f32;
+                (
+                    VisMode::ScalarLogHeat,
+                    VisSource::Scalar(&vb.importance_pyramid, &vb.importance_pyramid),
+                    [0.0, top, 0.0, 0.0],
+                    [0.0, (vb.res >> l) as f32, offsets[l] as f32, 0.0],
+                )
+            }
             ViewBuffer::ImportanceRaw | ViewBuffer::ImportanceFiltered => {
                 let vb = &self.vpl_buffers;
                 let (_, offsets) = passes::vpl_gen::pyramid_layout(vb.res);

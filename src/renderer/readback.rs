@@ -147,6 +147,29 @@ pub fn read_storage_buffer(ctx: &GpuContext, src: &wgpu::Buffer) -> Result<Vec<u
     read_buffer_bytes(ctx, &staging)
 }
 
+/// Copies `size` bytes at `offset` (both multiples of 4) of a storage buffer and reads them.
+pub fn read_buffer_range(
+    ctx: &GpuContext,
+    src: &wgpu::Buffer,
+    offset: u64,
+    size: u64,
+) -> Result<Vec<u8>, GpuError> {
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback::range"),
+        size: size.max(4),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback::encoder"),
+        });
+    enc.copy_buffer_to_buffer(src, offset, &staging, 0, size);
+    ctx.queue.submit([enc.finish()]);
+    read_buffer_bytes(ctx, &staging)
+}
+
 /// Reads a float colour or depth texture as RGBA f32 (depth goes to all of rgb, a = 1;
 /// Rgba8 formats are returned as their stored 0..1 values, not decoded).
 pub fn read_texture_f32(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32) -> Result<ImageF32, GpuError> {

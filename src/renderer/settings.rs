@@ -226,6 +226,13 @@ pub struct DisplaySettings {
     /// brighten dim (indirect-only) images.
     pub exposure_ev: f32,
     pub tonemap: Tonemap,
+    /// Draw the frame's VPLs over the view (in the camera view, or in RSM texel space over
+    /// RSM-space views), coloured by flux on a log scale around the mean VPL flux.
+    pub vpl_overlay: bool,
+    /// Radius of the VPL discs in view pixels (0 = one pixel).
+    pub vpl_point_size: u32,
+    /// Level shown by the PDF-pyramid view (0 = full resolution).
+    pub pyramid_level: u32,
 }
 
 impl Default for DisplaySettings {
@@ -233,6 +240,9 @@ impl Default for DisplaySettings {
         Self {
             exposure_ev: 0.0,
             tonemap: Tonemap::Aces,
+            vpl_overlay: false,
+            vpl_point_size: 1,
+            pyramid_level: 0,
         }
     }
 }
@@ -292,6 +302,12 @@ impl RenderSettings {
             return Err(format!(
                 "shadow.pcf_radius {} is out of range (0..=4)",
                 s.pcf_radius
+            ));
+        }
+        if self.display.vpl_point_size > 16 || self.display.pyramid_level > 12 {
+            return Err(format!(
+                "display.vpl_point_size {} (0..=16) or display.pyramid_level {} (0..=12) out of range",
+                self.display.vpl_point_size, self.display.pyramid_level
             ));
         }
         if !(-20.0..=20.0).contains(&self.display.exposure_ev) {
@@ -392,6 +408,8 @@ pub enum ViewBuffer {
     ImportanceRaw,
     /// BRSM importance after the edge-aware filter (log heat map).
     ImportanceFiltered,
+    /// A level of the importance (PDF) pyramid (`display.pyramid_level`; log heat map).
+    PdfPyramid,
     /// Diffuse albedo from the G-buffer.
     Albedo,
     /// Shading normals from the G-buffer.
@@ -407,7 +425,7 @@ pub enum ViewBuffer {
 }
 
 impl ViewBuffer {
-    pub const ALL: [ViewBuffer; 13] = [
+    pub const ALL: [ViewBuffer; 14] = [
         ViewBuffer::Final,
         ViewBuffer::Direct,
         ViewBuffer::Indirect,
@@ -415,6 +433,7 @@ impl ViewBuffer {
         ViewBuffer::RsmNormal,
         ViewBuffer::ImportanceRaw,
         ViewBuffer::ImportanceFiltered,
+        ViewBuffer::PdfPyramid,
         ViewBuffer::Albedo,
         ViewBuffer::Normal,
         ViewBuffer::Depth,
@@ -431,6 +450,7 @@ impl ViewBuffer {
             ViewBuffer::RsmNormal => "RSM normal",
             ViewBuffer::ImportanceRaw => "BRSM importance (raw)",
             ViewBuffer::ImportanceFiltered => "BRSM importance (filtered)",
+            ViewBuffer::PdfPyramid => "PDF pyramid level",
             ViewBuffer::Albedo => "albedo",
             ViewBuffer::Normal => "normal",
             ViewBuffer::Depth => "depth",
@@ -439,6 +459,27 @@ impl ViewBuffer {
             ViewBuffer::ShadowMap => "shadow map",
         }
     }
+    /// True for views drawn in RSM texel space (VPL overlays go to their texels there).
+    pub fn is_rsm_space(self) -> bool {
+        matches!(
+            self,
+            ViewBuffer::RsmFlux
+                | ViewBuffer::RsmNormal
+                | ViewBuffer::ImportanceRaw
+                | ViewBuffer::ImportanceFiltered
+                | ViewBuffer::PdfPyramid
+                | ViewBuffer::ShadowMap
+        )
+    }
+
+    /// True for log heat maps relative to their mean (the UI draws a legend).
+    pub fn is_log_heat(self) -> bool {
+        matches!(
+            self,
+            ViewBuffer::ImportanceRaw | ViewBuffer::ImportanceFiltered | ViewBuffer::PdfPyramid
+        )
+    }
+
     /// True for linear-radiance buffers (shown through exposure + tonemap).
     pub fn is_radiance(self) -> bool {
         matches!(

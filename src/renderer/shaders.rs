@@ -44,6 +44,7 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ),
     ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),
     ("reference.wgsl", include_str!("../../shaders/reference.wgsl")),
+    ("vpl_splat.wgsl", include_str!("../../shaders/vpl_splat.wgsl")),
     ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
     ("rsm.wgsl", include_str!("../../shaders/rsm.wgsl")),
     ("direct.wgsl", include_str!("../../shaders/direct.wgsl")),
@@ -64,6 +65,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "ground_truth.wgsl",
     "composite.wgsl",
     "reference.wgsl",
+    "vpl_splat.wgsl",
 ];
 
 #[derive(Debug, Error, PartialEq)]

@@ -11,6 +11,7 @@ pub mod reference;
 pub mod rsm;
 pub mod visualise;
 pub mod vpl_gen;
+pub mod vpl_splat;
 
 /// Workgroup edge of the 2D image kernels (`@workgroup_size(8, 8, 1)` in their WGSL; checked
 /// by `tests::workgroup_sizes_match_wgsl`).

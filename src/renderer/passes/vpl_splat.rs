@@ -1,0 +1,123 @@
+//! VPL overlay: the frame's VPLs as discs over the view texture, coloured by flux (log scale
+//! around the mean VPL flux). Reads: VPLs, camera, G-buffer. Writes: the view texture.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::renderer::{shaders, timing::GpuTimer};
+
+use super::{
+    WG_1D, compute_pipeline, display::VIEW_FORMAT, float_texture_entry, storage_entry, storage_texture_entry,
+    uniform_entry,
+};
+
+/// Twin: `SplatParams` in `shaders/vpl_splat.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuSplatParams {
+    pub count: u32,
+    /// 0 = camera view, 1 = RSM texel space.
+    pub space: u32,
+    pub radius: u32,
+    pub layer: u32,
+    pub rsm_res: u32,
+    pub light_count: u32,
+    pub per_layer: u32,
+    pub top_offset: u32,
+}
+
+pub struct VplSplatPass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+}
+
+impl VplSplatPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let module = shaders::create_module(device, "vpl_splat.wgsl")?;
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("vpl_splat::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                uniform_entry(1, c),
+                storage_entry(2, c, true),
+                float_texture_entry(3),
+                storage_texture_entry(4, VIEW_FORMAT),
+                storage_entry(5, c, true),
+            ],
+        });
+        let pipeline = compute_pipeline(device, "vpl_splat::pipeline", &[Some(&layout)], &module, "main");
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("vpl_splat::params"),
+            size: std::mem::size_of::<GpuSplatParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            pipeline,
+            layout,
+            params,
+        })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: GpuSplatParams,
+        camera: &wgpu::Buffer,
+        vpls: &wgpu::Buffer,
+        flux_pyramid: &wgpu::Buffer,
+        gb_position: &wgpu::TextureView,
+        dst: &wgpu::TextureView,
+    ) {
+        if p.count == 0 {
+            return;
+        }
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("vpl_splat::bind_group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: camera.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: vpls.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(gb_position),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(dst),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: flux_pyramid.as_entire_binding(),
+                },
+            ],
+        });
+        encoder.push_debug_group("vpl_splat");
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("vpl_splat::pass"),
+                timestamp_writes: timer.compute_pass("vpl_splat"),
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.dispatch_workgroups(p.count.div_ceil(WG_1D), 1, 1);
+        }
+        encoder.pop_debug_group();
+    }
+}
