@@ -8,6 +8,7 @@
 //   7 unsigned integer heat (range -> false colour)
 //   8 array layer, colour x range_max.x (RSM flux / (E x texel area) ~ albedo), sRGB
 //   9 array layer, normal (n * 0.5 + 0.5)
+//  11 array layer, position normalised to [range_min, range_max] (scene bounds); empty black
 //  10 scalar buffer, log heat relative to its mean: t = (log10(v / mean) + 3) / 5, i.e.
 //     1/1000 of the mean -> 0, 100x the mean -> 1; zero -> black.
 //     The mean is range_min.x (a pyramid's top / texel count, read on the GPU).
@@ -125,6 +126,8 @@ fn vis_array(@builtin(global_invocation_id) gid: vec3<u32>) {
     var c = vec3<f32>(0.0);
     if params.mode == 9u {
         c = select(vec3<f32>(0.0), v.xyz * 0.5 + 0.5, dot(v.xyz, v.xyz) > 0.0);
+    } else if params.mode == 11u {
+        c = select(vec3<f32>(0.0), normalised(v.xyz), v.w > 0.0);
     } else {
         c = linear_to_srgb(v.rgb * params.range_max.x);
     }

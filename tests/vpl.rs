@@ -370,3 +370,64 @@ fn converged_reference_converges_to_the_exact_sum_over_all_texels() {
     );
     assert!(r.ctx.errors.take().is_empty());
 }
+
+#[test]
+fn two_lights_split_the_budget_by_brightness_and_each_light_stays_unbiased() {
+    let mut settings = RenderSettings::default();
+    settings.vpl.count = 1024;
+    settings.shadow.resolution = 128;
+    let Some(ctx) = common::gpu() else { return };
+    let mut scene = default_scene::build();
+    let mut second = scene.lights[0].clone();
+    second.name = "second sun".into();
+    second.direction = Vec3::new(0.4, -0.8, 0.45).normalize();
+    second.irradiance = scene.lights[0].irradiance / 3.0;
+    scene.lights.push(second);
+    let mut r = Renderer::new(ctx, &scene, (64, 40), settings.clone()).unwrap();
+    frame(&mut r, &scene);
+    assert_eq!(r.vpl_frame().ranges, vec![(0, 768), (768, 256)]);
+    let totals: Vec<f64> = (0..2)
+        .map(|l| {
+            let f = r.read(Buffer::RsmFlux(l)).unwrap();
+            let p = r.read(Buffer::RsmPosition(l)).unwrap();
+            f.pixels
+                .iter()
+                .zip(&p.pixels)
+                .filter(|(_, p)| p[3] > 0.0)
+                .map(|(f, _)| lum([f[0], f[1], f[2]]))
+                .sum()
+        })
+        .collect();
+    let frames = 24;
+    let mut sums = vec![Vec::new(), Vec::new()];
+    for seed in 0..frames {
+        settings.vpl.seed = 500 + seed;
+        r.set_settings(settings.clone()).unwrap();
+        frame(&mut r, &scene);
+        let vpls = r.read_vpls().unwrap();
+        for (i, v) in vpls.iter().enumerate() {
+            let light = if i < 768 { 0 } else { 1 };
+            assert_eq!(v.id >> 24, light, "VPL {i} belongs to light {}", v.id >> 24);
+        }
+        for (l, range) in [(0usize, 0..768), (1, 768..1024)] {
+            sums[l].push(
+                vpls[range]
+                    .iter()
+                    .map(|v| lum([v.flux[0], v.flux[1], v.flux[2]]))
+                    .sum::<f64>(),
+            );
+        }
+    }
+    for l in 0..2 {
+        let n = sums[l].len() as f64;
+        let mean = sums[l].iter().sum::<f64>() / n;
+        let se = (sums[l].iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+        eprintln!("light {l}: RSM {:.4}, VPL mean {mean:.4} +- {se:.4}", totals[l]);
+        assert!(
+            (mean - totals[l]).abs() < 4.0 * se + 1e-4 * totals[l],
+            "light {l}: {mean} vs {}",
+            totals[l]
+        );
+    }
+    assert!(r.ctx.errors.take().is_empty());
+}

@@ -685,6 +685,7 @@ impl Renderer {
             ViewBuffer::ShadowMap
             | ViewBuffer::RsmFlux
             | ViewBuffer::RsmNormal
+            | ViewBuffer::RsmPosition
             | ViewBuffer::ImportanceRaw
             | ViewBuffer::ImportanceFiltered => (rsm_res, rsm_res),
             ViewBuffer::PdfPyramid => {
@@ -743,6 +744,12 @@ impl Renderer {
                 VisSource::Array(&t.shadow.normal_array, 0),
                 [0.0; 4],
                 [0.0; 4],
+            ),
+            ViewBuffer::RsmPosition => (
+                VisMode::ArrayPosition,
+                VisSource::Array(&t.shadow.position_array, 0),
+                bmin.extend(0.0).to_array(),
+                bmax.extend(1.0).to_array(),
             ),
             ViewBuffer::PdfPyramid => {
                 let vb = &self.vpl_buffers;

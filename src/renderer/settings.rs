@@ -404,6 +404,8 @@ pub enum ViewBuffer {
     RsmFlux,
     /// Normals of the reflective shadow map of light 0.
     RsmNormal,
+    /// World positions of the reflective shadow map of light 0 (normalised to the scene bounds).
+    RsmPosition,
     /// BRSM importance of light 0's texels, raw (log heat map).
     ImportanceRaw,
     /// BRSM importance after the edge-aware filter (log heat map).
@@ -425,12 +427,13 @@ pub enum ViewBuffer {
 }
 
 impl ViewBuffer {
-    pub const ALL: [ViewBuffer; 14] = [
+    pub const ALL: [ViewBuffer; 15] = [
         ViewBuffer::Final,
         ViewBuffer::Direct,
         ViewBuffer::Indirect,
         ViewBuffer::RsmFlux,
         ViewBuffer::RsmNormal,
+        ViewBuffer::RsmPosition,
         ViewBuffer::ImportanceRaw,
         ViewBuffer::ImportanceFiltered,
         ViewBuffer::PdfPyramid,
@@ -448,6 +451,7 @@ impl ViewBuffer {
             ViewBuffer::Indirect => "GI only",
             ViewBuffer::RsmFlux => "RSM flux",
             ViewBuffer::RsmNormal => "RSM normal",
+            ViewBuffer::RsmPosition => "RSM position",
             ViewBuffer::ImportanceRaw => "BRSM importance (raw)",
             ViewBuffer::ImportanceFiltered => "BRSM importance (filtered)",
             ViewBuffer::PdfPyramid => "PDF pyramid level",
@@ -465,6 +469,7 @@ impl ViewBuffer {
             self,
             ViewBuffer::RsmFlux
                 | ViewBuffer::RsmNormal
+                | ViewBuffer::RsmPosition
                 | ViewBuffer::ImportanceRaw
                 | ViewBuffer::ImportanceFiltered
                 | ViewBuffer::PdfPyramid

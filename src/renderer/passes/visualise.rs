@@ -22,6 +22,7 @@ pub enum VisMode {
     ArrayColor = 8,
     ArrayNormal = 9,
     ScalarLogHeat = 10,
+    ArrayPosition = 11,
 }
 
 /// What to visualise.
