@@ -399,7 +399,7 @@ fn two_lights_split_the_budget_by_brightness_and_each_light_stays_unbiased() {
         })
         .collect();
     let frames = 24;
-    let mut sums = vec![Vec::new(), Vec::new()];
+    let mut sums = [Vec::new(), Vec::new()];
     for seed in 0..frames {
         settings.vpl.seed = 500 + seed;
         r.set_settings(settings.clone()).unwrap();
