@@ -431,3 +431,25 @@ fn two_lights_split_the_budget_by_brightness_and_each_light_stays_unbiased() {
     }
     assert!(r.ctx.errors.take().is_empty());
 }
+
+#[test]
+fn raising_the_reference_target_continues_and_a_view_change_restarts() {
+    let mut settings = RenderSettings::default();
+    settings.shadow.resolution = 64;
+    settings.gi.method = GiMethod::Reference;
+    settings.gi.reference_samples = 64;
+    settings.gi.reference_spp_per_frame = 32;
+    let Some((mut r, scene)) = setup(settings.clone(), (32, 24)) else { return };
+    frame(&mut r, &scene);
+    frame(&mut r, &scene);
+    frame(&mut r, &scene);
+    assert_eq!(r.gi_progress().map(|p| (p.done, p.total)), Some((64, 64)));
+    settings.gi.reference_samples = 128;
+    r.set_settings(settings.clone()).unwrap();
+    frame(&mut r, &scene);
+    assert_eq!(r.gi_progress().map(|p| (p.done, p.total)), Some((96, 128)));
+    // Another camera: the sums restart.
+    let cam = scene.cameras[1].clone();
+    r.render(&FrameInput { camera: &cam, lights: &scene.lights, view: ViewBuffer::Final });
+    assert_eq!(r.gi_progress().map(|p| p.done), Some(32));
+}

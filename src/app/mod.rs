@@ -403,6 +403,29 @@ impl WorkbenchApp {
                         .show_percentage(),
                 );
             }
+            match g.method {
+                GiMethod::GroundTruth => {
+                    ui.add(
+                        egui::Slider::new(&mut g.rays_per_frame, 1 << 14..=1 << 26)
+                            .logarithmic(true)
+                            .text("shadow rays / frame"),
+                    )
+                    .on_hover_text("more finishes sooner, but each frame takes longer");
+                }
+                GiMethod::Reference => {
+                    ui.add(
+                        egui::Slider::new(&mut g.reference_samples, 16..=65536)
+                            .logarithmic(true)
+                            .text("samples per pixel"),
+                    );
+                    ui.add(egui::Slider::new(&mut g.reference_spp_per_frame, 1..=64).text("samples / frame"));
+                    ui.add(
+                        egui::Slider::new(&mut g.reference_flux_mix, 0.01..=1.0).text("reference flux mix"),
+                    )
+                    .on_hover_text("share of the texel PDF that follows flux (> 0 keeps it unbiased)");
+                }
+                GiMethod::Off => {}
+            }
             ui.add(
                 egui::Slider::new(&mut g.distance_epsilon, 0.001..=1.0)
                     .logarithmic(true)

@@ -468,6 +468,8 @@ impl Renderer {
         let mut s = self.settings.clone();
         s.display = Default::default();
         s.gi.rays_per_frame = 0;
+        s.gi.reference_samples = 0;
+        s.gi.reference_spp_per_frame = 0;
         s.vpl.animate = false;
         format!("{s:?}").hash(&mut h);
         h.finish()
@@ -560,6 +562,8 @@ impl Renderer {
         let Some((_, progress)) = self.reference_state.as_mut() else {
             return 0;
         };
+        // The target may change without restarting (more samples continue the same sums).
+        progress.total = total;
         let n = self
             .settings
             .gi
