@@ -4,9 +4,10 @@
 // Each sample picks a light (in proportion to its flux), then descends that light's RSM
 // pyramid from the top, choosing among the 4 children in proportion to
 //   W(child) = [(1 - m) importance share + m flux share] x B(child, x),
-// B = 1 / max(d_min^2, eps^2) if any corner of the child's position box lies in front of x's
-// tangent plane, else 0 (then every texel below has cos_x <= 0). With m > 0 every texel that
-// can contribute has a non-zero probability, so the estimator f / pmf is unbiased.
+// B = the average clamped cosine to the child box's corners (thesis eq. 5.2) / max(d_min^2,
+// eps^2), 0 only if every corner is behind x's tangent plane (then every texel below has
+// cos_x <= 0); at the texel level B is the exact unoccluded G. With m > 0 every texel that can
+// contribute has a non-zero probability, so the estimator f / pmf is unbiased.
 // CPU twin: src/reference/gi.rs (exact sum over all texels).
 #include "common/bvh.wgsl"
 #include "common/color.wgsl"
@@ -42,36 +43,43 @@ struct RefParams {
 @group(0) @binding(12) var<storage, read> bvh_triangles: array<BvhTriangle>;
 @group(0) @binding(13) var<storage, read_write> accum: array<vec4<f32>>;
 
-// Geometric bound B of a pyramid node's box for surface point x with normal n.
+// Geometric weight B of a pyramid node for surface point x with normal n. Levels >= 1: the
+// thesis's eq. 5.2 average clamped cosine towards the box's 8 corners over
+// max(d_min^2, eps^2) - positive whenever any corner is in front of x, which is whenever any
+// texel below can contribute, so every contributing texel keeps a non-zero probability.
+// Level 0 (single texels): the exact unoccluded G = cos_x cos_t / max(d^2, eps^2).
 fn box_bound(layer: u32, level: u32, nx: u32, ny: u32, x: vec3<f32>, n: vec3<f32>) -> f32 {
-    var lo = vec3<f32>(0.0);
-    var hi = vec3<f32>(0.0);
     if level == 0u {
-        let p = textureLoad(rsm_position, vec2<i32>(vec2<u32>(nx, ny)), i32(layer), 0);
+        let t = vec2<i32>(vec2<u32>(nx, ny));
+        let p = textureLoad(rsm_position, t, i32(layer), 0);
         if p.w == 0.0 {
             return 0.0;
         }
-        lo = p.xyz;
-        hi = p.xyz;
-    } else {
-        let b = bounds_index(layer, level, nx, ny);
-        lo = bounds_pyramid[2u * b].xyz;
-        hi = bounds_pyramid[2u * b + 1u].xyz;
+        let tn = normalize(textureLoad(rsm_normal, t, i32(layer), 0).xyz);
+        let d = p.xyz - x;
+        let d2 = dot(d, d);
+        let w = d * inverseSqrt(max(d2, 1e-30));
+        return max(dot(n, w), 0.0) * max(-dot(tn, w), 0.0) / max(d2, rp.epsilon * rp.epsilon);
     }
+    let b = bounds_index(layer, level, nx, ny);
+    let lo = bounds_pyramid[2u * b].xyz;
+    let hi = bounds_pyramid[2u * b + 1u].xyz;
     if lo.x > hi.x {
         return 0.0;
     }
-    var front = false;
+    var cos_sum = 0.0;
     for (var c = 0u; c < 8u; c++) {
         let p = select(lo, hi, vec3<bool>((c & 1u) != 0u, (c & 2u) != 0u, (c & 4u) != 0u));
-        front = front || dot(n, p - x) > 0.0;
+        let d = p - x;
+        cos_sum += max(dot(n, d) * inverseSqrt(max(dot(d, d), 1e-30)), 0.0);
     }
-    if !front {
+    if !(cos_sum > 0.0) {
+        // Every corner behind or on x's tangent plane: no texel below can contribute.
         return 0.0;
     }
     let q = clamp(x, lo, hi);
     let d2 = dot(q - x, q - x);
-    return 1.0 / max(d2, rp.epsilon * rp.epsilon);
+    return cos_sum * 0.125 / max(d2, rp.epsilon * rp.epsilon);
 }
 
 fn node_w(layer: u32, level: u32, x: u32, y: u32, wi: f32, wf: f32, p: vec3<f32>, n: vec3<f32>) -> f32 {

@@ -439,7 +439,9 @@ fn raising_the_reference_target_continues_and_a_view_change_restarts() {
     settings.gi.method = GiMethod::Reference;
     settings.gi.reference_samples = 64;
     settings.gi.reference_spp_per_frame = 32;
-    let Some((mut r, scene)) = setup(settings.clone(), (32, 24)) else { return };
+    let Some((mut r, scene)) = setup(settings.clone(), (32, 24)) else {
+        return;
+    };
     frame(&mut r, &scene);
     frame(&mut r, &scene);
     frame(&mut r, &scene);
@@ -450,6 +452,10 @@ fn raising_the_reference_target_continues_and_a_view_change_restarts() {
     assert_eq!(r.gi_progress().map(|p| (p.done, p.total)), Some((96, 128)));
     // Another camera: the sums restart.
     let cam = scene.cameras[1].clone();
-    r.render(&FrameInput { camera: &cam, lights: &scene.lights, view: ViewBuffer::Final });
+    r.render(&FrameInput {
+        camera: &cam,
+        lights: &scene.lights,
+        view: ViewBuffer::Final,
+    });
     assert_eq!(r.gi_progress().map(|p| p.done), Some(32));
 }
