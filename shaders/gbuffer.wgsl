@@ -5,36 +5,18 @@
 //   2 albedo:   Rgba16Float, rgb linear diffuse albedo = baseColorFactor x texture, a = alpha
 #include "common/camera.wgsl"
 #include "common/material.wgsl"
+#include "common/vertex.wgsl"
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> materials: array<MaterialGpu>;
 @group(0) @binding(2) var textures: texture_2d_array<f32>;
 @group(0) @binding(3) var tex_sampler: sampler;
 
-struct VertexIn {
-    @location(0) position: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
-    @location(3) material: u32,
-};
 
-struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
-    @location(3) @interpolate(flat) material: u32,
-};
 
 @vertex
 fn vs_main(v: VertexIn) -> VertexOut {
-    var o: VertexOut;
-    o.clip = camera.view_proj * vec4<f32>(v.position, 1.0);
-    o.world = v.position;
-    o.normal = v.normal;
-    o.uv = v.uv;
-    o.material = v.material;
-    return o;
+    return transform_vertex(v, camera.view_proj);
 }
 
 struct GbufferOut {

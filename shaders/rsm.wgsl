@@ -7,6 +7,7 @@
 // The texel area is measured perpendicular to the light, so E x area is the power the
 // texel's surface receives whatever its inclination (no cosine).
 #include "common/material.wgsl"
+#include "common/vertex.wgsl"
 
 struct RsmLight {
     view_proj: mat4x4<f32>,
@@ -18,30 +19,11 @@ struct RsmLight {
 @group(0) @binding(2) var textures: texture_2d_array<f32>;
 @group(0) @binding(3) var tex_sampler: sampler;
 
-struct VertexIn {
-    @location(0) position: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
-    @location(3) material: u32,
-};
 
-struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
-    @location(3) @interpolate(flat) material: u32,
-};
 
 @vertex
 fn vs_main(v: VertexIn) -> VertexOut {
-    var o: VertexOut;
-    o.clip = light.view_proj * vec4<f32>(v.position, 1.0);
-    o.world = v.position;
-    o.normal = v.normal;
-    o.uv = v.uv;
-    o.material = v.material;
-    return o;
+    return transform_vertex(v, light.view_proj);
 }
 
 struct RsmOut {

@@ -32,6 +32,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         "common/random.wgsl",
         include_str!("../../shaders/common/random.wgsl"),
     ),
+    (
+        "common/vertex.wgsl",
+        include_str!("../../shaders/common/vertex.wgsl"),
+    ),
     ("common/vpl.wgsl", include_str!("../../shaders/common/vpl.wgsl")),
     (
         "common/rsm_pyramid.wgsl",

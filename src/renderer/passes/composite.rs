@@ -6,8 +6,8 @@ use bytemuck::{Pod, Zeroable};
 use crate::renderer::{shaders, timing::GpuTimer};
 
 use super::{
-    compute_pipeline, direct::RADIANCE_FORMAT, float_texture_entry, groups_2d, storage_entry,
-    storage_texture_entry, uniform_entry,
+    compute_pipeline, direct::RADIANCE_FORMAT, float_texture_entry, groups_image, run_compute, storage_entry,
+    storage_texture_entry, uniform_buffer, uniform_entry,
 };
 
 /// Twin: `CompositeParams` in `shaders/composite.wgsl`.
@@ -41,12 +41,7 @@ impl CompositePass {
             ],
         });
         let pipeline = compute_pipeline(device, "composite::pipeline", &[Some(&layout)], &module, "main");
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("composite::params"),
-            size: std::mem::size_of::<GpuCompositeParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let params = uniform_buffer::<GpuCompositeParams>(device, "composite::params");
         Ok(Self {
             pipeline,
             layout,
@@ -102,17 +97,13 @@ impl CompositePass {
                 },
             ],
         });
-        encoder.push_debug_group("composite");
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("composite::pass"),
-                timestamp_writes: timer.compute_pass("composite"),
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            let (gx, gy) = groups_2d(size.0, size.1);
-            pass.dispatch_workgroups(gx, gy, 1);
-        }
-        encoder.pop_debug_group();
+        run_compute(
+            encoder,
+            timer,
+            "composite",
+            &self.pipeline,
+            &bind,
+            groups_image(size.0, size.1),
+        );
     }
 }

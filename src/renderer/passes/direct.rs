@@ -8,7 +8,8 @@ use crate::renderer::{
 };
 
 use super::{
-    compute_pipeline, float_texture_entry, groups_2d, storage_texture_entry, texture_entry, uniform_entry,
+    compute_pipeline, float_texture_entry, groups_image, run_compute, storage_texture_entry, texture_entry,
+    uniform_entry,
 };
 
 pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -91,17 +92,13 @@ impl DirectPass {
                 },
             ],
         });
-        encoder.push_debug_group("direct");
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("direct::pass"),
-                timestamp_writes: timer.compute_pass("direct"),
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            let (gx, gy) = groups_2d(size.0, size.1);
-            pass.dispatch_workgroups(gx, gy, 1);
-        }
-        encoder.pop_debug_group();
+        run_compute(
+            encoder,
+            timer,
+            "direct",
+            &self.pipeline,
+            &bind,
+            groups_image(size.0, size.1),
+        );
     }
 }

@@ -3,7 +3,10 @@
 
 use crate::renderer::{gpu_data::DisplayParams, settings::DisplaySettings, shaders, timing::GpuTimer};
 
-use super::{compute_pipeline, float_texture_entry, groups_2d, storage_texture_entry, uniform_entry};
+use super::{
+    compute_pipeline, float_texture_entry, groups_image, run_compute, storage_texture_entry, uniform_buffer,
+    uniform_entry,
+};
 
 pub const VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
@@ -25,12 +28,7 @@ impl DisplayPass {
             ],
         });
         let pipeline = compute_pipeline(device, "display::pipeline", &[Some(&layout)], &module, "main");
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("display::params"),
-            size: std::mem::size_of::<DisplayParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let params = uniform_buffer::<DisplayParams>(device, "display::params");
         Ok(Self {
             pipeline,
             layout,
@@ -74,17 +72,13 @@ impl DisplayPass {
                 },
             ],
         });
-        encoder.push_debug_group("display");
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("display::pass"),
-                timestamp_writes: timer.compute_pass("display"),
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            let (gx, gy) = groups_2d(size.0, size.1);
-            pass.dispatch_workgroups(gx, gy, 1);
-        }
-        encoder.pop_debug_group();
+        run_compute(
+            encoder,
+            timer,
+            "display",
+            &self.pipeline,
+            &bind,
+            groups_image(size.0, size.1),
+        );
     }
 }

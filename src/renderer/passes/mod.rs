@@ -19,6 +19,11 @@ pub const WG_2D: u32 = 8;
 /// Workgroup size of the 1D kernels (`@workgroup_size(64, 1, 1)`).
 pub const WG_1D: u32 = 64;
 
+/// Workgroup counts (x, y, 1) covering a `w` x `h` image.
+pub fn groups_image(w: u32, h: u32) -> (u32, u32, u32) {
+    (w.div_ceil(WG_2D), h.div_ceil(WG_2D), 1)
+}
+
 /// Number of workgroups covering a `w` x `h` image.
 pub fn groups_2d(w: u32, h: u32) -> (u32, u32) {
     (w.div_ceil(WG_2D), h.div_ceil(WG_2D))
@@ -92,6 +97,39 @@ pub(crate) fn storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -
         },
         count: None,
     }
+}
+
+/// A uniform buffer sized for `T`, written with `queue.write_buffer` before use.
+pub(crate) fn uniform_buffer<T>(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: std::mem::size_of::<T>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Records one timed compute pass `name` (inside a debug group of the same name) that
+/// dispatches `pipeline` once over `groups` with `bind` at group 0.
+pub(crate) fn run_compute(
+    encoder: &mut wgpu::CommandEncoder,
+    timer: &mut crate::renderer::timing::GpuTimer,
+    name: &str,
+    pipeline: &wgpu::ComputePipeline,
+    bind: &wgpu::BindGroup,
+    groups: (u32, u32, u32),
+) {
+    encoder.push_debug_group(name);
+    {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(name),
+            timestamp_writes: timer.compute_pass(name),
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind, &[]);
+        pass.dispatch_workgroups(groups.0, groups.1, groups.2);
+    }
+    encoder.pop_debug_group();
 }
 
 pub(crate) fn compute_pipeline(

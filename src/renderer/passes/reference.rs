@@ -12,8 +12,8 @@ use crate::renderer::{
 };
 
 use super::{
-    compute_pipeline, float_texture_entry, groups_2d, storage_entry, texture_entry, uniform_entry,
-    vpl_gen::VplBuffers,
+    compute_pipeline, float_texture_entry, groups_image, run_compute, storage_entry, texture_entry,
+    uniform_buffer, uniform_entry, vpl_gen::VplBuffers,
 };
 
 /// Twin: `RefParams` in `shaders/reference.wgsl`.
@@ -68,12 +68,7 @@ impl ReferencePass {
             ],
         });
         let pipeline = compute_pipeline(device, "reference::pipeline", &[Some(&layout)], &module, "main");
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("reference::params"),
-            size: std::mem::size_of::<GpuRefParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let params = uniform_buffer::<GpuRefParams>(device, "reference::params");
         Ok(Self {
             pipeline,
             layout,
@@ -128,17 +123,13 @@ impl ReferencePass {
             layout: &self.layout,
             entries: &entries,
         });
-        encoder.push_debug_group("reference");
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("reference::pass"),
-                timestamp_writes: timer.compute_pass("reference"),
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            let (gx, gy) = groups_2d(p.width, p.height);
-            pass.dispatch_workgroups(gx, gy, 1);
-        }
-        encoder.pop_debug_group();
+        run_compute(
+            encoder,
+            timer,
+            "reference",
+            &self.pipeline,
+            &bind,
+            groups_image(p.width, p.height),
+        );
     }
 }

@@ -6,8 +6,8 @@ use bytemuck::{Pod, Zeroable};
 use crate::renderer::{shaders, timing::GpuTimer};
 
 use super::{
-    WG_1D, compute_pipeline, display::VIEW_FORMAT, float_texture_entry, storage_entry, storage_texture_entry,
-    uniform_entry,
+    WG_1D, compute_pipeline, display::VIEW_FORMAT, float_texture_entry, run_compute, storage_entry,
+    storage_texture_entry, uniform_buffer, uniform_entry,
 };
 
 /// Twin: `SplatParams` in `shaders/vpl_splat.wgsl`.
@@ -47,12 +47,7 @@ impl VplSplatPass {
             ],
         });
         let pipeline = compute_pipeline(device, "vpl_splat::pipeline", &[Some(&layout)], &module, "main");
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("vpl_splat::params"),
-            size: std::mem::size_of::<GpuSplatParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let params = uniform_buffer::<GpuSplatParams>(device, "vpl_splat::params");
         Ok(Self {
             pipeline,
             layout,
@@ -108,16 +103,13 @@ impl VplSplatPass {
                 },
             ],
         });
-        encoder.push_debug_group("vpl_splat");
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("vpl_splat::pass"),
-                timestamp_writes: timer.compute_pass("vpl_splat"),
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.dispatch_workgroups(p.count.div_ceil(WG_1D), 1, 1);
-        }
-        encoder.pop_debug_group();
+        run_compute(
+            encoder,
+            timer,
+            "vpl_splat",
+            &self.pipeline,
+            &bind,
+            (p.count.div_ceil(WG_1D), 1, 1),
+        );
     }
 }
