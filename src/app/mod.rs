@@ -481,32 +481,43 @@ impl WorkbenchApp {
         });
     }
 
+    /// One line of fixed height (so the layout never jumps with the length of the timings):
+    /// the adapter, resolution, VPLs and frame time first, then the per-pass GPU times,
+    /// truncated to the window; hovering shows every pass.
     fn status_bar(&self, ui: &mut egui::Ui) {
-        ui.horizontal_wrapped(|ui| {
+        ui.horizontal(|ui| {
             ui.label(format!("GPU: {}", self.adapter));
+            let Some(r) = &self.renderer else { return };
             ui.separator();
-            if let Some(r) = &self.renderer {
-                let (w, h) = r.size();
-                ui.label(format!("{w}x{h}"));
-                ui.separator();
-                if !r.timestamps_supported() {
-                    ui.label("timestamps not supported");
-                } else if let Some(t) = &self.timings {
-                    ui.label(t.summary());
-                } else {
-                    ui.label("GPU timings pending");
-                }
-                ui.separator();
-                match self.flux_total {
-                    Some(f) => ui.label(format!(
-                        "VPLs {} · reflected flux {:.4} W (lum.)",
-                        r.vpl_frame().count,
-                        f
-                    )),
-                    None => ui.label(format!("VPLs {}", r.vpl_frame().count)),
-                };
-                ui.separator();
-                ui.label(format!("frame {:.1} ms", self.frame_ms_smoothed));
+            let (w, h) = r.size();
+            ui.label(format!("{w}x{h}"));
+            ui.separator();
+            match self.flux_total {
+                Some(f) => ui.label(format!(
+                    "VPLs {} · reflected flux {:.4} W (lum.)",
+                    r.vpl_frame().count,
+                    f
+                )),
+                None => ui.label(format!("VPLs {}", r.vpl_frame().count)),
+            };
+            ui.separator();
+            ui.label(format!("frame {:.1} ms", self.frame_ms_smoothed));
+            ui.separator();
+            if !r.timestamps_supported() {
+                ui.label("timestamps not supported");
+            } else if let Some(t) = &self.timings {
+                let lines: Vec<String> = t
+                    .passes
+                    .iter()
+                    .map(|(n, ms)| format!("{n:<16} {ms:>9.3} ms"))
+                    .collect();
+                ui.add(egui::Label::new(t.summary()).truncate())
+                    .on_hover_ui(|ui| {
+                        ui.label(egui::RichText::new(lines.join("\n")).monospace());
+                        ui.label(format!("total {:.3} ms", t.total_ms()));
+                    });
+            } else {
+                ui.label("GPU timings pending");
             }
         });
     }

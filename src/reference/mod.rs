@@ -13,5 +13,6 @@ pub mod direct;
 pub mod display;
 pub mod gbuffer;
 pub mod gi;
+pub mod sst;
 pub mod visualise;
 pub mod vpl;

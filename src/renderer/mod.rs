@@ -29,6 +29,7 @@ use passes::{
     ground_truth::GroundTruthPass,
     reference::{GpuRefParams, ReferencePass},
     rsm::RsmPass,
+    sst_sort::{SortBuffers, SortPass},
     visualise::{VisMode, VisSource, VisualisePass},
     vpl_gen::{VplBuffers, VplFrame, VplGenPass},
     vpl_splat::{GpuSplatParams, VplSplatPass},
@@ -119,6 +120,8 @@ pub struct Renderer {
     composite: CompositePass,
     reference: ReferencePass,
     vpl_splat: VplSplatPass,
+    sst_sort: SortPass,
+    sort_buffers: SortBuffers,
     vpl_buffers: VplBuffers,
     vpl_frame: VplFrame,
     gt: Option<GtState>,
@@ -199,6 +202,8 @@ impl Renderer {
             composite: CompositePass::new(device)?,
             reference: ReferencePass::new(device)?,
             vpl_splat: VplSplatPass::new(device)?,
+            sst_sort: SortPass::new(device)?,
+            sort_buffers: SortBuffers::new(device, settings.vpl.count),
             vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
             vpl_frame: VplFrame::default(),
             gt: None,
@@ -232,13 +237,14 @@ impl Renderer {
                 CompositePass::new(device),
                 ReferencePass::new(device),
                 VplSplatPass::new(device),
+                SortPass::new(device),
             ),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
         }
-        let (g, s, d, disp, v, (vg, gt, c, rf, sp)) = passes;
-        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?);
+        let (g, s, d, disp, v, (vg, gt, c, rf, sp, so)) = passes;
+        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?, so?);
         (
             self.gbuffer,
             self.rsm,
@@ -250,6 +256,7 @@ impl Renderer {
             self.composite,
             self.reference,
             self.vpl_splat,
+            self.sst_sort,
         ) = new;
         Ok(())
     }
@@ -414,6 +421,18 @@ impl Renderer {
                 &t.shadow,
                 &t.gbuffer,
                 &self.vpl_buffers,
+            );
+            // SST stages 8-9: sort keys and the bitonic sort of (key, index) pairs.
+            if self.sort_buffers.count != self.vpl_frame.count {
+                self.sort_buffers = SortBuffers::new(&device, self.vpl_frame.count);
+            }
+            self.sst_sort.record(
+                &device,
+                &queue,
+                &mut enc,
+                &mut self.timer,
+                &self.vpl_buffers.vpls,
+                &self.sort_buffers,
             );
         }
         let indirect_scale = match s.gi.method {
@@ -642,6 +661,13 @@ impl Renderer {
             total += f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
         }
         Ok(total)
+    }
+
+    /// The sorted (key, VPL index) pairs of the last frame (SST stages 8-9).
+    pub fn read_sorted_keys(&self) -> Result<Vec<(u64, u32)>, GpuError> {
+        let mut v = passes::sst_sort::read_pairs(&self.ctx, &self.sort_buffers)?;
+        v.truncate(self.sort_buffers.count as usize);
+        Ok(v)
     }
 
     /// Reads the last frame's VPLs back.

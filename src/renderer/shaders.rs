@@ -49,6 +49,7 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),
     ("reference.wgsl", include_str!("../../shaders/reference.wgsl")),
     ("vpl_splat.wgsl", include_str!("../../shaders/vpl_splat.wgsl")),
+    ("sst_sort.wgsl", include_str!("../../shaders/sst_sort.wgsl")),
     ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
     ("rsm.wgsl", include_str!("../../shaders/rsm.wgsl")),
     ("direct.wgsl", include_str!("../../shaders/direct.wgsl")),
@@ -70,6 +71,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "composite.wgsl",
     "reference.wgsl",
     "vpl_splat.wgsl",
+    "sst_sort.wgsl",
 ];
 
 #[derive(Debug, Error, PartialEq)]

@@ -1,0 +1,274 @@
+//! SST stages 8-9 (SST paper 3.3, thesis 4.2.1): VPL bounds, 64-bit sort keys (Morton |
+//! normal code | id) and a bitonic sort of (key, index) pairs padded to a power of two. Only
+//! the pairs move; the VPLs are permuted once afterwards (by the tree build).
+//! Reads: the VPL array. Writes: [`SortBuffers`].
+
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+use crate::renderer::{
+    context::{GpuContext, GpuError},
+    readback, shaders,
+    timing::GpuTimer,
+};
+
+use super::{WG_1D, compute_pipeline, storage_entry};
+
+/// Twin: `SortParams` in `shaders/sst_sort.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuSortParams {
+    pub count: u32,
+    pub padded: u32,
+    pub j: u32,
+    pub k: u32,
+}
+
+/// Dynamic-offset stride of the per-step uniforms, and the most steps (2^22 padded pairs).
+const STRIDE: u64 = 256;
+const MAX_STEPS: u64 = 22 * 23 / 2 + 1;
+
+/// The (key, index) pairs (vec4<u32>: key high word, key low word, index, 0) and the bounds.
+pub struct SortBuffers {
+    pub keys: wgpu::Buffer,
+    pub bounds: wgpu::Buffer,
+    pub count: u32,
+    pub padded: u32,
+}
+
+impl SortBuffers {
+    pub fn new(device: &wgpu::Device, count: u32) -> Self {
+        let padded = count.max(1).next_power_of_two();
+        Self {
+            keys: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("sst_sort::keys"),
+                size: 16 * padded as u64,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            bounds: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("sst_sort::bounds"),
+                size: 32,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            count,
+            padded,
+        }
+    }
+}
+
+/// The bitonic steps (j, k) for `padded` elements, in order.
+pub fn bitonic_steps(padded: u32) -> Vec<(u32, u32)> {
+    let mut steps = Vec::new();
+    let mut k = 2;
+    while k <= padded {
+        let mut j = k / 2;
+        while j > 0 {
+            steps.push((j, k));
+            j /= 2;
+        }
+        k *= 2;
+    }
+    steps
+}
+
+pub struct SortPass {
+    bounds: wgpu::ComputePipeline,
+    keys: wgpu::ComputePipeline,
+    step: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+}
+
+impl SortPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let module = shaders::create_module(device, "sst_sort.wgsl")?;
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sst_sort::layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: c,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(16),
+                    },
+                    count: None,
+                },
+                storage_entry(1, c, true),
+                storage_entry(2, c, false),
+                storage_entry(3, c, false),
+            ],
+        });
+        let l = [Some(&layout)];
+        Ok(Self {
+            bounds: compute_pipeline(device, "sst_sort::bounds", &l, &module, "vpl_bounds"),
+            keys: compute_pipeline(device, "sst_sort::keys", &l, &module, "make_keys"),
+            step: compute_pipeline(device, "sst_sort::bitonic", &l, &module, "bitonic_step"),
+            params: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("sst_sort::params"),
+                size: STRIDE * MAX_STEPS,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            layout,
+        })
+    }
+
+    fn bind(&self, device: &wgpu::Device, vpls: &wgpu::Buffer, out: &SortBuffers) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sst_sort::bind_group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.params,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(16),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: vpls.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: out.keys.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: out.bounds.as_entire_binding(),
+                },
+            ],
+        })
+    }
+
+    /// Records bounds + keys of the first `out.count` VPLs, then the sort.
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        vpls: &wgpu::Buffer,
+        out: &SortBuffers,
+    ) {
+        let bind = self.bind(device, vpls, out);
+        let base = GpuSortParams {
+            count: out.count,
+            padded: out.padded,
+            j: 0,
+            k: 0,
+        };
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&base));
+        encoder.push_debug_group("sst_keys");
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("sst_keys"),
+                timestamp_writes: timer.compute_pass("sst_keys"),
+            });
+            pass.set_bind_group(0, &bind, &[0]);
+            pass.set_pipeline(&self.bounds);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&self.keys);
+            pass.dispatch_workgroups(out.padded.div_ceil(WG_1D), 1, 1);
+        }
+        encoder.pop_debug_group();
+        self.record_sort_only(queue, encoder, timer, &bind, out);
+    }
+
+    fn record_sort_only(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        bind: &wgpu::BindGroup,
+        out: &SortBuffers,
+    ) {
+        let steps = bitonic_steps(out.padded);
+        for (n, (j, k)) in steps.iter().enumerate() {
+            let p = GpuSortParams {
+                count: out.count,
+                padded: out.padded,
+                j: *j,
+                k: *k,
+            };
+            queue.write_buffer(&self.params, (n as u64 + 1) * STRIDE, bytemuck::bytes_of(&p));
+        }
+        encoder.push_debug_group("sst_sort");
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("sst_sort"),
+                timestamp_writes: timer.compute_pass("sst_sort"),
+            });
+            pass.set_pipeline(&self.step);
+            for n in 0..steps.len() as u64 {
+                pass.set_bind_group(0, bind, &[((n + 1) * STRIDE) as u32]);
+                pass.dispatch_workgroups(out.padded.div_ceil(WG_1D), 1, 1);
+            }
+        }
+        encoder.pop_debug_group();
+    }
+
+    /// Sorts arbitrary 64-bit keys on the GPU (tests): returns (key, original index) pairs.
+    pub fn sort_keys(&self, ctx: &GpuContext, keys: &[u64]) -> Result<Vec<(u64, u32)>, GpuError> {
+        let device = &ctx.device;
+        let mut out = SortBuffers::new(device, keys.len() as u32);
+        let mut data: Vec<[u32; 4]> = keys
+            .iter()
+            .enumerate()
+            .map(|(i, k)| [(k >> 32) as u32, *k as u32, i as u32, 0])
+            .collect();
+        data.resize(out.padded as usize, [u32::MAX, u32::MAX, u32::MAX, 0]);
+        out.keys = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("sst_sort::test_keys"),
+            contents: bytemuck::cast_slice(&data),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        });
+        let dummy = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sst_sort::no_vpls"),
+            size: 48,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let bind = self.bind(device, &dummy, &out);
+        let mut timer = GpuTimer::new(device, &ctx.queue);
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("sst_sort::test"),
+        });
+        self.record_sort_only(&ctx.queue, &mut enc, &mut timer, &bind, &out);
+        ctx.queue.submit([enc.finish()]);
+        read_pairs(ctx, &out).map(|mut v| {
+            v.truncate(keys.len());
+            v
+        })
+    }
+}
+
+/// Reads the (key, index) pairs back.
+pub fn read_pairs(ctx: &GpuContext, out: &SortBuffers) -> Result<Vec<(u64, u32)>, GpuError> {
+    let bytes = readback::read_storage_buffer(ctx, &out.keys)?;
+    let words: &[[u32; 4]] = bytemuck::cast_slice(&bytes);
+    Ok(words
+        .iter()
+        .map(|w| (((w[0] as u64) << 32) | w[1] as u64, w[2]))
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bitonic_steps;
+
+    #[test]
+    fn bitonic_step_count() {
+        assert_eq!(bitonic_steps(1).len(), 0);
+        assert_eq!(bitonic_steps(8).len(), 6);
+        assert_eq!(bitonic_steps(1 << 20).len(), 210);
+    }
+}
