@@ -3,10 +3,9 @@
 // that no dispatch runs long:
 //   L(x) = rho_x / pi x sum_v flux_v / pi x cos_x x cos_v / max(d^2, eps^2) x V(x, v)
 // CPU twin: src/reference/gi.rs.
-#include "common/bvh.wgsl"
+#include "common/math.wgsl"
 #include "common/vpl.wgsl"
-
-const PI_G: f32 = 3.14159265358979;
+#include "common/vpl_visibility.wgsl"
 
 struct GtParams {
     begin: u32,
@@ -33,20 +32,11 @@ fn vpl_irradiance_term(v: Vpl, x: vec3<f32>, nx: vec3<f32>) -> vec3<f32> {
     if v.id == VPL_NONE {
         return vec3<f32>(0.0);
     }
-    let d = v.position.xyz - x;
-    let dist2 = dot(d, d);
-    let w = d * inverseSqrt(max(dist2, 1e-30));
-    let cx = dot(nx, w);
-    let cv = -dot(v.normal, w);
-    if cx <= 0.0 || cv <= 0.0 {
+    let g = vpl_geometry(v.position.xyz, v.normal, x, nx, params.epsilon);
+    if g <= 0.0 || !vpl_visible(v.position.xyz, v.normal, x, nx, params.ray_offset) {
         return vec3<f32>(0.0);
     }
-    let o = x + nx * params.ray_offset;
-    let e = v.position.xyz + v.normal * params.ray_offset;
-    if bvh_any_hit(o, e - o, 1e-4, 1.0 - 1e-4) {
-        return vec3<f32>(0.0);
-    }
-    return v.flux.rgb / PI_G * (cx * cv / max(dist2, params.epsilon * params.epsilon));
+    return v.flux.rgb / PI * g;
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -66,5 +56,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         sum += vpl_irradiance_term(vpls[i], g.xyz, nx);
     }
     let k = gid.y * params.width + gid.x;
-    accum[k] += vec4<f32>(albedo / PI_G * sum, 0.0);
+    accum[k] += vec4<f32>(albedo / PI * sum, 0.0);
 }

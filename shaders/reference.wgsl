@@ -9,13 +9,12 @@
 // cos_x <= 0); at the texel level B is the exact unoccluded G. With m > 0 every texel that can
 // contribute has a non-zero probability, so the estimator f / pmf is unbiased.
 // CPU twin: src/reference/gi.rs (exact sum over all texels).
-#include "common/bvh.wgsl"
+#include "common/math.wgsl"
+#include "common/vpl_visibility.wgsl"
 #include "common/color.wgsl"
 #include "common/random.wgsl"
 #include "common/vpl.wgsl"
 #include "common/rsm_pyramid.wgsl"
-
-const PI_R: f32 = 3.14159265358979;
 
 struct RefParams {
     width: u32,
@@ -56,10 +55,7 @@ fn box_bound(layer: u32, level: u32, nx: u32, ny: u32, x: vec3<f32>, n: vec3<f32
             return 0.0;
         }
         let tn = normalize(textureLoad(rsm_normal, t, i32(layer), 0).xyz);
-        let d = p.xyz - x;
-        let d2 = dot(d, d);
-        let w = d * inverseSqrt(max(d2, 1e-30));
-        return max(dot(n, w), 0.0) * max(-dot(tn, w), 0.0) / max(d2, rp.epsilon * rp.epsilon);
+        return vpl_geometry(p.xyz, tn, x, n, rp.epsilon);
     }
     let b = bounds_index(layer, level, nx, ny);
     let lo = bounds_pyramid[2u * b].xyz;
@@ -158,20 +154,11 @@ fn sample_once(rng: ptr<function, Rng>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32>
     }
     let tn = normalize(textureLoad(rsm_normal, t, i32(layer), 0).xyz);
     let flux = textureLoad(rsm_flux, t, i32(layer), 0).rgb;
-    let d = tp.xyz - p;
-    let dist2 = dot(d, d);
-    let w = d * inverseSqrt(max(dist2, 1e-30));
-    let cx = dot(n, w);
-    let cv = -dot(tn, w);
-    if cx <= 0.0 || cv <= 0.0 {
+    let g = vpl_geometry(tp.xyz, tn, p, n, rp.epsilon);
+    if g <= 0.0 || !vpl_visible(tp.xyz, tn, p, n, rp.ray_offset) {
         return vec3<f32>(0.0);
     }
-    let o = p + n * rp.ray_offset;
-    let e = tp.xyz + tn * rp.ray_offset;
-    if bvh_any_hit(o, e - o, 1e-4, 1.0 - 1e-4) {
-        return vec3<f32>(0.0);
-    }
-    return flux / PI_R * (cx * cv / max(dist2, rp.epsilon * rp.epsilon)) / pmf;
+    return flux / PI * g / pmf;
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -192,5 +179,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         var rng = rng_new(k, rp.first_sample + s, rp.seed ^ 0x5bd1e995u);
         sum += sample_once(&rng, g.xyz, n);
     }
-    accum[k] += vec4<f32>(albedo / PI_R * sum, 0.0);
+    accum[k] += vec4<f32>(albedo / PI * sum, 0.0);
 }

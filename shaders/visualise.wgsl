@@ -25,7 +25,6 @@ struct VisParams {
 @group(0) @binding(0) var<uniform> params: VisParams;
 @group(0) @binding(1) var dst: texture_storage_2d<rgba8unorm, write>;
 @group(1) @binding(0) var src_float: texture_2d<f32>;
-@group(1) @binding(1) var src_aux: texture_2d<f32>;
 @group(2) @binding(0) var src_depth: texture_depth_2d_array;
 @group(3) @binding(0) var src_uint: texture_2d<u32>;
 @group(1) @binding(2) var src_array: texture_2d_array<f32>;
@@ -58,7 +57,7 @@ fn vis_float(@builtin(global_invocation_id) gid: vec3<u32>) {
             c = linear_to_srgb(v.rgb);
         }
         case 2u: {
-            // src = position; aux unused. Background stays black.
+            // Background stays black.
             c = select(vec3<f32>(0.0), normalised(v.xyz), v.w > 0.0);
         }
         case 3u: {

@@ -4,9 +4,8 @@
 // CPU twin: src/reference/vpl.rs.
 #include "common/camera.wgsl"
 #include "common/color.wgsl"
+#include "common/math.wgsl"
 #include "common/random.wgsl"
-
-const PI_V: f32 = 3.14159265358979;
 
 
 
@@ -90,12 +89,7 @@ fn importance(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         let nx = normalize(textureLoad(gb_normal, vec2<i32>(px), 0).xyz);
         let albedo = luminance(textureLoad(gb_albedo, vec2<i32>(px), 0).rgb);
-        let d = g.xyz - p;
-        let dist2 = dot(d, d);
-        let w = d * inverseSqrt(max(dist2, 1e-30));
-        let cos_v = max(dot(nv, w), 0.0);
-        let cos_x = max(-dot(nx, w), 0.0);
-        sum += albedo / PI_V * flux_lum / PI_V * cos_v * cos_x / max(dist2, params.epsilon * params.epsilon);
+        sum += albedo / PI * flux_lum / PI * vpl_geometry(p, nv, g.xyz, nx, params.epsilon);
     }
     importance_raw[raw_index] = sum / f32(params.samples);
 }

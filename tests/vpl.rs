@@ -11,7 +11,7 @@ use lightcut::{
         passes::vpl_gen::pyramid_layout,
         settings::{GiMethod, RenderSettings, ViewBuffer, VplMode},
     },
-    scene::{Bvh, Scene, bvh::Ray, default_scene},
+    scene::{Bvh, Scene, default_scene},
 };
 
 fn lum(c: [f32; 3]) -> f64 {
@@ -240,44 +240,31 @@ fn ground_truth_on_the_gpu_equals_a_cpu_evaluation_of_the_same_vpls() {
     let alb = r.read(Buffer::Albedo).unwrap();
     let vpls = r.read_vpls().unwrap();
     let bvh = Bvh::build(&scene.positions, &scene.indices);
-    let eps = settings.gi.distance_epsilon;
-    let off = settings.gi.ray_offset;
+    // The VPLs as the CPU reference's emitters (empty VPLs contribute nothing).
+    let emitters: Vec<reference::gi::Texel> = vpls
+        .iter()
+        .filter(|v| v.id != VPL_NONE)
+        .map(|v| reference::gi::Texel {
+            position: Vec3::from_slice(&v.position[..3]),
+            normal: Vec3::from_array(v.normal),
+            flux: Vec3::from_slice(&v.flux[..3]),
+        })
+        .collect();
     let (mut checked, mut lit) = (0, 0);
     for k in (0..(w * h) as usize).step_by(7) {
         let p = pos.pixels[k];
         if p[3] == 0.0 {
             continue;
         }
-        let x = Vec3::new(p[0], p[1], p[2]);
-        let nx = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
-        let a = Vec3::from_slice(&alb.pixels[k][..3]);
-        let mut sum = Vec3::ZERO;
-        for v in &vpls {
-            if v.id == VPL_NONE {
-                continue;
-            }
-            let vp = Vec3::from_slice(&v.position[..3]);
-            let vn = Vec3::from_array(v.normal);
-            let d = vp - x;
-            let dist2 = d.length_squared();
-            let wdir = d / dist2.sqrt();
-            let (cx, cv) = (nx.dot(wdir), -vn.dot(wdir));
-            if cx <= 0.0 || cv <= 0.0 {
-                continue;
-            }
-            let o = x + nx * off;
-            let e = vp + vn * off;
-            if bvh.any_hit(&Ray {
-                origin: o,
-                dir: e - o,
-                tmin: 1e-4,
-                tmax: 1.0 - 1e-4,
-            }) {
-                continue;
-            }
-            sum += Vec3::from_slice(&v.flux[..3]) / std::f32::consts::PI * (cx * cv / dist2.max(eps * eps));
-        }
-        let want = a / std::f32::consts::PI * sum;
+        let want = reference::gi::exact_indirect(
+            &bvh,
+            Vec3::new(p[0], p[1], p[2]),
+            Vec3::from_slice(&nrm.pixels[k][..3]).normalize(),
+            Vec3::from_slice(&alb.pixels[k][..3]),
+            &emitters,
+            settings.gi.distance_epsilon,
+            settings.gi.ray_offset,
+        );
         let got = Vec3::from_slice(&ind.pixels[k][..3]);
         let tol = 1e-3 * want.max_element().max(1e-6);
         assert!(

@@ -4,8 +4,8 @@
 // Contract: a shader including this file declares
 //   `shadow_maps: texture_depth_2d_array` and `lights: Lights` (a uniform)
 // at module scope with its own bindings.
+#include "common/math.wgsl"
 
-const PI: f32 = 3.14159265358979;
 
 struct DirectionalLight {
     view_proj: mat4x4<f32>,

@@ -10,3 +10,17 @@ struct Vpl {
     id: u32,             // light layer << 24 | RSM texel index; VPL_NONE for an empty VPL
     flux: vec4<f32>,     // rgb flux in W (texel flux / (N_light x pmf)), w = 1 if valid
 };
+
+// Unoccluded geometric term of light from a VPL at pv (normal nv) to x (normal nx):
+// cos_x x cos_v / max(d^2, eps^2), 0 when either side faces away.
+fn vpl_geometry(pv: vec3<f32>, nv: vec3<f32>, x: vec3<f32>, nx: vec3<f32>, eps: f32) -> f32 {
+    let d = pv - x;
+    let dist2 = dot(d, d);
+    let w = d * inverseSqrt(max(dist2, 1e-30));
+    let cx = dot(nx, w);
+    let cv = -dot(nv, w);
+    if cx <= 0.0 || cv <= 0.0 {
+        return 0.0;
+    }
+    return cx * cv / max(dist2, eps * eps);
+}

@@ -122,8 +122,6 @@ pub struct WorkbenchApp {
     screenshot_requested: bool,
     last_frame_time: Option<f64>,
     frame_ms_smoothed: f64,
-    /// RSM reflected flux (luminance, W), refreshed every 30 frames.
-    flux_total: Option<f32>,
     adapter: String,
 }
 
@@ -151,7 +149,6 @@ impl WorkbenchApp {
             screenshot_requested: false,
             last_frame_time: None,
             frame_ms_smoothed: 0.0,
-            flux_total: None,
             adapter: String::new(),
         };
         let Some(rs) = app.render_state.clone() else {
@@ -225,14 +222,6 @@ impl WorkbenchApp {
     }
     pub fn frames(&self) -> u64 {
         self.frames
-    }
-
-    /// The lights of the next frame (light 0 as the sun controls say).
-    pub fn lights(&self) -> Vec<DirectionalLight> {
-        self.open
-            .as_ref()
-            .map(|o| lights_with_sun(&o.scene, self.sun.as_ref()))
-            .unwrap_or_default()
     }
 
     fn side_panel(&mut self, ui: &mut egui::Ui) {
@@ -492,7 +481,7 @@ impl WorkbenchApp {
             let (w, h) = r.size();
             ui.label(format!("{w}x{h}"));
             ui.separator();
-            match self.flux_total {
+            match r.flux_total() {
                 Some(f) => ui.label(format!(
                     "VPLs {} · reflected flux {:.4} W (lum.)",
                     r.vpl_frame().count,
@@ -625,11 +614,6 @@ impl WorkbenchApp {
             legend(ui, draw, "importance / mean (log)", -3.0, 2.0);
         } else if self.settings.display.vpl_overlay {
             legend(ui, draw, "VPL flux / mean (log)", -2.0, 2.0);
-        }
-        if self.frames.is_multiple_of(30)
-            && let Some(r) = &self.renderer
-        {
-            self.flux_total = r.rsm_flux_total().ok();
         }
         self.frames += 1;
     }

@@ -50,12 +50,4 @@ impl ViewportTexture {
             }
         }
     }
-
-    /// Forgets the texture (after the renderer was replaced).
-    pub fn reset(&mut self, render_state: &egui_wgpu::RenderState) {
-        if let Some(id) = self.id.take() {
-            render_state.renderer.write().free_texture(&id);
-        }
-        self.generation = u64::MAX;
-    }
 }

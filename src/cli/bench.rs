@@ -13,7 +13,7 @@ use crate::{
     },
     scene::{
         Scene,
-        bvh::{Bvh, Ray},
+        bvh::{Bvh, Pcg32, Ray},
         preset::{SceneSource, open_scene},
     },
 };
@@ -42,17 +42,6 @@ pub struct BenchArgs {
     pub seed: u64,
 }
 
-/// xorshift64* in [0, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 40) as f32) / (1u64 << 24) as f32
-    }
-}
-
 /// Area-weighted random points on the scene's triangles, with their geometric normals.
 pub fn surface_points(scene: &Scene, n: usize, seed: u64) -> Vec<(Vec3, Vec3)> {
     let mut cdf = Vec::with_capacity(scene.triangle_count());
@@ -62,13 +51,13 @@ pub fn surface_points(scene: &Scene, n: usize, seed: u64) -> Vec<(Vec3, Vec3)> {
         total += 0.5 * (b - a).cross(c - a).length() as f64;
         cdf.push(total);
     }
-    let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let mut rng = Pcg32::new(seed);
     (0..n)
         .map(|_| {
-            let x = rng.next() as f64 * total;
+            let x = rng.next_f32() as f64 * total;
             let t = cdf.partition_point(|&c| c < x).min(cdf.len() - 1);
             let [a, b, c] = scene.triangle(t);
-            let (mut u, mut v) = (rng.next(), rng.next());
+            let (mut u, mut v) = (rng.next_f32(), rng.next_f32());
             if u + v > 1.0 {
                 u = 1.0 - u;
                 v = 1.0 - v;
@@ -105,12 +94,12 @@ pub fn shadow_rays(scene: &Scene, n: usize, seed: u64) -> Vec<Ray> {
 /// Rays from random surface points in random directions (closest hit).
 pub fn probe_rays(scene: &Scene, n: usize, seed: u64) -> Vec<Ray> {
     let eps = 1e-4 * scene.bounds.radius().max(1e-3);
-    let mut rng = Rng(seed ^ 0x5555_5555 | 1);
+    let mut rng = Pcg32::new(seed ^ 0x5555_5555);
     surface_points(scene, n, seed ^ 0x1234)
         .into_iter()
         .map(|(p, nrm)| {
-            let z = 2.0 * rng.next() - 1.0;
-            let phi = std::f32::consts::TAU * rng.next();
+            let z = 2.0 * rng.next_f32() - 1.0;
+            let phi = std::f32::consts::TAU * rng.next_f32();
             let r = (1.0 - z * z).max(0.0).sqrt();
             let mut d = Vec3::new(r * phi.cos(), r * phi.sin(), z);
             if d.dot(nrm) < 0.0 {

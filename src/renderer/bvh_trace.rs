@@ -123,7 +123,7 @@ impl BvhTracer {
         };
         let groups = (rays.len() as u32).div_ceil(WG_1D);
         if groups > MAX_GROUPS_X {
-            return Err(GpuError::Readback(format!(
+            return Err(GpuError::Limit(format!(
                 "{} rays exceed one dispatch ({} max)",
                 rays.len(),
                 MAX_GROUPS_X as u64 * WG_1D as u64

@@ -26,6 +26,8 @@ pub enum GpuError {
     },
     #[error("GPU readback failed: {0}")]
     Readback(String),
+    #[error("{0}")]
+    Limit(String),
 }
 
 /// The optional features the workbench uses when the adapter has them.

@@ -126,9 +126,12 @@ pub struct Renderer {
     vpl_frame: VplFrame,
     gt: Option<GtState>,
     reference_state: Option<(u64, GiProgress)>,
-    /// Luminance of each light's irradiance and light 0's shadow texel size, last frame.
-    lights_cache: Vec<f32>,
+    /// Luminance of light 0's irradiance and its shadow texel size, last frame (RSM flux view).
+    light0_lum: f32,
     lights_texel: f32,
+    /// The RSMs' total reflected flux (flux-pyramid tops), read back without blocking.
+    flux_readback: readback::AsyncReadback,
+    flux_total: Option<f32>,
     camera_buf: wgpu::Buffer,
     lights_buf: wgpu::Buffer,
     timer: GpuTimer,
@@ -208,8 +211,14 @@ impl Renderer {
             vpl_frame: VplFrame::default(),
             gt: None,
             reference_state: None,
-            lights_cache: Vec::new(),
+            light0_lum: 0.0,
             lights_texel: 0.0,
+            flux_readback: readback::AsyncReadback::new(
+                device,
+                "vpl::flux_total_readback",
+                4 * MAX_LIGHTS as u64,
+            ),
+            flux_total: None,
             camera_buf: uniform("frame::camera", std::mem::size_of::<GpuCamera>()),
             lights_buf: uniform("frame::lights", std::mem::size_of::<GpuLights>()),
             timer: GpuTimer::new(device, &ctx.queue),
@@ -345,10 +354,10 @@ impl Renderer {
             bytemuck::bytes_of(&GpuCamera::new(input.camera, size.0, size.1)),
         );
         queue.write_buffer(&self.lights_buf, 0, bytemuck::bytes_of(&gpu_lights));
-        self.lights_cache = lights
-            .iter()
+        self.light0_lum = lights
+            .first()
             .map(|l| l.irradiance.dot(Vec3::new(0.2126, 0.7152, 0.0722)))
-            .collect();
+            .unwrap_or(1.0);
         self.lights_texel = gpu_lights.lights[0].shadow[0];
 
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -434,6 +443,14 @@ impl Renderer {
                 &self.vpl_buffers.vpls,
                 &self.sort_buffers,
             );
+            // The flux-pyramid tops (one float per light), read back on a later frame.
+            let (per_layer, offsets) = passes::vpl_gen::pyramid_layout(self.vpl_buffers.res);
+            let top = *offsets.last().unwrap_or(&0) as u64;
+            let fp = &self.vpl_buffers.flux_pyramid;
+            let copies: Vec<(&wgpu::Buffer, u64, u64, u64)> = (0..self.vpl_frame.ranges.len() as u64)
+                .map(|l| (fp, 4 * (l * per_layer as u64 + top), 4 * l, 4))
+                .collect();
+            self.flux_readback.record(&mut enc, &copies);
         }
         let indirect_scale = match s.gi.method {
             _ if !vpl_ok => 0.0,
@@ -467,6 +484,7 @@ impl Renderer {
         self.timer.resolve(&mut enc);
         queue.submit([enc.finish()]);
         self.timer.after_submit();
+        self.flux_readback.after_submit();
         self.frames += 1;
     }
 
@@ -644,32 +662,6 @@ impl Renderer {
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
 
-    /// Total reflected flux of the RSMs (luminance, W) = the expected total VPL flux; read from
-    /// the flux pyramids' tops (a small blocking readback).
-    pub fn rsm_flux_total(&self) -> Result<f32, GpuError> {
-        let vb = &self.vpl_buffers;
-        let (per_layer, offsets) = passes::vpl_gen::pyramid_layout(vb.res);
-        let top = *offsets.last().unwrap_or(&0) as u64;
-        let mut total = 0.0;
-        for l in 0..self.vpl_frame.ranges.len() as u64 {
-            let b = readback::read_buffer_range(
-                &self.ctx,
-                &vb.flux_pyramid,
-                4 * (l * per_layer as u64 + top),
-                4,
-            )?;
-            total += f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
-        }
-        Ok(total)
-    }
-
-    /// The sorted (key, VPL index) pairs of the last frame (SST stages 8-9).
-    pub fn read_sorted_keys(&self) -> Result<Vec<(u64, u32)>, GpuError> {
-        let mut v = passes::sst_sort::read_pairs(&self.ctx, &self.sort_buffers)?;
-        v.truncate(self.sort_buffers.count as usize);
-        Ok(v)
-    }
-
     /// Reads the last frame's VPLs back.
     pub fn read_vpls(&self) -> Result<Vec<GpuVpl>, GpuError> {
         let bytes = readback::read_storage_buffer(&self.ctx, &self.vpl_buffers.vpls)?;
@@ -759,7 +751,7 @@ impl Renderer {
             }
             ViewBuffer::RsmFlux => {
                 // Flux / (E x texel area) is the albedo the light saw: a readable image.
-                let l0 = self.lights_cache.first().copied().unwrap_or(1.0);
+                let l0 = self.light0_lum;
                 let texel = self.lights_texel;
                 let scale = 1.0 / (l0 * texel * texel).max(1e-30);
                 (
@@ -873,22 +865,36 @@ impl Renderer {
         )
     }
 
-    /// Latest per-pass GPU timings (non-blocking), or None if not (yet) available.
+    /// Picks up finished readbacks (timings, flux total) without blocking; returns the latest
+    /// per-pass GPU timings, or None if not (yet) available.
     pub fn poll_timings(&mut self) -> Option<PassTimings> {
-        self.timer.collect(&self.ctx.device).cloned()
+        let t = self.timer.collect(&self.ctx.device).cloned();
+        self.take_flux_total();
+        t
     }
 
     /// Waits for the GPU and returns the last frame's per-pass timings.
     pub fn wait_timings(&mut self) -> Option<PassTimings> {
-        self.timer.collect_blocking(&self.ctx.device).cloned()
+        let t = self.timer.collect_blocking(&self.ctx.device).cloned();
+        self.take_flux_total();
+        t
+    }
+
+    fn take_flux_total(&mut self) {
+        if let Some(bytes) = self.flux_readback.try_take() {
+            let tops: &[f32] = bytemuck::cast_slice(&bytes);
+            self.flux_total = Some(tops.iter().sum());
+        }
+    }
+
+    /// Total reflected flux of the RSMs (luminance, W) = the expected total VPL flux, from the
+    /// flux pyramids' tops of a recent frame (read back without blocking).
+    pub fn flux_total(&self) -> Option<f32> {
+        self.flux_total
     }
 
     pub fn timestamps_supported(&self) -> bool {
         self.timer.supported()
-    }
-
-    pub fn frames_rendered(&self) -> u64 {
-        self.frames
     }
 
     /// Reads a buffer of the last frame back as linear floats.

@@ -1,6 +1,106 @@
 //! Copies textures back to the CPU (exports, tests, the pixel inspector).
 
+use std::sync::{
+    Arc,
+    atomic::{AtomicU8, Ordering},
+};
+
 use super::context::{GpuContext, GpuError};
+
+// States of an [`AsyncReadback`]: IDLE (unmapped, free) -> PENDING (copies recorded) ->
+// MAPPING (map_async issued once) -> READY / FAILED (callback ran) -> IDLE (taken).
+const IDLE: u8 = 0;
+const PENDING: u8 = 1;
+const MAPPING: u8 = 2;
+const READY: u8 = 3;
+const FAILED: u8 = 4;
+
+/// A small GPU -> CPU copy that never blocks the frame: record copies into it when it is idle,
+/// call `after_submit` once the commands are submitted, and `try_take` on later frames (after
+/// a `device.poll`). At most one copy is in flight.
+pub struct AsyncReadback {
+    buffer: wgpu::Buffer,
+    state: Arc<AtomicU8>,
+    len: u64,
+}
+
+impl AsyncReadback {
+    pub fn new(device: &wgpu::Device, label: &str, size: u64) -> Self {
+        Self {
+            buffer: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(4),
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            state: Arc::new(AtomicU8::new(IDLE)),
+            len: 0,
+        }
+    }
+
+    pub fn is_idle(&self) -> bool {
+        self.state.load(Ordering::Acquire) == IDLE
+    }
+
+    /// Records `(source, source offset, destination offset, bytes)` copies when idle; returns
+    /// whether it did.
+    pub fn record(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        copies: &[(&wgpu::Buffer, u64, u64, u64)],
+    ) -> bool {
+        if !self.is_idle() || copies.is_empty() {
+            return false;
+        }
+        let mut len = 0;
+        for &(src, src_offset, dst_offset, bytes) in copies {
+            encoder.copy_buffer_to_buffer(src, src_offset, &self.buffer, dst_offset, bytes);
+            len = len.max(dst_offset + bytes);
+        }
+        self.len = len;
+        self.state.store(PENDING, Ordering::Release);
+        true
+    }
+
+    /// Starts mapping after the recorded copies were submitted.
+    pub fn after_submit(&self) {
+        if self
+            .state
+            .compare_exchange(PENDING, MAPPING, Ordering::AcqRel, Ordering::Acquire)
+            .is_err()
+        {
+            return;
+        }
+        let state = self.state.clone();
+        self.buffer
+            .slice(0..self.len)
+            .map_async(wgpu::MapMode::Read, move |r| {
+                state.store(if r.is_ok() { READY } else { FAILED }, Ordering::Release);
+            });
+    }
+
+    /// The copied bytes once the map finished (poll the device first); frees the buffer.
+    pub fn try_take(&mut self) -> Option<Vec<u8>> {
+        match self.state.load(Ordering::Acquire) {
+            READY => {
+                let bytes = self
+                    .buffer
+                    .slice(0..self.len)
+                    .get_mapped_range()
+                    .ok()
+                    .map(|v| v.to_vec());
+                self.buffer.unmap();
+                self.state.store(IDLE, Ordering::Release);
+                bytes
+            }
+            FAILED => {
+                self.state.store(IDLE, Ordering::Release);
+                None
+            }
+            _ => None,
+        }
+    }
+}
 
 /// A linear RGBA float image, row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
@@ -129,22 +229,9 @@ pub fn read_buffer_bytes(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<
     Ok(data)
 }
 
-/// Copies a storage buffer into a fresh MAP_READ buffer and reads it.
+/// Copies a whole storage buffer into a fresh MAP_READ buffer and reads it.
 pub fn read_storage_buffer(ctx: &GpuContext, src: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
-    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback::staging"),
-        size: src.size(),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut enc = ctx
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("readback::encoder"),
-        });
-    enc.copy_buffer_to_buffer(src, 0, &staging, 0, src.size());
-    ctx.queue.submit([enc.finish()]);
-    read_buffer_bytes(ctx, &staging)
+    read_buffer_range(ctx, src, 0, src.size())
 }
 
 /// Copies `size` bytes at `offset` (both multiples of 4) of a storage buffer and reads them.

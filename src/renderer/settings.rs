@@ -484,14 +484,6 @@ impl ViewBuffer {
             ViewBuffer::ImportanceRaw | ViewBuffer::ImportanceFiltered | ViewBuffer::PdfPyramid
         )
     }
-
-    /// True for linear-radiance buffers (shown through exposure + tonemap).
-    pub fn is_radiance(self) -> bool {
-        matches!(
-            self,
-            ViewBuffer::Final | ViewBuffer::Direct | ViewBuffer::Indirect
-        )
-    }
 }
 
 #[cfg(test)]

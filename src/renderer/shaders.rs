@@ -36,6 +36,11 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         "common/vertex.wgsl",
         include_str!("../../shaders/common/vertex.wgsl"),
     ),
+    ("common/math.wgsl", include_str!("../../shaders/common/math.wgsl")),
+    (
+        "common/vpl_visibility.wgsl",
+        include_str!("../../shaders/common/vpl_visibility.wgsl"),
+    ),
     ("common/vpl.wgsl", include_str!("../../shaders/common/vpl.wgsl")),
     (
         "common/rsm_pyramid.wgsl",

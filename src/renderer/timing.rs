@@ -1,9 +1,6 @@
 //! Per-pass GPU timings from timestamp queries, or "timestamps not supported".
 
-use std::sync::{
-    Arc,
-    atomic::{AtomicU8, Ordering},
-};
+use super::readback::AsyncReadback;
 
 /// Most timed passes per frame.
 pub const MAX_TIMED_PASSES: u32 = 32;
@@ -33,16 +30,9 @@ impl PassTimings {
     }
 }
 
-// Readback states: IDLE (buffer unmapped, free) -> PENDING (copy recorded) -> MAPPING
-// (map_async issued once) -> READY / FAILED (callback ran) -> IDLE (read and unmapped).
-const IDLE: u8 = 0;
-const PENDING: u8 = 1;
-const MAPPING: u8 = 2;
-const READY: u8 = 3;
-const FAILED: u8 = 4;
-
 /// Timestamp queries for one frame at a time: `begin_frame`, `compute_pass`/`render_pass` per
-/// pass, `resolve` before submit, then `collect` (non-blocking) or `collect_blocking`.
+/// pass, `resolve` before submit, `after_submit`, then `collect` (non-blocking) or
+/// `collect_blocking`. A frame gets timestamps only while the previous readback is done.
 pub struct GpuTimer {
     inner: Option<TimerInner>,
     names: Vec<String>,
@@ -52,9 +42,8 @@ pub struct GpuTimer {
 struct TimerInner {
     query_set: wgpu::QuerySet,
     resolve: wgpu::Buffer,
-    readback: wgpu::Buffer,
+    readback: AsyncReadback,
     period_ns: f32,
-    state: Arc<AtomicU8>,
     pending_names: Vec<String>,
 }
 
@@ -78,14 +67,8 @@ impl GpuTimer {
                         usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                         mapped_at_creation: false,
                     }),
-                    readback: device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("timer::readback"),
-                        size,
-                        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    }),
+                    readback: AsyncReadback::new(device, "timer::readback", size),
                     period_ns: queue.get_timestamp_period(),
-                    state: Arc::new(AtomicU8::new(IDLE)),
                     pending_names: Vec::new(),
                 }
             });
@@ -102,9 +85,7 @@ impl GpuTimer {
 
     /// True when this frame's passes get timestamps (the previous readback is finished).
     fn active(&self) -> bool {
-        self.inner
-            .as_ref()
-            .is_some_and(|i| i.state.load(Ordering::Acquire) == IDLE)
+        self.inner.as_ref().is_some_and(|i| i.readback.is_idle())
     }
 
     pub fn begin_frame(&mut self) {
@@ -144,33 +125,22 @@ impl GpuTimer {
         if !self.active() || self.names.is_empty() {
             return;
         }
-        let Some(inner) = self.inner.as_mut() else {
-            return;
-        };
+        let Some(inner) = self.inner.as_mut() else { return };
         let n = 2 * self.names.len() as u32;
         encoder.resolve_query_set(&inner.query_set, 0..n, &inner.resolve, 0);
-        encoder.copy_buffer_to_buffer(&inner.resolve, 0, &inner.readback, 0, n as u64 * 8);
-        inner.pending_names = std::mem::take(&mut self.names);
-        inner.state.store(PENDING, Ordering::Release);
+        if inner
+            .readback
+            .record(encoder, &[(&inner.resolve, 0, 0, n as u64 * 8)])
+        {
+            inner.pending_names = std::mem::take(&mut self.names);
+        }
     }
 
     /// Starts mapping the readback buffer; call right after submitting the frame.
     pub fn after_submit(&mut self) {
-        let Some(inner) = self.inner.as_ref() else {
-            return;
-        };
-        if inner.state.load(Ordering::Acquire) != PENDING || inner.pending_names.is_empty() {
-            return;
+        if let Some(inner) = self.inner.as_ref() {
+            inner.readback.after_submit();
         }
-        inner.state.store(MAPPING, Ordering::Release);
-        let n = 2 * inner.pending_names.len() as u64;
-        let state = inner.state.clone();
-        inner
-            .readback
-            .slice(0..n * 8)
-            .map_async(wgpu::MapMode::Read, move |r| {
-                state.store(if r.is_ok() { READY } else { FAILED }, Ordering::Release);
-            });
     }
 
     /// Picks up finished timings without blocking; returns the latest known timings.
@@ -187,38 +157,25 @@ impl GpuTimer {
         self.last.as_ref()
     }
 
-    fn read_if_ready(&mut self) {
-        let Some(inner) = self.inner.as_mut() else {
+    /// Reads finished timings (the caller polled the device).
+    pub fn read_if_ready(&mut self) {
+        let Some(inner) = self.inner.as_mut() else { return };
+        let Some(bytes) = inner.readback.try_take() else {
             return;
         };
-        match inner.state.load(Ordering::Acquire) {
-            READY => {
-                let n = 2 * inner.pending_names.len() as u64;
-                let slice = inner.readback.slice(0..n * 8);
-                if let Ok(view) = slice.get_mapped_range() {
-                    let ticks: &[u64] = bytemuck::cast_slice(&view);
-                    let passes = inner
-                        .pending_names
-                        .iter()
-                        .enumerate()
-                        .map(|(i, name)| {
-                            let dt = ticks[2 * i + 1].wrapping_sub(ticks[2 * i]);
-                            // Guard against wrapped or reordered stamps.
-                            let dt = if dt > (1u64 << 62) { 0 } else { dt };
-                            (name.clone(), dt as f64 * inner.period_ns as f64 * 1e-6)
-                        })
-                        .collect();
-                    drop(view);
-                    self.last = Some(PassTimings { passes });
-                }
-                inner.readback.unmap();
-                inner.state.store(IDLE, Ordering::Release);
-            }
-            FAILED => {
-                inner.state.store(IDLE, Ordering::Release);
-            }
-            _ => {}
-        }
+        let ticks: &[u64] = bytemuck::cast_slice(&bytes);
+        let passes = inner
+            .pending_names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| {
+                let dt = ticks[2 * i + 1].wrapping_sub(ticks[2 * i]);
+                // Guard against wrapped or reordered stamps.
+                let dt = if dt > (1u64 << 62) { 0 } else { dt };
+                (name.clone(), dt as f64 * inner.period_ns as f64 * 1e-6)
+            })
+            .collect();
+        self.last = Some(PassTimings { passes });
     }
 
     pub fn last(&self) -> Option<&PassTimings> {

@@ -6,7 +6,7 @@ use crate::renderer::{
     frame::GbufferTargets, gpu_data::GpuGtParams, scene_gpu::SceneGpu, shaders, timing::GpuTimer,
 };
 
-use super::{compute_pipeline, float_texture_entry, groups_2d, storage_entry};
+use super::{compute_pipeline, dynamic_uniform_entry, float_texture_entry, groups_2d, storage_entry};
 
 /// Dynamic-offset stride of the per-batch uniforms; most batches per recorded call.
 const STRIDE: u64 = 256;
@@ -25,16 +25,7 @@ impl GroundTruthPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ground_truth::layout"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: c,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<GpuGtParams>() as u64),
-                    },
-                    count: None,
-                },
+                dynamic_uniform_entry(0, c, std::mem::size_of::<GpuGtParams>() as u64),
                 storage_entry(1, c, true),
                 storage_entry(2, c, true),
                 storage_entry(3, c, true),

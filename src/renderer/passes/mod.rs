@@ -78,6 +78,34 @@ pub(crate) fn texture_entry(
     }
 }
 
+/// A uniform read with a dynamic offset (per-step/per-light parameters in one buffer).
+pub(crate) fn dynamic_uniform_entry(
+    binding: u32,
+    vis: wgpu::ShaderStages,
+    size: u64,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: vis,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: true,
+            min_binding_size: wgpu::BufferSize::new(size),
+        },
+        count: None,
+    }
+}
+
+/// An unfilterable float 2D-array texture read by compute shaders (RSM layers).
+pub(crate) fn float_array_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    texture_entry(
+        binding,
+        wgpu::ShaderStages::COMPUTE,
+        wgpu::TextureSampleType::Float { filterable: false },
+        wgpu::TextureViewDimension::D2Array,
+    )
+}
+
 pub(crate) fn float_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     texture_entry(
         binding,

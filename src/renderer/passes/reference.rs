@@ -12,8 +12,8 @@ use crate::renderer::{
 };
 
 use super::{
-    compute_pipeline, float_texture_entry, groups_image, run_compute, storage_entry, texture_entry,
-    uniform_buffer, uniform_entry, vpl_gen::VplBuffers,
+    compute_pipeline, float_array_texture_entry, float_texture_entry, groups_image, run_compute,
+    storage_entry, uniform_buffer, uniform_entry, vpl_gen::VplBuffers,
 };
 
 /// Twin: `RefParams` in `shaders/reference.wgsl`.
@@ -40,22 +40,14 @@ impl ReferencePass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "reference.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let array_tex = |b| {
-            texture_entry(
-                b,
-                c,
-                wgpu::TextureSampleType::Float { filterable: false },
-                wgpu::TextureViewDimension::D2Array,
-            )
-        };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("reference::layout"),
             entries: &[
                 uniform_entry(0, c),
                 uniform_entry(1, c),
-                array_tex(2),
-                array_tex(3),
-                array_tex(4),
+                float_array_texture_entry(2),
+                float_array_texture_entry(3),
+                float_array_texture_entry(4),
                 float_texture_entry(5),
                 float_texture_entry(6),
                 float_texture_entry(7),

@@ -13,6 +13,7 @@ use crate::renderer::{
 };
 
 use super::{
+    dynamic_uniform_entry,
     gbuffer::{DEPTH_FORMAT, vertex_layout},
     storage_entry, texture_entry,
 };
@@ -41,16 +42,11 @@ impl RsmPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("rsm::layout"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<GpuRsmLight>() as u64),
-                    },
-                    count: None,
-                },
+                dynamic_uniform_entry(
+                    0,
+                    wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    std::mem::size_of::<GpuRsmLight>() as u64,
+                ),
                 storage_entry(1, wgpu::ShaderStages::FRAGMENT, true),
                 texture_entry(
                     2,

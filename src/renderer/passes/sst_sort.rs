@@ -12,7 +12,7 @@ use crate::renderer::{
     timing::GpuTimer,
 };
 
-use super::{WG_1D, compute_pipeline, storage_entry};
+use super::{WG_1D, compute_pipeline, dynamic_uniform_entry, storage_entry};
 
 /// Twin: `SortParams` in `shaders/sst_sort.wgsl`.
 #[repr(C)]
@@ -90,16 +90,7 @@ impl SortPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("sst_sort::layout"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: c,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(16),
-                    },
-                    count: None,
-                },
+                dynamic_uniform_entry(0, c, 16),
                 storage_entry(1, c, true),
                 storage_entry(2, c, false),
                 storage_entry(3, c, false),

@@ -69,10 +69,7 @@ impl VisualisePass {
             "visualise::common_layout",
             &[uniform_entry(0, c), storage_texture_entry(1, VIEW_FORMAT)],
         );
-        let float_layout = bgl(
-            "visualise::float_layout",
-            &[float_texture_entry(0), float_texture_entry(1)],
-        );
+        let float_layout = bgl("visualise::float_layout", &[float_texture_entry(0)]);
         let depth_layout = bgl(
             "visualise::depth_layout",
             &[texture_entry(
@@ -211,16 +208,10 @@ impl VisualisePass {
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("visualise::float_source"),
                     layout: &self.float_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: tv(view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: tv(view),
-                        },
-                    ],
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: tv(view),
+                    }],
                 }),
             ),
             VisSource::Depth(view, _) => (

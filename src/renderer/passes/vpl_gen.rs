@@ -3,6 +3,7 @@
 //! Reads: camera, RSM, G-buffer. Writes: [`VplBuffers`] (pyramids and the VPL array).
 
 use glam::Vec3;
+use wgpu::util::DeviceExt;
 
 use crate::{
     renderer::{
@@ -16,7 +17,8 @@ use crate::{
 };
 
 use super::{
-    WG_1D, compute_pipeline, float_texture_entry, groups_2d, storage_entry, texture_entry, uniform_entry,
+    WG_1D, compute_pipeline, dynamic_uniform_entry, float_array_texture_entry, float_texture_entry,
+    groups_2d, storage_entry, uniform_entry,
 };
 
 /// Dynamic-offset stride of the per-level uniforms.
@@ -156,22 +158,14 @@ impl VplGenPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "vpl_gen.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let array_tex = |b| {
-            texture_entry(
-                b,
-                c,
-                wgpu::TextureSampleType::Float { filterable: false },
-                wgpu::TextureViewDimension::D2Array,
-            )
-        };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("vpl_gen::layout"),
             entries: &[
                 uniform_entry(0, c),
                 uniform_entry(1, c),
-                array_tex(2),
-                array_tex(3),
-                array_tex(4),
+                float_array_texture_entry(2),
+                float_array_texture_entry(3),
+                float_array_texture_entry(4),
                 float_texture_entry(5),
                 float_texture_entry(6),
                 float_texture_entry(7),
@@ -184,16 +178,7 @@ impl VplGenPass {
         });
         let level_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("vpl_gen::level_layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: c,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(4),
-                },
-                count: None,
-            }],
+            entries: &[dynamic_uniform_entry(0, c, 4)],
         });
         let one = [Some(&layout)];
         let two = [Some(&layout), Some(&level_layout)];
@@ -203,11 +188,15 @@ impl VplGenPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let level_params = device.create_buffer(&wgpu::BufferDescriptor {
+        // Level l's uniform is the constant l: written once, at creation.
+        let mut levels = vec![0u8; (LEVEL_STRIDE * MAX_LEVELS as u64) as usize];
+        for l in 0..MAX_LEVELS as usize {
+            levels[l * LEVEL_STRIDE as usize..][..4].copy_from_slice(&(l as u32).to_le_bytes());
+        }
+        let level_params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("vpl_gen::level_params"),
-            size: LEVEL_STRIDE * MAX_LEVELS as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
+            contents: &levels,
+            usage: wgpu::BufferUsages::UNIFORM,
         });
         Ok(Self {
             importance: compute_pipeline(device, "vpl_gen::importance", &one, &module, "importance"),
@@ -278,13 +267,6 @@ impl VplGenPass {
             p.level_offsets[l / 4][l % 4] = *o;
         }
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        for l in 0..offsets.len() as u64 {
-            queue.write_buffer(
-                &self.level_params,
-                l * LEVEL_STRIDE,
-                bytemuck::bytes_of(&(l as u32)),
-            );
-        }
         let tv = wgpu::BindingResource::TextureView;
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("vpl_gen::bind_group"),
