@@ -121,3 +121,254 @@ fn gpu_keys_of_the_frame_vpls_equal_the_cpu_keys() {
     assert_eq!(idx, (0..vpls.len() as u32).collect::<Vec<_>>());
     assert!(ctx.errors.take().is_empty());
 }
+
+// ---- Stage 10: the tree ----
+
+use lightcut::{
+    reference::sst_tree::{self, SstNode, build_with_leaves, classify},
+    renderer::{
+        gpu_data::GpuVpl,
+        passes::sst_build::{BuildPass, TreeBuffers, read_flags, read_nodes, read_sorted_vpls},
+    },
+};
+use wgpu::util::DeviceExt;
+
+fn f01(next: &mut impl FnMut() -> u64) -> f32 {
+    (next() >> 40) as f32 / (1u64 << 24) as f32
+}
+
+/// Synthetic VPLs: clusters on a few planes (floor, wall, a tilted panel) plus a scatter of
+/// random ones, with some empty VPLs at the end like a frame that did not fill its budget.
+fn synthetic_vpls(n: usize, seed: u64) -> Vec<GpuVpl> {
+    let mut next = rng(seed);
+    (0..n)
+        .map(|i| {
+            let (u, v, w) = (f01(&mut next), f01(&mut next), f01(&mut next));
+            let (p, nrm) = match i % 4 {
+                0 => (Vec3::new(u * 8.0, 0.0, v * 6.0), Vec3::Y),
+                1 => (Vec3::new(u * 8.0, v * 3.0, 0.0), Vec3::Z),
+                2 => (
+                    Vec3::new(2.0 + u, 1.0 + v, 3.0 + u),
+                    Vec3::new(-1.0, 0.0, 1.0).normalize(),
+                ),
+                _ => (
+                    Vec3::new(u * 8.0, v * 3.0, w * 6.0),
+                    Vec3::new(u - 0.5, v - 0.5, w - 0.5)
+                        .try_normalize()
+                        .unwrap_or(Vec3::X),
+                ),
+            };
+            let empty = n > 8 && i >= n - n / 50;
+            GpuVpl {
+                position: p.extend(1.0).to_array(),
+                normal: nrm.to_array(),
+                id: if empty { VPL_NONE } else { i as u32 },
+                flux: [
+                    f01(&mut next) * 0.01,
+                    f01(&mut next) * 0.01,
+                    f01(&mut next) * 0.01,
+                    1.0,
+                ],
+            }
+        })
+        .collect()
+}
+
+struct GpuTree {
+    nodes: Vec<SstNode>,
+    flags: Vec<u32>,
+    sorted: Vec<GpuVpl>,
+    leaves: usize,
+}
+
+/// Keys, sort and build of `vpls` on the GPU (v_min / sigma_max for the flags).
+fn gpu_tree(
+    ctx: &lightcut::renderer::context::GpuContext,
+    vpls: &[GpuVpl],
+    v_min: f32,
+    sigma_max: f32,
+) -> GpuTree {
+    let buf = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("test::vpls"),
+        contents: bytemuck::cast_slice(vpls),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let sort = SortPass::new(&ctx.device).unwrap();
+    let build = BuildPass::new(&ctx.device).unwrap();
+    let sb = SortBuffers::new(&ctx.device, vpls.len() as u32);
+    let tb = TreeBuffers::new(&ctx.device, vpls.len() as u32);
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    let mut timer = GpuTimer::new(&ctx.device, &ctx.queue);
+    sort.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, &buf, &sb);
+    build.record(
+        &ctx.device,
+        &ctx.queue,
+        &mut enc,
+        &mut timer,
+        &buf,
+        &sb,
+        &tb,
+        v_min,
+        sigma_max,
+    );
+    ctx.queue.submit([enc.finish()]);
+    GpuTree {
+        nodes: read_nodes(ctx, &tb)
+            .unwrap()
+            .iter()
+            .map(SstNode::decode)
+            .collect(),
+        flags: read_flags(ctx, &tb).unwrap(),
+        sorted: read_sorted_vpls(ctx, &tb).unwrap(),
+        leaves: tb.leaves as usize,
+    }
+}
+
+/// Compares a GPU tree with the CPU build of the same sorted VPLs. Tolerances: bounds and
+/// sums exact up to float summation order (bounds exactly), positions 1e-5 of the scene
+/// size, normals 2e-4 (16-bit octahedral codes may differ by one step), v 1e-4, variances
+/// 3e-3 relative to the node's trace (f16 tangent variances) + 1e-7 m^2.
+fn compare_trees(gpu: &[SstNode], cpu: &[SstNode], scale: f32) {
+    assert_eq!(gpu.len(), cpu.len());
+    for (i, (g, c)) in gpu.iter().zip(cpu).enumerate().skip(1) {
+        assert_eq!(g.is_empty(), c.is_empty(), "node {i} emptiness");
+        if c.is_empty() {
+            assert_eq!(g.intensity, Vec3::ZERO, "node {i}");
+            continue;
+        }
+        assert_eq!(
+            (g.bbox_min, g.bbox_max),
+            (c.bbox_min, c.bbox_max),
+            "node {i} bounds"
+        );
+        let tol_i = 1e-5 * c.intensity.max_element().max(1e-20);
+        assert!(
+            (g.intensity - c.intensity).abs().max_element() <= tol_i,
+            "node {i} intensity"
+        );
+        assert!(
+            (g.position - c.position).length() <= 1e-5 * scale,
+            "node {i} position {} vs {}",
+            g.position,
+            c.position
+        );
+        assert!(
+            (g.normal - c.normal).length() <= 2e-4,
+            "node {i} normal {} vs {}",
+            g.normal,
+            c.normal
+        );
+        assert!((g.v - c.v).abs() <= 1e-4, "node {i} v {} vs {}", g.v, c.v);
+        let tr = c.variance.x + c.variance.y + c.variance.z;
+        assert!(
+            (g.variance - c.variance).abs().max_element() <= 3e-3 * tr + 1e-7,
+            "node {i} variance {} vs {}",
+            g.variance,
+            c.variance
+        );
+    }
+}
+
+#[test]
+fn gpu_tree_equals_the_cpu_build_of_the_same_sorted_vpls() {
+    let Some(ctx) = common::gpu() else { return };
+    for (n, seed) in [(1usize, 1u64), (2, 2), (3, 3), (1000, 4), (4096, 5)] {
+        let vpls = synthetic_vpls(n, seed);
+        let g = gpu_tree(&ctx, &vpls, 0.7, 0.3);
+        assert_eq!(g.leaves, sst_tree::leaf_count(n as u32) as usize);
+        // The permuted VPLs are the input in key order, padded with empty VPLs.
+        let mut sorted_cpu = sst_tree::sort_vpls(&vpls);
+        sorted_cpu.resize(g.leaves, g.sorted[g.leaves - 1]);
+        let valid = vpls.iter().filter(|v| v.id != VPL_NONE).count();
+        assert_eq!(
+            g.sorted[..valid].iter().map(|v| v.id).collect::<Vec<_>>().len(),
+            valid
+        );
+        assert!(g.sorted[valid..].iter().all(|v| v.id == VPL_NONE), "n = {n}");
+        let mut ids: Vec<u32> = g.sorted[..valid].iter().map(|v| v.id).collect();
+        ids.sort_unstable();
+        let mut want: Vec<u32> = vpls.iter().filter(|v| v.id != VPL_NONE).map(|v| v.id).collect();
+        want.sort_unstable();
+        assert_eq!(ids, want, "every valid VPL once (n = {n})");
+        // CPU build of the GPU's order.
+        let cpu = build_with_leaves(&g.sorted[..n.min(g.leaves)], g.leaves);
+        compare_trees(&g.nodes, &cpu, 10.0);
+        // Flags: identical to the CPU's classification of the same tree.
+        assert_eq!(g.flags[..], classify(&cpu, 0.7, 0.3)[..], "flags, n = {n}");
+    }
+    assert!(ctx.errors.take().is_empty());
+}
+
+#[test]
+fn gpu_tree_invariants_and_reclassification() {
+    let Some(ctx) = common::gpu() else { return };
+    let vpls = synthetic_vpls(4096, 9);
+    let g = gpu_tree(&ctx, &vpls, 0.7, 0.3);
+    let t = &g.nodes;
+    let leaves = g.leaves;
+    for n in 1..leaves {
+        let (a, b, p) = (&t[2 * n], &t[2 * n + 1], &t[n]);
+        if a.is_empty() && b.is_empty() {
+            assert!(p.is_empty());
+            continue;
+        }
+        let sum = a.intensity + b.intensity;
+        assert!((p.intensity - sum).abs().max_element() <= 1e-6 * sum.max_element());
+        for c in [a, b].into_iter().filter(|c| !c.is_empty()) {
+            assert!(p.bbox_min.cmple(c.bbox_min).all() && p.bbox_max.cmpge(c.bbox_max).all());
+            assert!(p.v <= c.v, "v grows towards the root at node {n}");
+        }
+    }
+    // The root holds all the flux.
+    let total: Vec3 = vpls
+        .iter()
+        .filter(|v| v.id != VPL_NONE)
+        .map(|v| Vec3::from_slice(&v.flux[..3]))
+        .sum();
+    assert!((t[1].intensity - total).abs().max_element() < 1e-4 * total.max_element());
+    // Other thresholds: the same flags as the CPU classification of the GPU's nodes.
+    let ctx2 = ctx.clone();
+    for (v_min, sigma_max) in [(0.0, 1000.0), (0.95, 0.05), (0.5, 0.1), (1.0, 0.0)] {
+        let g2 = gpu_tree(&ctx2, &vpls, v_min, sigma_max);
+        assert_eq!(
+            g2.flags,
+            classify(&g2.nodes, v_min, sigma_max),
+            "{v_min} {sigma_max}"
+        );
+        let on: u32 = g2.flags.iter().map(|w| w.count_ones()).sum();
+        if v_min == 0.0 {
+            // Everything non-empty is usable.
+            let nonempty = g2.nodes.iter().skip(1).filter(|n| !n.is_empty()).count() as u32;
+            assert_eq!(on, nonempty);
+        }
+    }
+    assert!(ctx.errors.take().is_empty());
+}
+
+#[test]
+fn frame_tree_reclassifies_without_rebuilding() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = default_scene::build();
+    let cam = scene.camera_or_default(None).unwrap();
+    let mut r = Renderer::new(ctx.clone(), &scene, (64, 40), RenderSettings::default()).unwrap();
+    r.render(&FrameInput {
+        camera: &cam,
+        lights: &scene.lights,
+        view: ViewBuffer::Final,
+    });
+    let (nodes, flags) = r.read_tree().unwrap();
+    let leaves = r.tree_buffers().1.leaves as usize;
+    assert_eq!(nodes.len(), 2 * leaves);
+    assert_eq!(flags, classify(&nodes, 0.7, 0.3));
+    // The frame's tree equals the CPU build of its own sorted VPLs.
+    let sorted = read_sorted_vpls(&ctx, r.tree_buffers().1).unwrap();
+    let cpu = build_with_leaves(&sorted, leaves);
+    compare_trees(&nodes, &cpu, scene.bounds.radius() * 2.0);
+    // New thresholds: only the flags change.
+    r.reclassify(0.95, 0.01);
+    let (nodes2, flags2) = r.read_tree().unwrap();
+    assert_eq!(nodes2, nodes);
+    assert_eq!(flags2, classify(&nodes, 0.95, 0.01));
+    assert_ne!(flags2, flags, "stricter thresholds change some flags");
+    assert!(ctx.errors.take().is_empty());
+}

@@ -14,5 +14,6 @@ pub mod display;
 pub mod gbuffer;
 pub mod gi;
 pub mod sst;
+pub mod sst_tree;
 pub mod visualise;
 pub mod vpl;

@@ -17,6 +17,7 @@ pub mod timing;
 use glam::Vec3;
 use thiserror::Error;
 
+use crate::reference::sst_tree::SstNode;
 use crate::scene::{Camera, DirectionalLight, Scene};
 use context::{GpuContext, GpuError};
 use frame::{FrameTargets, ShadowTargets, ViewTarget};
@@ -29,6 +30,7 @@ use passes::{
     ground_truth::GroundTruthPass,
     reference::{GpuRefParams, ReferencePass},
     rsm::RsmPass,
+    sst_build::{BuildPass, TreeBuffers},
     sst_sort::{SortBuffers, SortPass},
     visualise::{VisMode, VisSource, VisualisePass},
     vpl_gen::{VplBuffers, VplFrame, VplGenPass},
@@ -122,6 +124,8 @@ pub struct Renderer {
     vpl_splat: VplSplatPass,
     sst_sort: SortPass,
     sort_buffers: SortBuffers,
+    sst_build: BuildPass,
+    tree: TreeBuffers,
     vpl_buffers: VplBuffers,
     vpl_frame: VplFrame,
     gt: Option<GtState>,
@@ -141,7 +145,8 @@ pub struct Renderer {
 /// Refuses settings whose buffers the device cannot bind (instead of failing every frame).
 fn check_device_limits(device: &wgpu::Device, s: &RenderSettings, layers: u32) -> Result<(), RenderError> {
     let limit = device.limits().max_storage_buffer_binding_size;
-    let need = VplBuffers::largest_binding(s.shadow.resolution, layers.max(1), s.vpl.count);
+    let need = VplBuffers::largest_binding(s.shadow.resolution, layers.max(1), s.vpl.count)
+        .max(TreeBuffers::largest_binding(s.vpl.count));
     if need > limit {
         return Err(RenderError::Settings(format!(
             "shadow.resolution {} with {} VPLs needs a {} MiB storage buffer; this device binds at most {} MiB",
@@ -207,6 +212,8 @@ impl Renderer {
             vpl_splat: VplSplatPass::new(device)?,
             sst_sort: SortPass::new(device)?,
             sort_buffers: SortBuffers::new(device, settings.vpl.count),
+            sst_build: BuildPass::new(device)?,
+            tree: TreeBuffers::new(device, settings.vpl.count),
             vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
             vpl_frame: VplFrame::default(),
             gt: None,
@@ -247,13 +254,14 @@ impl Renderer {
                 ReferencePass::new(device),
                 VplSplatPass::new(device),
                 SortPass::new(device),
+                BuildPass::new(device),
             ),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
         }
-        let (g, s, d, disp, v, (vg, gt, c, rf, sp, so)) = passes;
-        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?, so?);
+        let (g, s, d, disp, v, (vg, gt, c, rf, sp, so, b)) = passes;
+        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?, so?, b?);
         (
             self.gbuffer,
             self.rsm,
@@ -266,6 +274,7 @@ impl Renderer {
             self.reference,
             self.vpl_splat,
             self.sst_sort,
+            self.sst_build,
         ) = new;
         Ok(())
     }
@@ -442,6 +451,21 @@ impl Renderer {
                 &mut self.timer,
                 &self.vpl_buffers.vpls,
                 &self.sort_buffers,
+            );
+            // SST stage 10: the tree over the sorted VPLs, then its usable flags.
+            if self.tree.count != self.vpl_frame.count {
+                self.tree = TreeBuffers::new(&device, self.vpl_frame.count);
+            }
+            self.sst_build.record(
+                &device,
+                &queue,
+                &mut enc,
+                &mut self.timer,
+                &self.vpl_buffers.vpls,
+                &self.sort_buffers,
+                &self.tree,
+                s.tree.v_min,
+                s.tree.sigma_max,
             );
             // The flux-pyramid tops (one float per light), read back on a later frame.
             let (per_layer, offsets) = passes::vpl_gen::pyramid_layout(self.vpl_buffers.res);
@@ -657,6 +681,39 @@ impl Renderer {
     }
 
     /// Reads a storage buffer of f32 back (pyramids, importance).
+    /// The last frame's sorted (key, index) pairs and tree.
+    pub fn tree_buffers(&self) -> (&SortBuffers, &TreeBuffers) {
+        (&self.sort_buffers, &self.tree)
+    }
+
+    /// Reads the last frame's tree back: nodes decoded (2 x leaves, node 0 unused) and the
+    /// usable bits.
+    pub fn read_tree(&self) -> Result<(Vec<SstNode>, Vec<u32>), GpuError> {
+        let nodes = passes::sst_build::read_nodes(&self.ctx, &self.tree)?;
+        let flags = passes::sst_build::read_flags(&self.ctx, &self.tree)?;
+        Ok((nodes.iter().map(SstNode::decode).collect(), flags))
+    }
+
+    /// Re-runs only the classify pass of the last frame's tree with new thresholds (the
+    /// settings are not changed).
+    pub fn reclassify(&mut self, v_min: f32, sigma_max: f32) {
+        let device = self.ctx.device.clone();
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("sst_classify::encoder"),
+        });
+        let mut timer = GpuTimer::new(&device, &self.ctx.queue);
+        self.sst_build.record_classify(
+            &device,
+            &self.ctx.queue,
+            &mut enc,
+            &mut timer,
+            &self.tree,
+            v_min,
+            sigma_max,
+        );
+        self.ctx.queue.submit([enc.finish()]);
+    }
+
     pub fn read_f32_buffer(&self, buffer: &wgpu::Buffer) -> Result<Vec<f32>, GpuError> {
         let bytes = readback::read_storage_buffer(&self.ctx, buffer)?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())

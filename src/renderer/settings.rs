@@ -10,6 +10,7 @@ pub struct RenderSettings {
     pub shadow: ShadowSettings,
     pub vpl: VplSettings,
     pub gi: GiSettings,
+    pub tree: TreeSettings,
     pub display: DisplaySettings,
     pub textures: TextureSettings,
 }
@@ -188,6 +189,76 @@ impl Default for GiSettings {
     }
 }
 
+/// The Stochastic Substitute Tree (SST paper 3.2, thesis 4.2): when a node's substitute
+/// distribution is flat enough to be sampled instead of descending further (eq. 3 of the SST
+/// paper). Changing these re-runs only the classify pass, never the build.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TreeSettings {
+    /// Least normal similarity v (eq. 4.3, in 0..=1) of a usable node. Higher keeps only
+    /// clusters whose VPLs face the same way (deeper traversal, less bias).
+    pub v_min: f32,
+    /// Largest standard deviation along the node's normal (metres) of a usable node. Lower
+    /// keeps only clusters lying on one plane.
+    pub sigma_max: f32,
+}
+
+impl Default for TreeSettings {
+    fn default() -> Self {
+        // The thesis's values (chapter 5: "a good balance between quality and speed").
+        Self {
+            v_min: 0.7,
+            sigma_max: 0.3,
+        }
+    }
+}
+
+/// What the light-tree overlay draws over the camera view.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum TreeOverlay {
+    #[default]
+    Off,
+    /// Each node of the chosen level as its substitute distribution: an ellipse in the node's
+    /// plane with semi-axes of 1 and 2 standard deviations.
+    Distributions,
+    /// Each node of the chosen level as its bounding box.
+    Boxes,
+}
+
+impl TreeOverlay {
+    pub const ALL: [TreeOverlay; 3] = [TreeOverlay::Off, TreeOverlay::Distributions, TreeOverlay::Boxes];
+    pub fn name(self) -> &'static str {
+        match self {
+            TreeOverlay::Off => "off",
+            TreeOverlay::Distributions => "distributions",
+            TreeOverlay::Boxes => "bounding boxes",
+        }
+    }
+}
+
+/// Colouring of the light-tree overlay.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum TreeColor {
+    /// Log-scale false colour of the node's flux relative to the level's mean.
+    #[default]
+    Intensity,
+    /// Green = usable for sampling (v >= v_min, sigma_z <= sigma_max), red = not.
+    Usable,
+    /// A distinct colour per node (to tell neighbours apart).
+    Node,
+}
+
+impl TreeColor {
+    pub const ALL: [TreeColor; 3] = [TreeColor::Intensity, TreeColor::Usable, TreeColor::Node];
+    pub fn name(self) -> &'static str {
+        match self {
+            TreeColor::Intensity => "intensity",
+            TreeColor::Usable => "usable flag",
+            TreeColor::Node => "node id",
+        }
+    }
+}
+
 /// Tonemapping operator of the display pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Tonemap {
@@ -233,6 +304,11 @@ pub struct DisplaySettings {
     pub vpl_point_size: u32,
     /// Level shown by the PDF-pyramid view (0 = full resolution).
     pub pyramid_level: u32,
+    /// Light-tree overlay over the camera-space views.
+    pub tree_overlay: TreeOverlay,
+    /// Tree level it draws (0 = the root; clamped to the leaves' level).
+    pub tree_level: u32,
+    pub tree_color: TreeColor,
 }
 
 impl Default for DisplaySettings {
@@ -243,6 +319,9 @@ impl Default for DisplaySettings {
             vpl_overlay: false,
             vpl_point_size: 1,
             pyramid_level: 0,
+            tree_overlay: TreeOverlay::Off,
+            tree_level: 6,
+            tree_color: TreeColor::Intensity,
         }
     }
 }
@@ -378,6 +457,22 @@ impl RenderSettings {
             return Err(format!(
                 "gi.ray_offset {} is out of range (0..=1 m)",
                 g.ray_offset
+            ));
+        }
+        let t = &self.tree;
+        if !(0.0..=1.0).contains(&t.v_min) {
+            return Err(format!("tree.v_min {} is out of range (0..=1)", t.v_min));
+        }
+        if !(0.0..=1000.0).contains(&t.sigma_max) {
+            return Err(format!(
+                "tree.sigma_max {} is out of range (0..=1000 m)",
+                t.sigma_max
+            ));
+        }
+        if self.display.tree_level > 20 {
+            return Err(format!(
+                "display.tree_level {} is out of range (0..=20)",
+                self.display.tree_level
             ));
         }
         if !(1..=16).contains(&self.textures.anisotropy) {

@@ -33,6 +33,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         include_str!("../../shaders/common/random.wgsl"),
     ),
     (
+        "common/sst_node.wgsl",
+        include_str!("../../shaders/common/sst_node.wgsl"),
+    ),
+    (
         "common/vertex.wgsl",
         include_str!("../../shaders/common/vertex.wgsl"),
     ),
@@ -55,6 +59,11 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("reference.wgsl", include_str!("../../shaders/reference.wgsl")),
     ("vpl_splat.wgsl", include_str!("../../shaders/vpl_splat.wgsl")),
     ("sst_sort.wgsl", include_str!("../../shaders/sst_sort.wgsl")),
+    ("sst_build.wgsl", include_str!("../../shaders/sst_build.wgsl")),
+    (
+        "sst_classify.wgsl",
+        include_str!("../../shaders/sst_classify.wgsl"),
+    ),
     ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
     ("rsm.wgsl", include_str!("../../shaders/rsm.wgsl")),
     ("direct.wgsl", include_str!("../../shaders/direct.wgsl")),
@@ -77,6 +86,8 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "reference.wgsl",
     "vpl_splat.wgsl",
     "sst_sort.wgsl",
+    "sst_build.wgsl",
+    "sst_classify.wgsl",
 ];
 
 #[derive(Debug, Error, PartialEq)]

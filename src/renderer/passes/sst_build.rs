@@ -1,0 +1,259 @@
+//! SST stage 10 (thesis 4.2.2): the perfect binary tree over the sorted VPLs, built with one
+//! thread per leaf pair and per-node atomic counters, then the per-node "usable" flags
+//! (separate pass, so a change of v_min / sigma_max costs one tiny dispatch, not a rebuild).
+//! Reads: the VPLs and the sorted (key, index) pairs. Writes: [`TreeBuffers`].
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::{
+    reference::sst_tree::{leaf_count, level_count},
+    renderer::{
+        context::{GpuContext, GpuError},
+        gpu_data::{GpuSstNode, GpuVpl},
+        readback, shaders,
+        timing::GpuTimer,
+    },
+};
+
+use super::{WG_1D, compute_pipeline, run_compute, sst_sort::SortBuffers, storage_entry, uniform_entry};
+
+/// Twin: `TreeParams` in `shaders/sst_build.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuTreeParams {
+    pub count: u32,
+    pub leaves: u32,
+    pub _pad: [u32; 2],
+}
+
+/// Twin: `ClassifyParams` in `shaders/sst_classify.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuClassifyParams {
+    pub nodes: u32,
+    pub v_min: f32,
+    pub sigma_max: f32,
+    pub _pad: u32,
+}
+
+/// The tree of one frame: 2 x leaves nodes (node 0 unused), the usable bits, the per-node
+/// arrival counters of the build and the VPLs permuted into leaf order.
+pub struct TreeBuffers {
+    pub nodes: wgpu::Buffer,
+    pub flags: wgpu::Buffer,
+    pub counters: wgpu::Buffer,
+    pub sorted_vpls: wgpu::Buffer,
+    pub count: u32,
+    pub leaves: u32,
+}
+
+impl TreeBuffers {
+    /// Bytes the tree of `count` VPLs needs in its largest single binding (the nodes).
+    pub fn largest_binding(count: u32) -> u64 {
+        2 * leaf_count(count) as u64 * std::mem::size_of::<GpuSstNode>() as u64
+    }
+
+    pub fn new(device: &wgpu::Device, count: u32) -> Self {
+        let leaves = leaf_count(count);
+        let buf = |label: &str, size: u64| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let nodes = 2 * leaves as u64;
+        Self {
+            nodes: buf(
+                "sst_build::nodes",
+                nodes * std::mem::size_of::<GpuSstNode>() as u64,
+            ),
+            flags: buf("sst_build::flags", 4 * nodes.div_ceil(32).max(1)),
+            counters: buf("sst_build::counters", 4 * leaves as u64),
+            sorted_vpls: buf(
+                "sst_build::sorted_vpls",
+                leaves as u64 * std::mem::size_of::<GpuVpl>() as u64,
+            ),
+            count,
+            leaves,
+        }
+    }
+
+    pub fn levels(&self) -> u32 {
+        level_count(self.leaves)
+    }
+}
+
+pub struct BuildPass {
+    build: wgpu::ComputePipeline,
+    build_layout: wgpu::BindGroupLayout,
+    classify: wgpu::ComputePipeline,
+    classify_layout: wgpu::BindGroupLayout,
+    build_params: wgpu::Buffer,
+    classify_params: wgpu::Buffer,
+}
+
+impl BuildPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let module = shaders::create_module(device, "sst_build.wgsl")?;
+        let build_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sst_build::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                storage_entry(1, c, true),
+                storage_entry(2, c, true),
+                storage_entry(3, c, false),
+                storage_entry(4, c, false),
+                storage_entry(5, c, false),
+            ],
+        });
+        let cmodule = shaders::create_module(device, "sst_classify.wgsl")?;
+        let classify_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sst_classify::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                storage_entry(1, c, true),
+                storage_entry(2, c, false),
+            ],
+        });
+        Ok(Self {
+            build: compute_pipeline(device, "sst_build", &[Some(&build_layout)], &module, "build"),
+            classify: compute_pipeline(
+                device,
+                "sst_classify",
+                &[Some(&classify_layout)],
+                &cmodule,
+                "classify",
+            ),
+            build_params: super::uniform_buffer::<GpuTreeParams>(device, "sst_build::params"),
+            classify_params: super::uniform_buffer::<GpuClassifyParams>(device, "sst_classify::params"),
+            build_layout,
+            classify_layout,
+        })
+    }
+
+    /// Records the build over `sort`'s first `tree.count` sorted pairs, then the flags.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        vpls: &wgpu::Buffer,
+        sort: &SortBuffers,
+        tree: &TreeBuffers,
+        v_min: f32,
+        sigma_max: f32,
+    ) {
+        let p = GpuTreeParams {
+            count: tree.count.min(sort.count),
+            leaves: tree.leaves,
+            _pad: [0; 2],
+        };
+        queue.write_buffer(&self.build_params, 0, bytemuck::bytes_of(&p));
+        let entries = [
+            self.build_params.as_entire_binding(),
+            vpls.as_entire_binding(),
+            sort.keys.as_entire_binding(),
+            tree.nodes.as_entire_binding(),
+            tree.counters.as_entire_binding(),
+            tree.sorted_vpls.as_entire_binding(),
+        ];
+        let bind = bind_group(device, "sst_build::bind_group", &self.build_layout, &entries);
+        encoder.clear_buffer(&tree.counters, 0, None);
+        run_compute(
+            encoder,
+            timer,
+            "sst_build",
+            &self.build,
+            &bind,
+            ((tree.leaves / 2).div_ceil(WG_1D), 1, 1),
+        );
+        self.record_classify(device, queue, encoder, timer, tree, v_min, sigma_max);
+    }
+
+    /// Recomputes only the usable flags (v >= v_min and sigma_z <= sigma_max).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_classify(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        tree: &TreeBuffers,
+        v_min: f32,
+        sigma_max: f32,
+    ) {
+        let nodes = 2 * tree.leaves;
+        let p = GpuClassifyParams {
+            nodes,
+            v_min,
+            sigma_max,
+            _pad: 0,
+        };
+        queue.write_buffer(&self.classify_params, 0, bytemuck::bytes_of(&p));
+        let entries = [
+            self.classify_params.as_entire_binding(),
+            tree.nodes.as_entire_binding(),
+            tree.flags.as_entire_binding(),
+        ];
+        let bind = bind_group(
+            device,
+            "sst_classify::bind_group",
+            &self.classify_layout,
+            &entries,
+        );
+        run_compute(
+            encoder,
+            timer,
+            "sst_classify",
+            &self.classify,
+            &bind,
+            (nodes.div_ceil(32).div_ceil(WG_1D), 1, 1),
+        );
+    }
+}
+
+fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: &[wgpu::BindingResource<'_>],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
+        .iter()
+        .enumerate()
+        .map(|(i, r)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: r.clone(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// Reads every node back (2 x leaves, node 0 unused).
+pub fn read_nodes(ctx: &GpuContext, tree: &TreeBuffers) -> Result<Vec<GpuSstNode>, GpuError> {
+    let bytes = readback::read_storage_buffer(ctx, &tree.nodes)?;
+    Ok(bytemuck::cast_slice(&bytes).to_vec())
+}
+
+/// Reads the usable bits back (word w holds nodes 32w .. 32w+31).
+pub fn read_flags(ctx: &GpuContext, tree: &TreeBuffers) -> Result<Vec<u32>, GpuError> {
+    let bytes = readback::read_storage_buffer(ctx, &tree.flags)?;
+    Ok(bytemuck::cast_slice(&bytes).to_vec())
+}
+
+/// Reads the VPLs in leaf order back.
+pub fn read_sorted_vpls(ctx: &GpuContext, tree: &TreeBuffers) -> Result<Vec<GpuVpl>, GpuError> {
+    let bytes = readback::read_storage_buffer(ctx, &tree.sorted_vpls)?;
+    Ok(bytemuck::cast_slice(&bytes).to_vec())
+}
