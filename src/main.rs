@@ -17,12 +17,26 @@ fn main() {
         Some(Command::Render(args)) => render::run(args),
         Some(Command::Bench(args)) => bench::run(args),
         Some(Command::ExportScene(args)) => export_scene::run(args),
-        None => run_gui(AppOptions {
-            scene: cli.scene.clone(),
-            camera: cli.camera.clone(),
-            exit_after_frames: cli.frames,
-            screenshot: cli.screenshot.clone(),
-        }),
+        None => {
+            let settings = cli.settings.as_ref().map(|p| {
+                lightcut::cli::SettingsArgs {
+                    settings: Some(p.clone()),
+                    ..Default::default()
+                }
+                .resolve(0.0)
+            });
+            match settings.transpose() {
+                Err(e) => Err(e),
+                Ok(settings) => run_gui(AppOptions {
+                    scene: cli.scene.clone(),
+                    camera: cli.camera.clone(),
+                    exit_after_frames: cli.frames,
+                    screenshot: cli.screenshot.clone(),
+                    settings,
+                    tree_stats: cli.tree_stats,
+                }),
+            }
+        }
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

@@ -83,3 +83,35 @@ fn main_window_snapshot() {
     ));
     h.snapshot("main_window");
 }
+
+#[test]
+fn light_tree_overlay_and_statistics_window() {
+    let Some(_) = common::gpu() else { return };
+    // Tall, so that the whole side panel (the light-tree section is near its end) is visible.
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1100.0, 1700.0))
+        .wgpu_setup(setup())
+        .build_eframe(|cc| {
+            WorkbenchApp::new(
+                cc,
+                AppOptions {
+                    scene: "default".into(),
+                    ..Default::default()
+                },
+            )
+        });
+    h.run_steps(3);
+    let before = shown_pixels(&h);
+    h.get_by_role_and_label(Role::ComboBox, "tree overlay").click();
+    h.run_steps(2);
+    h.get_by_label("distributions").click();
+    h.run_steps(3);
+    assert_ne!(shown_pixels(&h), before, "the overlay drew nothing");
+    // The level slider appears with the overlay; the statistics window opens from its checkbox.
+    h.get_by_label("statistics").click();
+    h.run_steps(4);
+    // (get_by_* panics when no such node is shown.)
+    h.get_by_label_contains("4096 VPLs in 4096 leaves, 13 levels; root flux");
+    h.get_by_label_contains("usable = v ≥ 0.70");
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+}

@@ -2,6 +2,7 @@
 //! display settings, status line. Only [`viewport_texture`] touches `egui_wgpu`'s textures.
 
 pub mod camera_control;
+pub mod tree_panel;
 pub mod viewport_texture;
 
 use std::{
@@ -18,7 +19,7 @@ use crate::{
     renderer::{
         FrameInput, Renderer,
         context::{GpuContext, describe_adapter},
-        settings::{GiMethod, RenderSettings, Tonemap, ViewBuffer, VplMode},
+        settings::{GiMethod, RenderSettings, Tonemap, TreeColor, TreeOverlay, ViewBuffer, VplMode},
         timing::PassTimings,
     },
     scene::{
@@ -27,6 +28,7 @@ use crate::{
     },
 };
 use camera_control::{CameraController, CameraMode};
+use tree_panel::TreePanel;
 use viewport_texture::ViewportTexture;
 
 /// How the app was started.
@@ -39,6 +41,10 @@ pub struct AppOptions {
     pub exit_after_frames: Option<u64>,
     /// Save a window screenshot before exiting.
     pub screenshot: Option<PathBuf>,
+    /// Start-up settings (from `--settings`); None = defaults with the preset's exposure.
+    pub settings: Option<RenderSettings>,
+    /// Open the light-tree statistics window at start.
+    pub tree_stats: bool,
 }
 
 /// The sun as the UI edits it (light 0 of the scene).
@@ -123,15 +129,17 @@ pub struct WorkbenchApp {
     last_frame_time: Option<f64>,
     frame_ms_smoothed: f64,
     adapter: String,
+    tree_panel: TreePanel,
 }
 
 impl WorkbenchApp {
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
+        let tree_stats = options.tree_stats;
         let mut app = Self {
             render_state: cc.wgpu_render_state.clone(),
             renderer: None,
             open: None,
-            settings: RenderSettings::default(),
+            settings: options.settings.clone().unwrap_or_default(),
             view: ViewBuffer::Final,
             sun: None,
             render_scale: 1.0,
@@ -150,6 +158,7 @@ impl WorkbenchApp {
             last_frame_time: None,
             frame_ms_smoothed: 0.0,
             adapter: String::new(),
+            tree_panel: TreePanel::new(tree_stats),
         };
         let Some(rs) = app.render_state.clone() else {
             app.errors.push(format!(
@@ -187,7 +196,9 @@ impl WorkbenchApp {
         let camera = camera.map(str::to_string).or(opened.camera_name.clone());
         let open = OpenScene::new(opened.scene, source.to_string(), camera.as_deref())
             .map_err(|e| format!("Could not open '{source}': {e}"))?;
-        self.settings.display.exposure_ev = opened.exposure_ev;
+        if self.options.settings.is_none() {
+            self.settings.display.exposure_ev = opened.exposure_ev;
+        }
         match &mut self.renderer {
             Some(r) => {
                 r.load_scene(&open.scene);
@@ -454,6 +465,9 @@ impl WorkbenchApp {
                 ui.checkbox(&mut v.animate, "new VPLs every frame");
             });
             ui.separator();
+            let levels = self.renderer.as_ref().map(|r| r.tree_buffers().1.levels());
+            self.tree_panel.controls(ui, &mut self.settings, levels);
+            ui.separator();
             ui.heading("Shadow map");
             let s = &mut self.settings.shadow;
             egui::ComboBox::from_label("resolution")
@@ -569,11 +583,16 @@ impl WorkbenchApp {
         }
 
         let lights = lights_with_sun(&open.scene, self.sun.as_ref());
+        renderer.set_freeze_tree(self.tree_panel.freeze);
         renderer.render(&FrameInput {
             camera: &open.camera,
             lights: &lights,
             view: self.view,
         });
+        let now = ui.input(|i| i.time);
+        if let Err(e) = self.tree_panel.refresh(renderer, now) {
+            self.errors.push(format!("light tree statistics: {e}"));
+        }
         if let Some(t) = renderer.poll_timings() {
             self.timings = Some(t);
         }
@@ -614,6 +633,11 @@ impl WorkbenchApp {
             legend(ui, draw, "importance / mean (log)", -3.0, 2.0);
         } else if self.settings.display.vpl_overlay {
             legend(ui, draw, "VPL flux / mean (log)", -2.0, 2.0);
+        } else if self.settings.display.tree_overlay != TreeOverlay::Off
+            && self.settings.display.tree_color == TreeColor::Intensity
+            && !self.view.is_rsm_space()
+        {
+            legend(ui, draw, "node flux / level mean (log)", -2.0, 2.0);
         }
         self.frames += 1;
     }
@@ -763,6 +787,10 @@ impl eframe::App for WorkbenchApp {
             .default_size(290.0)
             .show(ui, |ui| self.side_panel(ui));
         egui::CentralPanel::default().show(ui, |ui| self.viewport(ui));
+        if self.tree_panel.show_stats {
+            self.tree_panel
+                .window(&ctx, &self.settings, self.timings.as_ref());
+        }
         self.error_window(&ctx);
         self.handle_exit(&ctx);
         ctx.request_repaint();

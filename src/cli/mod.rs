@@ -25,6 +25,13 @@ pub struct Cli {
     /// Save a screenshot of the whole window (PNG) just before exiting (with --frames).
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
+    /// GUI start-up settings: a TOML file with `RenderSettings` (as `render --settings`);
+    /// its exposure replaces the preset's.
+    #[arg(long)]
+    pub settings: Option<PathBuf>,
+    /// Open the light-tree statistics window at start.
+    #[arg(long)]
+    pub tree_stats: bool,
 }
 
 #[derive(Subcommand, Debug)]

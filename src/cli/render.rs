@@ -14,7 +14,7 @@ use crate::{
         Buffer, FrameInput, Renderer,
         context::GpuContext,
         readback::ImageF32,
-        settings::{GiMethod, ViewBuffer},
+        settings::{GiMethod, TreeColor, TreeOverlay, ViewBuffer},
     },
     scene::preset::{SceneSource, open_scene},
 };
@@ -256,6 +256,33 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             (ViewBuffer::PdfPyramid, "pdf_pyramid_level4.png"),
         ] {
             frame(&mut r, view);
+            let (w, h, bytes) = r.read_view_rgba8()?;
+            write_png(&out.join(name), w, h, &bytes)?;
+        }
+        // The light tree over the albedo (which shows the geometry): distributions by flux
+        // and by usable flag, and bounding boxes of a coarse level.
+        for (overlay, color, level, name) in [
+            (
+                TreeOverlay::Distributions,
+                TreeColor::Intensity,
+                6,
+                "tree_distributions_level6.png",
+            ),
+            (
+                TreeOverlay::Distributions,
+                TreeColor::Usable,
+                8,
+                "tree_usable_level8.png",
+            ),
+            (TreeOverlay::Boxes, TreeColor::Node, 4, "tree_boxes_level4.png"),
+        ] {
+            let mut s3 = r.settings().clone();
+            s3.display.vpl_overlay = false;
+            s3.display.tree_overlay = overlay;
+            s3.display.tree_color = color;
+            s3.display.tree_level = level;
+            r.set_settings(s3)?;
+            frame(&mut r, ViewBuffer::Albedo);
             let (w, h, bytes) = r.read_view_rgba8()?;
             write_png(&out.join(name), w, h, &bytes)?;
         }

@@ -202,7 +202,8 @@ impl ViewTarget {
             size,
             1,
             VIEW_FORMAT,
-            wgpu::TextureUsages::STORAGE_BINDING | READABLE,
+            // Render attachment: overlays (the light tree) are drawn into it with blending.
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT | READABLE,
         );
         Self {
             view: tex.create_view(&Default::default()),

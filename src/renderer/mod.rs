@@ -31,6 +31,7 @@ use passes::{
     reference::{GpuRefParams, ReferencePass},
     rsm::RsmPass,
     sst_build::{BuildPass, TreeBuffers},
+    sst_overlay::SstOverlayPass,
     sst_sort::{SortBuffers, SortPass},
     visualise::{VisMode, VisSource, VisualisePass},
     vpl_gen::{VplBuffers, VplFrame, VplGenPass},
@@ -38,7 +39,7 @@ use passes::{
 };
 use readback::ImageF32;
 use scene_gpu::SceneGpu;
-use settings::{GiMethod, RenderSettings, ViewBuffer};
+use settings::{GiMethod, RenderSettings, TreeOverlay, ViewBuffer};
 use timing::{GpuTimer, PassTimings};
 
 #[derive(Debug, Error)]
@@ -126,6 +127,7 @@ pub struct Renderer {
     sort_buffers: SortBuffers,
     sst_build: BuildPass,
     tree: TreeBuffers,
+    sst_overlay: SstOverlayPass,
     vpl_buffers: VplBuffers,
     vpl_frame: VplFrame,
     gt: Option<GtState>,
@@ -140,6 +142,8 @@ pub struct Renderer {
     lights_buf: wgpu::Buffer,
     timer: GpuTimer,
     frames: u64,
+    /// While frozen: the thresholds the flags were last classified with.
+    freeze: Option<(f32, f32)>,
 }
 
 /// Refuses settings whose buffers the device cannot bind (instead of failing every frame).
@@ -214,6 +218,7 @@ impl Renderer {
             sort_buffers: SortBuffers::new(device, settings.vpl.count),
             sst_build: BuildPass::new(device)?,
             tree: TreeBuffers::new(device, settings.vpl.count),
+            sst_overlay: SstOverlayPass::new(device)?,
             vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
             vpl_frame: VplFrame::default(),
             gt: None,
@@ -231,6 +236,7 @@ impl Renderer {
             timer: GpuTimer::new(device, &ctx.queue),
             settings,
             frames: 0,
+            freeze: None,
             ctx,
         })
     }
@@ -255,13 +261,14 @@ impl Renderer {
                 VplSplatPass::new(device),
                 SortPass::new(device),
                 BuildPass::new(device),
+                SstOverlayPass::new(device),
             ),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
         }
-        let (g, s, d, disp, v, (vg, gt, c, rf, sp, so, b)) = passes;
-        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?, so?, b?);
+        let (g, s, d, disp, v, (vg, gt, c, rf, sp, so, b, ov)) = passes;
+        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?, so?, b?, ov?);
         (
             self.gbuffer,
             self.rsm,
@@ -275,6 +282,7 @@ impl Renderer {
             self.vpl_splat,
             self.sst_sort,
             self.sst_build,
+            self.sst_overlay,
         ) = new;
         Ok(())
     }
@@ -423,7 +431,26 @@ impl Renderer {
             .vpl
             .seed
             .wrapping_add(if s.vpl.animate { self.frames as u32 } else { 0 });
-        if vpl_ok {
+        let frozen = self.freeze.is_some() && vpl_ok && self.tree.count == self.vpl_frame.count;
+        if frozen {
+            // Frozen VPLs and tree (debugging): only the flags follow new thresholds.
+            let th = (s.tree.v_min, s.tree.sigma_max);
+            if self.freeze != Some(th) {
+                self.sst_build.record_classify(
+                    &device,
+                    &queue,
+                    &mut enc,
+                    &mut self.timer,
+                    &self.tree,
+                    th.0,
+                    th.1,
+                );
+                self.freeze = Some(th);
+            }
+        } else if vpl_ok {
+            if self.freeze.is_some() {
+                self.freeze = Some((s.tree.v_min, s.tree.sigma_max));
+            }
             let t = &self.targets;
             self.vpl_frame = self.vpl_gen.record(
                 &device,
@@ -504,6 +531,23 @@ impl Renderer {
         self.record_view(&mut enc, input.view, input.camera);
         if self.settings.display.vpl_overlay && vpl_ok {
             self.record_vpl_overlay(&mut enc, input.view);
+        }
+        let d = &self.settings.display;
+        if d.tree_overlay != TreeOverlay::Off && vpl_ok && !input.view.is_rsm_space() {
+            self.sst_overlay.record(
+                &device,
+                &queue,
+                &mut enc,
+                &mut self.timer,
+                d.tree_overlay,
+                d.tree_color,
+                d.tree_level,
+                0.003 * self.scene.bounds.radius().max(1e-3),
+                &self.camera_buf,
+                &self.tree,
+                &self.targets.gbuffer.position_view,
+                &self.targets.view.view,
+            );
         }
         self.timer.resolve(&mut enc);
         queue.submit([enc.finish()]);
@@ -692,6 +736,21 @@ impl Renderer {
         let nodes = passes::sst_build::read_nodes(&self.ctx, &self.tree)?;
         let flags = passes::sst_build::read_flags(&self.ctx, &self.tree)?;
         Ok((nodes.iter().map(SstNode::decode).collect(), flags))
+    }
+
+    /// Freezes (or thaws) the VPLs and the light tree: while frozen, frames reuse the last
+    /// VPLs, sort and tree (the camera can move around them), and a change of v_min /
+    /// sigma_max re-runs only the classify pass.
+    pub fn set_freeze_tree(&mut self, freeze: bool) {
+        if freeze && self.freeze.is_none() {
+            self.freeze = Some((self.settings.tree.v_min, self.settings.tree.sigma_max));
+        } else if !freeze {
+            self.freeze = None;
+        }
+    }
+
+    pub fn tree_frozen(&self) -> bool {
+        self.freeze.is_some()
     }
 
     /// Re-runs only the classify pass of the last frame's tree with new thresholds (the

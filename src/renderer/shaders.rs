@@ -60,6 +60,7 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("vpl_splat.wgsl", include_str!("../../shaders/vpl_splat.wgsl")),
     ("sst_sort.wgsl", include_str!("../../shaders/sst_sort.wgsl")),
     ("sst_build.wgsl", include_str!("../../shaders/sst_build.wgsl")),
+    ("sst_overlay.wgsl", include_str!("../../shaders/sst_overlay.wgsl")),
     (
         "sst_classify.wgsl",
         include_str!("../../shaders/sst_classify.wgsl"),
@@ -88,6 +89,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "sst_sort.wgsl",
     "sst_build.wgsl",
     "sst_classify.wgsl",
+    "sst_overlay.wgsl",
 ];
 
 #[derive(Debug, Error, PartialEq)]

@@ -10,6 +10,7 @@ pub mod ground_truth;
 pub mod reference;
 pub mod rsm;
 pub mod sst_build;
+pub mod sst_overlay;
 pub mod sst_sort;
 pub mod visualise;
 pub mod vpl_gen;
