@@ -25,15 +25,22 @@ fn main() {
                 }
                 .resolve(0.0)
             });
-            match settings.transpose() {
-                Err(e) => Err(e),
-                Ok(settings) => run_gui(AppOptions {
+            let view = cli
+                .view
+                .as_deref()
+                .map(lightcut::renderer::settings::ViewBuffer::from_name)
+                .transpose()
+                .map_err(|e| anyhow::anyhow!("{e}"));
+            match (settings.transpose(), view) {
+                (Err(e), _) | (_, Err(e)) => Err(e),
+                (Ok(settings), Ok(view)) => run_gui(AppOptions {
                     scene: cli.scene.clone(),
                     camera: cli.camera.clone(),
                     exit_after_frames: cli.frames,
                     screenshot: cli.screenshot.clone(),
                     settings,
                     tree_stats: cli.tree_stats,
+                    view,
                 }),
             }
         }

@@ -45,6 +45,9 @@ fn render_default_scene_writes_exrs_pngs_and_timings() {
         "albedo.png",
         "depth.png",
         "shadow_map.png",
+        "tree_distributions_level6.png",
+        "tree_usable_level8.png",
+        "tree_boxes_level4.png",
     ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
@@ -86,6 +89,52 @@ fn bad_input_gives_one_clear_line() {
         "render", "--scene", "default", "--camera", "Nope", "--out", "/tmp/x",
     ]);
     assert!(e.contains("Nope"), "{e}");
+    let e = one_line_error(&["bench", "tree", "--min-log2", "12", "--max-log2", "21"]);
+    assert!(e.contains("--max-log2"), "{e}");
+    let e = one_line_error(&["--view", "nope", "--frames", "1"]);
+    assert!(e.contains("unknown view 'nope'"), "{e}");
+}
+
+#[test]
+fn bench_tree_prints_a_row_per_size_and_the_slopes() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let o = bin()
+        .args([
+            "bench",
+            "tree",
+            "--min-log2",
+            "8",
+            "--max-log2",
+            "10",
+            "--repeat",
+            "1",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{stdout}
+{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    for n in ["256", "512", "1024"] {
+        let row = stdout
+            .lines()
+            .find(|l| l.trim_start().starts_with(n))
+            .unwrap_or_else(|| panic!("no row for {n}: {stdout}"));
+        // VPLs, keys, sort, build, classify, total, Mnode/s: all numbers, the times > 0.
+        let cols: Vec<f64> = row.split_whitespace().filter_map(|c| c.parse().ok()).collect();
+        assert_eq!(cols.len(), 7, "{row}");
+        assert!(cols[1..6].iter().all(|t| *t > 0.0), "{row}");
+        assert!(
+            (cols[5] - cols[1..5].iter().sum::<f64>()).abs() < 0.01,
+            "total = sum: {row}"
+        );
+    }
+    assert!(stdout.contains("log-log slope of time vs N: keys"), "{stdout}");
 }
 
 #[test]

@@ -45,6 +45,8 @@ pub struct AppOptions {
     pub settings: Option<RenderSettings>,
     /// Open the light-tree statistics window at start.
     pub tree_stats: bool,
+    /// The buffer shown at start (default: final).
+    pub view: Option<ViewBuffer>,
 }
 
 /// The sun as the UI edits it (light 0 of the scene).
@@ -140,7 +142,7 @@ impl WorkbenchApp {
             renderer: None,
             open: None,
             settings: options.settings.clone().unwrap_or_default(),
-            view: ViewBuffer::Final,
+            view: options.view.unwrap_or(ViewBuffer::Final),
             sun: None,
             render_scale: 1.0,
             texture: ViewportTexture::new(),

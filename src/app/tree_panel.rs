@@ -5,7 +5,7 @@
 use egui_plot::{Bar, BarChart, Plot, VLine};
 
 use crate::{
-    reference::sst_tree::{TreeStats, level_count, stats},
+    reference::sst_tree::{TreeStats, level_count, luminance, stats},
     renderer::{
         Renderer,
         settings::{RenderSettings, TreeColor, TreeOverlay},
@@ -116,9 +116,12 @@ impl TreePanel {
     /// The statistics window.
     pub fn window(&mut self, ctx: &egui::Context, settings: &RenderSettings, timings: Option<&PassTimings>) {
         let mut open = self.show_stats;
+        // Top right, over the viewport rather than the side panel.
+        let right = ctx.content_rect().right();
         egui::Window::new("Light tree statistics")
             .open(&mut open)
             .default_width(360.0)
+            .default_pos(egui::pos2(right - 390.0, 30.0))
             .show(ctx, |ui| self.window_contents(ui, settings, timings));
         self.show_stats = open;
     }
@@ -135,14 +138,18 @@ impl TreePanel {
         };
         let valid_leaves = s.per_level.last().map_or(0, |l| l.0);
         ui.label(format!(
-            "{} VPLs in {} leaves, {} levels; root flux {:.4} {:.4} {:.4} W",
+            "{} VPLs in {} leaves, {} levels; root flux {:.4} {:.4} {:.4} W (lum. {:.4} W)",
             valid_leaves,
             s.leaves,
             level_count(s.leaves),
             s.root_intensity.x,
             s.root_intensity.y,
-            s.root_intensity.z
-        ));
+            s.root_intensity.z,
+            luminance(s.root_intensity)
+        ))
+        .on_hover_text(
+            "the VPLs' total flux: an unbiased estimate of the RSMs' reflected flux (status line)",
+        );
         if let Some(t) = timings {
             let get = |n| t.get(n).map_or("–".to_string(), |ms| format!("{ms:.3} ms"));
             ui.label(format!(

@@ -32,6 +32,9 @@ pub struct Cli {
     /// Open the light-tree statistics window at start.
     #[arg(long)]
     pub tree_stats: bool,
+    /// The buffer shown at start, by its name in the buffer selector (e.g. "albedo").
+    #[arg(long)]
+    pub view: Option<String>,
 }
 
 #[derive(Subcommand, Debug)]

@@ -558,6 +558,17 @@ impl ViewBuffer {
             ViewBuffer::ShadowMap => "shadow map",
         }
     }
+    /// The view called `name` (as [`ViewBuffer::name`] spells it, case-insensitive).
+    pub fn from_name(name: &str) -> Result<ViewBuffer, String> {
+        ViewBuffer::ALL
+            .into_iter()
+            .find(|v| v.name().eq_ignore_ascii_case(name.trim()))
+            .ok_or_else(|| {
+                let names: Vec<&str> = ViewBuffer::ALL.iter().map(|v| v.name()).collect();
+                format!("unknown view '{name}'; the views are: {}", names.join(", "))
+            })
+    }
+
     /// True for views drawn in RSM texel space (VPL overlays go to their texels there).
     pub fn is_rsm_space(self) -> bool {
         matches!(
