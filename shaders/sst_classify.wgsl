@@ -1,5 +1,5 @@
 // The "usable for sampling" flags of every SST node (SST paper eq. 3: v >= v_min and
-// sigma_z <= sigma_max), one bit per node: word w holds nodes 32w .. 32w+31. Cheap and
+// sigma_z < sigma_max), one bit per node: word w holds nodes 32w .. 32w+31. Cheap and
 // separate from the build, so that changing v_min / sigma_max never rebuilds the tree.
 // CPU twin: `classify` in src/reference/sst_tree.rs.
 #include "common/sst_node.wgsl"

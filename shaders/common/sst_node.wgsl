@@ -62,7 +62,8 @@ fn sst_variance(node: SstNode) -> vec3<f32> {
     return vec3<f32>(unpack2x16float(node.var_xy), node.var_z);
 }
 
-// SST paper eq. 3: usable for sampling.
+// SST paper eq. 3: usable for sampling (sigma bound strict, so that sigma_max = 0 turns
+// substitutes off; see src/reference/sst_tree.rs).
 fn sst_usable(node: SstNode, v_min: f32, sigma_max: f32) -> bool {
-    return !sst_is_empty(node) && node.v >= v_min && node.var_z <= sigma_max * sigma_max;
+    return !sst_is_empty(node) && node.v >= v_min && node.var_z < sigma_max * sigma_max;
 }

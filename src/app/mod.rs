@@ -15,11 +15,15 @@ use std::{
 
 use glam::{Vec2, Vec3};
 
+use crate::reference::sst_tree::{SstNode, luminance};
 use crate::{
     renderer::{
         FrameInput, Renderer,
         context::{GpuContext, describe_adapter},
-        settings::{GiMethod, RenderSettings, Tonemap, TreeColor, TreeOverlay, ViewBuffer, VplMode},
+        settings::{
+            CutBlending, CutFallback, GiMethod, RenderSettings, Tonemap, TreeColor, TreeOverlay, ViewBuffer,
+            VplMode,
+        },
         timing::PassTimings,
     },
     scene::{
@@ -132,6 +136,18 @@ pub struct WorkbenchApp {
     frame_ms_smoothed: f64,
     adapter: String,
     tree_panel: TreePanel,
+    sampling_stats: Option<crate::renderer::passes::slc::SamplingStats>,
+    cut_inspect: Option<CutInspect>,
+}
+
+/// The cut listed after a click in the cut views.
+struct CutInspect {
+    block: (u32, u32),
+    /// (node id, node, usable).
+    rows: Vec<(u32, SstNode, bool)>,
+    leaves: u32,
+    /// Luminance of the root's flux (every VPL).
+    root_flux: f32,
 }
 
 impl WorkbenchApp {
@@ -161,6 +177,8 @@ impl WorkbenchApp {
             frame_ms_smoothed: 0.0,
             adapter: String::new(),
             tree_panel: TreePanel::new(tree_stats),
+            sampling_stats: None,
+            cut_inspect: None,
         };
         let Some(rs) = app.render_state.clone() else {
             app.errors.push(format!(
@@ -426,6 +444,45 @@ impl WorkbenchApp {
                     )
                     .on_hover_text("share of the texel PDF that follows flux (> 0 keeps it unbiased)");
                 }
+                GiMethod::Slc | GiMethod::Sst | GiMethod::Rtslc => {
+                    let sm = &mut self.settings.sampling;
+                    let cut_label = if g.method == GiMethod::Sst {
+                        "samples per pixel"
+                    } else {
+                        "cut size (samples per pixel)"
+                    };
+                    ui.add(egui::Slider::new(&mut sm.cut_size, 1..=64).text(cut_label));
+                    if g.method != GiMethod::Sst {
+                        ui.add(egui::Slider::new(&mut sm.block_size, 1..=64).text("cut block k (pixels)"))
+                            .on_hover_text("one shallow light cut per k x k block (1 = per pixel)");
+                        egui::ComboBox::from_label("cut blending")
+                            .selected_text(sm.blending.name())
+                            .show_ui(ui, |ui| {
+                                for b in CutBlending::ALL {
+                                    ui.selectable_value(&mut sm.blending, b, b.name());
+                                }
+                            });
+                        egui::ComboBox::from_label("no similar cut")
+                            .selected_text(sm.fallback.name())
+                            .show_ui(ui, |ui| {
+                                for f in CutFallback::ALL {
+                                    ui.selectable_value(&mut sm.fallback, f, f.name());
+                                }
+                            });
+                        ui.checkbox(&mut sm.cull_behind, "cull nodes behind the block centre")
+                            .on_hover_text("thesis 5.1; off keeps every cut complete (unbiased)");
+                    }
+                    ui.checkbox(&mut sm.accumulate, "accumulate frames while static");
+                    if let Some(st) = self.sampling_stats {
+                        ui.label(format!(
+                            "{:.2} steps per traversal · {:.1} per pixel · {:.2}% pixels without a similar cut · {} dead branches",
+                            st.steps_per_traversal(),
+                            st.steps_per_pixel(),
+                            100.0 * st.fallback_fraction(),
+                            st.dead
+                        ));
+                    }
+                }
                 GiMethod::Off => {}
             }
             ui.add(
@@ -598,6 +655,9 @@ impl WorkbenchApp {
         if let Some(t) = renderer.poll_timings() {
             self.timings = Some(t);
         }
+        if self.settings.gi.method.samples_tree() {
+            self.sampling_stats = renderer.sampling_stats();
+        }
         for e in renderer.ctx.errors.take() {
             if !self.errors.contains(&e) {
                 self.errors.push(e);
@@ -631,7 +691,20 @@ impl WorkbenchApp {
             egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
             egui::Color32::WHITE,
         );
-        if self.view.is_log_heat() {
+        if self.view == ViewBuffer::TraversalSteps {
+            let top = renderer.sampling_steps_scale();
+            legend_with(ui, draw, "traversal steps per traversal", 0.0, top, Scale::Linear);
+        } else if self.view == ViewBuffer::CutDepth {
+            let top = renderer.sampling_steps_scale();
+            legend_with(
+                ui,
+                draw,
+                "mean cut node depth (root = 0)",
+                0.0,
+                top,
+                Scale::Linear,
+            );
+        } else if self.view.is_log_heat() {
             legend(ui, draw, "importance / mean (log)", -3.0, 2.0);
         } else if self.settings.display.vpl_overlay {
             legend(ui, draw, "VPL flux / mean (log)", -2.0, 2.0);
@@ -641,7 +714,96 @@ impl WorkbenchApp {
         {
             legend(ui, draw, "node flux / level mean (log)", -2.0, 2.0);
         }
+        // Clicking a block in the cut views lists its cut.
+        if response.clicked()
+            && matches!(self.view, ViewBuffer::CutBlocks | ViewBuffer::CutDepth)
+            && let Some(pos) = response.interact_pointer_pos()
+            && draw.contains(pos)
+        {
+            let u = (pos - draw.min) / draw.size();
+            let (px, py) = ((u.x * tw as f32) as u32, (u.y * th as f32) as u32);
+            let b = renderer.slc_buffers();
+            let block = (py / b.block) * b.grid.0 + px / b.block;
+            let (bx, by) = (px / b.block, py / b.block);
+            renderer.select_block(Some(block));
+            match (renderer.read_cut(block), renderer.read_tree()) {
+                (Ok(cut), Ok((nodes, flags))) => {
+                    self.cut_inspect = Some(CutInspect {
+                        block: (bx, by),
+                        rows: cut
+                            .iter()
+                            .map(|&n| {
+                                let node = nodes.get(n as usize).copied().unwrap_or(SstNode::EMPTY);
+                                (n, node, crate::reference::sst_tree::flag(&flags, n as usize))
+                            })
+                            .collect(),
+                        leaves: (nodes.len() / 2) as u32,
+                        root_flux: nodes.get(1).map_or(0.0, |r| luminance(r.intensity)),
+                    })
+                }
+                (Err(e), _) | (_, Err(e)) => self.errors.push(format!("reading the cut: {e}")),
+            }
+        }
         self.frames += 1;
+    }
+
+    /// The nodes of the clicked block's cut.
+    fn cut_window(&mut self, ctx: &egui::Context) {
+        let Some(ci) = &self.cut_inspect else { return };
+        let mut open = true;
+        egui::Window::new(format!("Cut of block ({}, {})", ci.block.0, ci.block.1))
+            .open(&mut open)
+            .default_width(420.0)
+            .show(ctx, |ui| {
+                if ci.rows.is_empty() {
+                    ui.label("empty: the block centre sees no geometry, or no node can light it");
+                    return;
+                }
+                let total: f32 = ci.rows.iter().map(|r| luminance(r.1.intensity)).sum();
+                ui.label(format!(
+                    "{} nodes; share of the root's flux: {:.1}%",
+                    ci.rows.len(),
+                    100.0 * total / ci.root_flux.max(1e-30)
+                ));
+                egui::ScrollArea::vertical().max_height(360.0).show(ui, |ui| {
+                    egui::Grid::new("cut_grid").striped(true).show(ui, |ui| {
+                        for h in [
+                            "slot",
+                            "node",
+                            "level",
+                            "flux (lum., W)",
+                            "v",
+                            "σ_z (m)",
+                            "usable",
+                        ] {
+                            ui.strong(h);
+                        }
+                        ui.end_row();
+                        for (i, (n, node, usable)) in ci.rows.iter().enumerate() {
+                            ui.label(i.to_string());
+                            ui.label(n.to_string());
+                            let level = n.ilog2();
+                            let leaf = *n >= ci.leaves;
+                            ui.label(if leaf {
+                                format!("{level} (leaf)")
+                            } else {
+                                level.to_string()
+                            });
+                            ui.label(format!("{:.5}", luminance(node.intensity)));
+                            ui.label(format!("{:.3}", node.v));
+                            ui.label(format!("{:.4}", node.sigma_z()));
+                            ui.label(if *usable { "yes" } else { "no" });
+                            ui.end_row();
+                        }
+                    });
+                });
+            });
+        if !open {
+            self.cut_inspect = None;
+            if let Some(r) = &mut self.renderer {
+                r.select_block(None);
+            }
+        }
     }
 
     fn error_window(&mut self, ctx: &egui::Context) {
@@ -698,6 +860,18 @@ impl WorkbenchApp {
 
 /// A false-colour scale bar in the lower left of `rect`, labelled in powers of ten.
 fn legend(ui: &egui::Ui, rect: egui::Rect, title: &str, lo: f32, hi: f32) {
+    legend_with(ui, rect, title, lo, hi, Scale::Log10);
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Scale {
+    /// Labels 10^lo .. 10^hi, one per decade.
+    Log10,
+    /// Labels lo .. hi, evenly (at most 7 ticks).
+    Linear,
+}
+
+fn legend_with(ui: &egui::Ui, rect: egui::Rect, title: &str, lo: f32, hi: f32, scale: Scale) {
     let w = 220.0;
     let bar = egui::Rect::from_min_size(rect.left_bottom() + egui::vec2(12.0, -34.0), egui::vec2(w, 12.0));
     let painter = ui.painter();
@@ -731,14 +905,33 @@ fn legend(ui: &egui::Ui, rect: egui::Rect, title: &str, lo: f32, hi: f32) {
         font.clone(),
         text,
     );
-    let decades = (hi - lo).round() as i32;
-    for d in 0..=decades {
-        let x = bar.left() + w * d as f32 / decades as f32;
-        let e = lo as i32 + d;
-        let label = match e {
-            0 => "1".to_string(),
-            e if e > 0 => format!("{}", 10i64.pow(e as u32)),
-            e => format!("1e{e}"),
+    let ticks = match scale {
+        Scale::Log10 => (hi - lo).round().max(1.0) as i32,
+        Scale::Linear => {
+            let span = (hi - lo).max(1e-6);
+            let mut n = span.round().max(1.0) as i32;
+            while n > 6 {
+                n = (n + 1) / 2;
+            }
+            n
+        }
+    };
+    for d in 0..=ticks {
+        let x = bar.left() + w * d as f32 / ticks as f32;
+        let label = match scale {
+            Scale::Log10 => match lo as i32 + d {
+                0 => "1".to_string(),
+                e if e > 0 => format!("{}", 10i64.pow(e as u32)),
+                e => format!("1e{e}"),
+            },
+            Scale::Linear => {
+                let v = lo + (hi - lo) * d as f32 / ticks as f32;
+                if (v - v.round()).abs() < 1e-3 {
+                    format!("{}", v.round() as i64)
+                } else {
+                    format!("{v:.1}")
+                }
+            }
         };
         painter.text(
             egui::pos2(x, bar.bottom() + 2.0),
@@ -789,6 +982,7 @@ impl eframe::App for WorkbenchApp {
             .default_size(290.0)
             .show(ui, |ui| self.side_panel(ui));
         egui::CentralPanel::default().show(ui, |ui| self.viewport(ui));
+        self.cut_window(&ctx);
         if self.tree_panel.show_stats {
             self.tree_panel
                 .window(&ctx, &self.settings, self.timings.as_ref());

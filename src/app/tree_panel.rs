@@ -166,7 +166,7 @@ impl TreePanel {
         ui.separator();
         let th = &settings.tree;
         ui.label(format!(
-            "usable = v ≥ {:.2} and σ_z ≤ {:.3} m (SST paper eq. 3)",
+            "usable = v ≥ {:.2} and σ_z < {:.3} m (SST paper eq. 3)",
             th.v_min, th.sigma_max
         ));
         egui::ScrollArea::vertical()

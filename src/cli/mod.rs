@@ -1,6 +1,7 @@
 //! Headless commands sharing the renderer with the app: `render` and `bench`.
 
 pub mod bench;
+pub mod compare;
 pub mod export_scene;
 pub mod render;
 
@@ -46,6 +47,8 @@ pub enum Command {
     /// Write a scene as PLY meshes + JSON (camera, sun, albedos) for independent renderers
     /// (scripts/mitsuba_check.py).
     ExportScene(export_scene::ExportSceneArgs),
+    /// Error metrics of an image against a reference: RMSE, relative RMSE, SSIM, mean ratio.
+    Compare(compare::CompareArgs),
 }
 
 /// Settings flags shared by the commands (override a settings file, which overrides defaults).

@@ -28,6 +28,104 @@ pub enum Method {
     GroundTruth,
     /// Every RSM texel as a VPL, per-pixel Monte Carlo (converged reference).
     Reference,
+    /// The thesis's method: shallow per-block cuts, stochastic blending, traversal stopping
+    /// at usable SST nodes.
+    Slc,
+    /// Baseline: traversals from the root, stopping at usable SST nodes (Tatzgern et al.).
+    Sst,
+    /// Baseline: the same cuts and blending, traversal down to leaf VPLs (Lin and Yuksel).
+    Rtslc,
+}
+
+/// Cut blending for `--blending`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BlendingArg {
+    Stochastic,
+    Off,
+}
+
+/// Fallback for `--fallback`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum FallbackArg {
+    Mock,
+    Average,
+    Root,
+    Recompute,
+}
+
+/// Settings of the tree samplers (override `--settings`).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct SamplingArgs {
+    /// Cut block edge k in pixels (1 = a cut per pixel).
+    #[arg(long)]
+    pub block: Option<u32>,
+    /// Nodes per cut = samples per pixel (SST: traversals from the root per pixel).
+    #[arg(long)]
+    pub cut_size: Option<u32>,
+    #[arg(long, value_enum)]
+    pub blending: Option<BlendingArg>,
+    #[arg(long, value_enum)]
+    pub fallback: Option<FallbackArg>,
+    /// Keep nodes behind the block centre's surface in the cuts (complete cuts).
+    #[arg(long)]
+    pub no_cull: bool,
+    /// Least normal similarity of a usable SST node.
+    #[arg(long)]
+    pub v_min: Option<f32>,
+    /// Bound on sigma_z (metres) of a usable SST node.
+    #[arg(long)]
+    pub sigma_max: Option<f32>,
+    /// Similarity S: least normal dot product.
+    #[arg(long)]
+    pub n_min: Option<f32>,
+    /// Similarity S: largest distance, as a fraction of the scene's bounding radius.
+    #[arg(long)]
+    pub d_max: Option<f32>,
+    /// Average this many independent frames of the tree sampler (new random numbers each).
+    #[arg(long, default_value_t = 1)]
+    pub frames: u32,
+}
+
+impl SamplingArgs {
+    pub fn apply(&self, s: &mut crate::renderer::settings::RenderSettings) {
+        use crate::renderer::settings::{CutBlending, CutFallback};
+        if let Some(v) = self.block {
+            s.sampling.block_size = v;
+        }
+        if let Some(v) = self.cut_size {
+            s.sampling.cut_size = v;
+        }
+        if let Some(b) = self.blending {
+            s.sampling.blending = match b {
+                BlendingArg::Stochastic => CutBlending::Stochastic,
+                BlendingArg::Off => CutBlending::Off,
+            };
+        }
+        if let Some(f) = self.fallback {
+            s.sampling.fallback = match f {
+                FallbackArg::Mock => CutFallback::MockCut,
+                FallbackArg::Average => CutFallback::Average,
+                FallbackArg::Root => CutFallback::Root,
+                FallbackArg::Recompute => CutFallback::Recompute,
+            };
+        }
+        if self.no_cull {
+            s.sampling.cull_behind = false;
+        }
+        if let Some(v) = self.v_min {
+            s.tree.v_min = v;
+        }
+        if let Some(v) = self.sigma_max {
+            s.tree.sigma_max = v;
+        }
+        if let Some(v) = self.n_min {
+            s.vpl.n_min = v;
+        }
+        if let Some(v) = self.d_max {
+            s.vpl.d_max = v;
+        }
+        s.sampling.accumulate = self.frames > 1;
+    }
 }
 
 /// Groups of files `render` writes.
@@ -85,6 +183,12 @@ pub struct RenderArgs {
     pub samples: Option<u32>,
     #[command(flatten)]
     pub settings: SettingsArgs,
+    #[command(flatten)]
+    pub sampling: SamplingArgs,
+}
+
+fn settings_method(r: &Renderer) -> GiMethod {
+    r.settings().gi.method
 }
 
 fn gi_label(m: Method) -> &'static str {
@@ -121,7 +225,14 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         Method::Off => GiMethod::Off,
         Method::GroundTruth => GiMethod::GroundTruth,
         Method::Reference => GiMethod::Reference,
+        Method::Slc => GiMethod::Slc,
+        Method::Sst => GiMethod::Sst,
+        Method::Rtslc => GiMethod::Rtslc,
     };
+    args.sampling.apply(&mut settings);
+    if args.sampling.frames == 0 {
+        return Err(anyhow!("--frames must be at least 1"));
+    }
     if let Some(v) = args.samples {
         settings.gi.reference_samples = v;
     }
@@ -162,6 +273,23 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         r.ctx.wait_idle()?;
     }
     let timings = r.wait_timings();
+    // Tree samplers: average --frames independent frames (the timing frames count).
+    if settings_method(&r).samples_tree() {
+        while r.sampling_frames() < args.sampling.frames {
+            frame(&mut r, ViewBuffer::Final);
+            r.ctx.wait_idle()?;
+        }
+        if let Some(st) = r.sampling_stats_blocking() {
+            println!(
+                "tree sampling: {} frame(s) averaged; {:.3} traversal steps per traversal, {:.2} per pixel; {:.3}% of pixels without a similar cut; {} dead branches in the last frame",
+                r.sampling_frames(),
+                st.steps_per_traversal(),
+                st.steps_per_pixel(),
+                100.0 * st.fallback_fraction(),
+                st.dead
+            );
+        }
+    }
     // Progressive GI: keep rendering the same frame until it has seen every VPL / sample.
     let mut gi_ms = timings
         .as_ref()
@@ -258,6 +386,22 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             frame(&mut r, view);
             let (w, h, bytes) = r.read_view_rgba8()?;
             write_png(&out.join(name), w, h, &bytes)?;
+        }
+        // The tree samplers' diagnostics (thesis figs. 7.2, 7.4, 7.6).
+        if settings_method(&r).samples_tree() {
+            let mut s3 = r.settings().clone();
+            s3.display.vpl_overlay = false;
+            r.set_settings(s3)?;
+            for (view, name) in [
+                (ViewBuffer::TraversalSteps, "traversal_steps.png"),
+                (ViewBuffer::CutFallback, "cut_fallback.png"),
+                (ViewBuffer::CutBlocks, "cut_blocks.png"),
+                (ViewBuffer::CutDepth, "cut_depth.png"),
+            ] {
+                frame(&mut r, view);
+                let (w, h, bytes) = r.read_view_rgba8()?;
+                write_png(&out.join(name), w, h, &bytes)?;
+            }
         }
         // The light tree over the albedo (which shows the geometry): distributions by flux
         // and by usable flag, and bounding boxes of a coarse level.

@@ -13,6 +13,7 @@ pub mod direct;
 pub mod display;
 pub mod gbuffer;
 pub mod gi;
+pub mod slc;
 pub mod sst;
 pub mod sst_tree;
 pub mod visualise;

@@ -22,7 +22,10 @@
 //! - intensity = sum of RGB flux, bounds = union.
 //!
 //! A node is "usable for sampling" (SST paper eq. 3) when it is not empty, v >= v_min and
-//! sigma_z <= sigma_max (sigma_z = the standard deviation along the normal, in metres).
+//! sigma_z < sigma_max (sigma_z = the standard deviation along the normal, in metres). Eq. 3
+//! writes sigma_z <= sigma_max; the strict form differs only where sigma_z equals the bound
+//! exactly, and makes sigma_max = 0 switch substitutes off (exactly flat clusters, sigma_z = 0,
+//! would otherwise stay usable).
 //!
 //! The GPU twin (`shaders/sst_build.wgsl`) runs the same operations in the same order; the
 //! stored normal and the f16 tangent variances are quantised identically here.
@@ -179,9 +182,10 @@ impl SstNode {
         self.variance.z.max(0.0).sqrt()
     }
 
-    /// SST paper eq. 3 (sigma_z compared squared, as on the GPU).
+    /// SST paper eq. 3 with a strict sigma bound (see the module doc; sigma_z compared
+    /// squared, as on the GPU).
     pub fn usable(&self, v_min: f32, sigma_max: f32) -> bool {
-        !self.is_empty() && self.v >= v_min && self.variance.z <= sigma_max * sigma_max
+        !self.is_empty() && self.v >= v_min && self.variance.z < sigma_max * sigma_max
     }
 }
 

@@ -246,6 +246,34 @@ pub struct GpuVpl {
 
 pub const VPL_NONE: u32 = u32::MAX;
 
+/// Twin: `SlcParams` in `shaders/common/slc_params.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuSlcParams {
+    pub width: u32,
+    pub height: u32,
+    pub block: u32,
+    pub grid_x: u32,
+    pub grid_y: u32,
+    pub cut_size: u32,
+    pub leaves: u32,
+    pub levels: u32,
+    /// 0 SLC, 1 SST, 2 RTSLC.
+    pub method: u32,
+    /// 0 stochastic, 1 off.
+    pub blending: u32,
+    /// 0 mock cut, 1 average, 2 root, 3 recompute.
+    pub fallback: u32,
+    pub cull: u32,
+    pub seed: u32,
+    pub accumulate: u32,
+    pub epsilon: f32,
+    pub ray_offset: f32,
+    pub n_min: f32,
+    pub d_max: f32,
+    pub _pad: [u32; 2],
+}
+
 /// A node of the Stochastic Substitute Tree, 64 bytes (one cache line; the SST paper's node
 /// is 96 B, RTSLC's 32 B). Twin: `SstNode` in `shaders/common/sst_node.wgsl`; decoded by
 /// `reference::sst_tree::SstNode::decode`.
@@ -425,6 +453,33 @@ mod tests {
                     offset_of!(GpuGtParams, ray_offset),
                     offset_of!(GpuGtParams, _pad),
                     offset_of!(GpuGtParams, _pad) + 4,
+                ],
+            ),
+            (
+                "slc_sample.wgsl",
+                "SlcParams",
+                size_of::<GpuSlcParams>(),
+                vec![
+                    offset_of!(GpuSlcParams, width),
+                    offset_of!(GpuSlcParams, height),
+                    offset_of!(GpuSlcParams, block),
+                    offset_of!(GpuSlcParams, grid_x),
+                    offset_of!(GpuSlcParams, grid_y),
+                    offset_of!(GpuSlcParams, cut_size),
+                    offset_of!(GpuSlcParams, leaves),
+                    offset_of!(GpuSlcParams, levels),
+                    offset_of!(GpuSlcParams, method),
+                    offset_of!(GpuSlcParams, blending),
+                    offset_of!(GpuSlcParams, fallback),
+                    offset_of!(GpuSlcParams, cull),
+                    offset_of!(GpuSlcParams, seed),
+                    offset_of!(GpuSlcParams, accumulate),
+                    offset_of!(GpuSlcParams, epsilon),
+                    offset_of!(GpuSlcParams, ray_offset),
+                    offset_of!(GpuSlcParams, n_min),
+                    offset_of!(GpuSlcParams, d_max),
+                    offset_of!(GpuSlcParams, _pad),
+                    offset_of!(GpuSlcParams, _pad) + 4,
                 ],
             ),
             (

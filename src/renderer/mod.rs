@@ -30,6 +30,7 @@ use passes::{
     ground_truth::GroundTruthPass,
     reference::{GpuRefParams, ReferencePass},
     rsm::RsmPass,
+    slc::{SamplingStats, SlcBuffers, SlcPass},
     sst_build::{BuildPass, TreeBuffers},
     sst_overlay::SstOverlayPass,
     sst_sort::{SortBuffers, SortPass},
@@ -128,6 +129,12 @@ pub struct Renderer {
     sst_build: BuildPass,
     tree: TreeBuffers,
     sst_overlay: SstOverlayPass,
+    slc: SlcPass,
+    slc_buffers: SlcBuffers,
+    /// Accumulation of the tree samplers: (key, frames summed).
+    slc_state: Option<(u64, u32)>,
+    /// Block outlined in the cut views (set by the UI).
+    selected_block: Option<u32>,
     vpl_buffers: VplBuffers,
     vpl_frame: VplFrame,
     gt: Option<GtState>,
@@ -219,6 +226,15 @@ impl Renderer {
             sst_build: BuildPass::new(device)?,
             tree: TreeBuffers::new(device, settings.vpl.count),
             sst_overlay: SstOverlayPass::new(device)?,
+            slc: SlcPass::new(device)?,
+            slc_buffers: SlcBuffers::new(
+                device,
+                size,
+                settings.sampling.block_size,
+                settings.sampling.cut_size,
+            ),
+            slc_state: None,
+            selected_block: None,
             vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
             vpl_frame: VplFrame::default(),
             gt: None,
@@ -262,13 +278,14 @@ impl Renderer {
                 SortPass::new(device),
                 BuildPass::new(device),
                 SstOverlayPass::new(device),
+                SlcPass::new(device),
             ),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
         }
-        let (g, s, d, disp, v, (vg, gt, c, rf, sp, so, b, ov)) = passes;
-        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?, so?, b?, ov?);
+        let (g, s, d, disp, v, (vg, gt, c, rf, sp, so, b, ov, sl)) = passes;
+        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?, so?, b?, ov?, sl?);
         (
             self.gbuffer,
             self.rsm,
@@ -283,6 +300,7 @@ impl Renderer {
             self.sst_sort,
             self.sst_build,
             self.sst_overlay,
+            self.slc,
         ) = new;
         Ok(())
     }
@@ -514,6 +532,10 @@ impl Renderer {
                 let n = self.step_reference(&mut enc, input, lights, size);
                 if n == 0 { 0.0 } else { 1.0 / n as f32 }
             }
+            GiMethod::Slc | GiMethod::Sst | GiMethod::Rtslc => {
+                let n = self.step_sampling(&mut enc, input, lights, size);
+                1.0 / n.max(1) as f32
+            }
         };
         let t = &self.targets;
         self.composite.record(
@@ -553,6 +575,7 @@ impl Renderer {
         queue.submit([enc.finish()]);
         self.timer.after_submit();
         self.flux_readback.after_submit();
+        self.slc.after_submit();
         self.frames += 1;
     }
 
@@ -651,6 +674,125 @@ impl Renderer {
     /// Converged reference: restart on any change (clear the sums), then add
     /// `reference_spp_per_frame` samples per pixel up to `reference_samples`. Returns the
     /// samples per pixel accumulated after this frame.
+    /// One frame of the tree samplers (SLC, SST, RTSLC); returns the frames summed in the
+    /// accumulation buffer (1 unless `sampling.accumulate` and nothing changed).
+    fn step_sampling(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        input: &FrameInput<'_>,
+        lights: &[DirectionalLight],
+        size: (u32, u32),
+    ) -> u32 {
+        let s = self.settings.clone();
+        let sm = &s.sampling;
+        let device = self.ctx.device.clone();
+        let queue = self.ctx.queue.clone();
+        if !self.slc_buffers.matches(size, sm.block_size, sm.cut_size) {
+            self.slc_buffers = SlcBuffers::new(&device, size, sm.block_size, sm.cut_size);
+        }
+        // Accumulate while nothing changes (the key also covers the method and its settings);
+        // a frozen tree keeps its VPLs, otherwise new VPLs average in too.
+        let key = self.gt_key(input, lights, size) ^ 0x51c0_51c0_51c0_51c0;
+        let frames = match self.slc_state {
+            Some((k, n)) if sm.accumulate && k == key => n + 1,
+            _ => 1,
+        };
+        self.slc_state = Some((key, frames));
+        let grid = self.slc_buffers.grid;
+        let p = crate::renderer::gpu_data::GpuSlcParams {
+            width: size.0,
+            height: size.1,
+            block: sm.block_size,
+            grid_x: grid.0,
+            grid_y: grid.1,
+            cut_size: sm.cut_size,
+            leaves: self.tree.leaves,
+            levels: self.tree.levels(),
+            method: match s.gi.method {
+                GiMethod::Sst => 1,
+                GiMethod::Rtslc => 2,
+                _ => 0,
+            },
+            blending: match sm.blending {
+                settings::CutBlending::Stochastic => 0,
+                settings::CutBlending::Off => 1,
+            },
+            fallback: match sm.fallback {
+                settings::CutFallback::MockCut => 0,
+                settings::CutFallback::Average => 1,
+                settings::CutFallback::Root => 2,
+                settings::CutFallback::Recompute => 3,
+            },
+            cull: sm.cull_behind as u32,
+            seed: s.vpl.seed ^ (self.frames as u32).wrapping_mul(0x9e37_79b9),
+            accumulate: (frames > 1) as u32,
+            epsilon: s.gi.distance_epsilon,
+            ray_offset: s.gi.ray_offset,
+            n_min: s.vpl.n_min,
+            d_max: s.vpl.d_max * self.scene.bounds.radius().max(1e-3),
+            _pad: [0; 2],
+        };
+        self.slc.record(
+            &device,
+            &queue,
+            enc,
+            &mut self.timer,
+            p,
+            &self.tree,
+            &self.scene,
+            &self.targets.gbuffer,
+            &self.targets.lighting.gi_accum,
+            &self.slc_buffers,
+        );
+        frames
+    }
+
+    /// The top of the traversal-steps heat map: the depth of the tree (root to leaves).
+    pub fn sampling_steps_scale(&self) -> f32 {
+        (self.tree.levels().max(2) - 1) as f32
+    }
+
+    /// Outlines a block in the cut views (None: no outline).
+    pub fn select_block(&mut self, block: Option<u32>) {
+        self.selected_block = block;
+    }
+
+    /// Reads the cut of block `b` (node ids in slot order, without empty slots).
+    pub fn read_cut(&self, b: u32) -> Result<Vec<u32>, GpuError> {
+        let s = &self.slc_buffers;
+        if b >= s.grid.0 * s.grid.1 {
+            return Ok(Vec::new());
+        }
+        let off = b as u64 * s.cut_size as u64 * 4;
+        let bytes = readback::read_buffer_range(&self.ctx, &s.cuts, off, s.cut_size as u64 * 4)?;
+        Ok(bytemuck::cast_slice::<u8, u32>(&bytes)
+            .iter()
+            .copied()
+            .take_while(|&n| n != 0)
+            .collect())
+    }
+
+    /// Frames summed in the tree samplers' accumulation (0 before the first).
+    pub fn sampling_frames(&self) -> u32 {
+        self.slc_state.map_or(0, |(_, n)| n)
+    }
+
+    /// The last frame's sampling counters, waiting for them.
+    pub fn sampling_stats_blocking(&mut self) -> Option<SamplingStats> {
+        let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+        self.slc.poll_stats()
+    }
+
+    /// Counters of a recent frame of the tree samplers (non-blocking; None before the first).
+    pub fn sampling_stats(&mut self) -> Option<SamplingStats> {
+        self.slc.poll_stats()
+    }
+
+    /// The tree samplers' buffers (cuts, per-pixel diagnostics, counters) of the last frame.
+    pub fn slc_buffers(&self) -> &SlcBuffers {
+        &self.slc_buffers
+    }
+
     fn step_reference(
         &mut self,
         enc: &mut wgpu::CommandEncoder,
@@ -711,7 +853,7 @@ impl Renderer {
         match self.settings.gi.method {
             GiMethod::GroundTruth => self.gt.as_ref().map(|g| g.progress),
             GiMethod::Reference => self.reference_state.map(|(_, p)| p),
-            GiMethod::Off => None,
+            GiMethod::Off | GiMethod::Slc | GiMethod::Sst | GiMethod::Rtslc => None,
         }
     }
 
@@ -846,6 +988,44 @@ impl Renderer {
         } else {
             (b.min, b.max)
         };
+        if view.is_sampling_view() {
+            let b = &self.slc_buffers;
+            if b.size != self.targets.size {
+                // No tree-sampling frame at this size yet: nothing to show.
+                enc.clear_texture(&self.targets.view.texture, &Default::default());
+                return;
+            }
+            let d = &self.settings.display;
+            let p = passes::slc::GpuSlcViewParams {
+                mode: match view {
+                    ViewBuffer::TraversalSteps => 0,
+                    ViewBuffer::CutFallback => 1,
+                    ViewBuffer::CutBlocks => 2,
+                    _ => 3,
+                },
+                grid_x: b.grid.0,
+                block: b.block,
+                cut_size: b.cut_size,
+                exposure: d.exposure_ev.exp2(),
+                tonemap: d.tonemap.gpu_id(),
+                max_steps: self.sampling_steps_scale(),
+                levels: self.tree.levels(),
+                selected: self.selected_block.map_or(0, |b| b + 1),
+                _pad: [0; 3],
+            };
+            self.slc.record_view(
+                &device,
+                &queue,
+                enc,
+                &mut self.timer,
+                p,
+                &t.lighting.final_view,
+                &t.gbuffer.position_view,
+                b,
+                dst,
+            );
+            return;
+        }
         let (mode, src, lo, hi) = match view {
             ViewBuffer::Final | ViewBuffer::Direct | ViewBuffer::Indirect => {
                 let src = match view {
@@ -950,6 +1130,10 @@ impl Renderer {
                 [0.0; 4],
                 [1.0; 4],
             ),
+            ViewBuffer::TraversalSteps
+            | ViewBuffer::CutFallback
+            | ViewBuffer::CutBlocks
+            | ViewBuffer::CutDepth => unreachable!("drawn by slc_views above"),
             ViewBuffer::ShadowMap => (
                 VisMode::DepthTexture,
                 VisSource::Depth(&t.shadow.array_view, 0),

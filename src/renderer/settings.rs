@@ -11,6 +11,7 @@ pub struct RenderSettings {
     pub vpl: VplSettings,
     pub gi: GiSettings,
     pub tree: TreeSettings,
+    pub sampling: SamplingSettings,
     pub display: DisplaySettings,
     pub textures: TextureSettings,
 }
@@ -137,16 +138,40 @@ pub enum GiMethod {
     /// Converged reference: every RSM texel as a VPL, per-pixel Monte Carlo over the RSM
     /// pyramids, accumulated over frames until `reference_samples` per pixel.
     Reference,
+    /// The thesis's method (Stochastic Light Cut Exploration): shallow per-block cuts,
+    /// stochastic cut blending, traversal from each cut node that stops at usable SST nodes,
+    /// substitute-distribution samples.
+    Slc,
+    /// Baseline, Tatzgern et al. 2020: `cut_size` traversals per pixel from the root, each
+    /// stopping at a usable SST node.
+    Sst,
+    /// Baseline, Lin and Yuksel 2020: the same cuts and blending, traversal always down to a
+    /// leaf VPL (no substitutes).
+    Rtslc,
 }
 
 impl GiMethod {
-    pub const ALL: [GiMethod; 3] = [GiMethod::Off, GiMethod::GroundTruth, GiMethod::Reference];
+    pub const ALL: [GiMethod; 6] = [
+        GiMethod::Off,
+        GiMethod::Slc,
+        GiMethod::Sst,
+        GiMethod::Rtslc,
+        GiMethod::GroundTruth,
+        GiMethod::Reference,
+    ];
     pub fn name(self) -> &'static str {
         match self {
             GiMethod::Off => "off (direct only)",
             GiMethod::GroundTruth => "ground truth (all VPLs)",
             GiMethod::Reference => "converged reference (all texels)",
+            GiMethod::Slc => "SLC (thesis)",
+            GiMethod::Sst => "SST (baseline)",
+            GiMethod::Rtslc => "RTSLC (baseline)",
         }
+    }
+    /// The tree samplers (one estimate per frame), as opposed to the progressive references.
+    pub fn samples_tree(self) -> bool {
+        matches!(self, GiMethod::Slc | GiMethod::Sst | GiMethod::Rtslc)
     }
 }
 
@@ -198,8 +223,9 @@ pub struct TreeSettings {
     /// Least normal similarity v (eq. 4.3, in 0..=1) of a usable node. Higher keeps only
     /// clusters whose VPLs face the same way (deeper traversal, less bias).
     pub v_min: f32,
-    /// Largest standard deviation along the node's normal (metres) of a usable node. Lower
-    /// keeps only clusters lying on one plane.
+    /// Bound on the standard deviation along the node's normal (metres) of a usable node
+    /// (strict: sigma_z < sigma_max, so 0 turns substitutes off and only leaves are sampled).
+    /// Lower keeps only clusters lying on one plane.
     pub sigma_max: f32,
 }
 
@@ -209,6 +235,95 @@ impl Default for TreeSettings {
         Self {
             v_min: 0.7,
             sigma_max: 0.3,
+        }
+    }
+}
+
+/// How a pixel picks a cut per slot (thesis 5.1.3, fig. 7.4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CutBlending {
+    /// Algorithm 1: per slot, one of the 4 surrounding blocks' cuts by bilinear weight x S.
+    #[default]
+    Stochastic,
+    /// No blending: the cut of the pixel's own block (if similar, else the fallback).
+    Off,
+}
+
+impl CutBlending {
+    pub const ALL: [CutBlending; 2] = [CutBlending::Stochastic, CutBlending::Off];
+    pub fn name(self) -> &'static str {
+        match self {
+            CutBlending::Stochastic => "stochastic (Algorithm 1)",
+            CutBlending::Off => "off (own block)",
+        }
+    }
+}
+
+/// What a pixel does when no surrounding cut is similar (thesis 5.1.4, fig. 7.6).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CutFallback {
+    /// All nodes of tree level floor(log2(cut_size)).
+    #[default]
+    MockCut,
+    /// Blend the dissimilar cuts anyway, by bilinear weight alone.
+    Average,
+    /// `cut_size` traversals from the root (as SST).
+    Root,
+    /// Build a cut at the pixel itself (costly).
+    Recompute,
+}
+
+impl CutFallback {
+    pub const ALL: [CutFallback; 4] = [
+        CutFallback::MockCut,
+        CutFallback::Average,
+        CutFallback::Root,
+        CutFallback::Recompute,
+    ];
+    pub fn name(self) -> &'static str {
+        match self {
+            CutFallback::MockCut => "mock cut",
+            CutFallback::Average => "average the cuts",
+            CutFallback::Root => "traverse from the root",
+            CutFallback::Recompute => "recompute a cut",
+        }
+    }
+}
+
+/// Sampling the tree (stages 11-16, thesis chapter 5): used by the SLC, SST and RTSLC methods.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SamplingSettings {
+    /// k: one shallow light cut per k x k block of GI pixels (1 = a cut per pixel). Larger
+    /// blocks cost less and blur the cut choice across edges (blending hides the seams).
+    pub block_size: u32,
+    /// Nodes per cut = cluster evaluations (shadow rays) per pixel; SST takes this many
+    /// traversals from the root.
+    pub cut_size: u32,
+    /// Leave out of the cuts children whose box lies wholly behind the block centre's
+    /// surface (thesis 5.1). Pixels of a block that face differently can then miss light
+    /// from those nodes (bias, bounded by the similarity test); off keeps the cuts complete.
+    pub cull_behind: bool,
+    pub blending: CutBlending,
+    pub fallback: CutFallback,
+    /// Average successive frames while the view, lights and settings stay (progressive);
+    /// off shows each frame's estimate alone, as a real-time renderer would.
+    pub accumulate: bool,
+    /// Render GI at half resolution and upsample it with a joint bilateral filter using S.
+    pub half_resolution: bool,
+}
+
+impl Default for SamplingSettings {
+    fn default() -> Self {
+        // The thesis's defaults: 8 x 8 blocks, 32 samples per pixel.
+        Self {
+            block_size: 8,
+            cut_size: 32,
+            cull_behind: true,
+            blending: CutBlending::Stochastic,
+            fallback: CutFallback::MockCut,
+            accumulate: false,
+            half_resolution: false,
         }
     }
 }
@@ -242,7 +357,7 @@ pub enum TreeColor {
     /// Log-scale false colour of the node's flux relative to the level's mean.
     #[default]
     Intensity,
-    /// Green = usable for sampling (v >= v_min, sigma_z <= sigma_max), red = not.
+    /// Green = usable for sampling (v >= v_min, sigma_z < sigma_max), red = not.
     Usable,
     /// A distinct colour per node (to tell neighbours apart).
     Node,
@@ -459,6 +574,19 @@ impl RenderSettings {
                 g.ray_offset
             ));
         }
+        let sm = &self.sampling;
+        if !(1..=64).contains(&sm.block_size) {
+            return Err(format!(
+                "sampling.block_size {} is out of range (1..=64)",
+                sm.block_size
+            ));
+        }
+        if !(1..=64).contains(&sm.cut_size) {
+            return Err(format!(
+                "sampling.cut_size {} is out of range (1..=64)",
+                sm.cut_size
+            ));
+        }
         let t = &self.tree;
         if !(0.0..=1.0).contains(&t.v_min) {
             return Err(format!("tree.v_min {} is out of range (0..=1)", t.v_min));
@@ -519,10 +647,18 @@ pub enum ViewBuffer {
     MaterialId,
     /// The shadow map of light 0 (near = white).
     ShadowMap,
+    /// Tree samplers: traversal steps per traversal, per pixel (heat map, thesis fig. 7.2).
+    TraversalSteps,
+    /// Tree samplers: pixels without a similar surrounding cut (red over the grey final).
+    CutFallback,
+    /// Tree samplers: the per-block cuts, a colour per cut, over the grey final.
+    CutBlocks,
+    /// Tree samplers: the per-block cuts coloured by their mean node depth.
+    CutDepth,
 }
 
 impl ViewBuffer {
-    pub const ALL: [ViewBuffer; 15] = [
+    pub const ALL: [ViewBuffer; 19] = [
         ViewBuffer::Final,
         ViewBuffer::Direct,
         ViewBuffer::Indirect,
@@ -538,6 +674,10 @@ impl ViewBuffer {
         ViewBuffer::Position,
         ViewBuffer::MaterialId,
         ViewBuffer::ShadowMap,
+        ViewBuffer::TraversalSteps,
+        ViewBuffer::CutFallback,
+        ViewBuffer::CutBlocks,
+        ViewBuffer::CutDepth,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -556,6 +696,10 @@ impl ViewBuffer {
             ViewBuffer::Position => "position",
             ViewBuffer::MaterialId => "material id",
             ViewBuffer::ShadowMap => "shadow map",
+            ViewBuffer::TraversalSteps => "traversal steps",
+            ViewBuffer::CutFallback => "pixels without a similar cut",
+            ViewBuffer::CutBlocks => "cuts per block",
+            ViewBuffer::CutDepth => "cut depth per block",
         }
     }
     /// The view called `name` (as [`ViewBuffer::name`] spells it, case-insensitive).
@@ -580,6 +724,17 @@ impl ViewBuffer {
                 | ViewBuffer::ImportanceFiltered
                 | ViewBuffer::PdfPyramid
                 | ViewBuffer::ShadowMap
+        )
+    }
+
+    /// True for the views of the tree samplers' diagnostics.
+    pub fn is_sampling_view(self) -> bool {
+        matches!(
+            self,
+            ViewBuffer::TraversalSteps
+                | ViewBuffer::CutFallback
+                | ViewBuffer::CutBlocks
+                | ViewBuffer::CutDepth
         )
     }
 

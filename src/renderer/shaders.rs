@@ -32,6 +32,11 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         "common/random.wgsl",
         include_str!("../../shaders/common/random.wgsl"),
     ),
+    ("common/slc.wgsl", include_str!("../../shaders/common/slc.wgsl")),
+    (
+        "common/slc_params.wgsl",
+        include_str!("../../shaders/common/slc_params.wgsl"),
+    ),
     (
         "common/sst_node.wgsl",
         include_str!("../../shaders/common/sst_node.wgsl"),
@@ -60,6 +65,9 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("vpl_splat.wgsl", include_str!("../../shaders/vpl_splat.wgsl")),
     ("sst_sort.wgsl", include_str!("../../shaders/sst_sort.wgsl")),
     ("sst_build.wgsl", include_str!("../../shaders/sst_build.wgsl")),
+    ("slc_cuts.wgsl", include_str!("../../shaders/slc_cuts.wgsl")),
+    ("slc_sample.wgsl", include_str!("../../shaders/slc_sample.wgsl")),
+    ("slc_views.wgsl", include_str!("../../shaders/slc_views.wgsl")),
     ("sst_overlay.wgsl", include_str!("../../shaders/sst_overlay.wgsl")),
     (
         "sst_classify.wgsl",
@@ -90,6 +98,9 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "sst_build.wgsl",
     "sst_classify.wgsl",
     "sst_overlay.wgsl",
+    "slc_cuts.wgsl",
+    "slc_sample.wgsl",
+    "slc_views.wgsl",
 ];
 
 #[derive(Debug, Error, PartialEq)]

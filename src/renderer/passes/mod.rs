@@ -9,6 +9,7 @@ pub mod gbuffer;
 pub mod ground_truth;
 pub mod reference;
 pub mod rsm;
+pub mod slc;
 pub mod sst_build;
 pub mod sst_overlay;
 pub mod sst_sort;
@@ -182,6 +183,28 @@ pub(crate) fn compute_pipeline(
         entry_point: Some(entry),
         compilation_options: Default::default(),
         cache: None,
+    })
+}
+
+/// A bind group whose entries are `resources` at bindings 0, 1, 2, ...
+pub(crate) fn bind_group_seq(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: &[wgpu::BindingResource<'_>],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
+        .iter()
+        .enumerate()
+        .map(|(i, r)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: r.clone(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
     })
 }
 

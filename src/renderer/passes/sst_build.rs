@@ -15,7 +15,9 @@ use crate::{
     },
 };
 
-use super::{WG_1D, compute_pipeline, run_compute, sst_sort::SortBuffers, storage_entry, uniform_entry};
+use super::{
+    WG_1D, bind_group_seq, compute_pipeline, run_compute, sst_sort::SortBuffers, storage_entry, uniform_entry,
+};
 
 /// Twin: `TreeParams` in `shaders/sst_build.wgsl`.
 #[repr(C)]
@@ -164,7 +166,7 @@ impl BuildPass {
             tree.counters.as_entire_binding(),
             tree.sorted_vpls.as_entire_binding(),
         ];
-        let bind = bind_group(device, "sst_build::bind_group", &self.build_layout, &entries);
+        let bind = bind_group_seq(device, "sst_build::bind_group", &self.build_layout, &entries);
         encoder.clear_buffer(&tree.counters, 0, None);
         run_compute(
             encoder,
@@ -177,7 +179,7 @@ impl BuildPass {
         self.record_classify(device, queue, encoder, timer, tree, v_min, sigma_max);
     }
 
-    /// Recomputes only the usable flags (v >= v_min and sigma_z <= sigma_max).
+    /// Recomputes only the usable flags (v >= v_min and sigma_z < sigma_max).
     #[allow(clippy::too_many_arguments)]
     pub fn record_classify(
         &self,
@@ -202,7 +204,7 @@ impl BuildPass {
             tree.nodes.as_entire_binding(),
             tree.flags.as_entire_binding(),
         ];
-        let bind = bind_group(
+        let bind = bind_group_seq(
             device,
             "sst_classify::bind_group",
             &self.classify_layout,
@@ -217,27 +219,6 @@ impl BuildPass {
             (nodes.div_ceil(32).div_ceil(WG_1D), 1, 1),
         );
     }
-}
-
-fn bind_group(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::BindGroupLayout,
-    resources: &[wgpu::BindingResource<'_>],
-) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
-        .iter()
-        .enumerate()
-        .map(|(i, r)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: r.clone(),
-        })
-        .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(label),
-        layout,
-        entries: &entries,
-    })
 }
 
 /// Reads every node back (2 x leaves, node 0 unused).

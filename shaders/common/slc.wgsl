@@ -1,0 +1,96 @@
+// Tree sampling helpers (thesis chapter 5): node weights (eq. 5.5 with the geometric term of
+// eq. 5.2) and shallow light cuts (5.1). CPU twin: src/reference/slc.rs.
+// Contract: the includer declares `tree: array<SstNode>` and includes common/sst_node.wgsl
+// and common/color.wgsl.
+
+const SLC_MAX_CUT: u32 = 64u;
+
+// w = luminance(I) x (1/8 sum over the box corners of max(n . (c - x)/|c - x|, 0))
+//     / max(d_min^2, eps^2); 0 when empty or every corner is on or behind x's tangent plane.
+fn slc_node_weight(node: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32) -> f32 {
+    if sst_is_empty(node) {
+        return 0.0;
+    }
+    let lo = node.bbox_min;
+    let hi = node.bbox_max;
+    var cos_sum = 0.0;
+    for (var c = 0u; c < 8u; c++) {
+        let p = select(lo, hi, vec3<bool>((c & 1u) != 0u, (c & 2u) != 0u, (c & 4u) != 0u));
+        let d = p - x;
+        cos_sum += max(dot(n, d) / sqrt(max(dot(d, d), 1e-30)), 0.0);
+    }
+    if !(cos_sum > 0.0) {
+        return 0.0;
+    }
+    let q = clamp(x, lo, hi);
+    let d2 = dot(q - x, q - x);
+    return luminance(node.intensity) * cos_sum * 0.125 / max(d2, eps * eps);
+}
+
+fn slc_keep(i: u32, w: f32, cull: bool) -> bool {
+    return !sst_is_empty(tree[i]) && (!cull || w > 0.0);
+}
+
+// The cut being built (per invocation).
+var<private> cut_ids: array<u32, 64>;
+var<private> cut_ws: array<f32, 64>;
+
+// Builds a shallow light cut at (x, n) into cut_ids[0..count) and returns count: from the
+// root, split the inner node of highest weight (ties: the lowest slot) until `cut_size`
+// nodes or nothing splits; the first kept child takes the parent's slot, the second is
+// appended; a parent without kept children leaves (the last slot moves into its place).
+fn slc_build_cut(x: vec3<f32>, n: vec3<f32>, eps: f32, cut_size: u32, cull: bool, leaves: u32) -> u32 {
+    var count = 0u;
+    let w_root = slc_node_weight(tree[1], x, n, eps);
+    if slc_keep(1u, w_root, cull) {
+        cut_ids[0] = 1u;
+        cut_ws[0] = w_root;
+        count = 1u;
+    }
+    let size = clamp(cut_size, 1u, SLC_MAX_CUT);
+    loop {
+        if count >= size {
+            break;
+        }
+        var best = 0xffffffffu;
+        var best_w = -1.0;
+        for (var i = 0u; i < count; i++) {
+            if cut_ids[i] < leaves && cut_ws[i] > best_w {
+                best = i;
+                best_w = cut_ws[i];
+            }
+        }
+        if best == 0xffffffffu {
+            break;
+        }
+        let c0 = 2u * cut_ids[best];
+        let c1 = c0 + 1u;
+        let w0 = slc_node_weight(tree[c0], x, n, eps);
+        let w1 = slc_node_weight(tree[c1], x, n, eps);
+        let k0 = slc_keep(c0, w0, cull);
+        let k1 = slc_keep(c1, w1, cull);
+        if k0 && k1 {
+            cut_ids[best] = c0;
+            cut_ws[best] = w0;
+            cut_ids[count] = c1;
+            cut_ws[count] = w1;
+            count += 1u;
+        } else if k0 {
+            cut_ids[best] = c0;
+            cut_ws[best] = w0;
+        } else if k1 {
+            cut_ids[best] = c1;
+            cut_ws[best] = w1;
+        } else {
+            count -= 1u;
+            cut_ids[best] = cut_ids[count];
+            cut_ws[best] = cut_ws[count];
+        }
+    }
+    return count;
+}
+
+// Eq. 5.3.
+fn slc_similar(px: vec3<f32>, nx: vec3<f32>, py: vec3<f32>, ny: vec3<f32>, n_min: f32, d_max: f32) -> bool {
+    return dot(nx, ny) > n_min && distance(px, py) < d_max;
+}

@@ -1,0 +1,32 @@
+// Parameters of the tree sampling passes. Twin of `GpuSlcParams` in
+// src/renderer/gpu_data.rs.
+struct SlcParams {
+    width: u32,      // GI resolution
+    height: u32,
+    block: u32,      // k: cut block edge in GI pixels
+    grid_x: u32,     // blocks per row
+    grid_y: u32,
+    cut_size: u32,   // nodes per cut = samples per pixel
+    leaves: u32,
+    levels: u32,
+    method: u32,     // 0 SLC (thesis), 1 SST (from the root), 2 RTSLC (to the leaves)
+    blending: u32,   // 0 stochastic (Algorithm 1), 1 off (own block only)
+    fallback: u32,   // 0 mock cut, 1 average the cuts, 2 traverse from the root, 3 recompute
+    cull: u32,       // drop children wholly behind the block centre's surface
+    seed: u32,
+    accumulate: u32, // 0: write the frame's estimate, 1: add it
+    epsilon: f32,    // distance bound (m)
+    ray_offset: f32,
+    n_min: f32,      // eq. 5.3
+    d_max: f32,      // eq. 5.3, metres
+    _pad0: u32,
+    _pad1: u32,
+};
+
+// The pixel whose G-buffer sample builds block b's cut.
+fn slc_block_centre(b: u32) -> vec2<u32> {
+    let bx = b % sp.grid_x;
+    let by = b / sp.grid_x;
+    return min(vec2<u32>(bx * sp.block + sp.block / 2u, by * sp.block + sp.block / 2u),
+        vec2<u32>(sp.width - 1u, sp.height - 1u));
+}

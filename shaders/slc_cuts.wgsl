@@ -1,0 +1,32 @@
+// Stage 11 (thesis 5.1): one shallow light cut per k x k pixel block, built at the block
+// centre's G-buffer sample (pixel (bx k + k/2, by k + k/2), clamped to the image). Output:
+// cut_size node ids per block in slot order, 0 for unused slots (and for every slot of a
+// block whose centre sees no geometry). CPU twin: `build_cut` in src/reference/slc.rs.
+#include "common/color.wgsl"
+#include "common/sst_node.wgsl"
+#include "common/slc.wgsl"
+#include "common/slc_params.wgsl"
+
+@group(0) @binding(0) var<uniform> sp: SlcParams;
+@group(0) @binding(1) var<storage, read> tree: array<SstNode>;
+@group(0) @binding(2) var gb_position: texture_2d<f32>;
+@group(0) @binding(3) var gb_normal: texture_2d<f32>;
+@group(0) @binding(4) var<storage, read_write> cuts: array<u32>;
+
+@compute @workgroup_size(64, 1, 1)
+fn build_cuts(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let b = gid.x;
+    if b >= sp.grid_x * sp.grid_y {
+        return;
+    }
+    let c = slc_block_centre(b);
+    let g = textureLoad(gb_position, vec2<i32>(c), 0);
+    var count = 0u;
+    if g.w > 0.0 {
+        let n = normalize(textureLoad(gb_normal, vec2<i32>(c), 0).xyz);
+        count = slc_build_cut(g.xyz, n, sp.epsilon, sp.cut_size, sp.cull != 0u, sp.leaves);
+    }
+    for (var i = 0u; i < sp.cut_size; i++) {
+        cuts[b * sp.cut_size + i] = select(0u, cut_ids[i], i < count);
+    }
+}

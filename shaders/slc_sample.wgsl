@@ -1,0 +1,295 @@
+// Stages 12-15 (thesis 5.1.3-5.3) and the baselines: per pixel, choose a cut per slot from
+// the 4 surrounding blocks (bilinear weight x similarity S, Algorithm 1) or fall back (mock
+// cut by default), traverse from each chosen node with p_left = w_left / (w_left + w_right)
+// until a usable node (SLC), a leaf (RTSLC), or from the root (SST), and evaluate the cluster:
+// a point drawn from its substitute distribution (Gaussian in the node's frame, clamped to its
+// box; the VPL itself at a leaf) shaded as a VPL of the node's total flux, one shadow ray,
+// divided by the probability of the path. Sum over slots (SST: mean over its samples).
+// Writes the estimate (or adds it), and per-pixel diagnostics.
+// CPU twin: src/reference/slc.rs (cuts, weights, blending); tests check the estimator
+// statistically against the ground truth.
+#include "common/math.wgsl"
+#include "common/color.wgsl"
+#include "common/random.wgsl"
+#include "common/vpl.wgsl"
+#include "common/vpl_visibility.wgsl"
+#include "common/sst_node.wgsl"
+#include "common/slc.wgsl"
+#include "common/slc_params.wgsl"
+
+@group(0) @binding(0) var<uniform> sp: SlcParams;
+@group(0) @binding(1) var<storage, read> tree: array<SstNode>;
+@group(0) @binding(2) var<storage, read> flags: array<u32>;
+@group(0) @binding(3) var<storage, read> sorted_vpls: array<Vpl>;
+@group(0) @binding(4) var<storage, read> cuts: array<u32>;
+@group(0) @binding(5) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(6) var<storage, read> bvh_triangles: array<BvhTriangle>;
+@group(0) @binding(7) var gb_position: texture_2d<f32>;
+@group(0) @binding(8) var gb_normal: texture_2d<f32>;
+@group(0) @binding(9) var gb_albedo: texture_2d<f32>;
+@group(0) @binding(10) var<storage, read_write> accum: array<vec4<f32>>;
+// Per pixel: x = traversal steps per traversal, y = 1 if the pixel fell back (no
+// similar cut), z = samples evaluated (not dead), w = 1 + the block whose cut slot 0 used
+// (0: none).
+@group(0) @binding(11) var<storage, read_write> diag: array<vec4<f32>>;
+// [0] pixels with geometry, [1] fallback pixels, [2] traversal steps, [3] traversals,
+// [4] dead branches.
+@group(0) @binding(12) var<storage, read_write> stats: array<atomic<u32>>;
+
+var<workgroup> wg_stats: array<atomic<u32>, 5>;
+
+fn is_usable(i: u32) -> bool {
+    return ((flags[i / 32u] >> (i % 32u)) & 1u) == 1u;
+}
+
+struct Walk {
+    node: u32,
+    prob: f32,
+    steps: u32,
+};
+
+// Descends from `start`; node 0 = dead branch (both children weigh 0).
+fn traverse(start: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>) -> Walk {
+    var node = start;
+    var prob = 1.0;
+    var steps = 0u;
+    loop {
+        if node >= sp.leaves || (sp.method != 2u && is_usable(node)) {
+            break;
+        }
+        let wl = slc_node_weight(tree[2u * node], x, n, sp.epsilon);
+        let wr = slc_node_weight(tree[2u * node + 1u], x, n, sp.epsilon);
+        let s = wl + wr;
+        if !(s > 0.0) {
+            return Walk(0u, 0.0, steps);
+        }
+        let pl = wl / s;
+        if rng_next(rng) < pl {
+            node = 2u * node;
+            prob *= pl;
+        } else {
+            node = 2u * node + 1u;
+            prob *= 1.0 - pl;
+        }
+        steps += 1u;
+    }
+    return Walk(node, prob, steps);
+}
+
+// Standard normal pair (Box-Muller).
+fn gauss2(rng: ptr<function, Rng>) -> vec2<f32> {
+    let u1 = 1.0 - rng_next(rng);
+    let u2 = rng_next(rng);
+    let r = sqrt(-2.0 * log(u1));
+    return r * vec2<f32>(cos(TAU * u2), sin(TAU * u2));
+}
+
+// Flux/pi x G x V of cluster `node` at x (without rho/pi).
+fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>) -> vec3<f32> {
+    var pv: vec3<f32>;
+    var nv: vec3<f32>;
+    var flux: vec3<f32>;
+    if node >= sp.leaves {
+        let v = sorted_vpls[node - sp.leaves];
+        if v.id == VPL_NONE {
+            return vec3<f32>(0.0);
+        }
+        pv = v.position.xyz;
+        nv = v.normal;
+        flux = v.flux.rgb;
+    } else {
+        let c = tree[node];
+        nv = oct_decode(c.normal);
+        let f = sst_basis(nv);
+        let sigma = sqrt(max(sst_variance(c), vec3<f32>(0.0)));
+        let g = vec3<f32>(gauss2(rng), gauss2(rng).x);
+        pv = clamp(c.position + g.x * sigma.x * f[0] + g.y * sigma.y * f[1] + g.z * sigma.z * nv,
+            c.bbox_min, c.bbox_max);
+        flux = c.intensity;
+    }
+    let geo = vpl_geometry(pv, nv, x, n, sp.epsilon);
+    if geo <= 0.0 || !vpl_visible(pv, nv, x, n, sp.ray_offset) {
+        return vec3<f32>(0.0);
+    }
+    return flux / PI * geo;
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    if li < 5u {
+        atomicStore(&wg_stats[li], 0u);
+    }
+    workgroupBarrier();
+    let inside = gid.x < sp.width && gid.y < sp.height;
+    var g = vec4<f32>(0.0);
+    if inside {
+        g = textureLoad(gb_position, vec2<i32>(gid.xy), 0);
+    }
+    if inside && g.w > 0.0 {
+        shade_pixel(gid.xy, g.xyz);
+    } else if inside {
+        let k = gid.y * sp.width + gid.x;
+        if sp.accumulate == 0u {
+            accum[k] = vec4<f32>(0.0);
+        }
+        diag[k] = vec4<f32>(0.0);
+    }
+    workgroupBarrier();
+    if li < 5u {
+        let v = atomicLoad(&wg_stats[li]);
+        if v > 0u {
+            atomicAdd(&stats[li], v);
+        }
+    }
+}
+
+fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
+    let k = px.y * sp.width + px.x;
+    let n = normalize(textureLoad(gb_normal, vec2<i32>(px), 0).xyz);
+    let albedo = textureLoad(gb_albedo, vec2<i32>(px), 0).rgb;
+    var rng = rng_new(k, sp.seed, 0x51c5u);
+    atomicAdd(&wg_stats[0], 1u);
+
+    // Blending weights of the 4 surrounding blocks (Algorithm 1).
+    var blocks = array<u32, 4>(0u, 0u, 0u, 0u);
+    var weights = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
+    var bil = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
+    var wsum = 0.0;
+    let f = (vec2<f32>(px) + 0.5) / f32(sp.block) - 0.5;
+    let b0 = floor(f);
+    let t = f - b0;
+    for (var i = 0u; i < 4u; i++) {
+        let d = vec2<i32>(i32(i & 1u), i32(i >> 1u));
+        let cb = vec2<i32>(b0) + d;
+        var w = select(1.0 - t.x, t.x, d.x == 1) * select(1.0 - t.y, t.y, d.y == 1);
+        if sp.blending == 1u {
+            // Blending off: only the block holding the pixel.
+            let own = vec2<i32>(px / sp.block);
+            w = select(0.0, 1.0, all(cb == own));
+        }
+        if cb.x < 0 || cb.y < 0 || cb.x >= i32(sp.grid_x) || cb.y >= i32(sp.grid_y) {
+            w = 0.0;
+        }
+        let b = u32(cb.y) * sp.grid_x + u32(cb.x);
+        blocks[i] = b;
+        bil[i] = w;
+        if w > 0.0 {
+            let c = slc_block_centre(b);
+            let gc = textureLoad(gb_position, vec2<i32>(c), 0);
+            let nc = normalize(textureLoad(gb_normal, vec2<i32>(c), 0).xyz);
+            if gc.w == 0.0 || !slc_similar(x, n, gc.xyz, nc, sp.n_min, sp.d_max) {
+                w = 0.0;
+            }
+        }
+        weights[i] = w;
+        wsum += w;
+    }
+
+    // Start nodes: 0 = the blended cuts, 1 = mock cut, 2 = from the root, 3 = own cut.
+    var mode = 0u;
+    var fell_back = false;
+    if sp.method == 1u {
+        mode = 2u;
+    } else if !(wsum > 0.0) {
+        fell_back = true;
+        switch sp.fallback {
+            case 1u: {
+                // Average the (dissimilar) cuts: bilinear weights alone.
+                wsum = 0.0;
+                for (var i = 0u; i < 4u; i++) {
+                    weights[i] = bil[i];
+                    wsum += bil[i];
+                }
+                mode = select(1u, 0u, wsum > 0.0);
+            }
+            case 2u: {
+                mode = 2u;
+            }
+            case 3u: {
+                mode = 3u;
+            }
+            default: {
+                mode = 1u;
+            }
+        }
+    }
+    var own_count = 0u;
+    if mode == 3u {
+        own_count = slc_build_cut(x, n, sp.epsilon, sp.cut_size, sp.cull != 0u, sp.leaves);
+    }
+    let mock_level = min(firstLeadingBit(max(sp.cut_size, 1u)), sp.levels - 1u);
+
+    var sum = vec3<f32>(0.0);
+    var steps = 0u;
+    var walks = 0u;
+    var evaluated = 0u;
+    var first_block = 0u;
+    for (var i = 0u; i < sp.cut_size; i++) {
+        var start = 0u;
+        switch mode {
+            case 0u: {
+                var u = rng_next(&rng) * wsum;
+                var s = 3u;
+                for (var j = 0u; j < 3u; j++) {
+                    if u < weights[j] && weights[j] > 0.0 {
+                        s = j;
+                        break;
+                    }
+                    u -= weights[j];
+                }
+                // Rounding may leave u past the last positive weight: take the last one.
+                if !(weights[s] > 0.0) {
+                    for (var j = 0u; j < 4u; j++) {
+                        if weights[j] > 0.0 {
+                            s = j;
+                        }
+                    }
+                }
+                start = cuts[blocks[s] * sp.cut_size + i];
+                if i == 0u {
+                    first_block = blocks[s] + 1u;
+                }
+            }
+            case 1u: {
+                if i < (1u << mock_level) {
+                    start = (1u << mock_level) + i;
+                }
+            }
+            case 2u: {
+                start = 1u;
+            }
+            default: {
+                start = select(0u, cut_ids[i], i < own_count);
+            }
+        }
+        if start == 0u {
+            continue;
+        }
+        let walk = traverse(start, x, n, &rng);
+        steps += walk.steps;
+        walks += 1u;
+        atomicAdd(&wg_stats[3], 1u);
+        if walk.node == 0u {
+            atomicAdd(&wg_stats[4], 1u);
+            continue;
+        }
+        evaluated += 1u;
+        sum += evaluate(walk.node, x, n, &rng) / walk.prob;
+    }
+    atomicAdd(&wg_stats[2], steps);
+    if fell_back {
+        atomicAdd(&wg_stats[1], 1u);
+    }
+    if mode == 2u {
+        // From the root: every sample estimates the whole sum.
+        sum /= f32(max(sp.cut_size, 1u));
+    }
+    let radiance = albedo / PI * sum;
+    if sp.accumulate == 0u {
+        accum[k] = vec4<f32>(radiance, 0.0);
+    } else {
+        accum[k] += vec4<f32>(radiance, 0.0);
+    }
+    diag[k] = vec4<f32>(f32(steps) / f32(max(walks, 1u)), select(0.0, 1.0, fell_back),
+        f32(evaluated), f32(first_block));
+}

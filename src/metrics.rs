@@ -1,0 +1,207 @@
+//! Image error metrics between a method's image and a reference of the same size.
+//!
+//! - RMSE on linear radiance (all three channels, W m^-2 sr^-1), and relative RMSE = RMSE /
+//!   mean of the reference (unitless; comparable across scenes and exposures).
+//! - SSIM (Wang et al. 2004: 11 x 11 Gaussian window, sigma 1.5, K1 = 0.01, K2 = 0.03,
+//!   L = 1) on the luminance of both images as the workbench displays them (exposure 2^EV,
+//!   tonemap, sRGB encoding), so that it judges what a viewer sees.
+//! - Mean ratio (method mean / reference mean): a bias indicator.
+//!
+//! Pixels without geometry (alpha 0 in the reference's position, passed as a mask) can be
+//! left out; by default every pixel counts.
+
+use glam::Vec3;
+
+use crate::{
+    reference::display,
+    renderer::{readback::ImageF32, settings::Tonemap},
+};
+
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Metrics {
+    pub rmse: f64,
+    pub relative_rmse: f64,
+    pub ssim: f64,
+    pub mean_ratio: f64,
+    pub reference_mean: f64,
+}
+
+fn rgb(p: &[f32; 4]) -> Vec3 {
+    Vec3::new(p[0], p[1], p[2])
+}
+
+/// RMSE over the RGB channels of the pixels where `mask` is true (all if None).
+pub fn rmse(a: &ImageF32, b: &ImageF32, mask: Option<&[bool]>) -> f64 {
+    let mut sum = 0.0f64;
+    let mut n = 0usize;
+    for (i, (pa, pb)) in a.pixels.iter().zip(&b.pixels).enumerate() {
+        if mask.is_some_and(|m| !m[i]) {
+            continue;
+        }
+        let d = rgb(pa) - rgb(pb);
+        sum += (d.x as f64).powi(2) + (d.y as f64).powi(2) + (d.z as f64).powi(2);
+        n += 3;
+    }
+    (sum / n.max(1) as f64).sqrt()
+}
+
+fn mean_rgb(a: &ImageF32, mask: Option<&[bool]>) -> f64 {
+    let mut sum = 0.0f64;
+    let mut n = 0usize;
+    for (i, p) in a.pixels.iter().enumerate() {
+        if mask.is_some_and(|m| !m[i]) {
+            continue;
+        }
+        sum += (p[0] + p[1] + p[2]) as f64;
+        n += 3;
+    }
+    sum / n.max(1) as f64
+}
+
+/// Display luminance in [0, 1] of every pixel (exposure, tonemap, sRGB).
+pub fn display_luminance(a: &ImageF32, exposure_ev: f32, tonemap: Tonemap) -> Vec<f32> {
+    a.pixels
+        .iter()
+        .map(|p| {
+            let e = display::encode(*p, exposure_ev, tonemap);
+            display::luminance(Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32) / 255.0)
+        })
+        .collect()
+}
+
+/// Mean SSIM of two grey images in [0, 1] (Wang et al. 2004, Gaussian window 11, sigma 1.5);
+/// windows are clipped at the borders.
+pub fn ssim(a: &[f32], b: &[f32], w: usize, h: usize) -> f64 {
+    const R: i32 = 5;
+    let g: Vec<f64> = (-R..=R)
+        .map(|i| (-(i * i) as f64 / (2.0 * 1.5 * 1.5)).exp())
+        .collect();
+    let (c1, c2) = ((0.01f64).powi(2), (0.03f64).powi(2));
+    // Separable weighted moments: mu_a, mu_b, E[a^2], E[b^2], E[ab].
+    let blur = |f: &dyn Fn(usize) -> f64| -> Vec<f64> {
+        let mut tmp = vec![0.0; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let (mut s, mut ws) = (0.0, 0.0);
+                for (k, gk) in g.iter().enumerate() {
+                    let xx = x as i32 + k as i32 - R;
+                    if xx >= 0 && (xx as usize) < w {
+                        s += gk * f(y * w + xx as usize);
+                        ws += gk;
+                    }
+                }
+                tmp[y * w + x] = s / ws;
+            }
+        }
+        let mut out = vec![0.0; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let (mut s, mut ws) = (0.0, 0.0);
+                for (k, gk) in g.iter().enumerate() {
+                    let yy = y as i32 + k as i32 - R;
+                    if yy >= 0 && (yy as usize) < h {
+                        s += gk * tmp[yy as usize * w + x];
+                        ws += gk;
+                    }
+                }
+                out[y * w + x] = s / ws;
+            }
+        }
+        out
+    };
+    let ma = blur(&|i| a[i] as f64);
+    let mb = blur(&|i| b[i] as f64);
+    let aa = blur(&|i| (a[i] as f64).powi(2));
+    let bb = blur(&|i| (b[i] as f64).powi(2));
+    let ab = blur(&|i| a[i] as f64 * b[i] as f64);
+    let mut total = 0.0;
+    for i in 0..w * h {
+        let (va, vb) = ((aa[i] - ma[i] * ma[i]).max(0.0), (bb[i] - mb[i] * mb[i]).max(0.0));
+        let cov = ab[i] - ma[i] * mb[i];
+        total += ((2.0 * ma[i] * mb[i] + c1) * (2.0 * cov + c2))
+            / ((ma[i] * ma[i] + mb[i] * mb[i] + c1) * (va + vb + c2));
+    }
+    total / (w * h).max(1) as f64
+}
+
+/// Every metric of `image` against `reference` (same size), SSIM on the display transform.
+pub fn compare(image: &ImageF32, reference: &ImageF32, exposure_ev: f32, tonemap: Tonemap) -> Metrics {
+    let rm = rmse(image, reference, None);
+    let mean_ref = mean_rgb(reference, None);
+    let mean_img = mean_rgb(image, None);
+    let (w, h) = (reference.width as usize, reference.height as usize);
+    let s = ssim(
+        &display_luminance(image, exposure_ev, tonemap),
+        &display_luminance(reference, exposure_ev, tonemap),
+        w,
+        h,
+    );
+    Metrics {
+        rmse: rm,
+        relative_rmse: if mean_ref > 0.0 { rm / mean_ref } else { f64::NAN },
+        ssim: s,
+        mean_ratio: if mean_ref > 0.0 {
+            mean_img / mean_ref
+        } else {
+            f64::NAN
+        },
+        reference_mean: mean_ref,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn img(w: u32, h: u32, f: impl Fn(u32, u32) -> f32) -> ImageF32 {
+        ImageF32 {
+            width: w,
+            height: h,
+            pixels: (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .map(|(x, y)| {
+                    let v = f(x, y);
+                    [v, v, v, 1.0]
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn rmse_and_ratio_by_hand() {
+        let a = img(4, 4, |_, _| 1.0);
+        let b = img(4, 4, |_, _| 0.5);
+        assert!((rmse(&a, &b, None) - 0.5).abs() < 1e-12);
+        let m = compare(&a, &b, 0.0, Tonemap::Clamp);
+        assert!((m.relative_rmse - 1.0).abs() < 1e-9);
+        assert!((m.mean_ratio - 2.0).abs() < 1e-9);
+        let mask: Vec<bool> = (0..16).map(|i| i < 8).collect();
+        let c = img(4, 4, |_, y| if y < 2 { 0.5 } else { 9.0 });
+        assert_eq!(rmse(&c, &b, Some(&mask)), 0.0);
+    }
+
+    #[test]
+    fn ssim_is_one_for_equal_images_and_drops_with_noise() {
+        let (w, h) = (48, 40);
+        let a: Vec<f32> = (0..w * h)
+            .map(|i| ((i % w) as f32 / w as f32) * 0.8 + 0.1)
+            .collect();
+        assert!((ssim(&a, &a, w, h) - 1.0).abs() < 1e-9);
+        let mut s = 1u32;
+        let noisy: Vec<f32> = a
+            .iter()
+            .map(|v| {
+                s ^= s << 13;
+                s ^= s >> 17;
+                s ^= s << 5;
+                (v + ((s >> 8) as f32 / (1 << 24) as f32 - 0.5) * 0.4).clamp(0.0, 1.0)
+            })
+            .collect();
+        let q = ssim(&a, &noisy, w, h);
+        assert!(q < 0.9 && q > 0.0, "{q}");
+        // A constant offset keeps the structure: SSIM stays high but below 1.
+        let shifted: Vec<f32> = a.iter().map(|v| v + 0.05).collect();
+        let q2 = ssim(&a, &shifted, w, h);
+        assert!(q2 > 0.95 && q2 < 1.0, "{q2}");
+    }
+}

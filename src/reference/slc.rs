@@ -1,0 +1,326 @@
+//! Reference of the tree sampling (stages 11-15; thesis chapter 5): node weights, shallow
+//! light cuts, cut blending weights, mock cuts, traversal and cluster evaluation. The GPU twins
+//! are `shaders/common/slc.wgsl`, `shaders/slc_cuts.wgsl` and `shaders/slc_sample.wgsl`.
+//!
+//! Weight of node C at shading point x with normal n (thesis eq. 5.5 with M = 1 for diffuse
+//! surfaces, V = 1, and the geometric term of eq. 5.2):
+//!   w = luminance(I_C) x (1/8 sum_corners max(n . (c - x)/|c - x|, 0)) / max(d_min^2, eps^2)
+//! with d_min the distance from x to the node's box (0 inside) and eps the distance bound of
+//! the ground truth (`gi.distance_epsilon`). w = 0 exactly when the node is empty or every
+//! corner lies on or behind x's tangent plane, i.e. when no VPL below can light x.
+
+use glam::Vec3;
+
+use super::sst_tree::{SstNode, luminance};
+
+/// Largest cut (samples per pixel) the GPU kernels hold in registers.
+pub const MAX_CUT: u32 = 64;
+
+/// Eq. 5.2 x eq. 5.5 (see the module doc). Same operations, in the same order, as
+/// `slc_node_weight` in `common/slc.wgsl`.
+pub fn node_weight(node: &SstNode, x: Vec3, n: Vec3, eps: f32) -> f32 {
+    if node.is_empty() {
+        return 0.0;
+    }
+    let (lo, hi) = (node.bbox_min, node.bbox_max);
+    let mut cos_sum = 0.0f32;
+    for c in 0..8u32 {
+        let p = Vec3::new(
+            if c & 1 != 0 { hi.x } else { lo.x },
+            if c & 2 != 0 { hi.y } else { lo.y },
+            if c & 4 != 0 { hi.z } else { lo.z },
+        );
+        let d = p - x;
+        cos_sum += (n.dot(d) / d.dot(d).max(1e-30).sqrt()).max(0.0);
+    }
+    if cos_sum.is_nan() || cos_sum <= 0.0 {
+        return 0.0;
+    }
+    let q = x.clamp(lo, hi);
+    let d2 = (q - x).dot(q - x);
+    luminance(node.intensity) * cos_sum * 0.125 / d2.max(eps * eps)
+}
+
+/// Whether a node may enter a cut (as a split's child): not empty, and (with culling) not
+/// wholly behind the surface.
+fn keep(node: &SstNode, w: f32, cull: bool) -> bool {
+    !node.is_empty() && (!cull || w > 0.0)
+}
+
+/// A shallow light cut at (x, n) (thesis 5.1): from the root, repeatedly split the splittable
+/// (inner) node of highest weight (ties: the lowest slot) until the cut holds `cut_size`
+/// nodes or nothing can be split. A split puts the first kept child in the parent's slot and
+/// appends the second; a parent with no kept child leaves the cut (the last slot moves into
+/// its place). Returns the node ids in slot order.
+pub fn build_cut(nodes: &[SstNode], x: Vec3, n: Vec3, eps: f32, cut_size: u32, cull: bool) -> Vec<u32> {
+    let leaves = (nodes.len() / 2) as u32;
+    let cut_size = cut_size.clamp(1, MAX_CUT) as usize;
+    let mut ids: Vec<u32> = Vec::with_capacity(cut_size);
+    let mut ws: Vec<f32> = Vec::with_capacity(cut_size);
+    let w_root = node_weight(&nodes[1], x, n, eps);
+    if keep(&nodes[1], w_root, cull) {
+        ids.push(1);
+        ws.push(w_root);
+    }
+    while ids.len() < cut_size {
+        let mut best = usize::MAX;
+        let mut best_w = -1.0f32;
+        for (i, (&id, &w)) in ids.iter().zip(&ws).enumerate() {
+            if id < leaves && w > best_w {
+                best = i;
+                best_w = w;
+            }
+        }
+        if best == usize::MAX {
+            break;
+        }
+        let parent = ids[best];
+        let (c0, c1) = (2 * parent, 2 * parent + 1);
+        let (w0, w1) = (
+            node_weight(&nodes[c0 as usize], x, n, eps),
+            node_weight(&nodes[c1 as usize], x, n, eps),
+        );
+        let (k0, k1) = (
+            keep(&nodes[c0 as usize], w0, cull),
+            keep(&nodes[c1 as usize], w1, cull),
+        );
+        match (k0, k1) {
+            (true, true) => {
+                (ids[best], ws[best]) = (c0, w0);
+                ids.push(c1);
+                ws.push(w1);
+            }
+            (true, false) => (ids[best], ws[best]) = (c0, w0),
+            (false, true) => (ids[best], ws[best]) = (c1, w1),
+            (false, false) => {
+                ids.swap_remove(best);
+                ws.swap_remove(best);
+            }
+        }
+    }
+    ids
+}
+
+/// Eq. 5.3: the normals agree (dot > n_min) and the points are closer than d_max (metres).
+pub fn similar(px: Vec3, nx: Vec3, py: Vec3, ny: Vec3, n_min: f32, d_max: f32) -> bool {
+    nx.dot(ny) > n_min && px.distance(py) < d_max
+}
+
+/// The block whose centre sample builds the cut: pixel (bx k + k/2, by k + k/2), clamped to
+/// the image.
+pub fn block_centre(bx: u32, by: u32, k: u32, w: u32, h: u32) -> (u32, u32) {
+    ((bx * k + k / 2).min(w - 1), (by * k + k / 2).min(h - 1))
+}
+
+/// The 4 blocks around pixel (x, y) and their bilinear weights (thesis Algorithm 1, line 2,
+/// before the similarity factor): block centres at ((b + 1/2) k); blocks outside the grid get
+/// weight 0. Returns ((bx, by), weight) with bx, by possibly outside the grid.
+pub fn bilinear_blocks(x: u32, y: u32, k: u32, grid: (u32, u32)) -> [((i32, i32), f32); 4] {
+    let fx = (x as f32 + 0.5) / k as f32 - 0.5;
+    let fy = (y as f32 + 0.5) / k as f32 - 0.5;
+    let (bx, by) = (fx.floor(), fy.floor());
+    let (tx, ty) = (fx - bx, fy - by);
+    let (bx, by) = (bx as i32, by as i32);
+    let mut out = [((0, 0), 0.0); 4];
+    for (i, (dx, dy)) in [(0, 0), (1, 0), (0, 1), (1, 1)].into_iter().enumerate() {
+        let (cx, cy) = (bx + dx, by + dy);
+        let wx = if dx == 0 { 1.0 - tx } else { tx };
+        let wy = if dy == 0 { 1.0 - ty } else { ty };
+        let inside = cx >= 0 && cy >= 0 && (cx as u32) < grid.0 && (cy as u32) < grid.1;
+        out[i] = ((cx, cy), if inside { wx * wy } else { 0.0 });
+    }
+    out
+}
+
+/// Level of the mock cut (thesis 5.1.4): floor(log2(cut_size)), at most the leaves' level.
+pub fn mock_level(cut_size: u32, levels: u32) -> u32 {
+    cut_size.max(1).ilog2().min(levels - 1)
+}
+
+/// Checks a cut: no node twice, none an ancestor of another (so every leaf is covered at
+/// most once), no empty node.
+pub fn check_cut(cut: &[u32], nodes: &[SstNode]) -> Result<(), String> {
+    for (i, &a) in cut.iter().enumerate() {
+        if a == 0 || a as usize >= nodes.len() {
+            return Err(format!("slot {i}: node {a} out of range"));
+        }
+        if nodes[a as usize].is_empty() {
+            return Err(format!("slot {i}: node {a} is empty"));
+        }
+        for &b in &cut[i + 1..] {
+            let (hi, lo) = if a < b { (a, b) } else { (b, a) };
+            // hi is an ancestor of lo iff lo >> (depth difference) == hi.
+            let diff = lo.ilog2() - hi.ilog2();
+            if lo >> diff == hi {
+                return Err(format!("nodes {a} and {b}: one contains the other"));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Nodes a cut could hold at most: the non-empty leaves reachable from the root through kept
+/// nodes (with culling: nodes of positive weight).
+pub fn reachable_leaves(nodes: &[SstNode], x: Vec3, n: Vec3, eps: f32, cull: bool) -> u32 {
+    let leaves = nodes.len() / 2;
+    let mut count = 0;
+    let mut stack = vec![1usize];
+    while let Some(i) = stack.pop() {
+        let w = node_weight(&nodes[i], x, n, eps);
+        if !keep(&nodes[i], w, cull) {
+            continue;
+        }
+        if i >= leaves {
+            count += 1;
+        } else {
+            stack.push(2 * i);
+            stack.push(2 * i + 1);
+        }
+    }
+    count
+}
+
+/// The exact sum a traversal from `node` estimates: sum over the non-empty leaves below of
+/// their unoccluded contribution flux/pi x G (without the albedo/pi), with `vpl_g` giving
+/// G for a leaf (tests pass the VPL geometry term).
+pub fn subtree_sum(nodes: &[SstNode], node: u32, g: &dyn Fn(&SstNode) -> f32) -> Vec3 {
+    let leaves = (nodes.len() / 2) as u32;
+    let depth = leaves.trailing_zeros() - node.ilog2();
+    let first = node << depth;
+    (first..first + (1 << depth))
+        .map(|i| &nodes[i as usize])
+        .filter(|l| !l.is_empty())
+        .map(|l| l.intensity / std::f32::consts::PI * g(l))
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reference::sst_tree::{build, sort_vpls};
+    use crate::renderer::gpu_data::GpuVpl;
+
+    fn floor_and_wall(n: usize) -> Vec<SstNode> {
+        let mut s = 7u32;
+        let mut r = move || {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            (s >> 8) as f32 / (1 << 24) as f32
+        };
+        let vpls: Vec<GpuVpl> = (0..n)
+            .map(|i| {
+                let (p, nrm) = if i % 2 == 0 {
+                    (Vec3::new(r() * 4.0, 0.0, r() * 4.0), Vec3::Y)
+                } else {
+                    (Vec3::new(r() * 4.0, r() * 3.0, 0.0), Vec3::Z)
+                };
+                GpuVpl {
+                    position: p.extend(1.0).to_array(),
+                    normal: nrm.to_array(),
+                    id: i as u32,
+                    flux: [r(), r(), r(), 1.0],
+                }
+            })
+            .collect();
+        build(&sort_vpls(&vpls))
+    }
+
+    #[test]
+    fn weights_by_hand() {
+        let mut n = SstNode::EMPTY;
+        assert_eq!(node_weight(&n, Vec3::ZERO, Vec3::Y, 0.05), 0.0);
+        // A point light 2 m straight above: cos 1, 1/d^2 = 1/4, luminance of (1,1,1) = 1.
+        n.intensity = Vec3::ONE;
+        n.bbox_min = Vec3::new(0.0, 2.0, 0.0);
+        n.bbox_max = n.bbox_min;
+        assert!((node_weight(&n, Vec3::ZERO, Vec3::Y, 0.05) - 0.25).abs() < 1e-6);
+        // Below the surface: 0; at 0.01 m: bounded by eps = 0.05 -> 1/0.0025.
+        assert_eq!(node_weight(&n, Vec3::ZERO, -Vec3::Y, 0.05), 0.0);
+        n.bbox_min = Vec3::new(0.0, 0.01, 0.0);
+        n.bbox_max = n.bbox_min;
+        assert!((node_weight(&n, Vec3::ZERO, Vec3::Y, 0.05) - 400.0).abs() < 1e-2);
+        // A box straddling the tangent plane: half its corners count.
+        n.bbox_min = Vec3::new(-1.0, -1.0, -1.0);
+        n.bbox_max = Vec3::new(1.0, 1.0, 1.0);
+        let w = node_weight(&n, Vec3::new(0.0, 0.0, 5.0), Vec3::Y, 0.05);
+        assert!(w > 0.0);
+    }
+
+    #[test]
+    fn cuts_are_valid_and_as_large_as_possible() {
+        let nodes = floor_and_wall(1000);
+        for (x, nx) in [
+            (Vec3::new(2.0, 0.0, 2.0), Vec3::Y),
+            (Vec3::new(2.0, 1.5, 0.0), Vec3::Z),
+            (Vec3::new(3.9, 2.9, 3.9), -Vec3::Y),
+            (Vec3::new(-1.0, 1.0, 2.0), Vec3::X),
+        ] {
+            for cull in [true, false] {
+                for size in [1, 2, 7, 32, 64] {
+                    let cut = build_cut(&nodes, x, nx, 0.05, size, cull);
+                    check_cut(&cut, &nodes).unwrap();
+                    let reach = reachable_leaves(&nodes, x, nx, 0.05, cull);
+                    assert_eq!(
+                        cut.len() as u32,
+                        size.min(reach),
+                        "size {size} cull {cull} at {x}"
+                    );
+                    if cull {
+                        assert!(
+                            cut.iter()
+                                .all(|&c| node_weight(&nodes[c as usize], x, nx, 0.05) > 0.0)
+                        );
+                    }
+                }
+            }
+        }
+        // Facing away from everything (above the room looking up): nothing reachable.
+        let cut = build_cut(&nodes, Vec3::new(2.0, 10.0, 2.0), Vec3::Y, 0.05, 32, true);
+        assert!(cut.is_empty());
+    }
+
+    #[test]
+    fn a_complete_cut_partitions_the_contributing_leaves() {
+        // Without culling, a cut covers every non-empty leaf exactly once.
+        let nodes = floor_and_wall(300);
+        let leaves = nodes.len() / 2;
+        let cut = build_cut(&nodes, Vec3::new(1.0, 1.0, 1.0), Vec3::Y, 0.05, 32, false);
+        let mut covered = vec![0u32; leaves];
+        for &c in &cut {
+            let depth = (leaves as u32).trailing_zeros() - c.ilog2();
+            for l in (c << depth)..((c + 1) << depth) {
+                covered[l as usize - leaves] += 1;
+            }
+        }
+        for (i, &c) in covered.iter().enumerate() {
+            let empty = nodes[leaves + i].is_empty();
+            assert_eq!(c, if empty { c.min(1) } else { 1 }, "leaf {i}");
+        }
+    }
+
+    #[test]
+    fn bilinear_weights_sum_to_one_inside() {
+        let grid = (10, 8);
+        for (x, y) in [(0, 0), (3, 4), (40, 30), (79, 63), (12, 60)] {
+            let b = bilinear_blocks(x, y, 8, grid);
+            let s: f32 = b.iter().map(|(_, w)| w).sum();
+            let all_inside = b
+                .iter()
+                .all(|((bx, by), _)| *bx >= 0 && *by >= 0 && (*bx as u32) < grid.0 && (*by as u32) < grid.1);
+            if all_inside {
+                assert!((s - 1.0).abs() < 1e-5, "({x},{y}) {s}");
+            }
+            assert!(s > 0.0);
+        }
+        // A pixel at a block centre (k even: between pixels 3 and 4 of the block) weighs
+        // its own block most.
+        let b = bilinear_blocks(20, 20, 8, grid);
+        let best = b.iter().max_by(|a, c| a.1.total_cmp(&c.1)).unwrap();
+        assert_eq!(best.0, (2, 2));
+        assert_eq!(mock_level(32, 13), 5);
+        assert_eq!(mock_level(33, 13), 5);
+        assert_eq!(mock_level(64, 4), 3);
+        assert_eq!(mock_level(1, 13), 0);
+    }
+}

@@ -1,0 +1,319 @@
+//! Stages 11-15 (thesis chapter 5) and the SST / RTSLC baselines: `slc_cuts` builds one
+//! shallow light cut per k x k block at the block centre's G-buffer sample; `slc_sample`
+//! blends the cuts per pixel (or falls back), traverses the tree from each chosen node and
+//! evaluates one cluster per slot with a shadow ray.
+//! Reads: the tree, its flags, the VPLs in leaf order, BVH, G-buffer. Writes: the GI
+//! accumulation buffer, per-pixel diagnostics and frame counters ([`SlcBuffers`]).
+
+use crate::renderer::{
+    frame::GbufferTargets, gpu_data::GpuSlcParams, readback::AsyncReadback, scene_gpu::SceneGpu, shaders,
+    timing::GpuTimer,
+};
+
+use super::{
+    WG_1D, bind_group_seq, compute_pipeline, float_texture_entry, groups_image, run_compute,
+    sst_build::TreeBuffers, storage_entry, storage_texture_entry, uniform_entry,
+};
+
+/// Frame counters written by `slc_sample` (u32 each).
+pub const STATS: usize = 5;
+
+/// Counters of one frame of tree sampling.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SamplingStats {
+    /// Pixels with geometry.
+    pub pixels: u32,
+    /// Pixels without a similar cut (mock cut or other fallback).
+    pub fallback_pixels: u32,
+    /// Traversal steps, all pixels.
+    pub steps: u32,
+    /// Traversals started.
+    pub traversals: u32,
+    /// Traversals that ended in a dead branch (both children weigh 0).
+    pub dead: u32,
+}
+
+impl SamplingStats {
+    pub fn from_words(w: &[u32]) -> Self {
+        let g = |i: usize| w.get(i).copied().unwrap_or(0);
+        Self {
+            pixels: g(0),
+            fallback_pixels: g(1),
+            steps: g(2),
+            traversals: g(3),
+            dead: g(4),
+        }
+    }
+    /// Mean traversal steps per traversal (thesis fig. 7.2 counts per pixel and sample).
+    pub fn steps_per_traversal(&self) -> f64 {
+        self.steps as f64 / self.traversals.max(1) as f64
+    }
+    /// Mean traversal steps per pixel (all its samples).
+    pub fn steps_per_pixel(&self) -> f64 {
+        self.steps as f64 / self.pixels.max(1) as f64
+    }
+    pub fn fallback_fraction(&self) -> f64 {
+        self.fallback_pixels as f64 / self.pixels.max(1) as f64
+    }
+}
+
+/// Per-frame buffers: the cuts (cut_size node ids per block, 0 = empty slot), per-pixel
+/// diagnostics (vec4: steps per traversal, fell back, samples evaluated, 1 + block of slot
+/// 0's cut) and the frame counters.
+pub struct SlcBuffers {
+    pub cuts: wgpu::Buffer,
+    pub diag: wgpu::Buffer,
+    pub stats: wgpu::Buffer,
+    pub size: (u32, u32),
+    pub block: u32,
+    pub grid: (u32, u32),
+    pub cut_size: u32,
+}
+
+impl SlcBuffers {
+    pub fn grid(size: (u32, u32), block: u32) -> (u32, u32) {
+        (size.0.div_ceil(block.max(1)), size.1.div_ceil(block.max(1)))
+    }
+
+    /// Bytes of the largest binding (the cuts or the diagnostics).
+    pub fn largest_binding(size: (u32, u32), block: u32, cut_size: u32) -> u64 {
+        let (gx, gy) = Self::grid(size, block);
+        (gx as u64 * gy as u64 * cut_size as u64 * 4).max(size.0 as u64 * size.1 as u64 * 16)
+    }
+
+    pub fn new(device: &wgpu::Device, size: (u32, u32), block: u32, cut_size: u32) -> Self {
+        let grid = Self::grid(size, block);
+        let buf = |label: &str, bytes: u64| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        Self {
+            cuts: buf("slc::cuts", grid.0 as u64 * grid.1 as u64 * cut_size as u64 * 4),
+            diag: buf("slc::diag", size.0 as u64 * size.1 as u64 * 16),
+            stats: buf("slc::stats", (STATS * 4) as u64),
+            size,
+            block,
+            grid,
+            cut_size,
+        }
+    }
+
+    pub fn matches(&self, size: (u32, u32), block: u32, cut_size: u32) -> bool {
+        self.size == size && self.block == block && self.cut_size == cut_size
+    }
+}
+
+/// Twin: `ViewParams` in `shaders/slc_views.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuSlcViewParams {
+    /// 0 steps, 1 fallback mask, 2 cut colours, 3 cut depth.
+    pub mode: u32,
+    pub grid_x: u32,
+    pub block: u32,
+    pub cut_size: u32,
+    /// Linear exposure multiplier.
+    pub exposure: f32,
+    pub tonemap: u32,
+    pub max_steps: f32,
+    pub levels: u32,
+    /// 1 + the selected block, 0 = none.
+    pub selected: u32,
+    pub _pad: [u32; 3],
+}
+
+pub struct SlcPass {
+    views: wgpu::ComputePipeline,
+    views_layout: wgpu::BindGroupLayout,
+    view_params: wgpu::Buffer,
+    cuts: wgpu::ComputePipeline,
+    cuts_layout: wgpu::BindGroupLayout,
+    sample: wgpu::ComputePipeline,
+    sample_layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+    /// The counters of a recent frame, read back without blocking.
+    stats_readback: AsyncReadback,
+    last_stats: Option<SamplingStats>,
+}
+
+impl SlcPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let cmod = shaders::create_module(device, "slc_cuts.wgsl")?;
+        let cuts_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("slc_cuts::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                storage_entry(1, c, true),
+                float_texture_entry(2),
+                float_texture_entry(3),
+                storage_entry(4, c, false),
+            ],
+        });
+        let smod = shaders::create_module(device, "slc_sample.wgsl")?;
+        let sample_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("slc_sample::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                storage_entry(1, c, true),
+                storage_entry(2, c, true),
+                storage_entry(3, c, true),
+                storage_entry(4, c, true),
+                storage_entry(5, c, true),
+                storage_entry(6, c, true),
+                float_texture_entry(7),
+                float_texture_entry(8),
+                float_texture_entry(9),
+                storage_entry(10, c, false),
+                storage_entry(11, c, false),
+                storage_entry(12, c, false),
+            ],
+        });
+        let vmod = shaders::create_module(device, "slc_views.wgsl")?;
+        let views_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("slc_views::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                float_texture_entry(1),
+                float_texture_entry(2),
+                storage_entry(3, c, true),
+                storage_entry(4, c, true),
+                storage_texture_entry(5, super::display::VIEW_FORMAT),
+            ],
+        });
+        Ok(Self {
+            views: compute_pipeline(device, "slc_views", &[Some(&views_layout)], &vmod, "main"),
+            views_layout,
+            view_params: super::uniform_buffer::<GpuSlcViewParams>(device, "slc_views::params"),
+            cuts: compute_pipeline(device, "slc_cuts", &[Some(&cuts_layout)], &cmod, "build_cuts"),
+            sample: compute_pipeline(device, "slc_sample", &[Some(&sample_layout)], &smod, "main"),
+            params: super::uniform_buffer::<GpuSlcParams>(device, "slc::params"),
+            stats_readback: AsyncReadback::new(device, "slc::stats_readback", (STATS * 4) as u64),
+            last_stats: None,
+            cuts_layout,
+            sample_layout,
+        })
+    }
+
+    /// Records the cuts (skipped for SST, which starts at the root) and the sampling.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: GpuSlcParams,
+        tree: &TreeBuffers,
+        scene: &SceneGpu,
+        gbuffer: &GbufferTargets,
+        accum: &wgpu::Buffer,
+        out: &SlcBuffers,
+    ) {
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let tv = wgpu::BindingResource::TextureView;
+        if p.method != 1 {
+            let entries = [
+                self.params.as_entire_binding(),
+                tree.nodes.as_entire_binding(),
+                tv(&gbuffer.position_view),
+                tv(&gbuffer.normal_view),
+                out.cuts.as_entire_binding(),
+            ];
+            let bind = bind_group_seq(device, "slc_cuts::bind_group", &self.cuts_layout, &entries);
+            run_compute(
+                encoder,
+                timer,
+                "slc_cuts",
+                &self.cuts,
+                &bind,
+                ((p.grid_x * p.grid_y).div_ceil(WG_1D), 1, 1),
+            );
+        }
+        let entries = [
+            self.params.as_entire_binding(),
+            tree.nodes.as_entire_binding(),
+            tree.flags.as_entire_binding(),
+            tree.sorted_vpls.as_entire_binding(),
+            out.cuts.as_entire_binding(),
+            scene.bvh_nodes.as_entire_binding(),
+            scene.bvh_triangles.as_entire_binding(),
+            tv(&gbuffer.position_view),
+            tv(&gbuffer.normal_view),
+            tv(&gbuffer.albedo_view),
+            accum.as_entire_binding(),
+            out.diag.as_entire_binding(),
+            out.stats.as_entire_binding(),
+        ];
+        let bind = bind_group_seq(device, "slc_sample::bind_group", &self.sample_layout, &entries);
+        encoder.clear_buffer(&out.stats, 0, None);
+        let name = match p.method {
+            1 => "sst_sample",
+            2 => "rtslc_sample",
+            _ => "slc_sample",
+        };
+        run_compute(
+            encoder,
+            timer,
+            name,
+            &self.sample,
+            &bind,
+            groups_image(p.width, p.height),
+        );
+        self.stats_readback
+            .record(encoder, &[(&out.stats, 0, 0, (STATS * 4) as u64)]);
+    }
+
+    /// Draws one of the diagnostic views into `dst` (the GI resolution).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_view(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: GpuSlcViewParams,
+        final_image: &wgpu::TextureView,
+        gb_position: &wgpu::TextureView,
+        out: &SlcBuffers,
+        dst: &wgpu::TextureView,
+    ) {
+        queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
+        let entries = [
+            self.view_params.as_entire_binding(),
+            wgpu::BindingResource::TextureView(final_image),
+            wgpu::BindingResource::TextureView(gb_position),
+            out.diag.as_entire_binding(),
+            out.cuts.as_entire_binding(),
+            wgpu::BindingResource::TextureView(dst),
+        ];
+        let bind = bind_group_seq(device, "slc_views::bind_group", &self.views_layout, &entries);
+        run_compute(
+            encoder,
+            timer,
+            "slc_views",
+            &self.views,
+            &bind,
+            groups_image(out.size.0, out.size.1),
+        );
+    }
+
+    /// Call after the frame's submit: starts the counters' readback.
+    pub fn after_submit(&self) {
+        self.stats_readback.after_submit();
+    }
+
+    /// The counters of the latest frame read back (non-blocking).
+    pub fn poll_stats(&mut self) -> Option<SamplingStats> {
+        if let Some(bytes) = self.stats_readback.try_take() {
+            self.last_stats = Some(SamplingStats::from_words(bytemuck::cast_slice(&bytes)));
+        }
+        self.last_stats
+    }
+}
