@@ -284,7 +284,12 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
         // From the root: every sample estimates the whole sum.
         sum /= f32(max(sp.cut_size, 1u));
     }
-    let radiance = albedo / PI * sum;
+    // Demodulated (half-resolution GI): without the albedo, which the upsampler applies at
+    // full resolution.
+    var radiance = albedo / PI * sum;
+    if sp.demodulate != 0u {
+        radiance = sum / PI;
+    }
     if sp.accumulate == 0u {
         accum[k] = vec4<f32>(radiance, 0.0);
     } else {

@@ -18,7 +18,7 @@ struct ViewParams {
     max_steps: f32,
     levels: u32,
     selected: u32,   // 1 + selected block, 0 = none
-    _pad0: u32,
+    final_scale: u32, // full-resolution pixels per GI pixel (final image, G-buffer)
     _pad1: u32,
     _pad2: u32,
 };
@@ -43,9 +43,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let px = vec2<i32>(gid.xy);
+    let fp = px * i32(vp.final_scale);
     let k = gid.y * size.x + gid.x;
     let d = diag[k];
-    let geometry = textureLoad(gb_position, px, 0).w > 0.0;
+    let geometry = textureLoad(gb_position, fp, 0).w > 0.0;
     var c = vec3<f32>(0.0);
     switch vp.mode {
         case 0u: {
@@ -54,7 +55,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
         case 1u: {
-            c = grey_final(px) * 0.8;
+            c = grey_final(fp) * 0.8;
             if d.y > 0.5 {
                 c = vec3<f32>(0.95, 0.1, 0.1);
             }
@@ -81,7 +82,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                     tint = false_color(depth / f32(count) / f32(max(vp.levels - 1u, 1u)));
                 }
             }
-            c = mix(grey_final(px), tint, 0.6);
+            c = mix(grey_final(fp), tint, 0.6);
             let in_block = gid.xy % vec2<u32>(vp.block);
             if vp.block >= 4u && (in_block.x == 0u || in_block.y == 0u) {
                 c *= 0.5;

@@ -42,6 +42,7 @@ fn main() {
                     settings,
                     tree_stats: cli.tree_stats,
                     view,
+                    compare_gt: cli.compare_gt,
                 }),
             }
         }

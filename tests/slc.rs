@@ -361,3 +361,74 @@ fn mock_level_matches_the_thesis_example() {
     // Fig. 5.2: a cut of 4 nodes -> level floor(log2 4) = 2.
     assert_eq!(slc::mock_level(4, 13), 2);
 }
+
+#[test]
+fn the_comparison_ground_truth_equals_the_ground_truth_method() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut st = setup(&ctx, settings(GiMethod::Slc));
+    st.set(|s| s.gi.rays_per_frame = 1 << 22);
+    st.r.set_compare_ground_truth(true);
+    let mut frames = 0;
+    while !st.r.compare_progress().is_some_and(|p| p.finished()) {
+        st.frame();
+        frames += 1;
+        assert!(frames < 200, "comparison never finished");
+    }
+    st.frame();
+    let cmp = st.r.read(Buffer::GroundTruthIndirect).unwrap();
+    let method = st.indirect();
+    let gt = st.ground_truth();
+    assert_eq!((cmp.width, cmp.height), (W, H));
+    let m = metrics::compare(&cmp, &gt, 0.0, lightcut::renderer::settings::Tonemap::Aces);
+    assert!(m.rmse <= 1e-6 * m.reference_mean.max(1e-6) + 1e-9, "{m:?}");
+    // The sampler's own image is a different (noisy) estimate of the same thing.
+    let mm = metrics::compare(&method, &gt, 0.0, lightcut::renderer::settings::Tonemap::Aces);
+    assert!(mm.mean_ratio > 0.5 && mm.mean_ratio < 1.5, "{mm:?}");
+    assert!(ctx.errors.take().is_empty());
+}
+
+#[test]
+fn half_resolution_upsampling_equals_the_cpu_reference() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut st = setup(&ctx, settings(GiMethod::Slc));
+    st.set(|s| s.sampling.half_resolution = true);
+    st.frame();
+    let (hpos, hnrm, hacc) = st.r.read_half_resolution().unwrap().expect("half resolution on");
+    assert_eq!((hpos.width, hpos.height), (W / 2, H / 2));
+    let pos = st.r.read(Buffer::Position).unwrap();
+    let nrm = st.r.read(Buffer::Normal).unwrap();
+    let alb = st.r.read(Buffer::Albedo).unwrap();
+    let ind = st.indirect();
+    // The half G-buffer holds every other full sample.
+    for y in 0..H / 2 {
+        for x in 0..W / 2 {
+            assert_eq!(hpos.get(x, y), pos.get(2 * x, 2 * y), "half position ({x},{y})");
+        }
+    }
+    let s = st.r.settings().clone();
+    let d_max = s.vpl.d_max * st.scene.bounds.radius();
+    let hp = |x: u32, y: u32| {
+        let p = hpos.get(x, y);
+        (p[3] > 0.0).then(|| v3(p))
+    };
+    let hn = |x: u32, y: u32| v3(hnrm.get(x, y)).normalize();
+    let hv = |x: u32, y: u32| v3(hacc[(y * (W / 2) + x) as usize]);
+    let mut worst = 0.0f32;
+    for y in 0..H {
+        for x in 0..W {
+            let p = pos.get(x, y);
+            let got = v3(ind.get(x, y));
+            if p[3] == 0.0 {
+                assert_eq!(got, Vec3::ZERO);
+                continue;
+            }
+            let n = v3(nrm.get(x, y)).normalize();
+            let e = slc::upsample_pixel(x, y, v3(p), n, (W / 2, H / 2), &hp, &hn, &hv, s.vpl.n_min, d_max);
+            let want = e * v3(alb.get(x, y));
+            let err = (got - want).abs().max_element() / want.max_element().max(1e-6);
+            worst = worst.max(err);
+        }
+    }
+    assert!(worst < 1e-3, "worst relative difference {worst}");
+    assert!(ctx.errors.take().is_empty());
+}

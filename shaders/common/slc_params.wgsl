@@ -19,7 +19,7 @@ struct SlcParams {
     ray_offset: f32,
     n_min: f32,      // eq. 5.3
     d_max: f32,      // eq. 5.3, metres
-    _pad0: u32,
+    demodulate: u32, // 1: write the estimate without the albedo (half-resolution GI)
     _pad1: u32,
 };
 

@@ -51,6 +51,8 @@ pub struct AppOptions {
     pub tree_stats: bool,
     /// The buffer shown at start (default: final).
     pub view: Option<ViewBuffer>,
+    /// Start with the ground-truth comparison on.
+    pub compare_gt: bool,
 }
 
 /// The sun as the UI edits it (light 0 of the scene).
@@ -138,6 +140,10 @@ pub struct WorkbenchApp {
     tree_panel: TreePanel,
     sampling_stats: Option<crate::renderer::passes::slc::SamplingStats>,
     cut_inspect: Option<CutInspect>,
+    /// Run the ground truth of the same VPLs beside a tree sampler.
+    compare_gt: bool,
+    compare_metrics: Option<crate::metrics::Metrics>,
+    last_metrics_time: f64,
 }
 
 /// The cut listed after a click in the cut views.
@@ -153,6 +159,7 @@ struct CutInspect {
 impl WorkbenchApp {
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
         let tree_stats = options.tree_stats;
+        let start_compare = options.compare_gt;
         let mut app = Self {
             render_state: cc.wgpu_render_state.clone(),
             renderer: None,
@@ -179,6 +186,9 @@ impl WorkbenchApp {
             tree_panel: TreePanel::new(tree_stats),
             sampling_stats: None,
             cut_inspect: None,
+            compare_gt: start_compare,
+            compare_metrics: None,
+            last_metrics_time: 0.0,
         };
         let Some(rs) = app.render_state.clone() else {
             app.errors.push(format!(
@@ -472,7 +482,36 @@ impl WorkbenchApp {
                         ui.checkbox(&mut sm.cull_behind, "cull nodes behind the block centre")
                             .on_hover_text("thesis 5.1; off keeps every cut complete (unbiased)");
                     }
+                    ui.checkbox(&mut sm.half_resolution, "half-resolution GI (bilateral upsampling)");
                     ui.checkbox(&mut sm.accumulate, "accumulate frames while static");
+                    ui.checkbox(&mut self.compare_gt, "compare with the ground truth")
+                        .on_hover_text(
+                            "runs the ground truth of the same VPLs beside the method (progressive; \
+                             keep the camera still); views: ground truth, split, relative error",
+                        );
+                    if self.compare_gt {
+                        if let Some(p) = self.renderer.as_ref().and_then(|r| r.compare_progress()) {
+                            ui.add(
+                                egui::ProgressBar::new(p.fraction())
+                                    .text(format!("ground truth {} / {} VPLs", p.done, p.total))
+                                    .show_percentage(),
+                            );
+                            if p.finished()
+                                && let Some(m) = &self.compare_metrics
+                            {
+                                ui.label(format!(
+                                    "vs ground truth: RMSE {:.2e} (relative {:.3}) · SSIM {:.4} · mean ratio {:.3}",
+                                    m.rmse, m.relative_rmse, m.ssim, m.mean_ratio
+                                ))
+                                .on_hover_text(
+                                    "RMSE on linear radiance; SSIM on the displayed luminance (exposure, tonemap)",
+                                );
+                            }
+                        }
+                        if self.view == ViewBuffer::SplitIndirect {
+                            ui.add(egui::Slider::new(&mut self.settings.display.split, 0.0..=1.0).text("split"));
+                        }
+                    }
                     if let Some(st) = self.sampling_stats {
                         ui.label(format!(
                             "{:.2} steps per traversal · {:.1} per pixel · {:.2}% pixels without a similar cut · {} dead branches",
@@ -643,12 +682,34 @@ impl WorkbenchApp {
 
         let lights = lights_with_sun(&open.scene, self.sun.as_ref());
         renderer.set_freeze_tree(self.tree_panel.freeze);
+        let comparing = self.compare_gt && self.settings.gi.method.samples_tree();
+        renderer.set_compare_ground_truth(comparing);
         renderer.render(&FrameInput {
             camera: &open.camera,
             lights: &lights,
             view: self.view,
         });
         let now = ui.input(|i| i.time);
+        // Live metrics against the finished comparison ground truth (twice a second).
+        if comparing
+            && now - self.last_metrics_time > 0.5
+            && renderer.compare_progress().is_some_and(|p| p.finished())
+        {
+            self.last_metrics_time = now;
+            match (
+                renderer.read(crate::renderer::Buffer::Indirect),
+                renderer.read(crate::renderer::Buffer::GroundTruthIndirect),
+            ) {
+                (Ok(a), Ok(b)) if (a.width, a.height) == (b.width, b.height) => {
+                    let d = &self.settings.display;
+                    self.compare_metrics = Some(crate::metrics::compare(&a, &b, d.exposure_ev, d.tonemap));
+                }
+                (Err(e), _) | (_, Err(e)) => self.errors.push(format!("comparison readback: {e}")),
+                _ => {}
+            }
+        } else if !comparing {
+            self.compare_metrics = None;
+        }
         if let Err(e) = self.tree_panel.refresh(renderer, now) {
             self.errors.push(format!("light tree statistics: {e}"));
         }
@@ -704,6 +765,8 @@ impl WorkbenchApp {
                 top,
                 Scale::Linear,
             );
+        } else if self.view == ViewBuffer::RelativeError {
+            legend(ui, draw, "relative error vs ground truth (log)", -2.0, 1.0);
         } else if self.view.is_log_heat() {
             legend(ui, draw, "importance / mean (log)", -3.0, 2.0);
         } else if self.settings.display.vpl_overlay {

@@ -36,6 +36,9 @@ pub struct Cli {
     /// The buffer shown at start, by its name in the buffer selector (e.g. "albedo").
     #[arg(long)]
     pub view: Option<String>,
+    /// Start with "compare with the ground truth" on (tree samplers).
+    #[arg(long)]
+    pub compare_gt: bool,
 }
 
 #[derive(Subcommand, Debug)]

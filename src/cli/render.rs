@@ -69,6 +69,9 @@ pub struct SamplingArgs {
     /// Keep nodes behind the block centre's surface in the cuts (complete cuts).
     #[arg(long)]
     pub no_cull: bool,
+    /// GI at half resolution, joint-bilateral upsampled with the similarity S.
+    #[arg(long)]
+    pub half_res: bool,
     /// Least normal similarity of a usable SST node.
     #[arg(long)]
     pub v_min: Option<f32>,
@@ -84,6 +87,10 @@ pub struct SamplingArgs {
     /// Average this many independent frames of the tree sampler (new random numbers each).
     #[arg(long, default_value_t = 1)]
     pub frames: u32,
+    /// Also compute the ground truth of the same VPLs and write ground_truth_indirect.exr
+    /// and the RMSE / SSIM of the method against it into metrics.json.
+    #[arg(long)]
+    pub compare_gt: bool,
 }
 
 impl SamplingArgs {
@@ -111,6 +118,9 @@ impl SamplingArgs {
         }
         if self.no_cull {
             s.sampling.cull_behind = false;
+        }
+        if self.half_res {
+            s.sampling.half_resolution = true;
         }
         if let Some(v) = self.v_min {
             s.tree.v_min = v;
@@ -185,6 +195,68 @@ pub struct RenderArgs {
     pub settings: SettingsArgs,
     #[command(flatten)]
     pub sampling: SamplingArgs,
+}
+
+/// metrics.json of a tree sampler: traversal statistics, per-pass times and (with
+/// --compare-gt) RMSE / SSIM against the ground truth of the same VPLs.
+fn write_metrics(
+    r: &mut Renderer,
+    args: &RenderArgs,
+    indirect: &ImageF32,
+    timings: Option<&crate::renderer::timing::PassTimings>,
+    frame: &dyn Fn(&mut Renderer, ViewBuffer),
+) -> anyhow::Result<()> {
+    let s = r.settings().clone();
+    let st = r.sampling_stats_blocking().unwrap_or_default();
+    let mut json = serde_json::json!({
+        "method": format!("{:?}", s.gi.method),
+        "width": args.width,
+        "height": args.height,
+        "vpls": r.vpl_frame().count,
+        "frames_averaged": r.sampling_frames(),
+        "sampling": &s.sampling,
+        "tree": &s.tree,
+        "n_min": s.vpl.n_min,
+        "d_max_fraction_of_scene_radius": s.vpl.d_max,
+        "distance_epsilon": s.gi.distance_epsilon,
+        "steps_per_traversal": st.steps_per_traversal(),
+        "steps_per_pixel": st.steps_per_pixel(),
+        "fallback_pixel_fraction": st.fallback_fraction(),
+        "dead_branches": st.dead,
+        "traversals": st.traversals,
+        "gpu_ms": timings.map(|t| t.passes.iter().map(|(n, ms)| (n.clone(), *ms)).collect::<std::collections::BTreeMap<_, _>>()),
+        "indirect_mean_rgb": indirect.mean_rgb(),
+    });
+    if args.sampling.compare_gt {
+        let mut g = s.clone();
+        g.gi.method = GiMethod::GroundTruth;
+        g.gi.rays_per_frame = 1 << 26;
+        r.set_settings(g)?;
+        loop {
+            frame(r, ViewBuffer::Final);
+            r.ctx.wait_idle()?;
+            if r.gi_progress().is_some_and(|p| p.finished()) {
+                break;
+            }
+        }
+        let gt = r.read(Buffer::Indirect)?;
+        write_exr(&args.out.join("ground_truth_indirect.exr"), &gt)?;
+        let m = crate::metrics::compare(indirect, &gt, s.display.exposure_ev, s.display.tonemap);
+        println!(
+            "vs ground truth ({} VPLs): RMSE {:.6} (relative {:.4}), SSIM {:.4}, mean ratio {:.4}",
+            r.vpl_frame().count,
+            m.rmse,
+            m.relative_rmse,
+            m.ssim,
+            m.mean_ratio
+        );
+        json["vs_ground_truth"] = serde_json::to_value(m)?;
+        r.set_settings(s)?;
+    }
+    let path = args.out.join("metrics.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&json)?)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
 }
 
 fn settings_method(r: &Renderer) -> GiMethod {
@@ -430,6 +502,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             let (w, h, bytes) = r.read_view_rgba8()?;
             write_png(&out.join(name), w, h, &bytes)?;
         }
+    }
+    if settings_method(&r).samples_tree() {
+        write_metrics(&mut r, args, &indirect, timings.as_ref(), &frame)?;
     }
     if let Some(e) = r.ctx.errors.take().into_iter().next() {
         return Err(anyhow!("GPU error: {e}"));

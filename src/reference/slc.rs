@@ -194,6 +194,54 @@ pub fn subtree_sum(nodes: &[SstNode], node: u32, g: &dyn Fn(&SstNode) -> f32) ->
         .sum()
 }
 
+/// Reference of `shaders/slc_upsample.wgsl`: full-resolution pixel (x, y) from the 4
+/// half-resolution samples around (x/2, y/2) (half pixel h holds full pixel 2h), with
+/// bilinear weights x S (eq. 5.3); if none is similar, the neighbour with the most similar
+/// normal. Returns the demodulated value (multiply by the albedo for radiance); None without
+/// geometry.
+#[allow(clippy::too_many_arguments)]
+pub fn upsample_pixel(
+    x: u32,
+    y: u32,
+    p: Vec3,
+    n: Vec3,
+    half_size: (u32, u32),
+    half_pos: &dyn Fn(u32, u32) -> Option<Vec3>,
+    half_nrm: &dyn Fn(u32, u32) -> Vec3,
+    half_val: &dyn Fn(u32, u32) -> Vec3,
+    n_min: f32,
+    d_max: f32,
+) -> Vec3 {
+    let (fx, fy) = (x as f32 * 0.5, y as f32 * 0.5);
+    let (bx, by) = (fx.floor(), fy.floor());
+    let (tx, ty) = (fx - bx, fy - by);
+    let (mut sum, mut wsum) = (Vec3::ZERO, 0.0f32);
+    let (mut best, mut best_dot) = (Vec3::ZERO, -2.0f32);
+    for i in 0..4u32 {
+        let (dx, dy) = ((i & 1) as i32, (i >> 1) as i32);
+        let (hx, hy) = (bx as i32 + dx, by as i32 + dy);
+        if hx < 0 || hy < 0 || hx >= half_size.0 as i32 || hy >= half_size.1 as i32 {
+            continue;
+        }
+        let Some(hp) = half_pos(hx as u32, hy as u32) else {
+            continue;
+        };
+        let hn = half_nrm(hx as u32, hy as u32);
+        let v = half_val(hx as u32, hy as u32);
+        let nd = n.dot(hn);
+        if nd > best_dot {
+            best_dot = nd;
+            best = v;
+        }
+        let w = if dx == 1 { tx } else { 1.0 - tx } * if dy == 1 { ty } else { 1.0 - ty };
+        if similar(p, n, hp, hn, n_min, d_max) {
+            sum += w * v;
+            wsum += w;
+        }
+    }
+    if wsum > 0.0 { sum / wsum } else { best }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -47,6 +47,33 @@ pub struct GbufferTargets {
 }
 
 impl GbufferTargets {
+    /// A G-buffer written by compute (the half-resolution copy for half-resolution GI): the
+    /// same formats, storage-writable; its depth texture is unused.
+    pub fn new_compute(device: &wgpu::Device, size: (u32, u32)) -> Self {
+        let st = wgpu::TextureUsages::STORAGE_BINDING | READABLE;
+        let position = texture(device, "gbuffer_half::position", size, 1, POSITION_FORMAT, st);
+        let normal = texture(device, "gbuffer_half::normal", size, 1, NORMAL_FORMAT, st);
+        let albedo = texture(device, "gbuffer_half::albedo", size, 1, ALBEDO_FORMAT, st);
+        let depth = texture(
+            device,
+            "gbuffer_half::depth",
+            (1, 1),
+            1,
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        Self {
+            position_view: position.create_view(&Default::default()),
+            normal_view: normal.create_view(&Default::default()),
+            albedo_view: albedo.create_view(&Default::default()),
+            depth_view: depth.create_view(&Default::default()),
+            position,
+            normal,
+            albedo,
+            depth,
+        }
+    }
+
     pub fn new(device: &wgpu::Device, size: (u32, u32)) -> Self {
         let rt = wgpu::TextureUsages::RENDER_ATTACHMENT | READABLE;
         let position = texture(device, "gbuffer::position", size, 1, POSITION_FORMAT, rt);

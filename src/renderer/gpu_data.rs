@@ -271,7 +271,9 @@ pub struct GpuSlcParams {
     pub ray_offset: f32,
     pub n_min: f32,
     pub d_max: f32,
-    pub _pad: [u32; 2],
+    /// 1: the estimate without the albedo (half-resolution GI, upsampled at full resolution).
+    pub demodulate: u32,
+    pub _pad: u32,
 }
 
 /// A node of the Stochastic Substitute Tree, 64 bytes (one cache line; the SST paper's node
@@ -478,8 +480,8 @@ mod tests {
                     offset_of!(GpuSlcParams, ray_offset),
                     offset_of!(GpuSlcParams, n_min),
                     offset_of!(GpuSlcParams, d_max),
+                    offset_of!(GpuSlcParams, demodulate),
                     offset_of!(GpuSlcParams, _pad),
-                    offset_of!(GpuSlcParams, _pad) + 4,
                 ],
             ),
             (

@@ -78,6 +78,8 @@ pub enum Buffer {
     RsmPosition(u32),
     RsmNormal(u32),
     RsmFlux(u32),
+    /// The comparison ground truth's GI (empty 0x0 image when no comparison runs).
+    GroundTruthIndirect,
 }
 
 /// Progress of the progressive GI method (ground truth).
@@ -109,6 +111,17 @@ struct GtState {
     snapshot: wgpu::Buffer,
 }
 
+/// Half-resolution G-buffer position and normal, and the sampler's demodulated sums there.
+pub type HalfReadback = (ImageF32, ImageF32, Vec<[f32; 4]>);
+
+/// The ground truth kept beside a tree sampler for comparison: its own accumulation and
+/// composite targets.
+struct CompareState {
+    gt: Option<GtState>,
+    targets: frame::LightingTargets,
+    targets_size: (u32, u32),
+}
+
 pub struct Renderer {
     pub ctx: GpuContext,
     settings: RenderSettings,
@@ -135,6 +148,11 @@ pub struct Renderer {
     slc_state: Option<(u64, u32)>,
     /// Block outlined in the cut views (set by the UI).
     selected_block: Option<u32>,
+    compare_on: bool,
+    compare: Option<CompareState>,
+    compare_views: passes::compare::CompareViewsPass,
+    slc_half: passes::slc_half::HalfPass,
+    half: Option<passes::slc_half::HalfTargets>,
     vpl_buffers: VplBuffers,
     vpl_frame: VplFrame,
     gt: Option<GtState>,
@@ -235,6 +253,11 @@ impl Renderer {
             ),
             slc_state: None,
             selected_block: None,
+            compare_on: false,
+            compare: None,
+            compare_views: passes::compare::CompareViewsPass::new(device)?,
+            slc_half: passes::slc_half::HalfPass::new(device)?,
+            half: None,
             vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
             vpl_frame: VplFrame::default(),
             gt: None,
@@ -279,13 +302,17 @@ impl Renderer {
                 BuildPass::new(device),
                 SstOverlayPass::new(device),
                 SlcPass::new(device),
+                passes::compare::CompareViewsPass::new(device),
+                passes::slc_half::HalfPass::new(device),
             ),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
         }
-        let (g, s, d, disp, v, (vg, gt, c, rf, sp, so, b, ov, sl)) = passes;
-        let new = (g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?, so?, b?, ov?, sl?);
+        let (g, s, d, disp, v, (vg, gt, c, rf, sp, so, b, ov, sl, cv, hp)) = passes;
+        let new = (
+            g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?, so?, b?, ov?, sl?, cv?, hp?,
+        );
         (
             self.gbuffer,
             self.rsm,
@@ -301,6 +328,8 @@ impl Renderer {
             self.sst_build,
             self.sst_overlay,
             self.slc,
+            self.compare_views,
+            self.slc_half,
         ) = new;
         Ok(())
     }
@@ -534,6 +563,9 @@ impl Renderer {
             }
             GiMethod::Slc | GiMethod::Sst | GiMethod::Rtslc => {
                 let n = self.step_sampling(&mut enc, input, lights, size);
+                if self.compare_on {
+                    self.step_compare(&mut enc, input, lights, size);
+                }
                 1.0 / n.max(1) as f32
             }
         };
@@ -612,13 +644,30 @@ impl Renderer {
         lights: &[DirectionalLight],
         size: (u32, u32),
     ) {
+        let key = self.gt_key(input, lights, size);
+        let mut st = self.gt.take();
+        let accum = self.targets.lighting.gi_accum.clone();
+        self.advance_ground_truth(enc, &mut st, key, &accum, size);
+        self.gt = st;
+    }
+
+    /// Starts (when `key` changed: snapshot of the frame's VPLs, accumulation cleared) or
+    /// continues a ground truth in `state`, adding at most `gi.rays_per_frame` shadow rays'
+    /// worth of VPL batches to `accum`.
+    fn advance_ground_truth(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        state: &mut Option<GtState>,
+        key: u64,
+        accum: &wgpu::Buffer,
+        size: (u32, u32),
+    ) {
         let device = self.ctx.device.clone();
         let queue = self.ctx.queue.clone();
-        let key = self.gt_key(input, lights, size);
         let total = self.vpl_frame.count;
-        if self.gt.as_ref().is_none_or(|g| g.key != key) {
+        if state.as_ref().is_none_or(|g| g.key != key) {
             let bytes = (std::mem::size_of::<GpuVpl>() as u64) * self.vpl_buffers.capacity as u64;
-            let snapshot = match self.gt.take() {
+            let snapshot = match state.take() {
                 Some(g) if g.snapshot.size() == bytes => g.snapshot,
                 _ => device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("ground_truth::vpl_snapshot"),
@@ -630,14 +679,14 @@ impl Renderer {
                 }),
             };
             enc.copy_buffer_to_buffer(&self.vpl_buffers.vpls, 0, &snapshot, 0, bytes);
-            enc.clear_buffer(&self.targets.lighting.gi_accum, 0, None);
-            self.gt = Some(GtState {
+            enc.clear_buffer(accum, 0, None);
+            *state = Some(GtState {
                 key,
                 progress: GiProgress { done: 0, total },
                 snapshot,
             });
         }
-        let Some(gt) = self.gt.as_mut() else { return };
+        let Some(gt) = state.as_mut() else { return };
         if gt.progress.finished() {
             return;
         }
@@ -666,9 +715,93 @@ impl Renderer {
             &self.scene,
             &gt.snapshot,
             &self.targets.gbuffer,
-            &self.targets.lighting.gi_accum,
+            accum,
         );
         gt.progress.done = reached;
+    }
+
+    /// Key of the comparison ground truth: what its image depends on (view, lights, size,
+    /// VPL and shading settings), not the sampler's settings.
+    fn compare_key(&self, input: &FrameInput<'_>, lights: &[DirectionalLight], size: (u32, u32)) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        let c = input.camera;
+        for v in [c.position, c.forward, c.up] {
+            v.to_array().map(f32::to_bits).hash(&mut h);
+        }
+        c.yfov.to_bits().hash(&mut h);
+        for l in lights {
+            l.direction.to_array().map(f32::to_bits).hash(&mut h);
+            l.irradiance.to_array().map(f32::to_bits).hash(&mut h);
+        }
+        size.hash(&mut h);
+        let s = &self.settings;
+        let mut v = s.vpl.clone();
+        v.animate = false;
+        format!(
+            "{:?}{:?}{}{}",
+            s.shadow, v, s.gi.distance_epsilon, s.gi.ray_offset
+        )
+        .hash(&mut h);
+        // Animated or unfrozen-but-changing VPLs: a new set each frame never converges.
+        if s.vpl.animate && self.freeze.is_none() {
+            self.frames.hash(&mut h);
+        }
+        h.finish()
+    }
+
+    /// The ground truth of the same VPLs beside a tree sampler (progressive, into its own
+    /// buffers), then its composite.
+    fn step_compare(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        input: &FrameInput<'_>,
+        lights: &[DirectionalLight],
+        size: (u32, u32),
+    ) {
+        let device = self.ctx.device.clone();
+        let queue = self.ctx.queue.clone();
+        let key = self.compare_key(input, lights, size);
+        let mut cmp = match self.compare.take() {
+            Some(c) if c.targets_size == size => c,
+            _ => CompareState {
+                gt: None,
+                targets: frame::LightingTargets::new(&device, size),
+                targets_size: size,
+            },
+        };
+        let accum = cmp.targets.gi_accum.clone();
+        self.advance_ground_truth(enc, &mut cmp.gt, key, &accum, size);
+        self.composite.record(
+            &device,
+            &queue,
+            enc,
+            &mut self.timer,
+            size,
+            1.0,
+            &self.targets.lighting.direct_view,
+            &cmp.targets.gi_accum,
+            &cmp.targets.indirect_view,
+            &cmp.targets.final_view,
+        );
+        self.compare = Some(cmp);
+    }
+
+    /// Runs the ground truth of the same VPLs beside a tree sampler (SLC, SST, RTSLC), for the
+    /// comparison views and metrics; off frees its buffers.
+    pub fn set_compare_ground_truth(&mut self, on: bool) {
+        self.compare_on = on;
+        if !on {
+            self.compare = None;
+        }
+    }
+
+    /// Progress of the comparison ground truth (None when off or not started).
+    pub fn compare_progress(&self) -> Option<GiProgress> {
+        self.compare
+            .as_ref()
+            .and_then(|c| c.gt.as_ref())
+            .map(|g| g.progress)
     }
 
     /// Converged reference: restart on any change (clear the sums), then add
@@ -687,12 +820,48 @@ impl Renderer {
         let sm = &s.sampling;
         let device = self.ctx.device.clone();
         let queue = self.ctx.queue.clone();
-        if !self.slc_buffers.matches(size, sm.block_size, sm.cut_size) {
-            self.slc_buffers = SlcBuffers::new(&device, size, sm.block_size, sm.cut_size);
+        // Half-resolution GI: the sampler runs on every other G-buffer sample (demodulated)
+        // and is upsampled into the full-resolution accumulation afterwards.
+        let half = sm.half_resolution;
+        let gi_size = if half {
+            passes::slc_half::HalfTargets::half_size(size)
+        } else {
+            size
+        };
+        if !self.slc_buffers.matches(gi_size, sm.block_size, sm.cut_size) {
+            self.slc_buffers = SlcBuffers::new(&device, gi_size, sm.block_size, sm.cut_size);
         }
+        let d_max = s.vpl.d_max * self.scene.bounds.radius().max(1e-3);
+        let half_targets = if half {
+            let h = match self.half.take() {
+                Some(h) if h.size == gi_size => h,
+                _ => passes::slc_half::HalfTargets::new(&device, size),
+            };
+            self.slc_half.record_downsample(
+                &device,
+                &queue,
+                enc,
+                &mut self.timer,
+                &self.targets.gbuffer,
+                size,
+                &h,
+                s.vpl.n_min,
+                d_max,
+            );
+            Some(h)
+        } else {
+            self.half = None;
+            None
+        };
         // Accumulate while nothing changes (the key also covers the method and its settings);
         // a frozen tree keeps its VPLs, otherwise new VPLs average in too.
         let key = self.gt_key(input, lights, size) ^ 0x51c0_51c0_51c0_51c0;
+        if half && self.slc_state.is_none_or(|(k, _)| k != key || !sm.accumulate) {
+            // The half-resolution sum restarts with the accumulation.
+            if let Some(h) = &half_targets {
+                enc.clear_buffer(&h.accum, 0, None);
+            }
+        }
         let frames = match self.slc_state {
             Some((k, n)) if sm.accumulate && k == key => n + 1,
             _ => 1,
@@ -700,8 +869,8 @@ impl Renderer {
         self.slc_state = Some((key, frames));
         let grid = self.slc_buffers.grid;
         let p = crate::renderer::gpu_data::GpuSlcParams {
-            width: size.0,
-            height: size.1,
+            width: gi_size.0,
+            height: gi_size.1,
             block: sm.block_size,
             grid_x: grid.0,
             grid_y: grid.1,
@@ -729,8 +898,13 @@ impl Renderer {
             epsilon: s.gi.distance_epsilon,
             ray_offset: s.gi.ray_offset,
             n_min: s.vpl.n_min,
-            d_max: s.vpl.d_max * self.scene.bounds.radius().max(1e-3),
-            _pad: [0; 2],
+            d_max,
+            demodulate: half as u32,
+            _pad: 0,
+        };
+        let (gbuffer, accum) = match &half_targets {
+            Some(h) => (&h.gbuffer, &h.accum),
+            None => (&self.targets.gbuffer, &self.targets.lighting.gi_accum),
         };
         self.slc.record(
             &device,
@@ -740,10 +914,22 @@ impl Renderer {
             p,
             &self.tree,
             &self.scene,
-            &self.targets.gbuffer,
-            &self.targets.lighting.gi_accum,
+            gbuffer,
+            accum,
             &self.slc_buffers,
         );
+        if let Some(h) = half_targets {
+            self.slc_half.record_upsample(
+                &device,
+                enc,
+                &mut self.timer,
+                &self.targets.gbuffer,
+                size,
+                &h,
+                &self.targets.lighting.gi_accum,
+            );
+            self.half = Some(h);
+        }
         frames
     }
 
@@ -770,6 +956,16 @@ impl Renderer {
             .copied()
             .take_while(|&n| n != 0)
             .collect())
+    }
+
+    /// Half-resolution GI of the last frame: its G-buffer position, normal and the sampler's
+    /// demodulated sums (None when half resolution is off).
+    pub fn read_half_resolution(&self) -> Result<Option<HalfReadback>, GpuError> {
+        let Some(h) = &self.half else { return Ok(None) };
+        let pos = readback::read_texture_f32(&self.ctx, &h.gbuffer.position, 0)?;
+        let nrm = readback::read_texture_f32(&self.ctx, &h.gbuffer.normal, 0)?;
+        let acc = readback::read_storage_buffer(&self.ctx, &h.accum)?;
+        Ok(Some((pos, nrm, bytemuck::cast_slice(&acc).to_vec())))
     }
 
     /// Frames summed in the tree samplers' accumulation (0 before the first).
@@ -974,6 +1170,7 @@ impl Renderer {
                 let s = (256 / r).max(1);
                 (r * s, r * s)
             }
+            v if v.is_sampling_view() => self.slc_buffers.size,
             _ => self.targets.size,
         };
         if self.targets.view.size != want {
@@ -988,9 +1185,54 @@ impl Renderer {
         } else {
             (b.min, b.max)
         };
+        if view.is_compare_view() {
+            let Some(cmp) = self
+                .compare
+                .as_ref()
+                .filter(|c| c.targets_size == self.targets.size)
+            else {
+                // No comparison running (or not at this size): nothing to show.
+                enc.clear_texture(&self.targets.view.texture, &Default::default());
+                return;
+            };
+            let d = &self.settings.display;
+            match view {
+                ViewBuffer::GroundTruthIndirect | ViewBuffer::GroundTruthFinal => {
+                    let src = if view == ViewBuffer::GroundTruthFinal {
+                        &cmp.targets.final_view
+                    } else {
+                        &cmp.targets.indirect_view
+                    };
+                    self.display
+                        .record(&device, &queue, enc, &mut self.timer, d, src, dst, want);
+                }
+                _ => {
+                    let p = passes::compare::GpuCmpParams {
+                        mode: (view == ViewBuffer::RelativeError) as u32,
+                        split_x: (d.split * want.0 as f32) as u32,
+                        exposure: d.exposure_ev.exp2(),
+                        tonemap: d.tonemap.gpu_id(),
+                    };
+                    self.compare_views.record(
+                        &device,
+                        &queue,
+                        enc,
+                        &mut self.timer,
+                        p,
+                        &t.lighting.indirect_view,
+                        &cmp.targets.indirect_view,
+                        &t.gbuffer.position_view,
+                        dst,
+                        want,
+                    );
+                }
+            }
+            return;
+        }
         if view.is_sampling_view() {
             let b = &self.slc_buffers;
-            if b.size != self.targets.size {
+            let scale = self.targets.size.0.div_ceil(b.size.0.max(1));
+            if scale == 0 || b.size.0 * scale < self.targets.size.0 || scale > 2 {
                 // No tree-sampling frame at this size yet: nothing to show.
                 enc.clear_texture(&self.targets.view.texture, &Default::default());
                 return;
@@ -1011,7 +1253,8 @@ impl Renderer {
                 max_steps: self.sampling_steps_scale(),
                 levels: self.tree.levels(),
                 selected: self.selected_block.map_or(0, |b| b + 1),
-                _pad: [0; 3],
+                final_scale: scale,
+                _pad: [0; 2],
             };
             self.slc.record_view(
                 &device,
@@ -1133,7 +1376,11 @@ impl Renderer {
             ViewBuffer::TraversalSteps
             | ViewBuffer::CutFallback
             | ViewBuffer::CutBlocks
-            | ViewBuffer::CutDepth => unreachable!("drawn by slc_views above"),
+            | ViewBuffer::CutDepth
+            | ViewBuffer::GroundTruthIndirect
+            | ViewBuffer::GroundTruthFinal
+            | ViewBuffer::SplitIndirect
+            | ViewBuffer::RelativeError => unreachable!("drawn above"),
             ViewBuffer::ShadowMap => (
                 VisMode::DepthTexture,
                 VisSource::Depth(&t.shadow.array_view, 0),
@@ -1204,6 +1451,14 @@ impl Renderer {
             Buffer::Final => readback::read_texture_f32(&self.ctx, &t.lighting.final_, 0),
             Buffer::Direct => readback::read_texture_f32(&self.ctx, &t.lighting.direct, 0),
             Buffer::Indirect => readback::read_texture_f32(&self.ctx, &t.lighting.indirect, 0),
+            Buffer::GroundTruthIndirect => match &self.compare {
+                Some(c) => readback::read_texture_f32(&self.ctx, &c.targets.indirect, 0),
+                None => Ok(ImageF32 {
+                    width: 0,
+                    height: 0,
+                    pixels: Vec::new(),
+                }),
+            },
             Buffer::Position => readback::read_texture_f32(&self.ctx, &t.gbuffer.position, 0),
             Buffer::Normal => readback::read_texture_f32(&self.ctx, &t.gbuffer.normal, 0),
             Buffer::Albedo => readback::read_texture_f32(&self.ctx, &t.gbuffer.albedo, 0),

@@ -424,6 +424,8 @@ pub struct DisplaySettings {
     /// Tree level it draws (0 = the root; clamped to the leaves' level).
     pub tree_level: u32,
     pub tree_color: TreeColor,
+    /// Position of the divider in the split comparison view (0 = left edge, 1 = right).
+    pub split: f32,
 }
 
 impl Default for DisplaySettings {
@@ -437,6 +439,7 @@ impl Default for DisplaySettings {
             tree_overlay: TreeOverlay::Off,
             tree_level: 6,
             tree_color: TreeColor::Intensity,
+            split: 0.5,
         }
     }
 }
@@ -597,6 +600,12 @@ impl RenderSettings {
                 t.sigma_max
             ));
         }
+        if !(0.0..=1.0).contains(&self.display.split) {
+            return Err(format!(
+                "display.split {} is out of range (0..=1)",
+                self.display.split
+            ));
+        }
         if self.display.tree_level > 20 {
             return Err(format!(
                 "display.tree_level {} is out of range (0..=20)",
@@ -655,10 +664,18 @@ pub enum ViewBuffer {
     CutBlocks,
     /// Tree samplers: the per-block cuts coloured by their mean node depth.
     CutDepth,
+    /// The ground truth of the same VPLs beside a tree sampler: GI only (comparison on).
+    GroundTruthIndirect,
+    /// The ground truth of the same VPLs beside a tree sampler: direct + GI (comparison on).
+    GroundTruthFinal,
+    /// Split view: the sampler's GI left, the ground truth's right (comparison on).
+    SplitIndirect,
+    /// Relative error of the sampler's GI against the ground truth, log false colour.
+    RelativeError,
 }
 
 impl ViewBuffer {
-    pub const ALL: [ViewBuffer; 19] = [
+    pub const ALL: [ViewBuffer; 23] = [
         ViewBuffer::Final,
         ViewBuffer::Direct,
         ViewBuffer::Indirect,
@@ -678,6 +695,10 @@ impl ViewBuffer {
         ViewBuffer::CutFallback,
         ViewBuffer::CutBlocks,
         ViewBuffer::CutDepth,
+        ViewBuffer::GroundTruthIndirect,
+        ViewBuffer::GroundTruthFinal,
+        ViewBuffer::SplitIndirect,
+        ViewBuffer::RelativeError,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -700,6 +721,10 @@ impl ViewBuffer {
             ViewBuffer::CutFallback => "pixels without a similar cut",
             ViewBuffer::CutBlocks => "cuts per block",
             ViewBuffer::CutDepth => "cut depth per block",
+            ViewBuffer::GroundTruthIndirect => "ground truth: GI only",
+            ViewBuffer::GroundTruthFinal => "ground truth: final",
+            ViewBuffer::SplitIndirect => "split: method | ground truth (GI)",
+            ViewBuffer::RelativeError => "relative error vs ground truth",
         }
     }
     /// The view called `name` (as [`ViewBuffer::name`] spells it, case-insensitive).
@@ -735,6 +760,17 @@ impl ViewBuffer {
                 | ViewBuffer::CutFallback
                 | ViewBuffer::CutBlocks
                 | ViewBuffer::CutDepth
+        )
+    }
+
+    /// True for the views that need the comparison ground truth.
+    pub fn is_compare_view(self) -> bool {
+        matches!(
+            self,
+            ViewBuffer::GroundTruthIndirect
+                | ViewBuffer::GroundTruthFinal
+                | ViewBuffer::SplitIndirect
+                | ViewBuffer::RelativeError
         )
     }
 

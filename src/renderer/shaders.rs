@@ -68,6 +68,15 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("slc_cuts.wgsl", include_str!("../../shaders/slc_cuts.wgsl")),
     ("slc_sample.wgsl", include_str!("../../shaders/slc_sample.wgsl")),
     ("slc_views.wgsl", include_str!("../../shaders/slc_views.wgsl")),
+    ("slc_half.wgsl", include_str!("../../shaders/slc_half.wgsl")),
+    (
+        "slc_upsample.wgsl",
+        include_str!("../../shaders/slc_upsample.wgsl"),
+    ),
+    (
+        "compare_views.wgsl",
+        include_str!("../../shaders/compare_views.wgsl"),
+    ),
     ("sst_overlay.wgsl", include_str!("../../shaders/sst_overlay.wgsl")),
     (
         "sst_classify.wgsl",
@@ -101,6 +110,9 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "slc_cuts.wgsl",
     "slc_sample.wgsl",
     "slc_views.wgsl",
+    "compare_views.wgsl",
+    "slc_half.wgsl",
+    "slc_upsample.wgsl",
 ];
 
 #[derive(Debug, Error, PartialEq)]

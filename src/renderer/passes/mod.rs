@@ -2,6 +2,7 @@
 //! what it reads and writes in its `record` signature (typed inputs, no global lookups), and
 //! builds its per-frame bind groups when it records.
 
+pub mod compare;
 pub mod composite;
 pub mod direct;
 pub mod display;
@@ -10,6 +11,7 @@ pub mod ground_truth;
 pub mod reference;
 pub mod rsm;
 pub mod slc;
+pub mod slc_half;
 pub mod sst_build;
 pub mod sst_overlay;
 pub mod sst_sort;

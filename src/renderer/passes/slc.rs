@@ -125,7 +125,9 @@ pub struct GpuSlcViewParams {
     pub levels: u32,
     /// 1 + the selected block, 0 = none.
     pub selected: u32,
-    pub _pad: [u32; 3],
+    /// Full-resolution pixels per GI pixel (2 with half-resolution GI).
+    pub final_scale: u32,
+    pub _pad: [u32; 2],
 }
 
 pub struct SlcPass {

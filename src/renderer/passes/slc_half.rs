@@ -1,0 +1,197 @@
+//! Half-resolution GI for the tree samplers (thesis chapter 6, "Upsampling"): `downsample`
+//! copies every other G-buffer sample into a half-resolution G-buffer, the sampler runs there
+//! demodulated (without the albedo), and `upsample` fills the full-resolution accumulation with
+//! a joint bilateral filter using the similarity S (eq. 5.3), re-modulated with the
+//! full-resolution albedo.
+//! Reads: the G-buffer, the half-resolution estimate. Writes: [`HalfTargets`], the GI
+//! accumulation buffer.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::renderer::{frame::GbufferTargets, shaders, timing::GpuTimer};
+
+use super::{
+    bind_group_seq, compute_pipeline, float_texture_entry, groups_image, run_compute, storage_entry,
+    storage_texture_entry, uniform_buffer, uniform_entry,
+};
+
+/// Twin: `HalfParams` in `shaders/slc_half.wgsl` and `shaders/slc_upsample.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuHalfParams {
+    pub full_w: u32,
+    pub full_h: u32,
+    pub half_w: u32,
+    pub half_h: u32,
+    pub n_min: f32,
+    /// Metres.
+    pub d_max: f32,
+    pub _pad: [u32; 2],
+}
+
+/// The half-resolution G-buffer and the sampler's (demodulated) accumulation there.
+pub struct HalfTargets {
+    pub gbuffer: GbufferTargets,
+    pub accum: wgpu::Buffer,
+    pub size: (u32, u32),
+}
+
+impl HalfTargets {
+    pub fn half_size(full: (u32, u32)) -> (u32, u32) {
+        (full.0.div_ceil(2).max(1), full.1.div_ceil(2).max(1))
+    }
+
+    pub fn new(device: &wgpu::Device, full: (u32, u32)) -> Self {
+        let size = Self::half_size(full);
+        Self {
+            gbuffer: GbufferTargets::new_compute(device, size),
+            accum: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("slc_half::accum"),
+                size: 16 * size.0 as u64 * size.1 as u64,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            size,
+        }
+    }
+}
+
+pub struct HalfPass {
+    down: wgpu::ComputePipeline,
+    down_layout: wgpu::BindGroupLayout,
+    up: wgpu::ComputePipeline,
+    up_layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+}
+
+impl HalfPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let dmod = shaders::create_module(device, "slc_half.wgsl")?;
+        let down_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("slc_half::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                float_texture_entry(1),
+                float_texture_entry(2),
+                float_texture_entry(3),
+                storage_texture_entry(4, super::gbuffer::POSITION_FORMAT),
+                storage_texture_entry(5, super::gbuffer::NORMAL_FORMAT),
+                storage_texture_entry(6, super::gbuffer::ALBEDO_FORMAT),
+            ],
+        });
+        let umod = shaders::create_module(device, "slc_upsample.wgsl")?;
+        let up_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("slc_upsample::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                float_texture_entry(1),
+                float_texture_entry(2),
+                float_texture_entry(3),
+                float_texture_entry(4),
+                float_texture_entry(5),
+                storage_entry(6, c, true),
+                storage_entry(7, c, false),
+            ],
+        });
+        Ok(Self {
+            down: compute_pipeline(device, "slc_half", &[Some(&down_layout)], &dmod, "downsample"),
+            up: compute_pipeline(device, "slc_upsample", &[Some(&up_layout)], &umod, "upsample"),
+            params: uniform_buffer::<GpuHalfParams>(device, "slc_half::params"),
+            down_layout,
+            up_layout,
+        })
+    }
+
+    fn write_params(
+        &self,
+        queue: &wgpu::Queue,
+        full: (u32, u32),
+        half: &HalfTargets,
+        n_min: f32,
+        d_max: f32,
+    ) {
+        let p = GpuHalfParams {
+            full_w: full.0,
+            full_h: full.1,
+            half_w: half.size.0,
+            half_h: half.size.1,
+            n_min,
+            d_max,
+            _pad: [0; 2],
+        };
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+    }
+
+    /// The half-resolution G-buffer from the full one.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_downsample(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        full: &GbufferTargets,
+        full_size: (u32, u32),
+        half: &HalfTargets,
+        n_min: f32,
+        d_max: f32,
+    ) {
+        self.write_params(queue, full_size, half, n_min, d_max);
+        let tv = wgpu::BindingResource::TextureView;
+        let entries = [
+            self.params.as_entire_binding(),
+            tv(&full.position_view),
+            tv(&full.normal_view),
+            tv(&full.albedo_view),
+            tv(&half.gbuffer.position_view),
+            tv(&half.gbuffer.normal_view),
+            tv(&half.gbuffer.albedo_view),
+        ];
+        let bind = bind_group_seq(device, "slc_half::bind_group", &self.down_layout, &entries);
+        run_compute(
+            encoder,
+            timer,
+            "gi_downsample",
+            &self.down,
+            &bind,
+            groups_image(half.size.0, half.size.1),
+        );
+    }
+
+    /// The full-resolution accumulation from the half-resolution one (joint bilateral).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_upsample(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        full: &GbufferTargets,
+        full_size: (u32, u32),
+        half: &HalfTargets,
+        accum: &wgpu::Buffer,
+    ) {
+        let tv = wgpu::BindingResource::TextureView;
+        let entries = [
+            self.params.as_entire_binding(),
+            tv(&full.position_view),
+            tv(&full.normal_view),
+            tv(&full.albedo_view),
+            tv(&half.gbuffer.position_view),
+            tv(&half.gbuffer.normal_view),
+            half.accum.as_entire_binding(),
+            accum.as_entire_binding(),
+        ];
+        let bind = bind_group_seq(device, "slc_upsample::bind_group", &self.up_layout, &entries);
+        run_compute(
+            encoder,
+            timer,
+            "gi_upsample",
+            &self.up,
+            &bind,
+            groups_image(full_size.0, full_size.1),
+        );
+    }
+}
