@@ -754,7 +754,14 @@ impl WorkbenchApp {
         );
         if self.view == ViewBuffer::TraversalSteps {
             let top = renderer.sampling_steps_scale();
-            legend_with(ui, draw, "traversal steps per traversal", 0.0, top, Scale::Linear);
+            let title = match self.sampling_stats {
+                Some(st) => format!(
+                    "traversal steps per traversal (image mean {:.2})",
+                    st.steps_per_traversal()
+                ),
+                None => "traversal steps per traversal".to_string(),
+            };
+            legend_with(ui, draw, &title, 0.0, top, Scale::Linear);
         } else if self.view == ViewBuffer::CutDepth {
             let top = renderer.sampling_steps_scale();
             legend_with(
