@@ -91,6 +91,22 @@ fn bad_input_gives_one_clear_line() {
     assert!(e.contains("Nope"), "{e}");
     let e = one_line_error(&["bench", "tree", "--min-log2", "12", "--max-log2", "21"]);
     assert!(e.contains("--max-log2"), "{e}");
+    let e = one_line_error(&[
+        "render",
+        "--scene",
+        "default",
+        "--width",
+        "96",
+        "--height",
+        "64",
+        "--method",
+        "slc",
+        "--cut-size",
+        "65",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("sampling.cut_size"), "{e}");
     let e = one_line_error(&["--view", "nope", "--frames", "1"]);
     assert!(e.contains("unknown view 'nope'"), "{e}");
 }

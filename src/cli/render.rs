@@ -348,6 +348,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     // Tree samplers: average --frames independent frames (the timing frames count).
     if settings_method(&r).samples_tree() {
         while r.sampling_frames() < args.sampling.frames {
+            if let Some(e) = r.ctx.errors.take().into_iter().next() {
+                return Err(anyhow!("GPU error: {e}"));
+            }
             frame(&mut r, ViewBuffer::Final);
             r.ctx.wait_idle()?;
         }

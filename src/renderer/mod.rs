@@ -245,12 +245,8 @@ impl Renderer {
             tree: TreeBuffers::new(device, settings.vpl.count),
             sst_overlay: SstOverlayPass::new(device)?,
             slc: SlcPass::new(device)?,
-            slc_buffers: SlcBuffers::new(
-                device,
-                size,
-                settings.sampling.block_size,
-                settings.sampling.cut_size,
-            ),
+            // Sized at the first tree-sampling frame (after the device-limit check).
+            slc_buffers: SlcBuffers::new(device, (1, 1), 1, 1),
             slc_state: None,
             selected_block: None,
             compare_on: false,
@@ -829,6 +825,25 @@ impl Renderer {
             size
         };
         if !self.slc_buffers.matches(gi_size, sm.block_size, sm.cut_size) {
+            let need = SlcBuffers::largest_binding(gi_size, sm.block_size, sm.cut_size);
+            let limit = device.limits().max_storage_buffer_binding_size;
+            if need > limit {
+                // Refuse (once per change) rather than fail validation; GI stays black.
+                self.ctx.errors.report(format!(
+                    "sampling: {}x{} pixels with {}x{} blocks and cuts of {} need a {} MiB buffer; \
+                     this device binds at most {} MiB (raise sampling.block_size or lower cut_size)",
+                    gi_size.0,
+                    gi_size.1,
+                    sm.block_size,
+                    sm.block_size,
+                    sm.cut_size,
+                    need >> 20,
+                    limit >> 20
+                ));
+                enc.clear_buffer(&self.targets.lighting.gi_accum, 0, None);
+                self.slc_state = None;
+                return 1;
+            }
             self.slc_buffers = SlcBuffers::new(&device, gi_size, sm.block_size, sm.cut_size);
         }
         let d_max = s.vpl.d_max * self.scene.bounds.radius().max(1e-3);
