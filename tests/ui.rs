@@ -115,3 +115,45 @@ fn light_tree_overlay_and_statistics_window() {
     h.get_by_label_contains("usable = v ≥ 0.70");
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }
+
+#[test]
+fn clicking_a_block_in_the_cut_view_lists_its_cut() {
+    let Some(_) = common::gpu() else { return };
+    let mut s = lightcut::renderer::settings::RenderSettings::default();
+    s.gi.method = lightcut::renderer::settings::GiMethod::Slc;
+    s.vpl.count = 1024;
+    s.sampling.cut_size = 16;
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1100.0, 700.0))
+        .wgpu_setup(setup())
+        .build_eframe(move |cc| {
+            WorkbenchApp::new(
+                cc,
+                AppOptions {
+                    scene: "default".into(),
+                    settings: Some(s.clone()),
+                    view: Some(ViewBuffer::CutBlocks),
+                    ..Default::default()
+                },
+            )
+        });
+    h.run_steps(3);
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+    // Click the middle of the viewport (right of the side panel): the floor / wall.
+    let pos = egui::pos2(700.0, 420.0);
+    for pressed in [true, false] {
+        h.input_mut().events.push(egui::Event::PointerMoved(pos));
+        h.input_mut().events.push(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Default::default(),
+        });
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+    // The window names the block and lists a full cut (16 nodes) with levels and flags.
+    h.get_by_label_contains("Cut of block (");
+    h.get_by_label_contains("16 nodes; share of the root's flux");
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+}
