@@ -2,7 +2,9 @@
 //   mode 0: split view, the method's GI left of `split_x`, the ground truth's right of it
 //           (both through the display transform), a white divider;
 //   mode 1: relative error |lum(a) - lum(b)| / lum(b) per pixel, log10 in false colour from
-//           1e-2 (0) to 1e1 (1); pixels without geometry black.
+//           1e-2 (0) to 1e1 (1); pixels without geometry black;
+//   mode 2: side by side, the method's GI on the left half of a twice-as-wide image, the
+//           ground truth's on the right.
 #include "common/color.wgsl"
 
 struct CmpParams {
@@ -28,7 +30,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if gid.x >= size.x || gid.y >= size.y {
         return;
     }
-    let px = vec2<i32>(gid.xy);
+    var px = vec2<i32>(gid.xy);
+    if cp.mode == 2u {
+        let w = i32(textureDimensions(method_image).x);
+        let right = px.x >= w;
+        let src = vec2<i32>(px.x - select(0, w, right), px.y);
+        let v = select(textureLoad(method_image, src, 0).rgb, textureLoad(reference_image, src, 0).rgb, right);
+        var c2 = show(v);
+        if px.x == w {
+            c2 = vec3<f32>(1.0);
+        }
+        textureStore(dst, px, vec4<f32>(c2, 1.0));
+        return;
+    }
     let a = textureLoad(method_image, px, 0).rgb;
     let b = textureLoad(reference_image, px, 0).rgb;
     var c = vec3<f32>(0.0);

@@ -375,6 +375,26 @@ fn the_comparison_ground_truth_equals_the_ground_truth_method() {
         assert!(frames < 200, "comparison never finished");
     }
     st.frame();
+    // Side by side: twice as wide, the right half is the ground truth's GI as displayed.
+    let view = |st: &mut Setup, v: ViewBuffer| {
+        st.r.render(&FrameInput {
+            camera: &st.cam,
+            lights: &st.scene.lights,
+            view: v,
+        });
+        st.r.read_view_rgba8().unwrap()
+    };
+    let (sw, sh, sbs) = view(&mut st, ViewBuffer::SideBySide);
+    assert_eq!((sw, sh), (2 * W, H));
+    let (gw, _, gt_view) = view(&mut st, ViewBuffer::GroundTruthIndirect);
+    assert_eq!(gw, W);
+    for y in 0..H as usize {
+        for x in 1..W as usize {
+            let a = &sbs[4 * (y * sw as usize + W as usize + x)..][..3];
+            let b = &gt_view[4 * (y * W as usize + x)..][..3];
+            assert_eq!(a, b, "side by side, right half, pixel ({x},{y})");
+        }
+    }
     let cmp = st.r.read(Buffer::GroundTruthIndirect).unwrap();
     let method = st.indirect();
     let gt = st.ground_truth();

@@ -1186,6 +1186,7 @@ impl Renderer {
                 (r * s, r * s)
             }
             v if v.is_sampling_view() => self.slc_buffers.size,
+            ViewBuffer::SideBySide => (2 * self.targets.size.0, self.targets.size.1),
             _ => self.targets.size,
         };
         if self.targets.view.size != want {
@@ -1223,7 +1224,11 @@ impl Renderer {
                 }
                 _ => {
                     let p = passes::compare::GpuCmpParams {
-                        mode: (view == ViewBuffer::RelativeError) as u32,
+                        mode: match view {
+                            ViewBuffer::RelativeError => 1,
+                            ViewBuffer::SideBySide => 2,
+                            _ => 0,
+                        },
                         split_x: (d.split * want.0 as f32) as u32,
                         exposure: d.exposure_ev.exp2(),
                         tonemap: d.tonemap.gpu_id(),
@@ -1395,6 +1400,7 @@ impl Renderer {
             | ViewBuffer::GroundTruthIndirect
             | ViewBuffer::GroundTruthFinal
             | ViewBuffer::SplitIndirect
+            | ViewBuffer::SideBySide
             | ViewBuffer::RelativeError => unreachable!("drawn above"),
             ViewBuffer::ShadowMap => (
                 VisMode::DepthTexture,

@@ -670,12 +670,14 @@ pub enum ViewBuffer {
     GroundTruthFinal,
     /// Split view: the sampler's GI left, the ground truth's right (comparison on).
     SplitIndirect,
+    /// The sampler's GI and the ground truth's side by side (comparison on).
+    SideBySide,
     /// Relative error of the sampler's GI against the ground truth, log false colour.
     RelativeError,
 }
 
 impl ViewBuffer {
-    pub const ALL: [ViewBuffer; 23] = [
+    pub const ALL: [ViewBuffer; 24] = [
         ViewBuffer::Final,
         ViewBuffer::Direct,
         ViewBuffer::Indirect,
@@ -698,6 +700,7 @@ impl ViewBuffer {
         ViewBuffer::GroundTruthIndirect,
         ViewBuffer::GroundTruthFinal,
         ViewBuffer::SplitIndirect,
+        ViewBuffer::SideBySide,
         ViewBuffer::RelativeError,
     ];
     pub fn name(self) -> &'static str {
@@ -724,6 +727,7 @@ impl ViewBuffer {
             ViewBuffer::GroundTruthIndirect => "ground truth: GI only",
             ViewBuffer::GroundTruthFinal => "ground truth: final",
             ViewBuffer::SplitIndirect => "split: method | ground truth (GI)",
+            ViewBuffer::SideBySide => "side by side: method | ground truth (GI)",
             ViewBuffer::RelativeError => "relative error vs ground truth",
         }
     }
@@ -770,6 +774,7 @@ impl ViewBuffer {
             ViewBuffer::GroundTruthIndirect
                 | ViewBuffer::GroundTruthFinal
                 | ViewBuffer::SplitIndirect
+                | ViewBuffer::SideBySide
                 | ViewBuffer::RelativeError
         )
     }

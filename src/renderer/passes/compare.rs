@@ -15,7 +15,7 @@ use super::{
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuCmpParams {
-    /// 0 split, 1 relative error.
+    /// 0 split, 1 relative error, 2 side by side (twice as wide).
     pub mode: u32,
     pub split_x: u32,
     pub exposure: f32,
