@@ -43,6 +43,7 @@ fn main() {
                     tree_stats: cli.tree_stats,
                     view,
                     compare_gt: cli.compare_gt,
+                    timings: cli.timings,
                 }),
             }
         }

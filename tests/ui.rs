@@ -157,3 +157,50 @@ fn clicking_a_block_in_the_cut_view_lists_its_cut() {
     h.get_by_label_contains("16 nodes; share of the root's flux");
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }
+
+#[test]
+fn hovering_a_pass_in_the_timings_window_shows_its_output() {
+    let Some(_) = common::gpu() else { return };
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1100.0, 700.0))
+        .wgpu_setup(setup())
+        .build_eframe(|cc| {
+            WorkbenchApp::new(
+                cc,
+                AppOptions {
+                    scene: "default".into(),
+                    timings: true,
+                    ..Default::default()
+                },
+            )
+        });
+    h.run_steps(6);
+    // The window lists the passes once timestamps came back.
+    h.get_by_label_contains("ms GPU over");
+    let final_px = shown_pixels(&h);
+    // The pass rows are above the history plot (whose legend may name the pass too).
+    let hover_row = |h: &Harness<'_, WorkbenchApp>, name: &str| {
+        let node = h
+            .get_all_by_label(name)
+            .min_by(|a, b| a.rect().min.y.total_cmp(&b.rect().min.y))
+            .expect("a timings row");
+        node.hover();
+    };
+    hover_row(&h, "gbuffer");
+    h.run_steps(3);
+    let hovered_px = shown_pixels(&h);
+    assert_eq!(
+        h.state().view(),
+        ViewBuffer::Final,
+        "hovering does not change the selection"
+    );
+    // Leave the window; then show the albedo for real and compare.
+    h.state_mut().set_view(ViewBuffer::Albedo);
+    hover_row(&h, "composite");
+    h.run_steps(1);
+    h.input_mut().events.push(egui::Event::PointerGone);
+    h.run_steps(3);
+    let albedo_px = shown_pixels(&h);
+    assert_ne!(hovered_px, final_px, "hovering gbuffer changed nothing");
+    assert_eq!(hovered_px, albedo_px, "hovering gbuffer shows the albedo");
+}

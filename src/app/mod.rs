@@ -2,6 +2,7 @@
 //! display settings, status line. Only [`viewport_texture`] touches `egui_wgpu`'s textures.
 
 pub mod camera_control;
+pub mod timings_panel;
 pub mod tree_panel;
 pub mod viewport_texture;
 
@@ -32,6 +33,7 @@ use crate::{
     },
 };
 use camera_control::{CameraController, CameraMode};
+use timings_panel::TimingsPanel;
 use tree_panel::TreePanel;
 use viewport_texture::ViewportTexture;
 
@@ -53,6 +55,8 @@ pub struct AppOptions {
     pub view: Option<ViewBuffer>,
     /// Start with the ground-truth comparison on.
     pub compare_gt: bool,
+    /// Open the GPU timings window at start.
+    pub timings: bool,
 }
 
 /// The sun as the UI edits it (light 0 of the scene).
@@ -144,6 +148,9 @@ pub struct WorkbenchApp {
     compare_gt: bool,
     compare_metrics: Option<crate::metrics::Metrics>,
     last_metrics_time: f64,
+    timings_panel: TimingsPanel,
+    /// A view shown while a pass is hovered in the timings window.
+    hover_view: Option<ViewBuffer>,
 }
 
 /// The cut listed after a click in the cut views.
@@ -160,6 +167,7 @@ impl WorkbenchApp {
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
         let tree_stats = options.tree_stats;
         let start_compare = options.compare_gt;
+        let start_timings = options.timings;
         let mut app = Self {
             render_state: cc.wgpu_render_state.clone(),
             renderer: None,
@@ -189,6 +197,8 @@ impl WorkbenchApp {
             compare_gt: start_compare,
             compare_metrics: None,
             last_metrics_time: 0.0,
+            timings_panel: TimingsPanel::new(start_timings),
+            hover_view: None,
         };
         let Some(rs) = app.render_state.clone() else {
             app.errors.push(format!(
@@ -382,6 +392,8 @@ impl WorkbenchApp {
                         ui.selectable_value(&mut self.settings.display.tonemap, t, t.name());
                     }
                 });
+            ui.checkbox(&mut self.timings_panel.show, "GPU timings window")
+                .on_hover_text("per-pass GPU times: last frame and history; hover a pass to see its output");
             let hint = if crate::renderer::shaders::ShaderSourceDisk::reload_from_disk() {
                 "rebuild the pipelines from shaders/ on disk (the last good ones stay on error)"
             } else {
@@ -684,10 +696,11 @@ impl WorkbenchApp {
         renderer.set_freeze_tree(self.tree_panel.freeze);
         let comparing = self.compare_gt && self.settings.gi.method.samples_tree();
         renderer.set_compare_ground_truth(comparing);
+        let shown = self.hover_view.unwrap_or(self.view);
         renderer.render(&FrameInput {
             camera: &open.camera,
             lights: &lights,
-            view: self.view,
+            view: shown,
         });
         let now = ui.input(|i| i.time);
         // Live metrics against the finished comparison ground truth (twice a second).
@@ -714,6 +727,7 @@ impl WorkbenchApp {
             self.errors.push(format!("light tree statistics: {e}"));
         }
         if let Some(t) = renderer.poll_timings() {
+            self.timings_panel.push(&t);
             self.timings = Some(t);
         }
         if self.settings.gi.method.samples_tree() {
@@ -752,7 +766,7 @@ impl WorkbenchApp {
             egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
             egui::Color32::WHITE,
         );
-        if self.view == ViewBuffer::TraversalSteps {
+        if shown == ViewBuffer::TraversalSteps {
             let top = renderer.sampling_steps_scale();
             let title = match self.sampling_stats {
                 Some(st) => format!(
@@ -762,7 +776,7 @@ impl WorkbenchApp {
                 None => "traversal steps per traversal".to_string(),
             };
             legend_with(ui, draw, &title, 0.0, top, Scale::Linear);
-        } else if self.view == ViewBuffer::CutDepth {
+        } else if shown == ViewBuffer::CutDepth {
             let top = renderer.sampling_steps_scale();
             legend_with(
                 ui,
@@ -772,15 +786,15 @@ impl WorkbenchApp {
                 top,
                 Scale::Linear,
             );
-        } else if self.view == ViewBuffer::RelativeError {
+        } else if shown == ViewBuffer::RelativeError {
             legend(ui, draw, "relative error vs ground truth (log)", -2.0, 1.0);
-        } else if self.view.is_log_heat() {
+        } else if shown.is_log_heat() {
             legend(ui, draw, "importance / mean (log)", -3.0, 2.0);
         } else if self.settings.display.vpl_overlay {
             legend(ui, draw, "VPL flux / mean (log)", -2.0, 2.0);
         } else if self.settings.display.tree_overlay != TreeOverlay::Off
             && self.settings.display.tree_color == TreeColor::Intensity
-            && !self.view.is_rsm_space()
+            && !shown.is_rsm_space()
         {
             legend(ui, draw, "node flux / level mean (log)", -2.0, 2.0);
         }
@@ -1053,6 +1067,11 @@ impl eframe::App for WorkbenchApp {
             .show(ui, |ui| self.side_panel(ui));
         egui::CentralPanel::default().show(ui, |ui| self.viewport(ui));
         self.cut_window(&ctx);
+        self.hover_view = if self.timings_panel.show {
+            self.timings_panel.window(&ctx)
+        } else {
+            None
+        };
         if self.tree_panel.show_stats {
             self.tree_panel
                 .window(&ctx, &self.settings, self.timings.as_ref());

@@ -39,6 +39,9 @@ pub struct Cli {
     /// Start with "compare with the ground truth" on (tree samplers).
     #[arg(long)]
     pub compare_gt: bool,
+    /// Open the GPU timings window at start.
+    #[arg(long)]
+    pub timings: bool,
 }
 
 #[derive(Subcommand, Debug)]
