@@ -452,3 +452,23 @@ fn half_resolution_upsampling_equals_the_cpu_reference() {
     assert!(worst < 1e-3, "worst relative difference {worst}");
     assert!(ctx.errors.take().is_empty());
 }
+
+#[test]
+fn pixel_values_equal_the_full_buffers() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut st = setup(&ctx, settings(GiMethod::Slc));
+    st.frame();
+    let fin = st.r.read(Buffer::Final).unwrap();
+    let pos = st.r.read(Buffer::Position).unwrap();
+    let alb = st.r.read(Buffer::Albedo).unwrap();
+    let diag = st.diag();
+    for (x, y) in [(0, 0), (10, 7), (W - 1, H - 1), (33, 20)] {
+        let rows = st.r.read_pixel(x, y).unwrap();
+        let get = |name: &str| rows.iter().find(|r| r.0.starts_with(name)).map(|r| r.1).unwrap();
+        assert_eq!(get("final"), fin.get(x, y));
+        assert_eq!(get("position"), pos.get(x, y));
+        assert_eq!(get("albedo"), alb.get(x, y));
+        assert_eq!(get("sampling"), diag[(y * W + x) as usize]);
+    }
+    assert!(ctx.errors.take().is_empty());
+}

@@ -204,3 +204,26 @@ fn hovering_a_pass_in_the_timings_window_shows_its_output() {
     assert_ne!(hovered_px, final_px, "hovering gbuffer changed nothing");
     assert_eq!(hovered_px, albedo_px, "hovering gbuffer shows the albedo");
 }
+
+#[test]
+fn the_pixel_values_window_lists_every_buffer_under_the_pointer() {
+    let Some(mut h) = harness() else { return };
+    h.run_steps(3);
+    h.get_by_label("pixel values window").click();
+    h.run_steps(1);
+    let pos = egui::pos2(700.0, 420.0);
+    h.input_mut().events.push(egui::Event::PointerMoved(pos));
+    h.run_steps(3);
+    h.get_by_label_contains("Pixel (");
+    for row in [
+        "final",
+        "direct",
+        "GI",
+        "albedo",
+        "normal",
+        "position (w: material + 1)",
+    ] {
+        h.get_by_label(row);
+    }
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+}

@@ -151,6 +151,16 @@ pub struct WorkbenchApp {
     timings_panel: TimingsPanel,
     /// A view shown while a pass is hovered in the timings window.
     hover_view: Option<ViewBuffer>,
+    pixel: PixelInspect,
+}
+
+/// Values of every buffer at the hovered (or pinned) frame pixel.
+#[derive(Default)]
+struct PixelInspect {
+    show: bool,
+    pinned: bool,
+    pixel: Option<(u32, u32)>,
+    rows: Vec<(&'static str, [f32; 4])>,
 }
 
 /// The cut listed after a click in the cut views.
@@ -199,6 +209,7 @@ impl WorkbenchApp {
             last_metrics_time: 0.0,
             timings_panel: TimingsPanel::new(start_timings),
             hover_view: None,
+            pixel: PixelInspect::default(),
         };
         let Some(rs) = app.render_state.clone() else {
             app.errors.push(format!(
@@ -392,6 +403,8 @@ impl WorkbenchApp {
                         ui.selectable_value(&mut self.settings.display.tonemap, t, t.name());
                     }
                 });
+            ui.checkbox(&mut self.pixel.show, "pixel values window")
+                .on_hover_text("every buffer at the pixel under the pointer (camera views); P pins it");
             ui.checkbox(&mut self.timings_panel.show, "GPU timings window")
                 .on_hover_text("per-pass GPU times: last frame and history; hover a pass to see its output");
             let hint = if crate::renderer::shaders::ShaderSourceDisk::reload_from_disk() {
@@ -798,6 +811,29 @@ impl WorkbenchApp {
         {
             legend(ui, draw, "node flux / level mean (log)", -2.0, 2.0);
         }
+        // Pixel values under the pointer (camera-space views; P pins / unpins).
+        if self.pixel.show && !shown.is_rsm_space() {
+            if ui.input(|i| i.key_pressed(egui::Key::P)) {
+                self.pixel.pinned = !self.pixel.pinned;
+            }
+            if !self.pixel.pinned
+                && let Some(pos) = response.hover_pos()
+                && draw.contains(pos)
+            {
+                let u = (pos - draw.min) / draw.size();
+                let (fw, fh) = renderer.size();
+                self.pixel.pixel = Some((
+                    ((u.x * fw as f32) as u32).min(fw - 1),
+                    ((u.y * fh as f32) as u32).min(fh - 1),
+                ));
+            }
+            if let Some((x, y)) = self.pixel.pixel {
+                match renderer.read_pixel(x, y) {
+                    Ok(rows) => self.pixel.rows = rows,
+                    Err(e) => self.errors.push(format!("pixel values: {e}")),
+                }
+            }
+        }
         // Clicking a block in the cut views lists its cut.
         if response.clicked()
             && matches!(self.view, ViewBuffer::CutBlocks | ViewBuffer::CutDepth)
@@ -829,6 +865,46 @@ impl WorkbenchApp {
             }
         }
         self.frames += 1;
+    }
+
+    /// The values of every buffer at the inspected pixel.
+    fn pixel_window(&mut self, ctx: &egui::Context) {
+        if !self.pixel.show {
+            return;
+        }
+        let mut open = true;
+        let p = &mut self.pixel;
+        let title = match p.pixel {
+            Some((x, y)) => format!("Pixel ({x}, {y}){}", if p.pinned { " · pinned" } else { "" }),
+            None => "Pixel values".to_string(),
+        };
+        egui::Window::new("Pixel values")
+            .open(&mut open)
+            .default_width(430.0)
+            .show(ctx, |ui| {
+                ui.label(title);
+                ui.checkbox(&mut p.pinned, "pinned (P)");
+                if p.rows.is_empty() {
+                    ui.label("hover the image (camera-space views)");
+                    return;
+                }
+                egui::Grid::new("pixel_grid").striped(true).show(ui, |ui| {
+                    for h in ["buffer", "r / x", "g / y", "b / z", "a / w"] {
+                        ui.strong(h);
+                    }
+                    ui.end_row();
+                    for (name, v) in &p.rows {
+                        ui.label(*name);
+                        for c in v {
+                            ui.label(egui::RichText::new(format!("{c:.5e}")).monospace());
+                        }
+                        ui.end_row();
+                    }
+                });
+            });
+        if !open {
+            self.pixel.show = false;
+        }
     }
 
     /// The nodes of the clicked block's cut.
@@ -1067,6 +1143,7 @@ impl eframe::App for WorkbenchApp {
             .show(ui, |ui| self.side_panel(ui));
         egui::CentralPanel::default().show(ui, |ui| self.viewport(ui));
         self.cut_window(&ctx);
+        self.pixel_window(&ctx);
         self.hover_view = if self.timings_panel.show {
             self.timings_panel.window(&ctx)
         } else {

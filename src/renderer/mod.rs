@@ -948,6 +948,48 @@ impl Renderer {
         frames
     }
 
+    /// Every buffer's value at frame pixel (x, y) (final, direct, GI, G-buffer; the tree
+    /// samplers' diagnostics and the comparison ground truth when present), as
+    /// (name, RGBA) rows, read with one submission.
+    pub fn read_pixel(&self, x: u32, y: u32) -> Result<Vec<(&'static str, [f32; 4])>, GpuError> {
+        let t = &self.targets;
+        let (x, y) = (x.min(t.size.0 - 1), y.min(t.size.1 - 1));
+        let mut names = vec![
+            "final",
+            "direct",
+            "GI",
+            "position (w: material + 1)",
+            "normal",
+            "albedo",
+        ];
+        let mut texels = vec![
+            (&t.lighting.final_, x, y),
+            (&t.lighting.direct, x, y),
+            (&t.lighting.indirect, x, y),
+            (&t.gbuffer.position, x, y),
+            (&t.gbuffer.normal, x, y),
+            (&t.gbuffer.albedo, x, y),
+        ];
+        if let Some(c) = self.compare.as_ref().filter(|c| c.targets_size == t.size) {
+            names.push("ground truth GI");
+            texels.push((&c.targets.indirect, x, y));
+        }
+        let values = readback::read_texels(&self.ctx, &texels)?;
+        let mut rows: Vec<(&'static str, [f32; 4])> = names.into_iter().zip(values).collect();
+        if self.settings.gi.method.samples_tree() {
+            let b = &self.slc_buffers;
+            let scale = t.size.0.div_ceil(b.size.0.max(1)).max(1);
+            let (dx, dy) = (x / scale, y / scale);
+            if dx < b.size.0 && dy < b.size.1 {
+                let off = (dy as u64 * b.size.0 as u64 + dx as u64) * 16;
+                let bytes = readback::read_buffer_range(&self.ctx, &b.diag, off, 16)?;
+                let d: [f32; 4] = bytemuck::pod_read_unaligned(&bytes[..16]);
+                rows.push(("sampling (steps, fallback, samples, 1 + block)", d));
+            }
+        }
+        Ok(rows)
+    }
+
     /// The top of the traversal-steps heat map: the depth of the tree (root to leaves).
     pub fn sampling_steps_scale(&self) -> f32 {
         (self.tree.levels().max(2) - 1) as f32

@@ -263,8 +263,87 @@ pub fn read_texture_f32(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32) -
     let bytes = read_texture_bytes(ctx, texture, layer)?;
     let (w, h) = (texture.width(), texture.height());
     let n = (w * h) as usize;
-    let pixels: Vec<[f32; 4]> = match texture.format() {
-        wgpu::TextureFormat::Rgba32Float => bytemuck::cast_slice::<u8, [f32; 4]>(&bytes).to_vec(),
+    let pixels = decode_texels(texture.format(), &bytes)?;
+    if pixels.len() != n {
+        return Err(GpuError::Readback("unexpected readback size".into()));
+    }
+    Ok(ImageF32 {
+        width: w,
+        height: h,
+        pixels,
+    })
+}
+
+/// Reads single texels (layer 0, mip 0) of several textures with one submission: for each
+/// (texture, x, y) its value as RGBA f32 (see [`read_texture_f32`] for the conversions).
+pub fn read_texels(
+    ctx: &GpuContext,
+    texels: &[(&wgpu::Texture, u32, u32)],
+) -> Result<Vec<[f32; 4]>, GpuError> {
+    const SLOT: u64 = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64;
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback::texels"),
+        size: SLOT * texels.len().max(1) as u64,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback::texels_encoder"),
+        });
+    for (i, (t, x, y)) in texels.iter().enumerate() {
+        if *x >= t.width() || *y >= t.height() {
+            return Err(GpuError::Readback(format!(
+                "texel ({x}, {y}) outside a {}x{} texture",
+                t.width(),
+                t.height()
+            )));
+        }
+        enc.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: t,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: *x, y: *y, z: 0 },
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: i as u64 * SLOT,
+                    bytes_per_row: Some(SLOT as u32),
+                    rows_per_image: Some(1),
+                },
+            },
+            wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+    ctx.queue.submit([enc.finish()]);
+    let data = read_buffer_bytes(ctx, &staging)?;
+    texels
+        .iter()
+        .enumerate()
+        .map(|(i, (t, _, _))| {
+            let f = t.format();
+            let size = f.block_copy_size(None).unwrap_or(16) as usize;
+            let start = i * SLOT as usize;
+            decode_texels(f, &data[start..start + size]).and_then(|v| {
+                v.first()
+                    .copied()
+                    .ok_or_else(|| GpuError::Readback("empty texel".into()))
+            })
+        })
+        .collect()
+}
+
+/// RGBA f32 of tightly packed texels of `format`.
+fn decode_texels(format: wgpu::TextureFormat, bytes: &[u8]) -> Result<Vec<[f32; 4]>, GpuError> {
+    Ok(match format {
+        wgpu::TextureFormat::Rgba32Float => bytemuck::cast_slice::<u8, [f32; 4]>(bytes).to_vec(),
         wgpu::TextureFormat::Rgba16Float => bytes
             .chunks_exact(8)
             .map(|c| {
@@ -284,14 +363,6 @@ pub fn read_texture_f32(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32) -
             .map(|c| [c[0], c[1], c[2], c[3]].map(|v| v as f32 / 255.0))
             .collect(),
         f => return Err(GpuError::Readback(format!("no float conversion for {f:?}"))),
-    };
-    if pixels.len() != n {
-        return Err(GpuError::Readback("unexpected readback size".into()));
-    }
-    Ok(ImageF32 {
-        width: w,
-        height: h,
-        pixels,
     })
 }
 
