@@ -15,6 +15,7 @@
 #include "common/random.wgsl"
 #include "common/vpl.wgsl"
 #include "common/rsm_pyramid.wgsl"
+#include "common/box_term.wgsl"
 
 struct RefParams {
     width: u32,
@@ -63,19 +64,8 @@ fn box_bound(layer: u32, level: u32, nx: u32, ny: u32, x: vec3<f32>, n: vec3<f32
     if lo.x > hi.x {
         return 0.0;
     }
-    var cos_sum = 0.0;
-    for (var c = 0u; c < 8u; c++) {
-        let p = select(lo, hi, vec3<bool>((c & 1u) != 0u, (c & 2u) != 0u, (c & 4u) != 0u));
-        let d = p - x;
-        cos_sum += max(dot(n, d) * inverseSqrt(max(dot(d, d), 1e-30)), 0.0);
-    }
-    if !(cos_sum > 0.0) {
-        // Every corner behind or on x's tangent plane: no texel below can contribute.
-        return 0.0;
-    }
-    let q = clamp(x, lo, hi);
-    let d2 = dot(q - x, q - x);
-    return cos_sum * 0.125 / max(d2, rp.epsilon * rp.epsilon);
+    // Zero when every corner is behind or on x's tangent plane: no texel below contributes.
+    return box_term(lo, hi, x, n, rp.epsilon);
 }
 
 fn node_w(layer: u32, level: u32, x: u32, y: u32, wi: f32, wf: f32, p: vec3<f32>, n: vec3<f32>) -> f32 {

@@ -4,6 +4,7 @@
 // block whose centre sees no geometry). CPU twin: `build_cut` in src/reference/slc.rs.
 #include "common/color.wgsl"
 #include "common/sst_node.wgsl"
+#include "common/box_term.wgsl"
 #include "common/slc.wgsl"
 #include "common/slc_params.wgsl"
 

@@ -14,6 +14,7 @@
 #include "common/vpl.wgsl"
 #include "common/vpl_visibility.wgsl"
 #include "common/sst_node.wgsl"
+#include "common/box_term.wgsl"
 #include "common/slc.wgsl"
 #include "common/slc_params.wgsl"
 

@@ -1,17 +1,7 @@
 // The upsampling half of shaders/slc_half.wgsl (separate module: it reads the half-resolution
 // G-buffer as textures and writes the full-resolution accumulation).
-#include "common/math.wgsl"
 
-struct HalfParams {
-    full_w: u32,
-    full_h: u32,
-    half_w: u32,
-    half_h: u32,
-    n_min: f32,
-    d_max: f32,
-    _pad0: u32,
-    _pad1: u32,
-};
+#include "common/slc_half_params.wgsl"
 
 @group(0) @binding(0) var<uniform> hp: HalfParams;
 @group(0) @binding(1) var full_position: texture_2d<f32>;

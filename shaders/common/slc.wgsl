@@ -1,30 +1,17 @@
 // Tree sampling helpers (thesis chapter 5): node weights (eq. 5.5 with the geometric term of
 // eq. 5.2) and shallow light cuts (5.1). CPU twin: src/reference/slc.rs.
-// Contract: the includer declares `tree: array<SstNode>` and includes common/sst_node.wgsl
-// and common/color.wgsl.
+// Contract: the includer declares `tree: array<SstNode>` and includes common/sst_node.wgsl,
+// common/color.wgsl and common/box_term.wgsl.
 
 const SLC_MAX_CUT: u32 = 64u;
 
-// w = luminance(I) x (1/8 sum over the box corners of max(n . (c - x)/|c - x|, 0))
-//     / max(d_min^2, eps^2); 0 when empty or every corner is on or behind x's tangent plane.
+// w = luminance(I) x box_term (eq. 5.2 over the node's box, common/box_term.wgsl); 0 when
+// the node is empty or nothing in it can light x.
 fn slc_node_weight(node: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32) -> f32 {
     if sst_is_empty(node) {
         return 0.0;
     }
-    let lo = node.bbox_min;
-    let hi = node.bbox_max;
-    var cos_sum = 0.0;
-    for (var c = 0u; c < 8u; c++) {
-        let p = select(lo, hi, vec3<bool>((c & 1u) != 0u, (c & 2u) != 0u, (c & 4u) != 0u));
-        let d = p - x;
-        cos_sum += max(dot(n, d) / sqrt(max(dot(d, d), 1e-30)), 0.0);
-    }
-    if !(cos_sum > 0.0) {
-        return 0.0;
-    }
-    let q = clamp(x, lo, hi);
-    let d2 = dot(q - x, q - x);
-    return luminance(node.intensity) * cos_sum * 0.125 / max(d2, eps * eps);
+    return luminance(node.intensity) * box_term(node.bbox_min, node.bbox_max, x, n, eps);
 }
 
 fn slc_keep(i: u32, w: f32, cull: bool) -> bool {

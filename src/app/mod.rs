@@ -161,6 +161,8 @@ struct PixelInspect {
     pinned: bool,
     pixel: Option<(u32, u32)>,
     rows: Vec<(&'static str, [f32; 4])>,
+    /// The pixel and time of the last readback (it blocks: at most 4 per second for one pixel).
+    read: Option<((u32, u32), f64)>,
 }
 
 /// The cut listed after a click in the cut views.
@@ -827,7 +829,11 @@ impl WorkbenchApp {
                     ((u.y * fh as f32) as u32).min(fh - 1),
                 ));
             }
-            if let Some((x, y)) = self.pixel.pixel {
+            let now = ui.input(|i| i.time);
+            if let Some((x, y)) = self.pixel.pixel
+                && self.pixel.read.is_none_or(|(p, t)| p != (x, y) || now - t > 0.25)
+            {
+                self.pixel.read = Some(((x, y), now));
                 match renderer.read_pixel(x, y) {
                     Ok(rows) => self.pixel.rows = rows,
                     Err(e) => self.errors.push(format!("pixel values: {e}")),

@@ -16,13 +16,9 @@ use super::sst_tree::{SstNode, luminance};
 /// Largest cut (samples per pixel) the GPU kernels hold in registers.
 pub const MAX_CUT: u32 = 64;
 
-/// Eq. 5.2 x eq. 5.5 (see the module doc). Same operations, in the same order, as
-/// `slc_node_weight` in `common/slc.wgsl`.
-pub fn node_weight(node: &SstNode, x: Vec3, n: Vec3, eps: f32) -> f32 {
-    if node.is_empty() {
-        return 0.0;
-    }
-    let (lo, hi) = (node.bbox_min, node.bbox_max);
+/// Eq. 5.2 over the box [lo, hi] with the inverse squared distance to it (see the module
+/// doc). Same operations, in the same order, as `box_term` in `common/box_term.wgsl`.
+pub fn box_term(lo: Vec3, hi: Vec3, x: Vec3, n: Vec3, eps: f32) -> f32 {
     let mut cos_sum = 0.0f32;
     for c in 0..8u32 {
         let p = Vec3::new(
@@ -38,7 +34,15 @@ pub fn node_weight(node: &SstNode, x: Vec3, n: Vec3, eps: f32) -> f32 {
     }
     let q = x.clamp(lo, hi);
     let d2 = (q - x).dot(q - x);
-    luminance(node.intensity) * cos_sum * 0.125 / d2.max(eps * eps)
+    cos_sum * 0.125 / d2.max(eps * eps)
+}
+
+/// Eq. 5.5 with eq. 5.2 (see the module doc): `slc_node_weight` in `common/slc.wgsl`.
+pub fn node_weight(node: &SstNode, x: Vec3, n: Vec3, eps: f32) -> f32 {
+    if node.is_empty() {
+        return 0.0;
+    }
+    luminance(node.intensity) * box_term(node.bbox_min, node.bbox_max, x, n, eps)
 }
 
 /// Whether a node may enter a cut (as a split's child): not empty, and (with culling) not

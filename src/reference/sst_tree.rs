@@ -35,9 +35,7 @@ use glam::Vec3;
 use crate::renderer::gpu_data::{GpuSstNode, GpuVpl, VPL_NONE};
 
 /// Rec. 709 luminance, the merge weight (twin: `luminance` in `common/color.wgsl`).
-pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
+pub use super::display::luminance;
 
 /// Leaves of the tree for `count` VPLs: a power of two, at least 2.
 pub fn leaf_count(count: u32) -> u32 {

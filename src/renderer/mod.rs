@@ -611,16 +611,7 @@ impl Renderer {
     fn gt_key(&self, input: &FrameInput<'_>, lights: &[DirectionalLight], size: (u32, u32)) -> u64 {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
-        let c = input.camera;
-        for v in [c.position, c.forward, c.up] {
-            v.to_array().map(f32::to_bits).hash(&mut h);
-        }
-        c.yfov.to_bits().hash(&mut h);
-        for l in lights {
-            l.direction.to_array().map(f32::to_bits).hash(&mut h);
-            l.irradiance.to_array().map(f32::to_bits).hash(&mut h);
-        }
-        size.hash(&mut h);
+        hash_view(&mut h, input, lights, size);
         let mut s = self.settings.clone();
         s.display = Default::default();
         s.gi.rays_per_frame = 0;
@@ -721,16 +712,7 @@ impl Renderer {
     fn compare_key(&self, input: &FrameInput<'_>, lights: &[DirectionalLight], size: (u32, u32)) -> u64 {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
-        let c = input.camera;
-        for v in [c.position, c.forward, c.up] {
-            v.to_array().map(f32::to_bits).hash(&mut h);
-        }
-        c.yfov.to_bits().hash(&mut h);
-        for l in lights {
-            l.direction.to_array().map(f32::to_bits).hash(&mut h);
-            l.irradiance.to_array().map(f32::to_bits).hash(&mut h);
-        }
-        size.hash(&mut h);
+        hash_view(&mut h, input, lights, size);
         let s = &self.settings;
         let mut v = s.vpl.clone();
         v.animate = false;
@@ -1542,6 +1524,26 @@ impl Renderer {
 }
 
 /// Linear depth range (near, far) of the scene bounds seen from `camera`.
+/// Hashes what a frame's image depends on besides the settings: camera, lights, size.
+fn hash_view(
+    h: &mut impl std::hash::Hasher,
+    input: &FrameInput<'_>,
+    lights: &[DirectionalLight],
+    size: (u32, u32),
+) {
+    use std::hash::Hash;
+    let c = input.camera;
+    for v in [c.position, c.forward, c.up] {
+        v.to_array().map(f32::to_bits).hash(h);
+    }
+    c.yfov.to_bits().hash(h);
+    for l in lights {
+        l.direction.to_array().map(f32::to_bits).hash(h);
+        l.irradiance.to_array().map(f32::to_bits).hash(h);
+    }
+    size.hash(h);
+}
+
 pub fn depth_range(camera: &Camera, b: &crate::scene::Aabb) -> (f32, f32) {
     if b.is_empty() {
         return (camera.znear, camera.zfar);

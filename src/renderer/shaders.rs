@@ -34,6 +34,14 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ),
     ("common/slc.wgsl", include_str!("../../shaders/common/slc.wgsl")),
     (
+        "common/box_term.wgsl",
+        include_str!("../../shaders/common/box_term.wgsl"),
+    ),
+    (
+        "common/slc_half_params.wgsl",
+        include_str!("../../shaders/common/slc_half_params.wgsl"),
+    ),
+    (
         "common/slc_params.wgsl",
         include_str!("../../shaders/common/slc_params.wgsl"),
     ),

@@ -11,7 +11,9 @@ use crate::renderer::{
     timing::GpuTimer,
 };
 
-use super::{display::VIEW_FORMAT, sst_build::TreeBuffers, storage_entry, texture_entry, uniform_entry};
+use super::{
+    bind_group_seq, display::VIEW_FORMAT, sst_build::TreeBuffers, storage_entry, texture_entry, uniform_entry,
+};
 
 /// Twin: `OverlayParams` in `shaders/sst_overlay.wgsl`.
 #[repr(C)]
@@ -139,32 +141,14 @@ impl SstOverlayPass {
             _pad: 0,
         };
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sst_overlay::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: tree.nodes.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: tree.flags.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::TextureView(gb_position),
-                },
-            ],
-        });
+        let entries = [
+            self.params.as_entire_binding(),
+            camera.as_entire_binding(),
+            tree.nodes.as_entire_binding(),
+            tree.flags.as_entire_binding(),
+            wgpu::BindingResource::TextureView(gb_position),
+        ];
+        let bind = bind_group_seq(device, "sst_overlay::bind_group", &self.layout, &entries);
         encoder.push_debug_group("sst_overlay");
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -1,0 +1,12 @@
+// Parameters of half-resolution GI (shaders/slc_half.wgsl, shaders/slc_upsample.wgsl).
+// Twin of `GpuHalfParams` in src/renderer/passes/slc_half.rs.
+struct HalfParams {
+    full_w: u32,
+    full_h: u32,
+    half_w: u32,
+    half_h: u32,
+    n_min: f32,
+    d_max: f32,   // metres
+    _pad0: u32,
+    _pad1: u32,
+};
