@@ -37,6 +37,18 @@
 // [4] dead branches.
 @group(0) @binding(12) var<storage, read_write> stats: array<atomic<u32>>;
 
+// The pixel story (`trace_pixel`): what its samples did this frame. Layout (u32 words, f32
+// bitcast) in `passes::slc::PixelTrace`: a 32-word header, then per sample (the first
+// TRACE_SAMPLES) a 64-word record: slot, start node, end node, steps, stop reason, path
+// probability, sampled point xyz, visible, contribution rgb (flux/pi x G x V / prob), then
+// the path as (child taken, its probability) pairs.
+@group(0) @binding(13) var<storage, read_write> trace: array<u32>;
+const TRACE_HEADER: u32 = 32u;
+const TRACE_RECORD: u32 = 64u;
+const TRACE_SAMPLES: u32 = 64u;
+const TRACE_PATH: u32 = 24u;
+const NO_TRACE: u32 = 0xffffffffu;
+
 var<workgroup> wg_stats: array<atomic<u32>, 5>;
 
 fn is_usable(i: u32) -> bool {
@@ -50,7 +62,7 @@ struct Walk {
 };
 
 // Descends from `start`; node 0 = dead branch (both children weigh 0).
-fn traverse(start: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>) -> Walk {
+fn traverse(start: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: u32) -> Walk {
     var node = start;
     var prob = 1.0;
     var steps = 0u;
@@ -65,12 +77,17 @@ fn traverse(start: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>) -> 
             return Walk(0u, 0.0, steps);
         }
         let pl = wl / s;
+        var pc = pl;
         if rng_next(rng) < pl {
             node = 2u * node;
-            prob *= pl;
         } else {
             node = 2u * node + 1u;
-            prob *= 1.0 - pl;
+            pc = 1.0 - pl;
+        }
+        prob *= pc;
+        if tb != NO_TRACE && steps < TRACE_PATH {
+            trace[tb + 16u + 2u * steps] = node;
+            trace[tb + 17u + 2u * steps] = bitcast<u32>(pc);
         }
         steps += 1u;
     }
@@ -86,7 +103,7 @@ fn gauss2(rng: ptr<function, Rng>) -> vec2<f32> {
 }
 
 // Flux/pi x G x V of cluster `node` at x (without rho/pi).
-fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>) -> vec3<f32> {
+fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: u32) -> vec3<f32> {
     var pv: vec3<f32>;
     var nv: vec3<f32>;
     var flux: vec3<f32>;
@@ -109,7 +126,15 @@ fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>) -> v
         flux = c.intensity;
     }
     let geo = vpl_geometry(pv, nv, x, n, sp.epsilon);
-    if geo <= 0.0 || !vpl_visible(pv, nv, x, n, sp.ray_offset) {
+    let lit = geo > 0.0 && vpl_visible(pv, nv, x, n, sp.ray_offset);
+    if tb != NO_TRACE {
+        trace[tb + 6u] = bitcast<u32>(pv.x);
+        trace[tb + 7u] = bitcast<u32>(pv.y);
+        trace[tb + 8u] = bitcast<u32>(pv.z);
+        // 0 facing away (G = 0), 1 shadow ray blocked, 2 visible.
+        trace[tb + 9u] = select(select(1u, 2u, lit), 0u, geo <= 0.0);
+    }
+    if !lit {
         return vec3<f32>(0.0);
     }
     return flux / PI * geo;
@@ -214,6 +239,19 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
             }
         }
     }
+    let tracing = sp.trace_pixel != NO_TRACE && sp.trace_pixel == (px.x | (px.y << 16u));
+    if tracing {
+        trace[0] = 1u;
+        trace[1] = mode;
+        trace[2] = select(0u, 1u, fell_back);
+        for (var i = 0u; i < 4u; i++) {
+            trace[3u + i] = blocks[i];
+            trace[7u + i] = bitcast<u32>(bil[i]);
+            trace[11u + i] = bitcast<u32>(weights[i]);
+        }
+        trace[15] = bitcast<u32>(wsum);
+        trace[16] = sp.cut_size;
+    }
     var own_count = 0u;
     if mode == 3u {
         own_count = slc_build_cut(x, n, sp.epsilon, sp.cut_size, sp.cull != 0u, sp.leaves);
@@ -227,6 +265,8 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
     var first_block = 0u;
     for (var i = 0u; i < sp.cut_size; i++) {
         var start = 0u;
+        var slot = 4u;
+        let tb = select(NO_TRACE, TRACE_HEADER + i * TRACE_RECORD, tracing && i < TRACE_SAMPLES);
         switch mode {
             case 0u: {
                 var u = rng_next(&rng) * wsum;
@@ -247,6 +287,7 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
                     }
                 }
                 start = cuts[blocks[s] * sp.cut_size + i];
+                slot = s;
                 if i == 0u {
                     first_block = blocks[s] + 1u;
                 }
@@ -263,19 +304,38 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
                 start = select(0u, cut_ids[i], i < own_count);
             }
         }
+        if tb != NO_TRACE {
+            trace[tb] = slot;
+            trace[tb + 1u] = start;
+            // Stop reason 3: an empty cut slot (nothing sampled).
+            trace[tb + 4u] = 3u;
+        }
         if start == 0u {
             continue;
         }
-        let walk = traverse(start, x, n, &rng);
+        let walk = traverse(start, x, n, &rng, tb);
         steps += walk.steps;
         walks += 1u;
         atomicAdd(&wg_stats[3], 1u);
+        if tb != NO_TRACE {
+            trace[tb + 2u] = walk.node;
+            trace[tb + 3u] = walk.steps;
+            trace[tb + 5u] = bitcast<u32>(walk.prob);
+            // 0 usable node, 1 leaf, 2 dead branch (both children weigh 0).
+            trace[tb + 4u] = select(select(0u, 1u, walk.node >= sp.leaves), 2u, walk.node == 0u);
+        }
         if walk.node == 0u {
             atomicAdd(&wg_stats[4], 1u);
             continue;
         }
         evaluated += 1u;
-        sum += evaluate(walk.node, x, n, &rng) / walk.prob;
+        let c = evaluate(walk.node, x, n, &rng, tb) / walk.prob;
+        if tb != NO_TRACE {
+            trace[tb + 10u] = bitcast<u32>(c.x);
+            trace[tb + 11u] = bitcast<u32>(c.y);
+            trace[tb + 12u] = bitcast<u32>(c.z);
+        }
+        sum += c;
     }
     atomicAdd(&wg_stats[2], steps);
     if fell_back {

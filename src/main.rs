@@ -32,9 +32,19 @@ fn main() {
                 .map(lightcut::renderer::settings::ViewBuffer::from_name)
                 .transpose()
                 .map_err(|e| anyhow::anyhow!("{e}"));
-            match (settings.transpose(), view) {
-                (Err(e), _) | (_, Err(e)) => Err(e),
-                (Ok(settings), Ok(view)) => run_gui(AppOptions {
+            let views: anyhow::Result<Vec<_>> = cli
+                .views
+                .as_deref()
+                .unwrap_or("")
+                .split(';')
+                .filter(|s| !s.trim().is_empty())
+                .map(|s| {
+                    lightcut::renderer::settings::ViewBuffer::from_name(s).map_err(|e| anyhow::anyhow!("{e}"))
+                })
+                .collect();
+            match (settings.transpose(), view, views) {
+                (Err(e), _, _) | (_, Err(e), _) | (_, _, Err(e)) => Err(e),
+                (Ok(settings), Ok(view), Ok(views)) => run_gui(AppOptions {
                     scene: cli.scene.clone(),
                     camera: cli.camera.clone(),
                     exit_after_frames: cli.frames,
@@ -44,6 +54,8 @@ fn main() {
                     view,
                     compare_gt: cli.compare_gt,
                     timings: cli.timings,
+                    views,
+                    reset_layout: cli.reset_layout,
                 }),
             }
         }

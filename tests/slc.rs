@@ -472,3 +472,112 @@ fn pixel_values_equal_the_full_buffers() {
     }
     assert!(ctx.errors.take().is_empty());
 }
+
+/// The pixel story (`slc_sample`'s trace of one pixel) tells what the frame did: its samples
+/// sum to the pixel's GI, each path is a chain of children whose probabilities are the CPU
+/// node weights' ratios and multiply to the path probability, each start node is in the
+/// chosen block's cut, and each path ends where the method stops (SLC: the first usable node
+/// or a leaf; RTSLC: a leaf; SST starts at the root).
+#[test]
+fn the_pixel_story_matches_the_frame_and_the_tree() {
+    use lightcut::reference::sst_tree::flag;
+    use lightcut::renderer::passes::slc::StopReason;
+    let Some(ctx) = common::gpu() else { return };
+    for method in [GiMethod::Slc, GiMethod::Rtslc, GiMethod::Sst] {
+        let mut st = setup(&ctx, settings(method));
+        st.set(|s| s.sampling.accumulate = false);
+        st.frame();
+        let pos = st.r.read(Buffer::Position).unwrap();
+        let nrm = st.r.read(Buffer::Normal).unwrap();
+        let alb = st.r.read(Buffer::Albedo).unwrap();
+        let eps = st.r.settings().gi.distance_epsilon;
+        let cut_size = st.r.settings().sampling.cut_size;
+        let pixels: Vec<(u32, u32)> = [(10, 30), (33, 21), (50, 12), (5, 5), (60, 38)]
+            .into_iter()
+            .filter(|&(x, y)| pos.get(x, y)[3] > 0.0)
+            .collect();
+        assert!(pixels.len() >= 3, "too few pixels with geometry");
+        let mut evaluated = 0;
+        for (x, y) in pixels {
+            st.r.set_trace_pixel(Some((x, y)));
+            st.frame();
+            let trace = st.r.read_pixel_trace().unwrap().expect("a trace");
+            let (nodes, flags) = st.r.read_tree().unwrap();
+            let leaves = (nodes.len() / 2) as u32;
+            let b = st.r.slc_buffers();
+            let cuts: Vec<u32> = bytemuck::cast_slice(&read_storage_buffer(&ctx, &b.cuts).unwrap()).to_vec();
+            let (p, n) = (v3(pos.get(x, y)), v3(nrm.get(x, y)).normalize());
+            assert_eq!(trace.cut_size, cut_size);
+            assert_eq!(trace.samples.len(), cut_size as usize);
+            if method == GiMethod::Slc && trace.mode == 0 {
+                let cpu = bilinear_blocks(x, y, b.block, b.grid);
+                for i in 0..4 {
+                    assert!((trace.bilinear[i] - cpu[i].1).abs() < 1e-5, "bilinear weight {i}");
+                }
+            }
+            let mut sum = Vec3::ZERO;
+            for (i, smp) in trace.samples.iter().enumerate() {
+                sum += smp.contribution;
+                match method {
+                    GiMethod::Sst => assert_eq!(smp.start, 1, "SST starts at the root"),
+                    _ if trace.mode == 0 => {
+                        let slot = smp.slot.expect("a blended sample names its block");
+                        let blk = trace.blocks[slot] as usize;
+                        assert_eq!(
+                            cuts[blk * cut_size as usize + i],
+                            smp.start,
+                            "start not in the cut"
+                        );
+                    }
+                    _ => {}
+                }
+                if !matches!(smp.stop, StopReason::Usable | StopReason::Leaf) {
+                    continue;
+                }
+                evaluated += 1;
+                assert_eq!(smp.steps as usize, smp.path.len());
+                let mut parent = smp.start;
+                let mut prob = 1.0f64;
+                for &(child, pc) in &smp.path {
+                    assert_eq!(child / 2, parent, "path is not a chain of children");
+                    assert!(
+                        !flag(&flags, parent as usize) || method == GiMethod::Rtslc,
+                        "passed a usable node"
+                    );
+                    let wl = slc::node_weight(&nodes[2 * parent as usize], p, n, eps);
+                    let wr = slc::node_weight(&nodes[2 * parent as usize + 1], p, n, eps);
+                    let want = if child % 2 == 0 { wl } else { wr } / (wl + wr);
+                    assert!(
+                        (pc - want).abs() < 1e-3 * want.max(1e-3),
+                        "child probability {pc} vs CPU {want}"
+                    );
+                    prob *= pc as f64;
+                    parent = child;
+                }
+                assert_eq!(parent, smp.end);
+                assert!(
+                    ((smp.prob as f64) - prob).abs() <= 1e-5 * prob,
+                    "path probability"
+                );
+                match (method, smp.stop) {
+                    (GiMethod::Rtslc, s) => assert_eq!(s, StopReason::Leaf),
+                    (_, StopReason::Leaf) => assert!(smp.end >= leaves),
+                    (_, _) => assert!(flag(&flags, smp.end as usize) && smp.end < leaves),
+                }
+            }
+            // The samples' sum is the pixel's estimate this frame.
+            let a = v3(alb.get(x, y));
+            let mut want = a / std::f32::consts::PI * sum;
+            if trace.mode == 2 {
+                want /= cut_size as f32;
+            }
+            let got = v3(st.indirect().get(x, y));
+            assert!(
+                (got - want).abs().max_element() <= 1e-4 * got.max_element().max(1e-6),
+                "{method:?} pixel ({x}, {y}): GI {got} vs the story's sum {want}"
+            );
+        }
+        assert!(evaluated > 0, "{method:?}: no sample was evaluated");
+    }
+    assert!(ctx.errors.take().is_empty());
+}

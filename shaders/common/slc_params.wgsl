@@ -20,7 +20,7 @@ struct SlcParams {
     n_min: f32,      // eq. 5.3
     d_max: f32,      // eq. 5.3, metres
     demodulate: u32, // 1: write the estimate without the albedo (half-resolution GI)
-    _pad1: u32,
+    trace_pixel: u32, // x | y << 16: the pixel whose samples slc_sample records (pixel story); ~0 none
 };
 
 // The pixel whose G-buffer sample builds block b's cut.

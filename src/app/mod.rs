@@ -2,6 +2,7 @@
 //! display settings, status line. Only [`viewport_texture`] touches `egui_wgpu`'s textures.
 
 pub mod camera_control;
+pub mod image_views;
 pub mod timings_panel;
 pub mod tree_panel;
 pub mod viewport_texture;
@@ -14,17 +15,14 @@ use std::{
     },
 };
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 use crate::reference::sst_tree::{SstNode, luminance};
 use crate::{
     renderer::{
         FrameInput, Renderer,
         context::{GpuContext, describe_adapter},
-        settings::{
-            CutBlending, CutFallback, GiMethod, RenderSettings, Tonemap, TreeColor, TreeOverlay, ViewBuffer,
-            VplMode,
-        },
+        settings::{CutBlending, CutFallback, GiMethod, RenderSettings, Tonemap, ViewBuffer, VplMode},
         timing::PassTimings,
     },
     scene::{
@@ -33,9 +31,9 @@ use crate::{
     },
 };
 use camera_control::{CameraController, CameraMode};
+use image_views::{ExportKind, Layout, PaneContext, ViewEvents};
 use timings_panel::TimingsPanel;
 use tree_panel::TreePanel;
-use viewport_texture::ViewportTexture;
 
 /// How the app was started.
 #[derive(Clone, Debug, Default)]
@@ -57,6 +55,10 @@ pub struct AppOptions {
     pub compare_gt: bool,
     /// Open the GPU timings window at start.
     pub timings: bool,
+    /// Start with these views (docked in a grid) instead of the saved layout.
+    pub views: Vec<ViewBuffer>,
+    /// Ignore the saved layout.
+    pub reset_layout: bool,
 }
 
 /// The sun as the UI edits it (light 0 of the scene).
@@ -125,11 +127,19 @@ pub struct WorkbenchApp {
     renderer: Option<Renderer>,
     open: Option<OpenScene>,
     settings: RenderSettings,
-    view: ViewBuffer,
+    /// The docked image views and their shared zoom / pan (saved with the app state).
+    layout: Layout,
+    /// What the user did in the views last frame (applied at the next frame).
+    events: ViewEvents,
+    /// A view export asked for this frame: (slot, spec, kind).
+    pending_export: Option<(usize, crate::renderer::views::ViewSpec, ExportKind)>,
+    /// Folder of exports and comparison sheets.
+    export_dir: String,
+    /// The files the last export wrote (shown in the side panel).
+    last_export: String,
     sun: Option<SunControls>,
-    /// Render resolution = viewport pixels x this.
+    /// Render resolution = largest view's pixels x this.
     render_scale: f32,
-    texture: ViewportTexture,
     timings: Option<PassTimings>,
     /// Messages shown in the error window until dismissed (each once).
     errors: Vec<String>,
@@ -180,15 +190,34 @@ impl WorkbenchApp {
         let tree_stats = options.tree_stats;
         let start_compare = options.compare_gt;
         let start_timings = options.timings;
+        let settings: RenderSettings = options.settings.clone().unwrap_or_default();
+        let mut layout = None;
+        if !options.reset_layout
+            && options.views.is_empty()
+            && options.view.is_none()
+            && let Some(storage) = cc.storage
+        {
+            layout = eframe::get_value::<Layout>(storage, LAYOUT_KEY);
+        }
+        let layout = layout.unwrap_or_else(|| {
+            let mut views = options.views.clone();
+            if let Some(v) = options.view {
+                views.insert(0, v);
+            }
+            Layout::new(&views, &settings.display)
+        });
         let mut app = Self {
             render_state: cc.wgpu_render_state.clone(),
             renderer: None,
             open: None,
-            settings: options.settings.clone().unwrap_or_default(),
-            view: options.view.unwrap_or(ViewBuffer::Final),
+            settings,
+            layout,
+            events: ViewEvents::default(),
+            pending_export: None,
+            export_dir: "screenshots".to_string(),
+            last_export: String::new(),
             sun: None,
             render_scale: 1.0,
-            texture: ViewportTexture::new(),
             timings: None,
             errors: Vec::new(),
             scene_path_input: if options.scene == "default" {
@@ -269,11 +298,23 @@ impl WorkbenchApp {
         Ok(())
     }
 
+    /// The buffer of the main view (the lowest-numbered one).
     pub fn view(&self) -> ViewBuffer {
-        self.view
+        self.layout
+            .main_pane()
+            .map_or(ViewBuffer::Final, |p| p.spec.buffer)
     }
     pub fn set_view(&mut self, v: ViewBuffer) {
-        self.view = v;
+        if let Some(p) = self.layout.main_pane_mut() {
+            p.spec.buffer = v;
+        }
+    }
+    /// The docked views.
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+    pub fn layout_mut(&mut self) -> &mut Layout {
+        &mut self.layout
     }
     pub fn renderer(&self) -> Option<&Renderer> {
         self.renderer.as_ref()
@@ -376,18 +417,52 @@ impl WorkbenchApp {
             }
             ui.separator();
             ui.heading("View");
+            let mut main = self.view();
             egui::ComboBox::from_label("buffer")
                 .height(600.0)
-                .selected_text(self.view.name())
+                .selected_text(main.name())
                 .show_ui(ui, |ui| {
                     for v in ViewBuffer::ALL {
-                        ui.selectable_value(&mut self.view, v, v.name());
+                        ui.selectable_value(&mut main, v, v.name());
                     }
-                });
+                })
+                .response
+                .on_hover_text("the buffer of view 1; every view has its own selector");
+            if main != self.view() {
+                self.set_view(main);
+            }
+            ui.horizontal(|ui| {
+                if ui
+                    .button("+ view")
+                    .on_hover_text("another image view (drag its :: handle to dock it elsewhere)")
+                    .clicked()
+                {
+                    let spec = crate::renderer::views::ViewSpec::new(ViewBuffer::Indirect, &self.settings.display);
+                    self.layout.add_view(spec);
+                }
+                if ui
+                    .button("+ A/B view")
+                    .on_hover_text("compare two images: live buffers or snapshots")
+                    .clicked()
+                {
+                    let spec =
+                        crate::renderer::views::ViewSpec::new(ViewBuffer::AbCompare, &self.settings.display);
+                    self.layout.add_view(spec);
+                }
+                if ui
+                    .button("reset layout")
+                    .on_hover_text("one view of the final image; zoom to fit")
+                    .clicked()
+                {
+                    self.reset_layout(&[ViewBuffer::Final]);
+                }
+            });
+            let before = (self.settings.display.exposure_ev, self.settings.display.tonemap);
             ui.add(
-                egui::Slider::new(&mut self.settings.display.exposure_ev, -10.0..=10.0).text("exposure (EV)"),
+                egui::Slider::new(&mut self.settings.display.exposure_ev, -10.0..=10.0)
+                    .text("exposure (EV, all views)"),
             );
-            if self.view == ViewBuffer::PdfPyramid {
+            if self.view() == ViewBuffer::PdfPyramid {
                 ui.add(
                     egui::Slider::new(&mut self.settings.display.pyramid_level, 0..=12).text("pyramid level"),
                 );
@@ -405,6 +480,15 @@ impl WorkbenchApp {
                         ui.selectable_value(&mut self.settings.display.tonemap, t, t.name());
                     }
                 });
+            // The global exposure and tonemap set every view's (each view's "look" menu
+            // overrides its own).
+            if before != (self.settings.display.exposure_ev, self.settings.display.tonemap) {
+                let d = self.settings.display.clone();
+                for p in self.layout.panes_mut() {
+                    p.spec.look.exposure_ev = d.exposure_ev;
+                    p.spec.look.tonemap = d.tonemap;
+                }
+            }
             ui.checkbox(&mut self.pixel.show, "pixel values window")
                 .on_hover_text("every buffer at the pixel under the pointer (camera views); P pins it");
             ui.checkbox(&mut self.timings_panel.show, "GPU timings window")
@@ -535,8 +619,10 @@ impl WorkbenchApp {
                                 );
                             }
                         }
-                        if self.view == ViewBuffer::SplitIndirect {
-                            ui.add(egui::Slider::new(&mut self.settings.display.split, 0.0..=1.0).text("split"));
+                        if let Some(p) = self.layout.main_pane_mut()
+                            && p.spec.buffer == ViewBuffer::SplitIndirect
+                        {
+                            ui.add(egui::Slider::new(&mut p.spec.ab.split, 0.0..=1.0).text("split"));
                         }
                     }
                     if let Some(st) = self.sampling_stats {
@@ -660,8 +746,10 @@ impl WorkbenchApp {
         let Some(renderer) = self.renderer.as_mut() else {
             return;
         };
-        let w = ((avail.x * ppp * self.render_scale) as u32).clamp(16, 8192);
-        let h = ((avail.y * ppp * self.render_scale) as u32).clamp(16, 8192);
+        // Render resolution: the largest view's image area (last layout) at the render scale.
+        let px = self.layout.largest_view_px().unwrap_or(avail * ppp);
+        let w = ((px.x * self.render_scale) as u32).clamp(16, 8192);
+        let h = ((px.y * self.render_scale) as u32).clamp(16, 8192);
         if let Err(e) = renderer.resize(w, h) {
             self.errors.push(e.to_string());
         }
@@ -672,23 +760,18 @@ impl WorkbenchApp {
             self.settings = renderer.settings().clone();
         }
 
-        // Input -> camera.
-        let (rect, response) = ui.allocate_exact_size(avail, egui::Sense::click_and_drag());
+        // The views' input of the last frame -> camera.
+        let ev = std::mem::take(&mut self.events);
         let dt = ui.input(|i| i.stable_dt).min(0.1);
-        if response.dragged() {
-            let d = response.drag_delta();
-            let primary = response.dragged_by(egui::PointerButton::Primary);
-            open.controller.on_drag(Vec2::new(d.x, d.y), primary);
+        if let Some((d, primary)) = ev.camera_drag {
+            open.controller.on_drag(d, primary);
             open.camera_index = None;
         }
-        if response.hovered() {
-            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
-            if scroll != 0.0 {
-                open.controller.on_scroll(scroll);
-                open.camera_index = None;
-            }
+        if ev.scroll != 0.0 {
+            open.controller.on_scroll(ev.scroll);
+            open.camera_index = None;
         }
-        if open.controller.mode == CameraMode::Fly && response.hovered() {
+        if open.controller.mode == CameraMode::Fly && ev.hovered {
             let mv = ui.input(|i| {
                 let k = |key| if i.key_down(key) { 1.0 } else { 0.0 };
                 let fast = if i.modifiers.shift { 4.0 } else { 1.0 };
@@ -711,12 +794,15 @@ impl WorkbenchApp {
         renderer.set_freeze_tree(self.tree_panel.freeze);
         let comparing = self.compare_gt && self.settings.gi.method.samples_tree();
         renderer.set_compare_ground_truth(comparing);
-        let shown = self.hover_view.unwrap_or(self.view);
-        renderer.render(&FrameInput {
-            camera: &open.camera,
-            lights: &lights,
-            view: shown,
-        });
+        let specs = self.layout.assign_slots(self.hover_view);
+        renderer.render_views(
+            &FrameInput {
+                camera: &open.camera,
+                lights: &lights,
+                view: specs[0].buffer,
+            },
+            &specs,
+        );
         let now = ui.input(|i| i.time);
         // Live metrics against the finished comparison ground truth (twice a second).
         if comparing
@@ -753,83 +839,43 @@ impl WorkbenchApp {
                 self.errors.push(e);
             }
         }
-        let (_, view, generation) = renderer.view_texture();
-        let filter = if self.render_scale < 1.0 {
-            wgpu::FilterMode::Linear
-        } else {
-            wgpu::FilterMode::Nearest
-        };
-        let id = self.texture.update(&rs, view, generation, filter);
-        // Keep the image's aspect (the shadow map is square).
-        let (tw, th) = (
-            renderer.view_texture().0.width(),
-            renderer.view_texture().0.height(),
+
+        // The docked views.
+        let mut tree = std::mem::replace(
+            &mut self.layout.tree,
+            egui_tiles::Tree::empty(egui::Id::unique("image_views_swap")),
         );
-        let img_aspect = tw as f32 / th.max(1) as f32;
-        let mut draw = rect;
-        if (rect.width() / rect.height() - img_aspect).abs() > 0.01 {
-            let size = if rect.width() / rect.height() > img_aspect {
-                egui::vec2(rect.height() * img_aspect, rect.height())
-            } else {
-                egui::vec2(rect.width(), rect.width() / img_aspect)
-            };
-            draw = egui::Rect::from_center_size(rect.center(), size);
-        }
-        ui.painter().image(
-            id,
-            draw,
-            egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
-            egui::Color32::WHITE,
-        );
-        if shown == ViewBuffer::TraversalSteps {
-            let top = renderer.sampling_steps_scale();
-            let title = match self.sampling_stats {
-                Some(st) => format!(
-                    "traversal steps per traversal (image mean {:.2})",
-                    st.steps_per_traversal()
-                ),
-                None => "traversal steps per traversal".to_string(),
-            };
-            legend_with(ui, draw, &title, 0.0, top, Scale::Linear);
-        } else if shown == ViewBuffer::CutDepth {
-            let top = renderer.sampling_steps_scale();
-            legend_with(
-                ui,
-                draw,
-                "mean cut node depth (root = 0)",
-                0.0,
-                top,
-                Scale::Linear,
-            );
-        } else if shown == ViewBuffer::RelativeError {
-            legend(ui, draw, "relative error vs ground truth (log)", -2.0, 1.0);
-        } else if shown.is_log_heat() {
-            legend(ui, draw, "importance / mean (log)", -3.0, 2.0);
-        } else if self.settings.display.vpl_overlay {
-            legend(ui, draw, "VPL flux / mean (log)", -2.0, 2.0);
-        } else if self.settings.display.tree_overlay != TreeOverlay::Off
-            && self.settings.display.tree_color == TreeColor::Intensity
-            && !shown.is_rsm_space()
+        let mut events = ViewEvents::default();
         {
-            legend(ui, draw, "node flux / level mean (log)", -2.0, 2.0);
+            let snapshots = renderer.snapshot_labels();
+            let mut cx = PaneContext {
+                renderer: &*renderer,
+                render_state: &rs,
+                transform: &mut self.layout.transform,
+                events: &mut events,
+                linear_filter: self.render_scale < 1.0,
+                stats: self.sampling_stats,
+                display: &self.settings.display,
+                snapshots: &snapshots,
+                pinned: if self.pixel.pinned { self.pixel.pixel } else { None },
+            };
+            tree.ui(&mut cx, ui);
         }
-        // Pixel values under the pointer (camera-space views; P pins / unpins).
-        if self.pixel.show && !shown.is_rsm_space() {
-            if ui.input(|i| i.key_pressed(egui::Key::P)) {
+        self.layout.tree = tree;
+
+        // Pixel values under the pointer (camera-space views; P pins / unpins, a click pins).
+        if self.pixel.show {
+            if events.hovered && ui.input(|i| i.key_pressed(egui::Key::P)) {
                 self.pixel.pinned = !self.pixel.pinned;
             }
-            if !self.pixel.pinned
-                && let Some(pos) = response.hover_pos()
-                && draw.contains(pos)
+            if let Some(c) = events.click
+                && let Some(p) = c.pixel
             {
-                let u = (pos - draw.min) / draw.size();
-                let (fw, fh) = renderer.size();
-                self.pixel.pixel = Some((
-                    ((u.x * fw as f32) as u32).min(fw - 1),
-                    ((u.y * fh as f32) as u32).min(fh - 1),
-                ));
+                self.pixel.pixel = Some(p);
+                self.pixel.pinned = true;
+            } else if !self.pixel.pinned && events.hover_pixel.is_some() {
+                self.pixel.pixel = events.hover_pixel;
             }
-            let now = ui.input(|i| i.time);
             if let Some((x, y)) = self.pixel.pixel
                 && self.pixel.read.is_none_or(|(p, t)| p != (x, y) || now - t > 0.25)
             {
@@ -841,13 +887,10 @@ impl WorkbenchApp {
             }
         }
         // Clicking a block in the cut views lists its cut.
-        if response.clicked()
-            && matches!(self.view, ViewBuffer::CutBlocks | ViewBuffer::CutDepth)
-            && let Some(pos) = response.interact_pointer_pos()
-            && draw.contains(pos)
+        if let Some(c) = events.click
+            && matches!(c.buffer, ViewBuffer::CutBlocks | ViewBuffer::CutDepth)
         {
-            let u = (pos - draw.min) / draw.size();
-            let (px, py) = ((u.x * tw as f32) as u32, (u.y * th as f32) as u32);
+            let (px, py) = c.texel;
             let b = renderer.slc_buffers();
             let block = (py / b.block) * b.grid.0 + px / b.block;
             let (bx, by) = (px / b.block, py / b.block);
@@ -870,7 +913,62 @@ impl WorkbenchApp {
                 (Err(e), _) | (_, Err(e)) => self.errors.push(format!("reading the cut: {e}")),
             }
         }
+        if let Some(src) = events.snapshot {
+            let label = format!(
+                "{} · {} · frame {}",
+                self.settings.gi.method.name(),
+                src.name(),
+                renderer.sampling_frames()
+            );
+            if let Err(e) = renderer.take_snapshot(src, label) {
+                self.errors.push(format!("snapshot: {e}"));
+            }
+        }
+        self.pending_export = events.export.take();
+        self.events = events;
         self.frames += 1;
+    }
+
+    /// Replaces the views by a grid of `buffers` (zoom to fit).
+    pub fn reset_layout(&mut self, buffers: &[ViewBuffer]) {
+        if let Some(rs) = &self.render_state {
+            for p in self.layout.panes_mut() {
+                p.rt.texture.free(rs);
+            }
+        }
+        self.layout = Layout::new(buffers, &self.settings.display);
+    }
+
+    /// Folder of exports (created on first use).
+    pub fn set_export_dir(&mut self, dir: &str) {
+        self.export_dir = dir.to_string();
+    }
+
+    /// Writes a view as displayed (PNG) or the linear buffer behind it (EXR; A and B of an
+    /// A/B view) into the export folder; the files written, or the problem, are reported.
+    pub fn export_view(
+        &mut self,
+        slot: usize,
+        spec: &crate::renderer::views::ViewSpec,
+        kind: ExportKind,
+    ) -> Vec<PathBuf> {
+        let Some(r) = &self.renderer else {
+            return Vec::new();
+        };
+        match export_view_files(r, slot, spec, kind, std::path::Path::new(&self.export_dir)) {
+            Ok(files) => {
+                self.last_export = files
+                    .iter()
+                    .map(|f| f.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                files
+            }
+            Err(e) => {
+                self.errors.push(format!("export: {e}"));
+                Vec::new()
+            }
+        }
     }
 
     /// The values of every buffer at the inspected pixel.
@@ -1025,10 +1123,6 @@ impl WorkbenchApp {
 }
 
 /// A false-colour scale bar in the lower left of `rect`, labelled in powers of ten.
-fn legend(ui: &egui::Ui, rect: egui::Rect, title: &str, lo: f32, hi: f32) {
-    legend_with(ui, rect, title, lo, hi, Scale::Log10);
-}
-
 #[derive(Clone, Copy, PartialEq)]
 enum Scale {
     /// Labels 10^lo .. 10^hi, one per decade.
@@ -1037,10 +1131,10 @@ enum Scale {
     Linear,
 }
 
-fn legend_with(ui: &egui::Ui, rect: egui::Rect, title: &str, lo: f32, hi: f32, scale: Scale) {
+/// A false-colour legend in the bottom-left corner of `rect`.
+fn legend_with(painter: &egui::Painter, rect: egui::Rect, title: &str, lo: f32, hi: f32, scale: Scale) {
     let w = 220.0;
     let bar = egui::Rect::from_min_size(rect.left_bottom() + egui::vec2(12.0, -34.0), egui::vec2(w, 12.0));
-    let painter = ui.painter();
     painter.rect_filled(
         bar.expand2(egui::vec2(6.0, 22.0))
             .translate(egui::vec2(0.0, -8.0)),
@@ -1117,6 +1211,67 @@ fn lights_with_sun(scene: &Scene, sun: Option<&SunControls>) -> Vec<DirectionalL
     lights
 }
 
+/// A file name in `dir` that does not exist yet: `stem_NNN.ext`.
+fn fresh_path(dir: &std::path::Path, stem: &str, ext: &str) -> PathBuf {
+    let slug: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let mut n = 0;
+    loop {
+        let p = dir.join(format!("{slug}_{n:03}.{ext}"));
+        if !p.exists() {
+            return p;
+        }
+        n += 1;
+    }
+}
+
+/// The files of one view export (see [`WorkbenchApp::export_view`]).
+pub fn export_view_files(
+    r: &Renderer,
+    slot: usize,
+    spec: &crate::renderer::views::ViewSpec,
+    kind: ExportKind,
+    dir: &std::path::Path,
+) -> Result<Vec<PathBuf>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let name = spec.buffer.name();
+    match kind {
+        ExportKind::Png => {
+            let (w, h, bytes) = r.read_view_rgba8_at(slot).map_err(|e| e.to_string())?;
+            let path = fresh_path(dir, name, "png");
+            crate::export::write_png(&path, w, h, &bytes).map_err(|e| e.to_string())?;
+            Ok(vec![path])
+        }
+        ExportKind::Exr => {
+            let images = match spec.effective_ab() {
+                Some(ab) => vec![
+                    (format!("{name} A {}", ab.a.name()), r.read_ab_source(ab.a)),
+                    (format!("{name} B {}", ab.b.name()), r.read_ab_source(ab.b)),
+                ],
+                None => vec![(name.to_string(), r.read_view_buffer(spec.buffer))],
+            };
+            let mut files = Vec::new();
+            for (stem, img) in images {
+                let img = img.map_err(|e| e.to_string())?.ok_or_else(|| {
+                    format!("'{stem}' has no linear image now (PNG export shows it as displayed)")
+                })?;
+                let path = fresh_path(dir, &stem, "exr");
+                crate::export::write_exr(&path, &img).map_err(|e| e.to_string())?;
+                files.push(path);
+            }
+            Ok(files)
+        }
+    }
+}
+
 /// Preset files shipped under `scenes/` (next to the executable's working directory).
 pub fn preset_files() -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir("scenes")
@@ -1130,7 +1285,14 @@ pub fn preset_files() -> Vec<PathBuf> {
     v
 }
 
+/// Storage key of the saved view layout.
+const LAYOUT_KEY: &str = "lightcut_view_layout";
+
 impl eframe::App for WorkbenchApp {
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        eframe::set_value(storage, LAYOUT_KEY, &self.layout);
+    }
+
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         let now = ctx.input(|i| i.time);
@@ -1147,7 +1309,12 @@ impl eframe::App for WorkbenchApp {
         egui::Panel::left("controls")
             .default_size(290.0)
             .show(ui, |ui| self.side_panel(ui));
-        egui::CentralPanel::default().show(ui, |ui| self.viewport(ui));
+        egui::CentralPanel::default()
+            .frame(egui::Frame::NONE)
+            .show(ui, |ui| self.viewport(ui));
+        if let Some((slot, spec, kind)) = self.pending_export.take() {
+            self.export_view(slot, &spec, kind);
+        }
         self.cut_window(&ctx);
         self.pixel_window(&ctx);
         self.hover_view = if self.timings_panel.show {

@@ -50,4 +50,12 @@ impl ViewportTexture {
             }
         }
     }
+
+    /// Unregisters the texture (when its view closes).
+    pub fn free(&mut self, render_state: &egui_wgpu::RenderState) {
+        if let Some(id) = self.id.take() {
+            render_state.renderer.write().free_texture(&id);
+        }
+        self.generation = u64::MAX;
+    }
 }

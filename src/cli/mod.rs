@@ -42,6 +42,13 @@ pub struct Cli {
     /// Open the GPU timings window at start.
     #[arg(long)]
     pub timings: bool,
+    /// Start with several docked views, by buffer name, separated by ';'
+    /// (e.g. "final;GI only;traversal steps"); the saved layout is not used then.
+    #[arg(long)]
+    pub views: Option<String>,
+    /// Ignore the saved view layout (one view of the final image).
+    #[arg(long)]
+    pub reset_layout: bool,
 }
 
 #[derive(Subcommand, Debug)]

@@ -2,7 +2,10 @@
 
 use glam::Vec3;
 
-use crate::renderer::settings::Tonemap;
+use crate::renderer::{
+    settings::Tonemap,
+    views::{Channel, ViewLook},
+};
 
 pub fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
@@ -28,13 +31,50 @@ pub fn tonemap(c: Vec3, mode: Tonemap) -> Vec3 {
     }
 }
 
-/// The RGBA8 the display pass stores for linear radiance `c` at `exposure_ev`.
+/// The RGBA8 the display pass stores for linear radiance `c` at `exposure_ev` (default look).
 pub fn encode(c: [f32; 4], exposure_ev: f32, mode: Tonemap) -> [u8; 4] {
-    let c = Vec3::new(c[0], c[1], c[2]) * exposure_ev.exp2();
-    if !c.is_finite() {
-        return [255, 0, 255, 255];
+    encode_look(
+        c,
+        &ViewLook {
+            exposure_ev,
+            tonemap: mode,
+            ..Default::default()
+        },
+    )
+}
+
+/// The RGBA8 the display pass stores for linear radiance `c` with a view's look.
+pub fn encode_look(c: [f32; 4], look: &ViewLook) -> [u8; 4] {
+    let c = Vec3::new(c[0], c[1], c[2]);
+    let raw = match look.channel {
+        Channel::Rgb => c,
+        Channel::R => Vec3::splat(c.x),
+        Channel::G => Vec3::splat(c.y),
+        Channel::B => Vec3::splat(c.z),
+        Channel::Luminance => Vec3::splat(luminance(c)),
+    };
+    if !raw.is_finite() {
+        return if look.nan_highlight {
+            [255, 0, 255, 255]
+        } else {
+            [0, 0, 0, 255]
+        };
     }
-    let t = tonemap(c.max(Vec3::ZERO), mode);
-    let q = |x: f32| (linear_to_srgb(x) * 255.0).round() as u8;
-    [q(t.x), q(t.y), q(t.z), 255]
+    let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+    if look.false_color {
+        let v = if look.channel == Channel::Rgb {
+            luminance(raw)
+        } else {
+            raw.x
+        };
+        if v <= 0.0 {
+            return [0, 0, 0, 255];
+        }
+        let [lo, hi] = look.range_log10;
+        let f = super::visualise::false_color((v.log10() - lo) / (hi - lo).max(1e-6));
+        return [q(f[0]), q(f[1]), q(f[2]), 255];
+    }
+    let t = tonemap((raw * look.exposure_ev.exp2()).max(Vec3::ZERO), look.tonemap);
+    let s = |x: f32| (linear_to_srgb(x) * 255.0).round() as u8;
+    [s(t.x), s(t.y), s(t.z), 255]
 }

@@ -145,7 +145,27 @@ pub struct DisplayParams {
     pub exposure: f32,
     /// 0 = clamp, 1 = Reinhard (luminance), 2 = ACES (Narkowicz fit).
     pub tonemap: u32,
+    /// 0 = rgb, 1/2/3 = r/g/b, 4 = luminance (`views::Channel`).
+    pub channel: u32,
+    /// Bit 0: log10 false colour over [lo, hi] instead of the tonemap; bit 1: NaN/Inf magenta.
+    pub flags: u32,
+    pub lo: f32,
+    pub hi: f32,
     pub _pad: [u32; 2],
+}
+
+impl DisplayParams {
+    pub fn new(look: &crate::renderer::views::ViewLook) -> Self {
+        Self {
+            exposure: look.exposure_ev.exp2(),
+            tonemap: look.tonemap.gpu_id(),
+            channel: look.channel.gpu_id(),
+            flags: look.false_color as u32 | (look.nan_highlight as u32) << 1,
+            lo: look.range_log10[0],
+            hi: look.range_log10[1],
+            _pad: [0; 2],
+        }
+    }
 }
 
 /// Twin: `VisParams` in `shaders/visualise.wgsl`.
@@ -273,7 +293,9 @@ pub struct GpuSlcParams {
     pub d_max: f32,
     /// 1: the estimate without the albedo (half-resolution GI, upsampled at full resolution).
     pub demodulate: u32,
-    pub _pad: u32,
+    /// x | y << 16 of the pixel whose samples are recorded (`passes::slc::PixelTrace`);
+    /// `u32::MAX` = none.
+    pub trace_pixel: u32,
 }
 
 /// A node of the Stochastic Substitute Tree, 64 bytes (one cache line; the SST paper's node
@@ -346,6 +368,24 @@ mod tests {
         use std::mem::{offset_of, size_of};
         let cases: Vec<(&str, &str, usize, Vec<usize>)> = vec![
             (
+                "compare_views.wgsl",
+                "CmpParams",
+                size_of::<crate::renderer::passes::compare::GpuCmpParams>(),
+                {
+                    use crate::renderer::passes::compare::GpuCmpParams as P;
+                    vec![
+                        offset_of!(P, mode),
+                        offset_of!(P, split_x),
+                        offset_of!(P, exposure),
+                        offset_of!(P, tonemap),
+                        offset_of!(P, diff_scale),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                        offset_of!(P, _pad) + 8,
+                    ]
+                },
+            ),
+            (
                 "direct.wgsl",
                 "Camera",
                 size_of::<GpuCamera>(),
@@ -382,6 +422,10 @@ mod tests {
                 vec![
                     offset_of!(DisplayParams, exposure),
                     offset_of!(DisplayParams, tonemap),
+                    offset_of!(DisplayParams, channel),
+                    offset_of!(DisplayParams, flags),
+                    offset_of!(DisplayParams, lo),
+                    offset_of!(DisplayParams, hi),
                     offset_of!(DisplayParams, _pad),
                 ],
             ),
@@ -481,7 +525,7 @@ mod tests {
                     offset_of!(GpuSlcParams, n_min),
                     offset_of!(GpuSlcParams, d_max),
                     offset_of!(GpuSlcParams, demodulate),
-                    offset_of!(GpuSlcParams, _pad),
+                    offset_of!(GpuSlcParams, trace_pixel),
                 ],
             ),
             (

@@ -13,6 +13,7 @@ pub mod scene_gpu;
 pub mod settings;
 pub mod shaders;
 pub mod timing;
+pub mod views;
 
 use glam::Vec3;
 use thiserror::Error;
@@ -42,6 +43,7 @@ use readback::ImageF32;
 use scene_gpu::SceneGpu;
 use settings::{GiMethod, RenderSettings, TreeOverlay, ViewBuffer};
 use timing::{GpuTimer, PassTimings};
+use views::{AbMode, AbSource, ViewSpec};
 
 #[derive(Debug, Error)]
 pub enum RenderError {
@@ -169,6 +171,15 @@ pub struct Renderer {
     frames: u64,
     /// While frozen: the thresholds the flags were last classified with.
     freeze: Option<(f32, f32)>,
+    /// View textures of the views after the first (`render_views`); the first is
+    /// `targets.view`.
+    extra_views: Vec<ViewTarget>,
+    /// Source of unique view-texture generations (the UI re-registers a texture on change).
+    view_generation: u64,
+    /// Radiance buffers kept for A/B comparison.
+    snapshots: Vec<views::Snapshot>,
+    /// Frame pixel whose tree samples `slc_sample` records (the pixel story).
+    trace_pixel: Option<(u32, u32)>,
 }
 
 /// Refuses settings whose buffers the device cannot bind (instead of failing every frame).
@@ -272,6 +283,10 @@ impl Renderer {
             settings,
             frames: 0,
             freeze: None,
+            extra_views: Vec::new(),
+            view_generation: 0,
+            snapshots: Vec::new(),
+            trace_pixel: None,
             ctx,
         })
     }
@@ -375,7 +390,8 @@ impl Renderer {
     pub fn resize(&mut self, w: u32, h: u32) -> Result<(), RenderError> {
         check_size(w, h)?;
         if (w, h) != self.targets.size {
-            let gen_ = self.targets.view.generation + 1;
+            self.view_generation += 1;
+            let gen_ = self.view_generation;
             self.targets = FrameTargets::new(
                 &self.ctx.device,
                 (w, h),
@@ -387,8 +403,19 @@ impl Renderer {
         Ok(())
     }
 
-    /// Records and submits one frame, ending with the selected view in the view texture.
+    /// Records and submits one frame, ending with the selected view (with the global display
+    /// look) in the view texture.
     pub fn render(&mut self, input: &FrameInput<'_>) {
+        let spec = ViewSpec::new(input.view, &self.settings.display);
+        self.render_views(input, &[spec]);
+    }
+
+    /// Records and submits one frame and draws every view of `views` (at least one; the
+    /// first into [`Renderer::view_texture`], the others into [`Renderer::view_texture_at`]).
+    /// `input.view` is ignored. Each extra view is its own submission (the view passes share
+    /// their parameter buffers).
+    pub fn render_views(&mut self, input: &FrameInput<'_>, views: &[ViewSpec]) {
+        let first = views.first().copied().unwrap_or_default();
         let device = self.ctx.device.clone();
         let queue = self.ctx.queue.clone();
         let size = self.targets.size;
@@ -578,16 +605,59 @@ impl Renderer {
             &t.lighting.indirect_view,
             &t.lighting.final_view,
         );
-        self.record_view(&mut enc, input.view, input.camera);
+        self.record_view_with_overlays(&mut enc, &first, input.camera, vpl_ok);
+        queue.submit([enc.finish()]);
+        // The other views, each into its own texture.
+        self.extra_views.truncate(views.len().saturating_sub(1));
+        for (i, spec) in views.iter().enumerate().skip(1) {
+            if self.extra_views.len() < i {
+                self.view_generation += 1;
+                self.extra_views
+                    .push(ViewTarget::new(&device, (1, 1), self.view_generation));
+            }
+            let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frame::view_encoder"),
+            });
+            std::mem::swap(&mut self.targets.view, &mut self.extra_views[i - 1]);
+            self.record_view_with_overlays(&mut enc, spec, input.camera, vpl_ok);
+            std::mem::swap(&mut self.targets.view, &mut self.extra_views[i - 1]);
+            queue.submit([enc.finish()]);
+        }
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("frame::resolve_encoder"),
+        });
+        self.timer.resolve(&mut enc);
+        queue.submit([enc.finish()]);
+        self.timer.after_submit();
+        self.flux_readback.after_submit();
+        self.slc.after_submit();
+        self.frames += 1;
+    }
+
+    /// One view into `targets.view`, then the overlays that apply to it.
+    fn record_view_with_overlays(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        spec: &ViewSpec,
+        camera: &Camera,
+        vpl_ok: bool,
+    ) {
+        let device = self.ctx.device.clone();
+        let queue = self.ctx.queue.clone();
+        self.record_view(enc, spec, camera);
         if self.settings.display.vpl_overlay && vpl_ok {
-            self.record_vpl_overlay(&mut enc, input.view);
+            self.record_vpl_overlay(enc, spec.buffer);
         }
         let d = &self.settings.display;
-        if d.tree_overlay != TreeOverlay::Off && vpl_ok && !input.view.is_rsm_space() {
+        if d.tree_overlay != TreeOverlay::Off
+            && vpl_ok
+            && !spec.buffer.is_rsm_space()
+            && spec.effective_ab().is_none()
+        {
             self.sst_overlay.record(
                 &device,
                 &queue,
-                &mut enc,
+                enc,
                 &mut self.timer,
                 d.tree_overlay,
                 d.tree_color,
@@ -599,12 +669,6 @@ impl Renderer {
                 &self.targets.view.view,
             );
         }
-        self.timer.resolve(&mut enc);
-        queue.submit([enc.finish()]);
-        self.timer.after_submit();
-        self.flux_readback.after_submit();
-        self.slc.after_submit();
-        self.frames += 1;
     }
 
     /// Fingerprint of everything the ground truth depends on (not the animated seed).
@@ -897,7 +961,12 @@ impl Renderer {
             n_min: s.vpl.n_min,
             d_max,
             demodulate: half as u32,
-            _pad: 0,
+            trace_pixel: match self.trace_pixel {
+                // In GI pixels (half resolution: the GI pixel covering it).
+                Some((x, y)) if half => (x / 2) | (y / 2) << 16,
+                Some((x, y)) => x | y << 16,
+                None => u32::MAX,
+            },
         };
         let (gbuffer, accum) = match &half_targets {
             Some(h) => (&h.gbuffer, &h.accum),
@@ -970,6 +1039,22 @@ impl Renderer {
             }
         }
         Ok(rows)
+    }
+
+    /// Records the tree samples of frame pixel (x, y) from the next frame on (None: stop).
+    pub fn set_trace_pixel(&mut self, pixel: Option<(u32, u32)>) {
+        self.trace_pixel = pixel.filter(|&(x, y)| x < 8192 && y < 8192);
+    }
+
+    /// What the traced pixel's samples did in the last tree-sampling frame (None: no trace,
+    /// or the pixel saw no geometry).
+    pub fn read_pixel_trace(&self) -> Result<Option<passes::slc::PixelTrace>, GpuError> {
+        if self.trace_pixel.is_none() || !self.settings.gi.method.samples_tree() {
+            return Ok(None);
+        }
+        let bytes = readback::read_storage_buffer(&self.ctx, &self.slc_buffers.trace)?;
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        Ok(passes::slc::PixelTrace::parse(&words))
     }
 
     /// The top of the traversal-steps heat map: the depth of the tree (root to leaves).
@@ -1192,7 +1277,10 @@ impl Renderer {
         );
     }
 
-    fn record_view(&mut self, enc: &mut wgpu::CommandEncoder, view: ViewBuffer, camera: &Camera) {
+    fn record_view(&mut self, enc: &mut wgpu::CommandEncoder, spec: &ViewSpec, camera: &Camera) {
+        let view = spec.buffer;
+        let look = spec.look;
+        let ab = spec.effective_ab();
         let device = self.ctx.device.clone();
         let queue = self.ctx.queue.clone();
         let rsm_res = self.targets.shadow.resolution;
@@ -1210,12 +1298,22 @@ impl Renderer {
                 (r * s, r * s)
             }
             v if v.is_sampling_view() => self.slc_buffers.size,
-            ViewBuffer::SideBySide => (2 * self.targets.size.0, self.targets.size.1),
-            _ => self.targets.size,
+            _ => match ab {
+                Some(ab) => {
+                    let (w, h) = ab_source(&self.targets, self.compare.as_ref(), &self.snapshots, ab.a)
+                        .map_or(self.targets.size, |(_, size)| size);
+                    if ab.mode == AbMode::SideBySide {
+                        (2 * w, h)
+                    } else {
+                        (w, h)
+                    }
+                }
+                None => self.targets.size,
+            },
         };
         if self.targets.view.size != want {
-            let g = self.targets.view.generation + 1;
-            self.targets.view = ViewTarget::new(&device, want, g);
+            self.view_generation += 1;
+            self.targets.view = ViewTarget::new(&device, want, self.view_generation);
         }
         let t = &self.targets;
         let dst = &t.view.view;
@@ -1225,6 +1323,38 @@ impl Renderer {
         } else {
             (b.min, b.max)
         };
+        if let Some(ab) = ab {
+            let images = (
+                ab_source(&self.targets, self.compare.as_ref(), &self.snapshots, ab.a),
+                ab_source(&self.targets, self.compare.as_ref(), &self.snapshots, ab.b),
+            );
+            let (Some((a, _)), Some((b, _))) = images else {
+                // An image that does not exist (no comparison running, snapshot gone).
+                enc.clear_texture(&self.targets.view.texture, &Default::default());
+                return;
+            };
+            let p = passes::compare::GpuCmpParams {
+                mode: ab.mode.gpu_id(),
+                split_x: (ab.split.clamp(0.0, 1.0) * want.0 as f32) as u32,
+                exposure: look.exposure_ev.exp2(),
+                tonemap: look.tonemap.gpu_id(),
+                diff_scale: ab.diff_scale,
+                _pad: [0; 3],
+            };
+            self.compare_views.record(
+                &device,
+                &queue,
+                enc,
+                &mut self.timer,
+                p,
+                a,
+                b,
+                &t.gbuffer.position_view,
+                dst,
+                want,
+            );
+            return;
+        }
         if view.is_compare_view() {
             let Some(cmp) = self
                 .compare
@@ -1235,42 +1365,13 @@ impl Renderer {
                 enc.clear_texture(&self.targets.view.texture, &Default::default());
                 return;
             };
-            let d = &self.settings.display;
-            match view {
-                ViewBuffer::GroundTruthIndirect | ViewBuffer::GroundTruthFinal => {
-                    let src = if view == ViewBuffer::GroundTruthFinal {
-                        &cmp.targets.final_view
-                    } else {
-                        &cmp.targets.indirect_view
-                    };
-                    self.display
-                        .record(&device, &queue, enc, &mut self.timer, d, src, dst, want);
-                }
-                _ => {
-                    let p = passes::compare::GpuCmpParams {
-                        mode: match view {
-                            ViewBuffer::RelativeError => 1,
-                            ViewBuffer::SideBySide => 2,
-                            _ => 0,
-                        },
-                        split_x: (d.split * want.0 as f32) as u32,
-                        exposure: d.exposure_ev.exp2(),
-                        tonemap: d.tonemap.gpu_id(),
-                    };
-                    self.compare_views.record(
-                        &device,
-                        &queue,
-                        enc,
-                        &mut self.timer,
-                        p,
-                        &t.lighting.indirect_view,
-                        &cmp.targets.indirect_view,
-                        &t.gbuffer.position_view,
-                        dst,
-                        want,
-                    );
-                }
-            }
+            let src = if view == ViewBuffer::GroundTruthFinal {
+                &cmp.targets.final_view
+            } else {
+                &cmp.targets.indirect_view
+            };
+            self.display
+                .record(&device, &queue, enc, &mut self.timer, &look, src, dst, want);
             return;
         }
         if view.is_sampling_view() {
@@ -1281,7 +1382,6 @@ impl Renderer {
                 enc.clear_texture(&self.targets.view.texture, &Default::default());
                 return;
             }
-            let d = &self.settings.display;
             let p = passes::slc::GpuSlcViewParams {
                 mode: match view {
                     ViewBuffer::TraversalSteps => 0,
@@ -1292,8 +1392,8 @@ impl Renderer {
                 grid_x: b.grid.0,
                 block: b.block,
                 cut_size: b.cut_size,
-                exposure: d.exposure_ev.exp2(),
-                tonemap: d.tonemap.gpu_id(),
+                exposure: look.exposure_ev.exp2(),
+                tonemap: look.tonemap.gpu_id(),
                 max_steps: self.sampling_steps_scale(),
                 levels: self.tree.levels(),
                 selected: self.selected_block.map_or(0, |b| b + 1),
@@ -1320,16 +1420,8 @@ impl Renderer {
                     ViewBuffer::Direct => &t.lighting.direct_view,
                     _ => &t.lighting.indirect_view,
                 };
-                self.display.record(
-                    &device,
-                    &queue,
-                    enc,
-                    &mut self.timer,
-                    &self.settings.display,
-                    src,
-                    dst,
-                    want,
-                );
+                self.display
+                    .record(&device, &queue, enc, &mut self.timer, &look, src, dst, want);
                 return;
             }
             ViewBuffer::RsmFlux => {
@@ -1425,7 +1517,8 @@ impl Renderer {
             | ViewBuffer::GroundTruthFinal
             | ViewBuffer::SplitIndirect
             | ViewBuffer::SideBySide
-            | ViewBuffer::RelativeError => unreachable!("drawn above"),
+            | ViewBuffer::RelativeError
+            | ViewBuffer::AbCompare => unreachable!("drawn above"),
             ViewBuffer::ShadowMap => (
                 VisMode::DepthTexture,
                 VisSource::Depth(&t.shadow.array_view, 0),
@@ -1455,6 +1548,127 @@ impl Renderer {
             &self.targets.view.view,
             self.targets.view.generation,
         )
+    }
+
+    /// The texture of view `slot` of the last `render_views` (0 = [`Renderer::view_texture`]);
+    /// None past the views rendered.
+    pub fn view_texture_at(&self, slot: usize) -> Option<(&wgpu::Texture, &wgpu::TextureView, u64)> {
+        let t = if slot == 0 {
+            &self.targets.view
+        } else {
+            self.extra_views.get(slot - 1)?
+        };
+        Some((&t.texture, &t.view, t.generation))
+    }
+
+    /// Reads view `slot` (sRGB-encoded RGBA8, as shown).
+    pub fn read_view_rgba8_at(&self, slot: usize) -> Result<(u32, u32, Vec<u8>), GpuError> {
+        let t = if slot == 0 {
+            &self.targets.view
+        } else {
+            self.extra_views
+                .get(slot - 1)
+                .ok_or_else(|| GpuError::Readback(format!("no view {slot}")))?
+        };
+        let bytes = readback::read_texture_bytes(&self.ctx, &t.texture, 0)?;
+        Ok((t.size.0, t.size.1, bytes))
+    }
+
+    /// Copies a live radiance buffer into a new snapshot (replacing the oldest past
+    /// [`views::MAX_SNAPSHOTS`]); returns its index.
+    pub fn take_snapshot(&mut self, src: AbSource, label: String) -> Result<u32, String> {
+        let (tex, size) = {
+            let l = &self.targets.lighting;
+            let cmp = self
+                .compare
+                .as_ref()
+                .filter(|c| c.targets_size == self.targets.size);
+            match src {
+                AbSource::Final => (&l.final_, self.targets.size),
+                AbSource::Direct => (&l.direct, self.targets.size),
+                AbSource::Indirect => (&l.indirect, self.targets.size),
+                AbSource::GroundTruthIndirect => (
+                    &cmp.ok_or("the ground-truth comparison is not running")?
+                        .targets
+                        .indirect,
+                    self.targets.size,
+                ),
+                AbSource::GroundTruthFinal => (
+                    &cmp.ok_or("the ground-truth comparison is not running")?
+                        .targets
+                        .final_,
+                    self.targets.size,
+                ),
+                AbSource::Snapshot(_) => return Err("a snapshot of a snapshot is the snapshot".into()),
+            }
+        };
+        let device = &self.ctx.device;
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("views::snapshot"),
+            size: wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: tex.format(),
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let mut enc = device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_texture(tex.as_image_copy(), texture.as_image_copy(), tex.size());
+        self.ctx.queue.submit([enc.finish()]);
+        let snap = views::Snapshot {
+            label,
+            view: texture.create_view(&Default::default()),
+            texture,
+            size,
+        };
+        if self.snapshots.len() >= views::MAX_SNAPSHOTS {
+            self.snapshots.remove(0);
+        }
+        self.snapshots.push(snap);
+        Ok(self.snapshots.len() as u32 - 1)
+    }
+
+    /// The snapshots' labels, by index.
+    pub fn snapshot_labels(&self) -> Vec<String> {
+        self.snapshots.iter().map(|s| s.label.clone()).collect()
+    }
+
+    pub fn clear_snapshots(&mut self) {
+        self.snapshots.clear();
+    }
+
+    /// Reads an A/B source back as linear floats (None: it does not exist now).
+    pub fn read_ab_source(&self, src: AbSource) -> Result<Option<ImageF32>, GpuError> {
+        let cmp = self
+            .compare
+            .as_ref()
+            .filter(|c| c.targets_size == self.targets.size);
+        let l = &self.targets.lighting;
+        let tex = match src {
+            AbSource::Final => &l.final_,
+            AbSource::Direct => &l.direct,
+            AbSource::Indirect => &l.indirect,
+            AbSource::GroundTruthIndirect => match cmp {
+                Some(c) => &c.targets.indirect,
+                None => return Ok(None),
+            },
+            AbSource::GroundTruthFinal => match cmp {
+                Some(c) => &c.targets.final_,
+                None => return Ok(None),
+            },
+            AbSource::Snapshot(i) => match self.snapshots.get(i as usize) {
+                Some(s) => &s.texture,
+                None => return Ok(None),
+            },
+        };
+        readback::read_texture_f32(&self.ctx, tex, 0).map(Some)
     }
 
     /// Picks up finished readbacks (timings, flux total) without blocking; returns the latest
@@ -1523,7 +1737,25 @@ impl Renderer {
     }
 }
 
-/// Linear depth range (near, far) of the scene bounds seen from `camera`.
+/// The radiance texture of an A/B source and its size (None: it does not exist now).
+fn ab_source<'a>(
+    targets: &'a FrameTargets,
+    compare: Option<&'a CompareState>,
+    snapshots: &'a [views::Snapshot],
+    src: AbSource,
+) -> Option<(&'a wgpu::TextureView, (u32, u32))> {
+    let l = &targets.lighting;
+    let cmp = || compare.filter(|c| c.targets_size == targets.size);
+    match src {
+        AbSource::Final => Some((&l.final_view, targets.size)),
+        AbSource::Direct => Some((&l.direct_view, targets.size)),
+        AbSource::Indirect => Some((&l.indirect_view, targets.size)),
+        AbSource::GroundTruthIndirect => cmp().map(|c| (&c.targets.indirect_view, targets.size)),
+        AbSource::GroundTruthFinal => cmp().map(|c| (&c.targets.final_view, targets.size)),
+        AbSource::Snapshot(i) => snapshots.get(i as usize).map(|s| (&s.view, s.size)),
+    }
+}
+
 /// Hashes what a frame's image depends on besides the settings: camera, lights, size.
 fn hash_view(
     h: &mut impl std::hash::Hasher,

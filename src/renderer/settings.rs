@@ -674,10 +674,13 @@ pub enum ViewBuffer {
     SideBySide,
     /// Relative error of the sampler's GI against the ground truth, log false colour.
     RelativeError,
+    /// Any two radiance images (live buffers or snapshots) compared: split, side by side, A,
+    /// B, difference x N, relative error (`views::AbSpec`).
+    AbCompare,
 }
 
 impl ViewBuffer {
-    pub const ALL: [ViewBuffer; 24] = [
+    pub const ALL: [ViewBuffer; 25] = [
         ViewBuffer::Final,
         ViewBuffer::Direct,
         ViewBuffer::Indirect,
@@ -702,6 +705,7 @@ impl ViewBuffer {
         ViewBuffer::SplitIndirect,
         ViewBuffer::SideBySide,
         ViewBuffer::RelativeError,
+        ViewBuffer::AbCompare,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -729,6 +733,7 @@ impl ViewBuffer {
             ViewBuffer::SplitIndirect => "split: method | ground truth (GI)",
             ViewBuffer::SideBySide => "side by side: method | ground truth (GI)",
             ViewBuffer::RelativeError => "relative error vs ground truth",
+            ViewBuffer::AbCompare => "A/B comparison",
         }
     }
     /// The view called `name` (as [`ViewBuffer::name`] spells it, case-insensitive).

@@ -1,6 +1,7 @@
-//! Comparison views of a tree sampler against the ground truth of the same VPLs: a split
-//! view (method left, ground truth right) and the relative error in log false colour.
-//! Reads: the two GI images, G-buffer positions. Writes: the view texture.
+//! A/B comparison views of two radiance images (a tree sampler against the ground truth of the
+//! same VPLs, snapshots, live buffers): split, side by side, A, B, difference x N, relative
+//! error in log false colour. Reads: the two images, G-buffer positions. Writes: the view
+//! texture.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -15,11 +16,14 @@ use super::{
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuCmpParams {
-    /// 0 split, 1 relative error, 2 side by side (twice as wide).
+    /// `views::AbMode::gpu_id`: 0 split, 1 relative error, 2 side by side (twice as wide),
+    /// 3 difference x diff_scale, 4 A, 5 B.
     pub mode: u32,
     pub split_x: u32,
     pub exposure: f32,
     pub tonemap: u32,
+    pub diff_scale: f32,
+    pub _pad: [u32; 3],
 }
 
 pub struct CompareViewsPass {

@@ -1,7 +1,7 @@
 //! Display: exposure (2^EV), tonemap and sRGB encoding of a linear-radiance buffer into the
-//! `Rgba8Unorm` view texture. Reads: one radiance buffer. Writes: the view texture.
+//! `Rgba8Unorm` view texture, with the view's look (channel, false colour, NaN highlight). Reads: one radiance buffer. Writes: the view texture.
 
-use crate::renderer::{gpu_data::DisplayParams, settings::DisplaySettings, shaders, timing::GpuTimer};
+use crate::renderer::{gpu_data::DisplayParams, shaders, timing::GpuTimer, views::ViewLook};
 
 use super::{
     compute_pipeline, float_texture_entry, groups_image, run_compute, storage_texture_entry, uniform_buffer,
@@ -43,16 +43,12 @@ impl DisplayPass {
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        settings: &DisplaySettings,
+        look: &ViewLook,
         src: &wgpu::TextureView,
         dst: &wgpu::TextureView,
         size: (u32, u32),
     ) {
-        let p = DisplayParams {
-            exposure: settings.exposure_ev.exp2(),
-            tonemap: settings.tonemap.gpu_id(),
-            _pad: [0; 2],
-        };
+        let p = DisplayParams::new(look);
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("display::bind_group"),

@@ -57,6 +57,154 @@ impl SamplingStats {
     }
 }
 
+/// Layout of the pixel story (twin of the constants in `shaders/slc_sample.wgsl`).
+pub const TRACE_HEADER: usize = 32;
+pub const TRACE_RECORD: usize = 64;
+pub const TRACE_SAMPLES: usize = 64;
+pub const TRACE_PATH: usize = 24;
+pub const TRACE_WORDS: usize = TRACE_HEADER + TRACE_RECORD * TRACE_SAMPLES;
+
+/// Where a traversal stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// At a usable node (v >= v_min and sigma_z < sigma_max): its distribution is sampled.
+    Usable,
+    /// At a leaf (a single VPL).
+    Leaf,
+    /// Both children of a node weigh 0 (nothing there can light the point).
+    Dead,
+    /// The cut slot was empty (fewer nodes than the cut size).
+    EmptySlot,
+}
+
+impl StopReason {
+    pub fn name(self) -> &'static str {
+        match self {
+            StopReason::Usable => "usable node",
+            StopReason::Leaf => "leaf (VPL)",
+            StopReason::Dead => "dead branch",
+            StopReason::EmptySlot => "empty cut slot",
+        }
+    }
+}
+
+/// Whether the sampled light point reached the pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SampleVisibility {
+    /// G = 0: the point and the pixel face away from each other (no shadow ray).
+    FacingAway,
+    /// The shadow ray hit geometry.
+    Blocked,
+    Visible,
+}
+
+/// One sample of the traced pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TraceSample {
+    /// Which of the 4 surrounding blocks' cuts it came from (0-3), or None (mock cut, root,
+    /// recomputed cut).
+    pub slot: Option<usize>,
+    /// The node the traversal started at (0: empty slot).
+    pub start: u32,
+    /// The node it stopped at (0: dead branch).
+    pub end: u32,
+    pub steps: u32,
+    pub stop: StopReason,
+    /// Probability of the path (product of the child probabilities).
+    pub prob: f32,
+    /// The nodes taken below `start`, each with the probability of taking it (at most
+    /// [`TRACE_PATH`]).
+    pub path: Vec<(u32, f32)>,
+    /// The sampled light point (world) and what its shadow ray found (None: not evaluated).
+    pub point: Option<(glam::Vec3, SampleVisibility)>,
+    /// Flux/pi x G x V / prob: the sample's estimate of the incident sum (times rho/pi is
+    /// radiance; SST divides by the sample count).
+    pub contribution: glam::Vec3,
+}
+
+/// The story of one pixel in the last tree-sampling frame: the 4 surrounding blocks, their
+/// bilinear and blend weights, whether it fell back, and every sample (at most
+/// [`TRACE_SAMPLES`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PixelTrace {
+    /// 0 blended cuts, 1 mock cut, 2 from the root, 3 recomputed cut.
+    pub mode: u32,
+    pub fell_back: bool,
+    pub blocks: [u32; 4],
+    pub bilinear: [f32; 4],
+    /// Bilinear x similarity (the blend weights before normalising).
+    pub weights: [f32; 4],
+    pub weight_sum: f32,
+    pub cut_size: u32,
+    pub samples: Vec<TraceSample>,
+}
+
+impl PixelTrace {
+    /// Parses the trace buffer (None: the pixel was not traced this frame).
+    pub fn parse(w: &[u32]) -> Option<Self> {
+        if w.len() < TRACE_WORDS || w[0] != 1 {
+            return None;
+        }
+        let f = |i: usize| f32::from_bits(w[i]);
+        let cut_size = w[16];
+        let samples = (0..(cut_size as usize).min(TRACE_SAMPLES))
+            .map(|i| {
+                let b = TRACE_HEADER + i * TRACE_RECORD;
+                let stop = match w[b + 4] {
+                    0 => StopReason::Usable,
+                    1 => StopReason::Leaf,
+                    2 => StopReason::Dead,
+                    _ => StopReason::EmptySlot,
+                };
+                let steps = w[b + 3];
+                let path = (0..(steps as usize).min(TRACE_PATH))
+                    .map(|k| (w[b + 16 + 2 * k], f(b + 17 + 2 * k)))
+                    .collect();
+                let end = w[b + 2];
+                let evaluated = matches!(stop, StopReason::Usable | StopReason::Leaf);
+                let point = evaluated.then(|| {
+                    let vis = match w[b + 9] {
+                        0 => SampleVisibility::FacingAway,
+                        1 => SampleVisibility::Blocked,
+                        _ => SampleVisibility::Visible,
+                    };
+                    (glam::Vec3::new(f(b + 6), f(b + 7), f(b + 8)), vis)
+                });
+                TraceSample {
+                    slot: (w[b] < 4).then_some(w[b] as usize),
+                    start: w[b + 1],
+                    end,
+                    steps,
+                    stop,
+                    prob: f(b + 5),
+                    path,
+                    point,
+                    contribution: glam::Vec3::new(f(b + 10), f(b + 11), f(b + 12)),
+                }
+            })
+            .collect();
+        Some(Self {
+            mode: w[1],
+            fell_back: w[2] != 0,
+            blocks: [w[3], w[4], w[5], w[6]],
+            bilinear: [f(7), f(8), f(9), f(10)],
+            weights: [f(11), f(12), f(13), f(14)],
+            weight_sum: f(15),
+            cut_size,
+            samples,
+        })
+    }
+
+    pub fn mode_name(&self) -> &'static str {
+        match self.mode {
+            0 => "blended cuts of the 4 surrounding blocks",
+            1 => "mock cut (no similar block cut)",
+            2 => "from the root",
+            _ => "own cut, recomputed at the pixel",
+        }
+    }
+}
+
 /// Per-frame buffers: the cuts (cut_size node ids per block, 0 = empty slot), per-pixel
 /// diagnostics (vec4: steps per traversal, fell back, samples evaluated, 1 + block of slot
 /// 0's cut) and the frame counters.
@@ -64,6 +212,8 @@ pub struct SlcBuffers {
     pub cuts: wgpu::Buffer,
     pub diag: wgpu::Buffer,
     pub stats: wgpu::Buffer,
+    /// The pixel story ([`PixelTrace`]), cleared every frame.
+    pub trace: wgpu::Buffer,
     pub size: (u32, u32),
     pub block: u32,
     pub grid: (u32, u32),
@@ -97,6 +247,7 @@ impl SlcBuffers {
             cuts: buf("slc::cuts", grid.0 as u64 * grid.1 as u64 * cut_size as u64 * 4),
             diag: buf("slc::diag", size.0 as u64 * size.1 as u64 * 16),
             stats: buf("slc::stats", (STATS * 4) as u64),
+            trace: buf("slc::trace", TRACE_WORDS as u64 * 4),
             size,
             block,
             grid,
@@ -175,6 +326,7 @@ impl SlcPass {
                 storage_entry(10, c, false),
                 storage_entry(11, c, false),
                 storage_entry(12, c, false),
+                storage_entry(13, c, false),
             ],
         });
         let vmod = shaders::create_module(device, "slc_views.wgsl")?;
@@ -252,9 +404,11 @@ impl SlcPass {
             accum.as_entire_binding(),
             out.diag.as_entire_binding(),
             out.stats.as_entire_binding(),
+            out.trace.as_entire_binding(),
         ];
         let bind = bind_group_seq(device, "slc_sample::bind_group", &self.sample_layout, &entries);
         encoder.clear_buffer(&out.stats, 0, None);
+        encoder.clear_buffer(&out.trace, 0, None);
         let name = match p.method {
             1 => "sst_sample",
             2 => "rtslc_sample",

@@ -1,0 +1,665 @@
+//! Docked image views (egui_tiles): any number of panes, each showing any buffer by name with
+//! its own look (exposure, tonemap, channel, false colour, NaN highlight) or an A/B comparison,
+//! all sharing one zoom and pan (nearest-neighbour when magnified). Panes can be dragged
+//! (handle at the left of each toolbar), split, tabbed and closed; the layout is saved with the
+//! app state. A pane reports what the user did (camera drags, hovered and clicked pixels,
+//! exports) as [`ViewEvents`]; the app applies them.
+
+use egui_tiles::{Behavior, TileId, UiResponse};
+use glam::Vec2;
+use serde::{Deserialize, Serialize};
+
+use super::viewport_texture::ViewportTexture;
+use crate::renderer::{
+    Renderer,
+    passes::slc::SamplingStats,
+    settings::{DisplaySettings, Tonemap, ViewBuffer},
+    views::{AbMode, AbSource, Channel, ViewSpec},
+};
+
+/// One image view.
+#[derive(Serialize, Deserialize)]
+pub struct ViewPane {
+    /// Stable number (titles, labels; the lowest is the main view).
+    pub id: u32,
+    pub spec: ViewSpec,
+    #[serde(skip)]
+    pub rt: PaneRuntime,
+}
+
+/// Per-frame state of a pane (not saved).
+#[derive(Default)]
+pub struct PaneRuntime {
+    pub texture: ViewportTexture,
+    /// Its texture in the renderer's last `render_views` (None: not rendered, e.g. a hidden tab).
+    pub slot: Option<usize>,
+    /// Size of its image area in physical pixels at the last layout.
+    pub size_px: Option<egui::Vec2>,
+}
+
+/// The zoom and pan all views share: `zoom` 1 fits the image, `center` is the image point
+/// (0..1 each axis) at the centre of every pane.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ViewTransform {
+    pub zoom: f32,
+    pub center: [f32; 2],
+}
+
+impl Default for ViewTransform {
+    fn default() -> Self {
+        Self {
+            zoom: 1.0,
+            center: [0.5, 0.5],
+        }
+    }
+}
+
+/// The saved layout: the tile tree of views and the shared transform.
+#[derive(Serialize, Deserialize)]
+pub struct Layout {
+    pub tree: egui_tiles::Tree<ViewPane>,
+    pub transform: ViewTransform,
+    pub next_id: u32,
+}
+
+impl Layout {
+    /// A grid of views of `buffers` (at least one: final).
+    pub fn new(buffers: &[ViewBuffer], d: &DisplaySettings) -> Self {
+        let buffers = if buffers.is_empty() {
+            &[ViewBuffer::Final][..]
+        } else {
+            buffers
+        };
+        let panes: Vec<ViewPane> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| ViewPane {
+                id: i as u32 + 1,
+                spec: ViewSpec::new(*b, d),
+                rt: PaneRuntime::default(),
+            })
+            .collect();
+        Self {
+            tree: egui_tiles::Tree::new_grid(egui::Id::unique("image_views"), panes),
+            transform: ViewTransform::default(),
+            next_id: buffers.len() as u32 + 1,
+        }
+    }
+
+    /// Adds a view beside the others.
+    pub fn add_view(&mut self, spec: ViewSpec) -> u32 {
+        let id = self.next_id;
+        self.next_id += 1;
+        let tile = self.tree.tiles.insert_pane(ViewPane {
+            id,
+            spec,
+            rt: PaneRuntime::default(),
+        });
+        match self.tree.root() {
+            Some(root) => {
+                if let Some(egui_tiles::Tile::Container(c)) = self.tree.tiles.get_mut(root) {
+                    c.add_child(tile);
+                } else {
+                    let grid = self.tree.tiles.insert_grid_tile(vec![root, tile]);
+                    self.tree.root = Some(grid);
+                }
+            }
+            None => self.tree.root = Some(tile),
+        }
+        id
+    }
+
+    /// Pane tiles in id order.
+    fn pane_ids(&self) -> Vec<(u32, TileId)> {
+        let mut v: Vec<(u32, TileId)> = self
+            .tree
+            .tiles
+            .iter()
+            .filter_map(|(tid, t)| match t {
+                egui_tiles::Tile::Pane(p) => Some((p.id, *tid)),
+                _ => None,
+            })
+            .collect();
+        v.sort_by_key(|(id, _)| *id);
+        v
+    }
+
+    pub fn view_count(&self) -> usize {
+        self.pane_ids().len()
+    }
+
+    /// The main view (lowest id): the buffer selector of the side panel, hovered timings.
+    pub fn main_pane_mut(&mut self) -> Option<&mut ViewPane> {
+        let (_, tid) = *self.pane_ids().first()?;
+        match self.tree.tiles.get_mut(tid) {
+            Some(egui_tiles::Tile::Pane(p)) => Some(p),
+            _ => None,
+        }
+    }
+
+    pub fn main_pane(&self) -> Option<&ViewPane> {
+        let (_, tid) = *self.pane_ids().first()?;
+        self.tree.tiles.get_pane(&tid)
+    }
+
+    /// Every pane, in id order.
+    pub fn panes_mut(&mut self) -> Vec<&mut ViewPane> {
+        let order: Vec<u32> = self.pane_ids().into_iter().map(|(id, _)| id).collect();
+        let mut panes: Vec<&mut ViewPane> = self
+            .tree
+            .tiles
+            .tiles_mut()
+            .filter_map(|t| match t {
+                egui_tiles::Tile::Pane(p) => Some(p),
+                _ => None,
+            })
+            .collect();
+        panes.sort_by_key(|p| order.iter().position(|&i| i == p.id));
+        panes
+    }
+
+    pub fn panes(&self) -> Vec<&ViewPane> {
+        self.pane_ids()
+            .into_iter()
+            .filter_map(|(_, t)| self.tree.tiles.get_pane(&t))
+            .collect()
+    }
+
+    /// The specs to render this frame (the visible panes, main view first; `main_override`
+    /// replaces the main view's buffer) and each pane's slot.
+    pub fn assign_slots(&mut self, main_override: Option<ViewBuffer>) -> Vec<ViewSpec> {
+        let ids = self.pane_ids();
+        let mut specs = Vec::new();
+        for (k, (_, tid)) in ids.iter().enumerate() {
+            let visible = self.tree.is_visible(*tid) && self.tree.active_tiles().contains(tid);
+            if let Some(egui_tiles::Tile::Pane(p)) = self.tree.tiles.get_mut(*tid) {
+                if visible || (k == 0 && specs.is_empty()) {
+                    let mut spec = p.spec;
+                    if k == 0
+                        && let Some(b) = main_override
+                    {
+                        spec.buffer = b;
+                    }
+                    p.rt.slot = Some(specs.len());
+                    specs.push(spec);
+                } else {
+                    p.rt.slot = None;
+                }
+            }
+        }
+        if specs.is_empty() {
+            specs.push(ViewSpec::default());
+        }
+        specs
+    }
+
+    /// The largest image area of the views (physical pixels), for the render resolution.
+    pub fn largest_view_px(&self) -> Option<egui::Vec2> {
+        self.panes()
+            .iter()
+            .filter(|p| p.rt.slot.is_some())
+            .filter_map(|p| p.rt.size_px)
+            .reduce(|a, b| a.max(b))
+    }
+}
+
+/// What to export from a view.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExportKind {
+    /// The view as displayed (PNG).
+    Png,
+    /// The linear buffer behind it (EXR; both images of an A/B view).
+    Exr,
+}
+
+/// A click on a view's image.
+#[derive(Clone, Copy, Debug)]
+pub struct ViewClick {
+    /// Frame pixel (camera-space views).
+    pub pixel: Option<(u32, u32)>,
+    /// Texel of the view's texture.
+    pub texel: (u32, u32),
+    pub buffer: ViewBuffer,
+}
+
+/// What the user did in the views this frame.
+#[derive(Default)]
+pub struct ViewEvents {
+    /// Drag delta (points) and whether with the primary button.
+    pub camera_drag: Option<(Vec2, bool)>,
+    pub scroll: f32,
+    /// A view is hovered (fly-mode keys apply).
+    pub hovered: bool,
+    pub hover_pixel: Option<(u32, u32)>,
+    pub click: Option<ViewClick>,
+    pub export: Option<(usize, ViewSpec, ExportKind)>,
+    pub snapshot: Option<AbSource>,
+}
+
+/// Everything a pane needs to draw itself.
+pub struct PaneContext<'a> {
+    pub renderer: &'a Renderer,
+    pub render_state: &'a egui_wgpu::RenderState,
+    pub transform: &'a mut ViewTransform,
+    pub events: &'a mut ViewEvents,
+    /// Smooth an upscaled render (render scale < 1) unless magnified.
+    pub linear_filter: bool,
+    pub stats: Option<SamplingStats>,
+    pub display: &'a DisplaySettings,
+    pub snapshots: &'a [String],
+    pub pinned: Option<(u32, u32)>,
+}
+
+impl Behavior<ViewPane> for PaneContext<'_> {
+    fn pane_ui(&mut self, ui: &mut egui::Ui, _tile_id: TileId, pane: &mut ViewPane) -> UiResponse {
+        view_pane_ui(self, ui, pane)
+    }
+
+    fn tab_title_for_pane(&mut self, pane: &ViewPane) -> egui::WidgetText {
+        format!("view {} · {}", pane.id, pane.spec.buffer.name()).into()
+    }
+
+    fn is_tab_closable(&self, tiles: &egui_tiles::Tiles<ViewPane>, _tile_id: TileId) -> bool {
+        tiles
+            .tiles()
+            .filter(|t| matches!(t, egui_tiles::Tile::Pane(_)))
+            .count()
+            > 1
+    }
+
+    fn on_tab_close(&mut self, tiles: &mut egui_tiles::Tiles<ViewPane>, tile_id: TileId) -> bool {
+        if let Some(egui_tiles::Tile::Pane(p)) = tiles.get_mut(tile_id) {
+            p.rt.texture.free(self.render_state);
+        }
+        true
+    }
+
+    fn simplification_options(&self) -> egui_tiles::SimplificationOptions {
+        egui_tiles::SimplificationOptions {
+            all_panes_must_have_tabs: true,
+            ..Default::default()
+        }
+    }
+}
+
+fn view_toolbar(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane) -> UiResponse {
+    let mut response = UiResponse::None;
+    let id = pane.id;
+    let spec = &mut pane.spec;
+    let pane_hovered = ui.rect_contains_pointer(ui.max_rect());
+    ui.horizontal(|ui| {
+        let handle = ui
+            .add(egui::Label::new("::").sense(egui::Sense::drag()))
+            .on_hover_text("drag to move this view");
+        if handle.drag_started() {
+            response = UiResponse::DragStarted;
+        }
+        egui::ComboBox::new(("view_buffer", id), format!("view {id}"))
+            .height(600.0)
+            .selected_text(spec.buffer.name())
+            .show_ui(ui, |ui| {
+                for v in ViewBuffer::ALL {
+                    ui.selectable_value(&mut spec.buffer, v, v.name());
+                }
+            });
+        if let Some(ab) = (spec.buffer == ViewBuffer::AbCompare).then_some(&mut spec.ab) {
+            let sources: Vec<AbSource> = AbSource::LIVE
+                .into_iter()
+                .chain((0..cx.snapshots.len() as u32).map(AbSource::Snapshot))
+                .collect();
+            let name = |s: AbSource| match s {
+                AbSource::Snapshot(i) => cx
+                    .snapshots
+                    .get(i as usize)
+                    .map_or_else(|| s.name(), |l| format!("{}: {l}", s.name())),
+                _ => s.name(),
+            };
+            for (label, which) in [("A", &mut ab.a), ("B", &mut ab.b)] {
+                egui::ComboBox::new(("ab", label, id), label)
+                    .selected_text(name(*which))
+                    .width(110.0)
+                    .show_ui(ui, |ui| {
+                        for s in &sources {
+                            ui.selectable_value(which, *s, name(*s));
+                        }
+                    });
+            }
+            egui::ComboBox::new(("ab_mode", id), "mode")
+                .selected_text(ab.mode.name())
+                .show_ui(ui, |ui| {
+                    for m in AbMode::ALL {
+                        ui.selectable_value(&mut ab.mode, m, m.name());
+                    }
+                });
+            match ab.mode {
+                AbMode::Split => {
+                    ui.add(egui::Slider::new(&mut ab.split, 0.0..=1.0).show_value(false))
+                        .on_hover_text("divider");
+                }
+                AbMode::Difference => {
+                    ui.add(
+                        egui::DragValue::new(&mut ab.diff_scale)
+                            .range(1.0..=1.0e4)
+                            .prefix("N = ")
+                            .speed(0.5),
+                    );
+                }
+                AbMode::A | AbMode::B
+                    if ui
+                        .button("toggle A/B (T)")
+                        .on_hover_text("flip between A and B (T over this view)")
+                        .clicked()
+                        || (pane_hovered && ui.input(|i| i.key_pressed(egui::Key::T))) =>
+                {
+                    ab.mode = if ab.mode == AbMode::A {
+                        AbMode::B
+                    } else {
+                        AbMode::A
+                    };
+                }
+                _ => {}
+            }
+        }
+        ui.menu_button("look", |ui| look_menu(ui, spec));
+        ui.menu_button("export", |ui| {
+            if ui.button("PNG as displayed").clicked()
+                && let Some(slot) = pane.rt.slot
+            {
+                cx.events.export = Some((slot, *spec, ExportKind::Png));
+                ui.close();
+            }
+            if ui
+                .button("EXR of the buffer")
+                .on_hover_text("linear, unscaled; an A/B view writes A and B")
+                .clicked()
+                && let Some(slot) = pane.rt.slot
+            {
+                cx.events.export = Some((slot, *spec, ExportKind::Exr));
+                ui.close();
+            }
+            ui.separator();
+            for s in [AbSource::Final, AbSource::Indirect, AbSource::GroundTruthIndirect] {
+                if ui.button(format!("snapshot of {}", s.name())).clicked() {
+                    cx.events.snapshot = Some(s);
+                    ui.close();
+                }
+            }
+        });
+    });
+    response
+}
+
+fn look_menu(ui: &mut egui::Ui, spec: &mut ViewSpec) {
+    let l = &mut spec.look;
+    ui.add(egui::Slider::new(&mut l.exposure_ev, -10.0..=10.0).text("exposure (EV)"));
+    egui::ComboBox::from_label("tonemap ")
+        .selected_text(l.tonemap.name())
+        .show_ui(ui, |ui| {
+            for t in Tonemap::ALL {
+                ui.selectable_value(&mut l.tonemap, t, t.name());
+            }
+        });
+    egui::ComboBox::from_label("channel")
+        .selected_text(l.channel.name())
+        .show_ui(ui, |ui| {
+            for c in Channel::ALL {
+                ui.selectable_value(&mut l.channel, c, c.name());
+            }
+        });
+    ui.checkbox(&mut l.false_color, "false colour (log10 radiance)");
+    if l.false_color {
+        ui.add(egui::Slider::new(&mut l.range_log10[0], -8.0..=4.0).text("from 10^"));
+        ui.add(egui::Slider::new(&mut l.range_log10[1], -8.0..=4.0).text("to 10^"));
+        if l.range_log10[1] <= l.range_log10[0] {
+            l.range_log10[1] = l.range_log10[0] + 0.5;
+        }
+    }
+    ui.checkbox(&mut l.nan_highlight, "NaN / Inf in magenta");
+    ui.label(
+        egui::RichText::new("the look applies to radiance buffers (final, direct, GI, ground truth, A/B)")
+            .small(),
+    );
+}
+
+fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane) -> UiResponse {
+    let response = view_toolbar(cx, ui, pane);
+    let avail = ui.available_size().max(egui::vec2(16.0, 16.0));
+    let (rect, resp) = ui.allocate_exact_size(avail, egui::Sense::click_and_drag());
+    let ppp = ui.ctx().pixels_per_point();
+    pane.rt.size_px = Some(rect.size() * ppp);
+    ui.painter().rect_filled(rect, 0.0, egui::Color32::from_gray(12));
+    let Some(slot) = pane.rt.slot else {
+        return response;
+    };
+    let Some((tex, view, generation)) = cx.renderer.view_texture_at(slot) else {
+        return response;
+    };
+    let (tw, th) = (tex.width().max(1), tex.height().max(1));
+    let t = *cx.transform;
+    let filter = if t.zoom > 1.01 || !cx.linear_filter {
+        wgpu::FilterMode::Nearest
+    } else {
+        wgpu::FilterMode::Linear
+    };
+    let id = pane.rt.texture.update(cx.render_state, view, generation, filter);
+    let aspect = tw as f32 / th as f32;
+    let fit = if rect.width() / rect.height() > aspect {
+        egui::vec2(rect.height() * aspect, rect.height())
+    } else {
+        egui::vec2(rect.width(), rect.width() / aspect)
+    };
+    let size = fit * t.zoom;
+    let disp = egui::Rect::from_min_size(
+        rect.center() - egui::vec2(t.center[0] * size.x, t.center[1] * size.y),
+        size,
+    );
+    let painter = ui.painter_at(rect);
+    painter.image(
+        id,
+        disp,
+        egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+        egui::Color32::WHITE,
+    );
+
+    // Shared zoom (ctrl + wheel or pinch, about the pointer) and pan (ctrl/middle drag).
+    let (fw, fh) = cx.renderer.size();
+    let buffer = pane.spec.buffer;
+    let ab = pane.spec.effective_ab();
+    let side_by_side = ab.is_some_and(|a| a.mode == AbMode::SideBySide);
+    if resp.hovered() {
+        cx.events.hovered = true;
+        let zoom = ui.input(|i| i.zoom_delta());
+        if zoom != 1.0
+            && let Some(pos) = resp.hover_pos()
+        {
+            let uv = (pos - disp.min) / disp.size();
+            let z = (t.zoom * zoom).clamp(0.25, 512.0);
+            let off = (pos - rect.center()) / (fit * z);
+            cx.transform.zoom = z;
+            cx.transform.center = [uv.x - off.x, uv.y - off.y];
+        } else {
+            cx.events.scroll += ui.input(|i| i.smooth_scroll_delta.y);
+        }
+        ui.input(|i| {
+            if i.key_pressed(egui::Key::F) {
+                *cx.transform = ViewTransform::default();
+            }
+            if i.key_pressed(egui::Key::Num1) {
+                // One texel per physical pixel.
+                cx.transform.zoom = tw as f32 / (fit.x * ppp);
+            }
+        });
+    }
+    if resp.dragged() {
+        let d = resp.drag_delta();
+        let pan = ui.input(|i| i.modifiers.command || i.modifiers.ctrl)
+            || resp.dragged_by(egui::PointerButton::Middle);
+        if pan {
+            cx.transform.center[0] -= d.x / size.x;
+            cx.transform.center[1] -= d.y / size.y;
+        } else {
+            let primary = resp.dragged_by(egui::PointerButton::Primary);
+            cx.events.camera_drag = Some((Vec2::new(d.x, d.y), primary));
+        }
+    }
+    // The frame pixel under the pointer (camera-space views).
+    type Hit = Option<((u32, u32), Option<(u32, u32)>)>;
+    let to_pixel = |pos: egui::Pos2| -> Hit {
+        if !disp.contains(pos) {
+            return None;
+        }
+        let uv = (pos - disp.min) / disp.size();
+        let texel = (
+            ((uv.x * tw as f32) as u32).min(tw - 1),
+            ((uv.y * th as f32) as u32).min(th - 1),
+        );
+        let pixel = (!buffer.is_rsm_space()).then(|| {
+            let u = if side_by_side { (uv.x * 2.0).fract() } else { uv.x };
+            (
+                ((u * fw as f32) as u32).min(fw - 1),
+                ((uv.y * fh as f32) as u32).min(fh - 1),
+            )
+        });
+        Some((texel, pixel))
+    };
+    if let Some(pos) = resp.hover_pos()
+        && let Some((_, Some(p))) = to_pixel(pos)
+    {
+        cx.events.hover_pixel = Some(p);
+    }
+    if resp.clicked()
+        && let Some(pos) = resp.interact_pointer_pos()
+        && let Some((texel, pixel)) = to_pixel(pos)
+    {
+        cx.events.click = Some(ViewClick { pixel, texel, buffer });
+    }
+    // The pinned pixel, outlined.
+    if let Some((px, py)) = cx.pinned
+        && !buffer.is_rsm_space()
+    {
+        let w = if side_by_side { 2 } else { 1 };
+        for k in 0..w {
+            let u = (px as f32 + 0.5) / fw as f32 / w as f32 + k as f32 / w as f32;
+            let v = (py as f32 + 0.5) / fh as f32;
+            let c = disp.min + egui::vec2(u * disp.width(), v * disp.height());
+            let r = (disp.width() / tw as f32).max(4.0);
+            painter.rect_stroke(
+                egui::Rect::from_center_size(c, egui::vec2(r, r)),
+                0.0,
+                egui::Stroke::new(1.5, egui::Color32::from_rgb(255, 60, 200)),
+                egui::StrokeKind::Outside,
+            );
+        }
+    }
+    if (t.zoom - 1.0).abs() > 1e-3 {
+        painter.text(
+            rect.right_top() + egui::vec2(-6.0, 4.0),
+            egui::Align2::RIGHT_TOP,
+            format!("{:.0}% · F fits", 100.0 * disp.width() / (tw as f32 / ppp)),
+            egui::FontId::proportional(11.0),
+            egui::Color32::from_gray(220),
+        );
+    }
+    draw_legend(cx, ui, &painter, rect, pane);
+    response
+}
+
+fn draw_legend(
+    cx: &PaneContext<'_>,
+    ui: &egui::Ui,
+    painter: &egui::Painter,
+    rect: egui::Rect,
+    pane: &ViewPane,
+) {
+    use super::{Scale, legend_with};
+    let shown = pane.spec.buffer;
+    let look = pane.spec.look;
+    let radiance = matches!(
+        shown,
+        ViewBuffer::Final
+            | ViewBuffer::Direct
+            | ViewBuffer::Indirect
+            | ViewBuffer::GroundTruthFinal
+            | ViewBuffer::GroundTruthIndirect
+    );
+    let ab = pane.spec.effective_ab();
+    let _ = ui;
+    if radiance && look.false_color {
+        let what = match look.channel {
+            Channel::Rgb | Channel::Luminance => "luminance",
+            Channel::R => "red",
+            Channel::G => "green",
+            Channel::B => "blue",
+        };
+        legend_with(
+            painter,
+            rect,
+            &format!("{what} radiance, W/(m² sr) (log)"),
+            look.range_log10[0],
+            look.range_log10[1],
+            Scale::Log10,
+        );
+    } else if shown == ViewBuffer::TraversalSteps {
+        let top = cx.renderer.sampling_steps_scale();
+        let title = match cx.stats {
+            Some(st) => format!(
+                "traversal steps per traversal (image mean {:.2})",
+                st.steps_per_traversal()
+            ),
+            None => "traversal steps per traversal".to_string(),
+        };
+        legend_with(painter, rect, &title, 0.0, top, Scale::Linear);
+    } else if shown == ViewBuffer::CutDepth {
+        let top = cx.renderer.sampling_steps_scale();
+        legend_with(
+            painter,
+            rect,
+            "mean cut node depth (root = 0)",
+            0.0,
+            top,
+            Scale::Linear,
+        );
+    } else if ab.is_some_and(|a| a.mode == AbMode::RelativeError) {
+        legend_with(
+            painter,
+            rect,
+            "relative error |A - B| / B (log)",
+            -2.0,
+            1.0,
+            Scale::Log10,
+        );
+    } else if shown.is_log_heat() {
+        legend_with(painter, rect, "importance / mean (log)", -3.0, 2.0, Scale::Log10);
+    } else if cx.display.vpl_overlay {
+        legend_with(painter, rect, "VPL flux / mean (log)", -2.0, 2.0, Scale::Log10);
+    } else if cx.display.tree_overlay != crate::renderer::settings::TreeOverlay::Off
+        && cx.display.tree_color == crate::renderer::settings::TreeColor::Intensity
+        && !shown.is_rsm_space()
+        && ab.is_none()
+    {
+        legend_with(
+            painter,
+            rect,
+            "node flux / level mean (log)",
+            -2.0,
+            2.0,
+            Scale::Log10,
+        );
+    }
+    if let Some(ab) = ab {
+        let text = match ab.mode {
+            AbMode::Split | AbMode::SideBySide => format!("A: {}  |  B: {}", ab.a.name(), ab.b.name()),
+            AbMode::A => format!("A: {}", ab.a.name()),
+            AbMode::B => format!("B: {}", ab.b.name()),
+            AbMode::Difference => format!("|A - B| x {} ({} vs {})", ab.diff_scale, ab.a.name(), ab.b.name()),
+            AbMode::RelativeError => format!("{} vs {}", ab.a.name(), ab.b.name()),
+        };
+        painter.text(
+            rect.left_top() + egui::vec2(6.0, 4.0),
+            egui::Align2::LEFT_TOP,
+            text,
+            egui::FontId::proportional(12.0),
+            egui::Color32::from_gray(235),
+        );
+    }
+}
