@@ -56,6 +56,7 @@ fn main() {
                     timings: cli.timings,
                     views,
                     reset_layout: cli.reset_layout,
+                    pin: cli.pin,
                 }),
             }
         }

@@ -511,8 +511,8 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
             assert_eq!(trace.samples.len(), cut_size as usize);
             if method == GiMethod::Slc && trace.mode == 0 {
                 let cpu = bilinear_blocks(x, y, b.block, b.grid);
-                for i in 0..4 {
-                    assert!((trace.bilinear[i] - cpu[i].1).abs() < 1e-5, "bilinear weight {i}");
+                for (i, (got, want)) in trace.bilinear.iter().zip(cpu).enumerate() {
+                    assert!((got - want.1).abs() < 1e-5, "bilinear weight {i}");
                 }
             }
             let mut sum = Vec3::ZERO;

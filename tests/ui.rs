@@ -227,3 +227,146 @@ fn the_pixel_values_window_lists_every_buffer_under_the_pointer() {
     }
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }
+
+fn slc_harness(views: Vec<ViewBuffer>, size: egui::Vec2) -> Option<Harness<'static, WorkbenchApp>> {
+    common::gpu()?;
+    let mut s = lightcut::renderer::settings::RenderSettings::default();
+    s.gi.method = lightcut::renderer::settings::GiMethod::Slc;
+    s.vpl.count = 1024;
+    s.sampling.cut_size = 16;
+    Some(
+        Harness::builder()
+            .with_size(size)
+            .wgpu_setup(setup())
+            .build_eframe(move |cc| {
+                WorkbenchApp::new(
+                    cc,
+                    AppOptions {
+                        scene: "default".into(),
+                        settings: Some(s.clone()),
+                        views: views.clone(),
+                        reset_layout: true,
+                        ..Default::default()
+                    },
+                )
+            }),
+    )
+}
+
+fn click(h: &mut Harness<'_, WorkbenchApp>, pos: egui::Pos2) {
+    for pressed in [true, false] {
+        h.input_mut().events.push(egui::Event::PointerMoved(pos));
+        h.input_mut().events.push(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Default::default(),
+        });
+        h.run_steps(1);
+    }
+}
+
+#[test]
+fn clicking_a_view_pins_the_pixel_and_tells_its_story() {
+    use lightcut::renderer::passes::slc::StopReason;
+    let Some(mut h) = slc_harness(vec![ViewBuffer::Final], egui::vec2(1100.0, 700.0)) else {
+        return;
+    };
+    h.run_steps(3);
+    h.get_by_label("pixel story window").click();
+    h.run_steps(1);
+    // The floor, right of the side panel.
+    click(&mut h, egui::pos2(760.0, 560.0));
+    h.run_steps(4);
+    h.get_by_label_contains("last frame ·");
+    h.get_by_label_contains("16 samples; their estimate");
+    let story = h.state().story();
+    let t = story.trace.as_ref().expect("a story");
+    assert_eq!(
+        t.samples.len(),
+        16,
+        "one sample per slot of the configured cut size"
+    );
+    let evaluated = t
+        .samples
+        .iter()
+        .filter(|s| matches!(s.stop, StopReason::Usable | StopReason::Leaf))
+        .count();
+    assert!(evaluated > 0, "no sample reached a usable node or a leaf");
+    for s in &t.samples {
+        assert!(matches!(
+            s.stop,
+            StopReason::Usable | StopReason::Leaf | StopReason::Dead | StopReason::EmptySlot
+        ),);
+        if matches!(s.stop, StopReason::Usable | StopReason::Leaf) {
+            assert_eq!(
+                s.path.last().map_or(s.start, |p| p.0),
+                s.end,
+                "the path ends at its end node"
+            );
+        }
+    }
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+}
+
+#[test]
+fn raising_v_min_changes_the_traversal_steps_image() {
+    let Some(mut h) = slc_harness(vec![ViewBuffer::TraversalSteps], egui::vec2(1100.0, 700.0)) else {
+        return;
+    };
+    h.run_steps(4);
+    let before = shown_pixels(&h);
+    // Fewer usable nodes: traversals go deeper.
+    let mut s = h.state().settings().clone();
+    s.tree.v_min = 0.999;
+    s.tree.sigma_max = 0.01;
+    h.state_mut().set_settings(s);
+    h.run_steps(4);
+    let after = shown_pixels(&h);
+    let mean = |p: &[u8]| {
+        p.chunks(4)
+            .map(|c| c[0] as f64 + c[1] as f64 + c[2] as f64)
+            .sum::<f64>()
+    };
+    assert_ne!(before, after, "the traversal-steps image did not change");
+    assert!(mean(&after) != mean(&before));
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+}
+
+#[test]
+fn several_views_render_their_buffers_and_export_files_that_decode() {
+    use lightcut::app::image_views::ExportKind;
+    let Some(mut h) = slc_harness(
+        vec![ViewBuffer::Final, ViewBuffer::Normal, ViewBuffer::AbCompare],
+        egui::vec2(1200.0, 700.0),
+    ) else {
+        return;
+    };
+    h.run_steps(4);
+    let r = h.state().renderer().unwrap();
+    let images: Vec<Vec<u8>> = (0..3)
+        .map(|i| r.read_view_rgba8_at(i).expect("a view").2)
+        .collect();
+    assert_ne!(images[0], images[1], "final and normal views are the same");
+    assert_eq!(h.state().layout().view_count(), 3);
+    let dir = std::env::temp_dir().join(format!("lightcut_ui_export_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    h.state_mut().set_export_dir(dir.to_str().unwrap());
+    let specs: Vec<_> = h.state().layout().panes().iter().map(|p| p.spec).collect();
+    let png = h.state_mut().export_view(0, &specs[0], ExportKind::Png);
+    let exr = h.state_mut().export_view(1, &specs[1], ExportKind::Exr);
+    // The A/B view (live GI vs the ground truth, which is off): A exists, B does not.
+    let mut ab = specs[2];
+    ab.ab.b = lightcut::renderer::views::AbSource::Direct;
+    let ab_files = h.state_mut().export_view(2, &ab, ExportKind::Exr);
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+    assert_eq!((png.len(), exr.len(), ab_files.len()), (1, 1, 2));
+    let img = image::open(&png[0]).expect("the PNG decodes");
+    let (w, hh) = h.state().renderer().unwrap().size();
+    assert_eq!((img.width(), img.height()), (w, hh));
+    for f in exr.iter().chain(&ab_files) {
+        let e = lightcut::export::read_exr(f).expect("the EXR decodes");
+        assert_eq!((e.width, e.height), (w, hh));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -236,6 +236,21 @@ pub struct ViewEvents {
     pub snapshot: Option<AbSource>,
 }
 
+/// A world-space overlay primitive drawn over the camera views (the pixel story).
+#[derive(Clone, Copy, Debug)]
+pub enum Prim {
+    Point(glam::Vec3, egui::Color32),
+    Line(glam::Vec3, glam::Vec3, egui::Color32),
+    /// Axis-aligned box (min, max).
+    Box(glam::Vec3, glam::Vec3, egui::Color32),
+    /// Ellipse centre + the two semi-axes (world vectors).
+    Ellipse {
+        center: glam::Vec3,
+        axes: [glam::Vec3; 2],
+        color: egui::Color32,
+    },
+}
+
 /// Everything a pane needs to draw itself.
 pub struct PaneContext<'a> {
     pub renderer: &'a Renderer,
@@ -248,6 +263,9 @@ pub struct PaneContext<'a> {
     pub display: &'a DisplaySettings,
     pub snapshots: &'a [String],
     pub pinned: Option<(u32, u32)>,
+    /// World-space overlays and the camera's view-projection (frame aspect).
+    pub overlay: &'a [Prim],
+    pub view_proj: glam::Mat4,
 }
 
 impl Behavior<ViewPane> for PaneContext<'_> {
@@ -549,6 +567,58 @@ fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
                 egui::Stroke::new(1.5, egui::Color32::from_rgb(255, 60, 200)),
                 egui::StrokeKind::Outside,
             );
+        }
+    }
+    // World-space overlays on the single-image camera views.
+    if !cx.overlay.is_empty() && !buffer.is_rsm_space() && !side_by_side {
+        let project = |p: glam::Vec3| -> Option<egui::Pos2> {
+            let c = cx.view_proj * p.extend(1.0);
+            if c.w <= 1e-6 {
+                return None;
+            }
+            let (u, v) = (c.x / c.w * 0.5 + 0.5, 0.5 - c.y / c.w * 0.5);
+            Some(disp.min + egui::vec2(u * disp.width(), v * disp.height()))
+        };
+        let line = |a: glam::Vec3, b: glam::Vec3, c: egui::Color32, w: f32| {
+            if let (Some(pa), Some(pb)) = (project(a), project(b)) {
+                painter.line_segment([pa, pb], egui::Stroke::new(w, c));
+            }
+        };
+        for prim in cx.overlay {
+            match *prim {
+                Prim::Point(p, c) => {
+                    if let Some(q) = project(p) {
+                        painter.circle_filled(q, 3.0, c);
+                    }
+                }
+                Prim::Line(a, b, c) => line(a, b, c, 1.0),
+                Prim::Box(lo, hi, c) => {
+                    let corner = |i: u32| {
+                        glam::Vec3::new(
+                            if i & 1 == 0 { lo.x } else { hi.x },
+                            if i & 2 == 0 { lo.y } else { hi.y },
+                            if i & 4 == 0 { lo.z } else { hi.z },
+                        )
+                    };
+                    for i in 0..8u32 {
+                        for bit in [1, 2, 4] {
+                            if i & bit == 0 {
+                                line(corner(i), corner(i | bit), c, 1.0);
+                            }
+                        }
+                    }
+                }
+                Prim::Ellipse { center, axes, color } => {
+                    let n = 32;
+                    let at = |k: u32| {
+                        let a = k as f32 / n as f32 * std::f32::consts::TAU;
+                        center + axes[0] * a.cos() + axes[1] * a.sin()
+                    };
+                    for k in 0..n {
+                        line(at(k), at(k + 1), color, 1.5);
+                    }
+                }
+            }
         }
     }
     if (t.zoom - 1.0).abs() > 1e-3 {

@@ -3,6 +3,7 @@
 
 pub mod camera_control;
 pub mod image_views;
+pub mod story_panel;
 pub mod timings_panel;
 pub mod tree_panel;
 pub mod viewport_texture;
@@ -59,6 +60,8 @@ pub struct AppOptions {
     pub views: Vec<ViewBuffer>,
     /// Ignore the saved layout.
     pub reset_layout: bool,
+    /// Pin this frame pixel and open the pixel story window.
+    pub pin: Option<(u32, u32)>,
 }
 
 /// The sun as the UI edits it (light 0 of the scene).
@@ -162,6 +165,7 @@ pub struct WorkbenchApp {
     /// A view shown while a pass is hovered in the timings window.
     hover_view: Option<ViewBuffer>,
     pixel: PixelInspect,
+    story: story_panel::StoryPanel,
 }
 
 /// Values of every buffer at the hovered (or pinned) frame pixel.
@@ -241,6 +245,7 @@ impl WorkbenchApp {
             timings_panel: TimingsPanel::new(start_timings),
             hover_view: None,
             pixel: PixelInspect::default(),
+            story: story_panel::StoryPanel::new(),
         };
         let Some(rs) = app.render_state.clone() else {
             app.errors.push(format!(
@@ -254,6 +259,9 @@ impl WorkbenchApp {
         if info.device_type == wgpu::DeviceType::Cpu {
             // Software rasterisers: keep the viewport interactive.
             app.render_scale = 0.5;
+        }
+        if let Some(p) = app.options.pin {
+            app.pin_pixel(p.0, p.1);
         }
         let source = app.options.scene.clone();
         let camera = app.options.camera.clone();
@@ -308,6 +316,24 @@ impl WorkbenchApp {
         if let Some(p) = self.layout.main_pane_mut() {
             p.spec.buffer = v;
         }
+    }
+    /// The settings the next frame renders with.
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+    /// Replaces the settings (as the side panel's controls do).
+    pub fn set_settings(&mut self, s: RenderSettings) {
+        self.settings = s;
+    }
+    /// Pins frame pixel (x, y) and opens the pixel story (as a click on a camera view does).
+    pub fn pin_pixel(&mut self, x: u32, y: u32) {
+        self.pixel.pixel = Some((x, y));
+        self.pixel.pinned = true;
+        self.story.show = true;
+    }
+    /// The pixel story of the pinned pixel (last read).
+    pub fn story(&self) -> &story_panel::StoryPanel {
+        &self.story
     }
     /// The docked views.
     pub fn layout(&self) -> &Layout {
@@ -491,6 +517,9 @@ impl WorkbenchApp {
             }
             ui.checkbox(&mut self.pixel.show, "pixel values window")
                 .on_hover_text("every buffer at the pixel under the pointer (camera views); P pins it");
+            ui.checkbox(&mut self.story.show, "pixel story window").on_hover_text(
+                "click a camera view: the pinned pixel's cuts, blend weights and every sample's path (tree samplers)",
+            );
             ui.checkbox(&mut self.timings_panel.show, "GPU timings window")
                 .on_hover_text("per-pass GPU times: last frame and history; hover a pass to see its output");
             let hint = if crate::renderer::shaders::ShaderSourceDisk::reload_from_disk() {
@@ -846,6 +875,7 @@ impl WorkbenchApp {
             egui_tiles::Tree::empty(egui::Id::unique("image_views_swap")),
         );
         let mut events = ViewEvents::default();
+        let overlay = self.story.overlay();
         {
             let snapshots = renderer.snapshot_labels();
             let mut cx = PaneContext {
@@ -858,13 +888,17 @@ impl WorkbenchApp {
                 display: &self.settings.display,
                 snapshots: &snapshots,
                 pinned: if self.pixel.pinned { self.pixel.pixel } else { None },
+                overlay: &overlay,
+                view_proj: open
+                    .camera
+                    .view_projection(renderer.size().0 as f32 / renderer.size().1.max(1) as f32),
             };
             tree.ui(&mut cx, ui);
         }
         self.layout.tree = tree;
 
         // Pixel values under the pointer (camera-space views; P pins / unpins, a click pins).
-        if self.pixel.show {
+        if self.pixel.show || self.story.show {
             if events.hovered && ui.input(|i| i.key_pressed(egui::Key::P)) {
                 self.pixel.pinned = !self.pixel.pinned;
             }
@@ -877,6 +911,7 @@ impl WorkbenchApp {
                 self.pixel.pixel = events.hover_pixel;
             }
             if let Some((x, y)) = self.pixel.pixel
+                && self.pixel.show
                 && self.pixel.read.is_none_or(|(p, t)| p != (x, y) || now - t > 0.25)
             {
                 self.pixel.read = Some(((x, y), now));
@@ -885,6 +920,11 @@ impl WorkbenchApp {
                     Err(e) => self.errors.push(format!("pixel values: {e}")),
                 }
             }
+        }
+        // The story of the pinned pixel (tree samplers).
+        let story_pixel = if self.pixel.pinned { self.pixel.pixel } else { None };
+        if let Err(e) = self.story.refresh(renderer, story_pixel, now) {
+            self.errors.push(format!("pixel story: {e}"));
         }
         // Clicking a block in the cut views lists its cut.
         if let Some(c) = events.click
@@ -1317,6 +1357,7 @@ impl eframe::App for WorkbenchApp {
         }
         self.cut_window(&ctx);
         self.pixel_window(&ctx);
+        self.story.window(&ctx);
         self.hover_view = if self.timings_panel.show {
             self.timings_panel.window(&ctx)
         } else {

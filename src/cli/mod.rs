@@ -49,6 +49,22 @@ pub struct Cli {
     /// Ignore the saved view layout (one view of the final image).
     #[arg(long)]
     pub reset_layout: bool,
+    /// Pin a frame pixel "X,Y" and open its pixel story (tree samplers).
+    #[arg(long, value_parser = parse_pixel)]
+    pub pin: Option<(u32, u32)>,
+}
+
+/// "X,Y" as two pixel coordinates.
+fn parse_pixel(s: &str) -> Result<(u32, u32), String> {
+    let (x, y) = s
+        .split_once(',')
+        .ok_or_else(|| format!("'{s}' is not a pixel; write X,Y (e.g. 120,80)"))?;
+    let p = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{s}' is not a pixel; write X,Y with whole numbers"))
+    };
+    Ok((p(x)?, p(y)?))
 }
 
 #[derive(Subcommand, Debug)]

@@ -1330,7 +1330,7 @@ impl Renderer {
             );
             let (Some((a, _)), Some((b, _))) = images else {
                 // An image that does not exist (no comparison running, snapshot gone).
-                enc.clear_texture(&self.targets.view.texture, &Default::default());
+                clear_view(enc, &self.targets.view.view);
                 return;
             };
             let p = passes::compare::GpuCmpParams {
@@ -1362,7 +1362,7 @@ impl Renderer {
                 .filter(|c| c.targets_size == self.targets.size)
             else {
                 // No comparison running (or not at this size): nothing to show.
-                enc.clear_texture(&self.targets.view.texture, &Default::default());
+                clear_view(enc, &self.targets.view.view);
                 return;
             };
             let src = if view == ViewBuffer::GroundTruthFinal {
@@ -1379,7 +1379,7 @@ impl Renderer {
             let scale = self.targets.size.0.div_ceil(b.size.0.max(1));
             if scale == 0 || b.size.0 * scale < self.targets.size.0 || scale > 2 {
                 // No tree-sampling frame at this size yet: nothing to show.
-                enc.clear_texture(&self.targets.view.texture, &Default::default());
+                clear_view(enc, &self.targets.view.view);
                 return;
             }
             let p = passes::slc::GpuSlcViewParams {
@@ -1735,6 +1735,26 @@ impl Renderer {
         let bytes = readback::read_texture_bytes(&self.ctx, &t.texture, 0)?;
         Ok((t.size.0, t.size.1, bytes))
     }
+}
+
+/// Clears a view texture to black (a render pass: `clear_texture` needs a device feature).
+fn clear_view(enc: &mut wgpu::CommandEncoder, view: &wgpu::TextureView) {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("view::clear"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            resolve_target: None,
+            depth_slice: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
 }
 
 /// The radiance texture of an A/B source and its size (None: it does not exist now).
