@@ -9,3 +9,4 @@ pub mod metrics;
 pub mod reference;
 pub mod renderer;
 pub mod scene;
+pub mod sheet;

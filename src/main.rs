@@ -3,7 +3,7 @@
 use clap::Parser;
 use lightcut::{
     app::{AppOptions, run_gui},
-    cli::{Cli, Command, bench, compare, export_scene, render},
+    cli::{Cli, Command, bench, compare, export_scene, render, sheet},
 };
 
 fn main() {
@@ -18,6 +18,7 @@ fn main() {
         Some(Command::Bench(args)) => bench::run(args),
         Some(Command::ExportScene(args)) => export_scene::run(args),
         Some(Command::Compare(args)) => compare::run(args),
+        Some(Command::Sheet(args)) => sheet::run(args),
         None => {
             let settings = cli.settings.as_ref().map(|p| {
                 lightcut::cli::SettingsArgs {

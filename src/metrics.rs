@@ -6,6 +6,10 @@
 //!   L = 1) on the luminance of both images as the workbench displays them (exposure 2^EV,
 //!   tonemap, sRGB encoding), so that it judges what a viewer sees.
 //! - Mean ratio (method mean / reference mean): a bias indicator.
+//! - FLIP (Andersson et al. 2020, "FLIP: A Difference Evaluator for Alternating Images"):
+//!   the mean of NVIDIA's LDR-FLIP error map (the `nv-flip` crate, the reference C++ code)
+//!   of both images as displayed (sRGB 8-bit), at 67 pixels per degree (0.7 m from a 0.7 m
+//!   wide 4K monitor).
 //!
 //! Pixels without geometry (alpha 0 in the reference's position, passed as a mask) can be
 //! left out; by default every pixel counts.
@@ -24,6 +28,49 @@ pub struct Metrics {
     pub ssim: f64,
     pub mean_ratio: f64,
     pub reference_mean: f64,
+    /// Mean LDR-FLIP of the displayed images (0 = identical, 1 = maximal).
+    pub flip: f64,
+}
+
+/// The displayed sRGB 8-bit RGB of an image (the display pass's encoding).
+fn displayed_rgb8(img: &ImageF32, exposure_ev: f32, tonemap: Tonemap) -> Vec<u8> {
+    img.pixels
+        .iter()
+        .flat_map(|p| {
+            let e = display::encode(*p, exposure_ev, tonemap);
+            [e[0], e[1], e[2]]
+        })
+        .collect()
+}
+
+/// Mean LDR-FLIP of `image` against `reference` (same size) as displayed.
+pub fn flip(image: &ImageF32, reference: &ImageF32, exposure_ev: f32, tonemap: Tonemap) -> f64 {
+    let (w, h) = (reference.width, reference.height);
+    if w == 0 || h == 0 || (image.width, image.height) != (w, h) {
+        return f64::NAN;
+    }
+    let r = nv_flip::FlipImageRgb8::with_data(w, h, &displayed_rgb8(reference, exposure_ev, tonemap));
+    let t = nv_flip::FlipImageRgb8::with_data(w, h, &displayed_rgb8(image, exposure_ev, tonemap));
+    let err = nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    nv_flip::FlipPool::from_image(&err).mean() as f64
+}
+
+/// The pixels of `img` in [x0, x1) x [y0, y1) (clamped to the image).
+pub fn crop(img: &ImageF32, rect: [u32; 4]) -> ImageF32 {
+    let [x0, y0, x1, y1] = rect;
+    let (x1, y1) = (x1.min(img.width), y1.min(img.height));
+    let (x0, y0) = (x0.min(x1), y0.min(y1));
+    let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            pixels.push(img.get(x, y));
+        }
+    }
+    ImageF32 {
+        width: x1 - x0,
+        height: y1 - y0,
+        pixels,
+    }
 }
 
 fn rgb(p: &[f32; 4]) -> Vec3 {
@@ -146,12 +193,36 @@ pub fn compare(image: &ImageF32, reference: &ImageF32, exposure_ev: f32, tonemap
             f64::NAN
         },
         reference_mean: mean_ref,
+        flip: flip(image, reference, exposure_ev, tonemap),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn flip_is_zero_for_equal_images_and_grows_with_the_difference() {
+        let base = img(48, 32, |x, y| 0.05 + 0.01 * ((x * 7 + y * 3) % 11) as f32);
+        assert_eq!(flip(&base, &base, 0.0, Tonemap::Aces), 0.0);
+        let noisy = |amp: f32| {
+            img(48, 32, |x, y| {
+                let n = (((x * 92_821 + y * 68_917) % 1000) as f32 / 1000.0 - 0.5) * amp;
+                (0.05 + 0.01 * ((x * 7 + y * 3) % 11) as f32 + n).max(0.0)
+            })
+        };
+        let (small, large) = (
+            flip(&noisy(0.02), &base, 0.0, Tonemap::Aces),
+            flip(&noisy(0.2), &base, 0.0, Tonemap::Aces),
+        );
+        assert!(
+            small > 0.0 && large > small && large <= 1.0,
+            "FLIP {small} then {large}"
+        );
+        let c = crop(&base, [10, 5, 20, 30]);
+        assert_eq!((c.width, c.height), (10, 25));
+        assert_eq!(c.get(0, 0), base.get(10, 5));
+    }
 
     fn img(w: u32, h: u32, f: impl Fn(u32, u32) -> f32) -> ImageF32 {
         ImageF32 {

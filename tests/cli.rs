@@ -238,3 +238,64 @@ fn render_ground_truth_writes_indirect_and_final_is_direct_plus_indirect() {
     }
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn sheet_writes_a_comparison_image_and_its_metrics() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = std::env::temp_dir().join(format!("lightcut-sheet-{}", std::process::id()));
+    let png = out.join("s.png");
+    let o = bin()
+        .args([
+            "sheet",
+            "--width",
+            "48",
+            "--height",
+            "32",
+            "--vpls",
+            "256",
+            "--methods",
+            "slc,rtslc",
+            "--frames",
+            "2",
+            "--out",
+        ])
+        .arg(&png)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "stdout: {stdout}\nstderr: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(stdout.contains("SSIM") && stdout.contains("FLIP"), "{stdout}");
+    let img = image::open(&png).expect("the sheet decodes");
+    // Three columns (ground truth + 2 methods) of images scaled to >= 320 px.
+    assert!(
+        img.width() >= 3 * 320 && img.height() > 2 * 200,
+        "{}x{}",
+        img.width(),
+        img.height()
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("s.json")).unwrap()).unwrap();
+    let cols = json["columns"].as_array().unwrap();
+    assert_eq!(cols.len(), 2);
+    for c in cols {
+        let m = &c["vs_ground_truth"];
+        assert!(m["rmse"].as_f64().unwrap() >= 0.0);
+        assert!(m["flip"].as_f64().unwrap() >= 0.0 && m["flip"].as_f64().unwrap() <= 1.0);
+        assert!(m["ssim"].as_f64().unwrap() <= 1.0);
+    }
+    let _ = std::fs::remove_dir_all(&out);
+    // A method that cannot be a column: one clear line, non-zero exit.
+    let o = bin().args(["sheet", "--methods", "off"]).output().unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.trim().lines().count() == 1 && err.contains("cannot be a sheet column"),
+        "{err}"
+    );
+}

@@ -370,3 +370,64 @@ fn several_views_render_their_buffers_and_export_files_that_decode() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_comparison_sheet_runs_in_the_gui_and_can_be_cancelled() {
+    use lightcut::renderer::settings::GiMethod;
+    let Some(mut h) = slc_harness(vec![ViewBuffer::Final], egui::vec2(700.0, 500.0)) else {
+        return;
+    };
+    let mut s = h.state().settings().clone();
+    s.gi.rays_per_frame = 1 << 26;
+    h.state_mut().set_settings(s);
+    h.run_steps(2);
+    let dir = std::env::temp_dir().join(format!("lightcut_ui_sheet_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    h.state_mut().set_export_dir(dir.to_str().unwrap());
+    // Cancelled: nothing is written, the settings are back.
+    h.state_mut().start_sheet(vec![GiMethod::Slc, GiMethod::Rtslc], 2);
+    h.run_steps(1);
+    assert!(h.state().sheet_progress().is_some(), "the sheet shows progress");
+    h.state_mut().cancel_sheet();
+    h.run_steps(2);
+    assert!(h.state().sheet_progress().is_none());
+    assert!(!dir.exists(), "a cancelled sheet wrote files");
+    assert_eq!(h.state().renderer().unwrap().settings().gi.method, GiMethod::Slc);
+    // Run to the end.
+    h.state_mut().start_sheet(vec![GiMethod::Slc, GiMethod::Rtslc], 2);
+    let mut steps = 0;
+    while h.state().sheet_progress().is_some() && steps < 200 {
+        h.run_steps(1);
+        steps += 1;
+    }
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+    let written = h.state().last_export().to_string();
+    assert!(written.contains(".png") && written.contains(".json"), "{written}");
+    let png = written.split(", ").next().unwrap();
+    let img = image::open(png).expect("the sheet decodes");
+    assert!(img.width() > 3 * 320);
+    assert_eq!(h.state().renderer().unwrap().settings().gi.method, GiMethod::Slc);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_sun_sweep_rebuilds_every_frame_and_pause_freezes_the_image() {
+    let Some(mut h) = slc_harness(vec![ViewBuffer::RsmFlux], egui::vec2(700.0, 500.0)) else {
+        return;
+    };
+    h.run_steps(3);
+    let a = shown_pixels(&h);
+    h.state_mut().animation_mut().sun_deg_per_frame = 5.0;
+    h.run_steps(2);
+    let b = shown_pixels(&h);
+    assert_ne!(a, b, "the sun moved but the RSM did not change");
+    h.state_mut().animation_mut().paused = true;
+    h.run_steps(1);
+    let c = shown_pixels(&h);
+    h.run_steps(2);
+    assert_eq!(c, shown_pixels(&h), "paused, yet the image changed");
+    h.state_mut().animation_mut().step = true;
+    h.run_steps(1);
+    assert_ne!(c, shown_pixels(&h), "a step rendered nothing new");
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+}

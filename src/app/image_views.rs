@@ -23,6 +23,10 @@ pub struct ViewPane {
     /// Stable number (titles, labels; the lowest is the main view).
     pub id: u32,
     pub spec: ViewSpec,
+    /// A/B views: the rectangle (frame pixels x0, y0, x1, y1) measured besides the whole image
+    /// (shift + drag selects it).
+    #[serde(default)]
+    pub rect: Option<[u32; 4]>,
     #[serde(skip)]
     pub rt: PaneRuntime,
 }
@@ -35,6 +39,12 @@ pub struct PaneRuntime {
     pub slot: Option<usize>,
     /// Size of its image area in physical pixels at the last layout.
     pub size_px: Option<egui::Vec2>,
+    /// A/B views: metrics of the whole pair and of the rectangle, and when they were taken.
+    pub metrics: Option<(crate::metrics::Metrics, Option<crate::metrics::Metrics>)>,
+    pub metrics_at: f64,
+    /// Why there are no metrics (e.g. the ground truth is still accumulating).
+    pub metrics_note: Option<String>,
+    drag_start: Option<(u32, u32)>,
 }
 
 /// The zoom and pan all views share: `zoom` 1 fits the image, `center` is the image point
@@ -76,6 +86,7 @@ impl Layout {
             .map(|(i, b)| ViewPane {
                 id: i as u32 + 1,
                 spec: ViewSpec::new(*b, d),
+                rect: None,
                 rt: PaneRuntime::default(),
             })
             .collect();
@@ -93,6 +104,7 @@ impl Layout {
         let tile = self.tree.tiles.insert_pane(ViewPane {
             id,
             spec,
+            rect: None,
             rt: PaneRuntime::default(),
         });
         match self.tree.root() {
@@ -305,7 +317,8 @@ fn view_toolbar(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
     let id = pane.id;
     let spec = &mut pane.spec;
     let pane_hovered = ui.rect_contains_pointer(ui.max_rect());
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
+        ui.set_max_width(ui.available_width());
         let handle = ui
             .add(egui::Label::new("::").sense(egui::Sense::drag()))
             .on_hover_text("drag to move this view");
@@ -335,7 +348,8 @@ fn view_toolbar(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
             for (label, which) in [("A", &mut ab.a), ("B", &mut ab.b)] {
                 egui::ComboBox::new(("ab", label, id), label)
                     .selected_text(name(*which))
-                    .width(110.0)
+                    .width(120.0)
+                    .truncate()
                     .show_ui(ui, |ui| {
                         for s in &sources {
                             ui.selectable_value(which, *s, name(*s));
@@ -377,6 +391,9 @@ fn view_toolbar(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
                 }
                 _ => {}
             }
+        }
+        if pane.rect.is_some() && spec.effective_ab().is_some() && ui.button("clear rectangle").clicked() {
+            pane.rect = None;
         }
         ui.menu_button("look", |ui| look_menu(ui, spec));
         ui.menu_button("export", |ui| {
@@ -441,7 +458,11 @@ fn look_menu(ui: &mut egui::Ui, spec: &mut ViewSpec) {
 
 fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane) -> UiResponse {
     let response = view_toolbar(cx, ui, pane);
-    let avail = ui.available_size().max(egui::vec2(16.0, 16.0));
+    // The image takes the rest of the pane (never wider than the pane).
+    let pane_rect = ui.max_rect();
+    let top = ui.cursor().top();
+    let avail =
+        egui::vec2(pane_rect.width(), (pane_rect.bottom() - top).max(16.0)).max(egui::vec2(16.0, 16.0));
     let (rect, resp) = ui.allocate_exact_size(avail, egui::Sense::click_and_drag());
     let ppp = ui.ctx().pixels_per_point();
     pane.rt.size_px = Some(rect.size() * ppp);
@@ -508,7 +529,9 @@ fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
             }
         });
     }
-    if resp.dragged() {
+    let shift = ui.input(|i| i.modifiers.shift);
+    let selecting = ab.is_some() && shift && resp.dragged_by(egui::PointerButton::Primary);
+    if resp.dragged() && !selecting {
         let d = resp.drag_delta();
         let pan = ui.input(|i| i.modifiers.command || i.modifiers.ctrl)
             || resp.dragged_by(egui::PointerButton::Middle);
@@ -550,6 +573,79 @@ fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
         && let Some((texel, pixel)) = to_pixel(pos)
     {
         cx.events.click = Some(ViewClick { pixel, texel, buffer });
+    }
+    // Shift + drag on an A/B view: the rectangle the metrics also measure.
+    if selecting
+        && let Some(pos) = resp.interact_pointer_pos()
+        && let Some((_, Some(p))) = to_pixel(pos)
+    {
+        if resp.drag_started() || pane.rt.drag_start.is_none() {
+            pane.rt.drag_start = Some(p);
+        }
+        if let Some(a) = pane.rt.drag_start {
+            pane.rect = Some([a.0.min(p.0), a.1.min(p.1), a.0.max(p.0) + 1, a.1.max(p.1) + 1]);
+            pane.rt.metrics_at = f64::NEG_INFINITY;
+        }
+    }
+    if resp.drag_stopped() {
+        pane.rt.drag_start = None;
+    }
+    if let Some([x0, y0, x1, y1]) = pane.rect.filter(|_| ab.is_some()) {
+        let halves = if side_by_side { 2 } else { 1 };
+        for k in 0..halves {
+            let at = |x: u32, y: u32| {
+                let u = x as f32 / fw as f32 / halves as f32 + k as f32 / halves as f32;
+                disp.min + egui::vec2(u * disp.width(), y as f32 / fh as f32 * disp.height())
+            };
+            painter.rect_stroke(
+                egui::Rect::from_min_max(at(x0, y0), at(x1, y1)),
+                0.0,
+                egui::Stroke::new(1.5, egui::Color32::from_rgb(255, 220, 0)),
+                egui::StrokeKind::Outside,
+            );
+        }
+    }
+    let note = pane.rt.metrics_note.clone().filter(|_| ab.is_some());
+    if let Some(n) = note {
+        painter.text(
+            rect.right_bottom() - egui::vec2(8.0, 8.0),
+            egui::Align2::RIGHT_BOTTOM,
+            n,
+            egui::FontId::proportional(11.0),
+            egui::Color32::from_gray(235),
+        );
+    } else if let Some((m, mr)) = pane.rt.metrics.filter(|_| ab.is_some()) {
+        let mut text = format!(
+            "A vs B: RMSE {:.3e} (rel. {:.3}) · SSIM {:.4} · FLIP {:.4} · mean ratio {:.3}",
+            m.rmse, m.relative_rmse, m.ssim, m.flip, m.mean_ratio
+        );
+        if let (Some(r), Some([x0, y0, x1, y1])) = (mr, pane.rect) {
+            text += &format!(
+                "\nrectangle {}x{} at ({x0}, {y0}): RMSE {:.3e} (rel. {:.3}) · SSIM {:.4} · FLIP {:.4} · mean ratio {:.3}",
+                x1 - x0,
+                y1 - y0,
+                r.rmse,
+                r.relative_rmse,
+                r.ssim,
+                r.flip,
+                r.mean_ratio
+            );
+        } else {
+            text += "\nshift + drag: measure a rectangle too";
+        }
+        let galley = painter.layout(
+            text,
+            egui::FontId::proportional(11.0),
+            egui::Color32::from_gray(235),
+            rect.width() - 20.0,
+        );
+        let at = rect.right_bottom() - galley.size() - egui::vec2(8.0, 8.0);
+        painter.rect_filled(
+            egui::Rect::from_min_size(at, galley.size()).expand(4.0),
+            3.0,
+            egui::Color32::from_black_alpha(170),
+        );
+        painter.galley(at, galley, egui::Color32::WHITE);
     }
     // The pinned pixel, outlined.
     if let Some((px, py)) = cx.pinned

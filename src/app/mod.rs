@@ -19,6 +19,7 @@ use std::{
 use glam::Vec3;
 
 use crate::reference::sst_tree::{SstNode, luminance};
+use crate::renderer::views::AbSource;
 use crate::{
     renderer::{
         FrameInput, Renderer,
@@ -166,6 +167,31 @@ pub struct WorkbenchApp {
     hover_view: Option<ViewBuffer>,
     pixel: PixelInspect,
     story: story_panel::StoryPanel,
+    anim: Animation,
+    /// The comparison sheet being made (one frame per UI frame), its progress, and its setup.
+    sheet_job: Option<crate::sheet::SheetJob>,
+    sheet_status: Option<(f32, String)>,
+    cancel_sheet: bool,
+    sheet_methods: [bool; 4],
+    sheet_frames: u32,
+    bookmark_name: String,
+    bookmark_note: String,
+    /// The GI method to return to when a progressive one (ground truth, reference) is stopped.
+    last_fast_method: GiMethod,
+}
+
+/// The dynamic scene: the sun's azimuth sweep and the camera's orbit path, per rendered frame;
+/// pause and single steps.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Animation {
+    /// Degrees the sun's azimuth advances per frame (0 = still).
+    pub sun_deg_per_frame: f32,
+    /// Degrees the orbit camera turns about its target per frame (0 = still).
+    pub orbit_deg_per_frame: f32,
+    /// No new frames (the views keep the last one) until unpaused or stepped.
+    pub paused: bool,
+    /// Render one frame while paused.
+    pub step: bool,
 }
 
 /// Values of every buffer at the hovered (or pinned) frame pixel.
@@ -246,6 +272,15 @@ impl WorkbenchApp {
             hover_view: None,
             pixel: PixelInspect::default(),
             story: story_panel::StoryPanel::new(),
+            anim: Animation::default(),
+            sheet_job: None,
+            sheet_status: None,
+            cancel_sheet: false,
+            sheet_methods: [true, true, true, false],
+            sheet_frames: 8,
+            bookmark_name: "bookmark 1".into(),
+            bookmark_note: String::new(),
+            last_fast_method: GiMethod::Off,
         };
         let Some(rs) = app.render_state.clone() else {
             app.errors.push(format!(
@@ -316,6 +351,38 @@ impl WorkbenchApp {
         if let Some(p) = self.layout.main_pane_mut() {
             p.spec.buffer = v;
         }
+    }
+    /// The animation state (sun sweep, camera orbit, pause).
+    pub fn animation_mut(&mut self) -> &mut Animation {
+        &mut self.anim
+    }
+    /// Starts a comparison sheet of `methods` (`frames` accumulated each) on the current view;
+    /// it runs one frame per UI frame and is written to the export folder.
+    pub fn start_sheet(&mut self, methods: Vec<GiMethod>, frames: u32) {
+        let title = self
+            .open
+            .as_ref()
+            .map(|o| format!("{} · camera {}", o.source, o.camera.name))
+            .unwrap_or_default();
+        match crate::sheet::SheetJob::new(self.settings.clone(), methods, frames, None, title) {
+            Ok(job) => {
+                self.sheet_job = Some(job);
+                self.sheet_status = Some((0.0, "starting".into()));
+            }
+            Err(e) => self.errors.push(format!("comparison sheet: {e}")),
+        }
+    }
+    /// Progress of the running comparison sheet (None: none runs).
+    pub fn sheet_progress(&self) -> Option<&(f32, String)> {
+        self.sheet_status.as_ref()
+    }
+    /// Cancels the running comparison sheet (at the next frame).
+    pub fn cancel_sheet(&mut self) {
+        self.cancel_sheet = true;
+    }
+    /// What the last export wrote.
+    pub fn last_export(&self) -> &str {
+        &self.last_export
     }
     /// The settings the next frame renders with.
     pub fn settings(&self) -> &RenderSettings {
@@ -440,6 +507,39 @@ impl WorkbenchApp {
                 {
                     open.camera.yfov = fov.to_radians();
                 }
+                ui.horizontal(|ui| {
+                    ui.add(egui::TextEdit::singleline(&mut self.bookmark_name).desired_width(110.0));
+                    if ui
+                        .button("save bookmark")
+                        .on_hover_text("adds this camera to the list; a preset scene keeps it in its .toml")
+                        .clicked()
+                    {
+                        let mut cam = open.camera.clone();
+                        cam.name = self.bookmark_name.trim().to_string();
+                        if cam.name.is_empty() {
+                            cam.name = format!("bookmark {}", open.scene.cameras.len() + 1);
+                        }
+                        open.scene.cameras.retain(|c| c.name != cam.name);
+                        open.scene.cameras.push(cam.clone());
+                        open.camera_index = Some(open.scene.cameras.len() - 1);
+                        let path = std::path::Path::new(&open.source);
+                        self.bookmark_note = if path.extension().is_some_and(|e| e == "toml") {
+                            match crate::scene::preset::append_bookmark(path, &cam) {
+                                Ok(()) => format!("saved '{}' in {}", cam.name, path.display()),
+                                Err(e) => e,
+                            }
+                        } else {
+                            format!(
+                                "'{}' is kept for this session (the scene has no preset file to store it in)",
+                                cam.name
+                            )
+                        };
+                        self.bookmark_name = format!("bookmark {}", open.scene.cameras.len() + 1);
+                    }
+                });
+                if !self.bookmark_note.is_empty() {
+                    ui.label(egui::RichText::new(&self.bookmark_note).small());
+                }
             }
             ui.separator();
             ui.heading("View");
@@ -554,6 +654,32 @@ impl WorkbenchApp {
                 });
             }
             ui.separator();
+            ui.heading("Animation");
+            ui.add(
+                egui::Slider::new(&mut self.anim.sun_deg_per_frame, -10.0..=10.0)
+                    .text("sun azimuth sweep (deg/frame)"),
+            )
+            .on_hover_text("the sun turns every frame: RSM, VPLs and tree are rebuilt each frame");
+            ui.add(
+                egui::Slider::new(&mut self.anim.orbit_deg_per_frame, -10.0..=10.0)
+                    .text("camera orbit (deg/frame)"),
+            )
+            .on_hover_text("the camera circles its orbit target");
+            ui.horizontal(|ui| {
+                let label = if self.anim.paused { "resume" } else { "pause" };
+                if ui.button(label).clicked() {
+                    self.anim.paused = !self.anim.paused;
+                }
+                if ui
+                    .add_enabled(self.anim.paused, egui::Button::new("step frame"))
+                    .clicked()
+                {
+                    self.anim.step = true;
+                }
+                ui.checkbox(&mut self.settings.sampling.fixed_seed, "fixed seed")
+                    .on_hover_text("the samplers draw the same random numbers every frame");
+            });
+            ui.separator();
             ui.heading("Global illumination");
             let g = &mut self.settings.gi;
             egui::ComboBox::from_label("method")
@@ -564,14 +690,25 @@ impl WorkbenchApp {
                     }
                 });
             if let Some(p) = self.renderer.as_ref().and_then(|r| r.gi_progress()) {
-                ui.add(
-                    egui::ProgressBar::new(p.fraction())
-                        .text(match g.method {
-                            GiMethod::Reference => format!("{} / {} samples per pixel", p.done, p.total),
-                            _ => format!("{} / {} VPLs", p.done, p.total),
-                        })
-                        .show_percentage(),
-                );
+                ui.horizontal(|ui| {
+                    ui.add(
+                        egui::ProgressBar::new(p.fraction())
+                            .desired_width(200.0)
+                            .text(match g.method {
+                                GiMethod::Reference => format!("{} / {} samples per pixel", p.done, p.total),
+                                _ => format!("{} / {} VPLs", p.done, p.total),
+                            })
+                            .show_percentage(),
+                    );
+                    if !p.finished()
+                        && ui
+                            .button("stop")
+                            .on_hover_text(format!("back to {}", self.last_fast_method.name()))
+                            .clicked()
+                    {
+                        g.method = self.last_fast_method;
+                    }
+                });
             }
             match g.method {
                 GiMethod::GroundTruth => {
@@ -631,11 +768,17 @@ impl WorkbenchApp {
                         );
                     if self.compare_gt {
                         if let Some(p) = self.renderer.as_ref().and_then(|r| r.compare_progress()) {
-                            ui.add(
-                                egui::ProgressBar::new(p.fraction())
-                                    .text(format!("ground truth {} / {} VPLs", p.done, p.total))
-                                    .show_percentage(),
-                            );
+                            ui.horizontal(|ui| {
+                                ui.add(
+                                    egui::ProgressBar::new(p.fraction())
+                                        .desired_width(200.0)
+                                        .text(format!("ground truth {} / {} VPLs", p.done, p.total))
+                                        .show_percentage(),
+                                );
+                                if !p.finished() && ui.button("stop").clicked() {
+                                    self.compare_gt = false;
+                                }
+                            });
                             if p.finished()
                                 && let Some(m) = &self.compare_metrics
                             {
@@ -707,6 +850,43 @@ impl WorkbenchApp {
             ui.separator();
             let levels = self.renderer.as_ref().map(|r| r.tree_buffers().1.levels());
             self.tree_panel.controls(ui, &mut self.settings, levels);
+            ui.separator();
+            ui.heading("Export");
+            ui.horizontal(|ui| {
+                ui.label("folder");
+                ui.add(egui::TextEdit::singleline(&mut self.export_dir).desired_width(170.0));
+            });
+            ui.label(egui::RichText::new("each view: export menu (PNG as displayed, EXR of its buffer)").small());
+            ui.label("comparison sheet (same VPLs, vs their ground truth):");
+            ui.horizontal_wrapped(|ui| {
+                for (i, m) in [GiMethod::Slc, GiMethod::Rtslc, GiMethod::Sst, GiMethod::Reference]
+                    .into_iter()
+                    .enumerate()
+                {
+                    ui.checkbox(&mut self.sheet_methods[i], m.name());
+                }
+            });
+            ui.add(egui::Slider::new(&mut self.sheet_frames, 1..=256).text("frames per method"));
+            if let Some((f, label)) = &self.sheet_status {
+                ui.add(egui::ProgressBar::new(*f).text(label.clone()).show_percentage());
+                if ui.button("cancel sheet").clicked() {
+                    self.cancel_sheet = true;
+                }
+            } else if ui
+                .button("make comparison sheet")
+                .on_hover_text("ground truth of the frame's VPLs, then each method; one PNG + JSON in the folder")
+                .clicked()
+            {
+                let methods: Vec<GiMethod> = [GiMethod::Slc, GiMethod::Rtslc, GiMethod::Sst, GiMethod::Reference]
+                    .into_iter()
+                    .zip(self.sheet_methods)
+                    .filter_map(|(m, on)| on.then_some(m))
+                    .collect();
+                self.start_sheet(methods, self.sheet_frames);
+            }
+            if !self.last_export.is_empty() {
+                ui.label(egui::RichText::new(format!("wrote {}", self.last_export)).small());
+            }
             ui.separator();
             ui.heading("Shadow map");
             let s = &mut self.settings.shadow;
@@ -782,11 +962,19 @@ impl WorkbenchApp {
         if let Err(e) = renderer.resize(w, h) {
             self.errors.push(e.to_string());
         }
-        if renderer.settings() != &self.settings
+        let job_running = self.sheet_job.is_some();
+        if !job_running
+            && renderer.settings() != &self.settings
             && let Err(e) = renderer.set_settings(self.settings.clone())
         {
             self.errors.push(e.to_string());
             self.settings = renderer.settings().clone();
+        }
+        if !matches!(
+            self.settings.gi.method,
+            GiMethod::GroundTruth | GiMethod::Reference
+        ) {
+            self.last_fast_method = self.settings.gi.method;
         }
 
         // The views' input of the last frame -> camera.
@@ -815,23 +1003,71 @@ impl WorkbenchApp {
                 open.camera_index = None;
             }
         }
+        // The dynamic scene: sun sweep and camera orbit, one step per rendered frame.
+        let render_now = !self.anim.paused || self.anim.step;
+        self.anim.step = false;
+        if render_now && !job_running {
+            if self.anim.sun_deg_per_frame != 0.0
+                && let Some(sun) = &mut self.sun
+            {
+                sun.azimuth_deg =
+                    (sun.azimuth_deg + self.anim.sun_deg_per_frame + 180.0).rem_euclid(360.0) - 180.0;
+            }
+            if self.anim.orbit_deg_per_frame != 0.0 {
+                open.controller.yaw += self.anim.orbit_deg_per_frame.to_radians();
+                open.camera_index = None;
+            }
+        }
         if open.camera_index.is_none() {
             open.controller.apply(&mut open.camera);
         }
 
         let lights = lights_with_sun(&open.scene, self.sun.as_ref());
-        renderer.set_freeze_tree(self.tree_panel.freeze);
-        let comparing = self.compare_gt && self.settings.gi.method.samples_tree();
-        renderer.set_compare_ground_truth(comparing);
+        let comparing = self.compare_gt && self.settings.gi.method.samples_tree() && !job_running;
         let specs = self.layout.assign_slots(self.hover_view);
-        renderer.render_views(
-            &FrameInput {
-                camera: &open.camera,
-                lights: &lights,
-                view: specs[0].buffer,
-            },
-            &specs,
-        );
+        if self.cancel_sheet {
+            self.cancel_sheet = false;
+            if let Some(job) = self.sheet_job.take() {
+                job.restore(renderer);
+                self.sheet_status = None;
+                let _ = renderer.set_settings(self.settings.clone());
+            }
+        }
+        if let Some(job) = &mut self.sheet_job {
+            // A comparison sheet drives the renderer (one frame per UI frame; cancellable).
+            renderer.set_compare_ground_truth(false);
+            match job.step(renderer, &open.camera, &lights) {
+                Ok(crate::sheet::Step::Running { fraction, label }) => {
+                    self.sheet_status = Some((fraction, label));
+                }
+                Ok(crate::sheet::Step::Done(sheet)) => {
+                    self.sheet_job = None;
+                    self.sheet_status = None;
+                    match write_sheet(&sheet, std::path::Path::new(&self.export_dir)) {
+                        Ok(files) => self.last_export = files,
+                        Err(e) => self.errors.push(format!("comparison sheet: {e}")),
+                    }
+                    let _ = renderer.set_settings(self.settings.clone());
+                }
+                Err(e) => {
+                    job.restore(renderer);
+                    self.sheet_job = None;
+                    self.sheet_status = None;
+                    self.errors.push(format!("comparison sheet: {e}"));
+                }
+            }
+        } else if render_now {
+            renderer.set_freeze_tree(self.tree_panel.freeze);
+            renderer.set_compare_ground_truth(comparing);
+            renderer.render_views(
+                &FrameInput {
+                    camera: &open.camera,
+                    lights: &lights,
+                    view: specs[0].buffer,
+                },
+                &specs,
+            );
+        }
         let now = ui.input(|i| i.time);
         // Live metrics against the finished comparison ground truth (twice a second).
         if comparing
@@ -897,6 +1133,54 @@ impl WorkbenchApp {
         }
         self.layout.tree = tree;
 
+        // A/B metrics (whole pair and rectangle), twice a second per view.
+        for p in self.layout.panes_mut() {
+            let Some(ab) = p.spec.effective_ab() else {
+                p.rt.metrics = None;
+                continue;
+            };
+            if p.rt.slot.is_none() || now - p.rt.metrics_at < 0.5 {
+                continue;
+            }
+            p.rt.metrics_at = now;
+            p.rt.metrics_note = None;
+            let gt = |s: AbSource| matches!(s, AbSource::GroundTruthIndirect | AbSource::GroundTruthFinal);
+            if gt(ab.a) || gt(ab.b) {
+                match renderer.compare_progress() {
+                    Some(pr) if !pr.finished() => {
+                        p.rt.metrics = None;
+                        p.rt.metrics_note = Some(format!(
+                            "metrics when the ground truth is done ({:.0}%)",
+                            100.0 * pr.fraction()
+                        ));
+                        continue;
+                    }
+                    None => {
+                        p.rt.metrics = None;
+                        p.rt.metrics_note =
+                            Some("no ground truth: turn on \"compare with the ground truth\"".into());
+                        continue;
+                    }
+                    _ => {}
+                }
+            }
+            p.rt.metrics = match (renderer.read_ab_source(ab.a), renderer.read_ab_source(ab.b)) {
+                (Ok(Some(a)), Ok(Some(b))) if (a.width, a.height) == (b.width, b.height) => {
+                    let l = p.spec.look;
+                    let whole = crate::metrics::compare(&a, &b, l.exposure_ev, l.tonemap);
+                    let part = p.rect.filter(|r| r[2] > r[0] && r[3] > r[1]).map(|r| {
+                        let (ca, cb) = (crate::metrics::crop(&a, r), crate::metrics::crop(&b, r));
+                        crate::metrics::compare(&ca, &cb, l.exposure_ev, l.tonemap)
+                    });
+                    Some((whole, part))
+                }
+                (Err(e), _) | (_, Err(e)) => {
+                    self.errors.push(format!("A/B readback: {e}"));
+                    None
+                }
+                _ => None,
+            };
+        }
         // Pixel values under the pointer (camera-space views; P pins / unpins, a click pins).
         if self.pixel.show || self.story.show {
             if events.hovered && ui.input(|i| i.key_pressed(egui::Key::P)) {
@@ -1271,6 +1555,18 @@ fn fresh_path(dir: &std::path::Path, stem: &str, ext: &str) -> PathBuf {
         }
         n += 1;
     }
+}
+
+/// Writes a comparison sheet (PNG + JSON of its metrics) into `dir`; returns the paths.
+pub fn write_sheet(sheet: &crate::sheet::Sheet, dir: &std::path::Path) -> Result<String, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let canvas = crate::sheet::compose(sheet)?;
+    let png = fresh_path(dir, "comparison sheet", "png");
+    crate::export::write_png(&png, canvas.width, canvas.height, &canvas.rgba).map_err(|e| e.to_string())?;
+    let json = png.with_extension("json");
+    std::fs::write(&json, crate::sheet::metrics_json(sheet))
+        .map_err(|e| format!("cannot write {}: {e}", json.display()))?;
+    Ok(format!("{}, {}", png.display(), json.display()))
 }
 
 /// The files of one view export (see [`WorkbenchApp::export_view`]).

@@ -1,5 +1,6 @@
 //! `compare`: error metrics of an image against a reference (linear EXRs of the same size):
-//! RMSE and relative RMSE on linear radiance, SSIM on the displayed luminance, mean ratio.
+//! RMSE and relative RMSE on linear radiance, SSIM on the displayed luminance, FLIP of the
+//! displayed images, mean ratio.
 //! See `crate::metrics` for the definitions.
 
 use std::path::PathBuf;
@@ -58,8 +59,8 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     }
     let m = metrics::compare(&a, &b, args.exposure, args.tonemap.tonemap());
     println!(
-        "RMSE {:.6} (relative {:.4}) | SSIM {:.4} | mean ratio {:.4} | reference mean {:.6}",
-        m.rmse, m.relative_rmse, m.ssim, m.mean_ratio, m.reference_mean
+        "RMSE {:.6} (relative {:.4}) | SSIM {:.4} | FLIP {:.4} | mean ratio {:.4} | reference mean {:.6}",
+        m.rmse, m.relative_rmse, m.ssim, m.flip, m.mean_ratio, m.reference_mean
     );
     if let Some(p) = &args.json {
         std::fs::write(p, serde_json::to_string_pretty(&m)?)

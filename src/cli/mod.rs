@@ -4,6 +4,7 @@ pub mod bench;
 pub mod compare;
 pub mod export_scene;
 pub mod render;
+pub mod sheet;
 
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
@@ -76,8 +77,11 @@ pub enum Command {
     /// Write a scene as PLY meshes + JSON (camera, sun, albedos) for independent renderers
     /// (scripts/mitsuba_check.py).
     ExportScene(export_scene::ExportSceneArgs),
-    /// Error metrics of an image against a reference: RMSE, relative RMSE, SSIM, mean ratio.
+    /// Error metrics of an image against a reference: RMSE, relative RMSE, SSIM, FLIP, mean ratio.
     Compare(compare::CompareArgs),
+    /// A comparison sheet: methods side by side on the same VPLs, their error maps against
+    /// the ground truth, and captions (method, settings, RMSE, SSIM, FLIP, GPU time).
+    Sheet(sheet::SheetArgs),
 }
 
 /// Settings flags shared by the commands (override a settings file, which overrides defaults).

@@ -243,11 +243,12 @@ fn write_metrics(
         write_exr(&args.out.join("ground_truth_indirect.exr"), &gt)?;
         let m = crate::metrics::compare(indirect, &gt, s.display.exposure_ev, s.display.tonemap);
         println!(
-            "vs ground truth ({} VPLs): RMSE {:.6} (relative {:.4}), SSIM {:.4}, mean ratio {:.4}",
+            "vs ground truth ({} VPLs): RMSE {:.6} (relative {:.4}), SSIM {:.4}, FLIP {:.4}, mean ratio {:.4}",
             r.vpl_frame().count,
             m.rmse,
             m.relative_rmse,
             m.ssim,
+            m.flip,
             m.mean_ratio
         );
         json["vs_ground_truth"] = serde_json::to_value(m)?;

@@ -954,7 +954,11 @@ impl Renderer {
                 settings::CutFallback::Recompute => 3,
             },
             cull: sm.cull_behind as u32,
-            seed: s.vpl.seed ^ (self.frames as u32).wrapping_mul(0x9e37_79b9),
+            seed: if sm.fixed_seed {
+                s.vpl.seed
+            } else {
+                s.vpl.seed ^ (self.frames as u32).wrapping_mul(0x9e37_79b9)
+            },
             accumulate: (frames > 1) as u32,
             epsilon: s.gi.distance_epsilon,
             ray_offset: s.gi.ray_offset,

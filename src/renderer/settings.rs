@@ -311,6 +311,9 @@ pub struct SamplingSettings {
     pub accumulate: bool,
     /// Render GI at half resolution and upsample it with a joint bilateral filter using S.
     pub half_resolution: bool,
+    /// The samplers' random numbers are the same every frame (debugging: a pixel's story
+    /// repeats); off, the seed changes per frame (needed to accumulate).
+    pub fixed_seed: bool,
 }
 
 impl Default for SamplingSettings {
@@ -324,6 +327,7 @@ impl Default for SamplingSettings {
             fallback: CutFallback::MockCut,
             accumulate: false,
             half_resolution: false,
+            fixed_seed: false,
         }
     }
 }

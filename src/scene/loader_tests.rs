@@ -985,3 +985,39 @@ fn presets_in_scenes_folder_open() {
         assert!(!has_warning(&o.scene, "default sun"));
     }
 }
+
+#[test]
+fn camera_bookmarks_append_to_a_preset_and_load_as_cameras() {
+    use super::preset::append_bookmark;
+    let dir = temp_dir("bookmark");
+    let p = dir.join("b.toml");
+    let text = "# a comment that must survive\nname = \"B\"\ngltf = \"m.gltf\"\n[sun]\nazimuth_deg = 30.0\nelevation_deg = 70.0\nirradiance = 10.0\n";
+    std::fs::write(&p, text).unwrap();
+    let cam = crate::scene::Camera::look_at(
+        "desk view",
+        glam::Vec3::new(1.0, 2.0, 3.0),
+        glam::Vec3::new(0.0, 1.0, 0.0),
+        50f32.to_radians(),
+        0.01,
+        100.0,
+    );
+    append_bookmark(&p, &cam).unwrap();
+    append_bookmark(
+        &p,
+        &crate::scene::Camera {
+            name: "second".into(),
+            ..cam.clone()
+        },
+    )
+    .unwrap();
+    let after = std::fs::read_to_string(&p).unwrap();
+    assert!(after.starts_with("# a comment that must survive"));
+    let pr = load_preset(&p).unwrap();
+    assert_eq!(pr.bookmarks.len(), 2);
+    let b = &pr.bookmarks[0];
+    assert_eq!(b.name, "desk view");
+    let back = b.camera(100.0);
+    assert!((back.position - cam.position).length() < 1e-3);
+    assert!((back.forward - cam.forward).length() < 1e-3);
+    assert!((back.yfov - cam.yfov).abs() < 1e-4);
+}

@@ -15,6 +15,11 @@
 //! eye = [0.0, 1.5, 4.0]
 //! target = [0.0, 1.0, 0.0]
 //! yfov_deg = 50.0
+//! [[bookmarks]]                  # optional, any number: saved cameras (the workbench's
+//! name = "table"                 # "save bookmark" appends them), listed after the file's
+//! eye = [1.0, 1.2, 0.5]          # cameras
+//! target = [0.0, 0.8, -1.0]
+//! yfov_deg = 55.0
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -46,6 +51,9 @@ pub struct ScenePreset {
     /// An explicit camera, added to the scene and selected.
     #[serde(default)]
     pub camera_pose: Option<CameraPose>,
+    /// Saved cameras (camera bookmarks), added to the scene's cameras.
+    #[serde(default)]
+    pub bookmarks: Vec<CameraPose>,
 }
 
 /// A directional light given by angles (see [`DirectionalLight::from_angles`]).
@@ -109,6 +117,28 @@ impl SunPreset {
             self.irradiance * Vec3::from_array(self.color),
         )
     }
+}
+
+/// The `[[bookmarks]]` entry of `camera` (appended to a preset file by the workbench).
+pub fn bookmark_toml(camera: &Camera) -> String {
+    let f = |v: Vec3| format!("[{:.4}, {:.4}, {:.4}]", v.x, v.y, v.z);
+    let name = camera.name.replace(['"', '\\'], "_");
+    format!(
+        "\n[[bookmarks]]\nname = \"{name}\"\neye = {}\ntarget = {}\nyfov_deg = {:.3}\n",
+        f(camera.position),
+        f(camera.position + camera.forward),
+        camera.yfov.to_degrees()
+    )
+}
+
+/// Appends a camera bookmark to the preset file `path` (comments and order stay), after
+/// checking that the result still parses.
+pub fn append_bookmark(path: &Path, camera: &Camera) -> Result<(), String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let new = format!("{}{}", text.trim_end(), bookmark_toml(camera));
+    ScenePreset::from_toml_str(&new, path)
+        .map_err(|e| format!("the bookmark would break {}: {e}", path.display()))?;
+    std::fs::write(path, new).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 impl CameraPose {
@@ -200,6 +230,15 @@ impl ScenePreset {
                 && !(f.is_finite() && f > c.znear)
             {
                 return Err(format!("camera_pose.zfar = {f} must be finite and > znear"));
+            }
+        }
+        for b in &self.bookmarks {
+            let ok = b.eye.iter().chain(&b.target).all(|v| v.is_finite()) && b.eye != b.target;
+            if !(ok && b.yfov_deg > 0.0 && b.yfov_deg < 180.0) {
+                return Err(format!(
+                    "bookmark '{}': eye and target must be finite and differ, yfov_deg in (0, 180)",
+                    b.name
+                ));
             }
         }
         Ok(())
@@ -325,6 +364,12 @@ pub fn apply_preset(
             ));
         }
         scene.lights = vec![sun.light()];
+    }
+    for b in &preset.bookmarks {
+        let far = 2.0 * (b.eye_distance_to(&scene.bounds) + scene.bounds.radius());
+        let cam = b.camera(far.max(1.0));
+        scene.cameras.retain(|c| c.name != cam.name);
+        scene.cameras.push(cam);
     }
     if let Some(pose) = &preset.camera_pose {
         let far = 2.0 * (pose.eye_distance_to(&scene.bounds) + scene.bounds.radius());

@@ -1,0 +1,120 @@
+//! `sheet`: a comparison sheet of methods on the same VPLs and tree (`crate::sheet`), as the
+//! GUI's "comparison sheet" export writes it: PNG + JSON of the metrics.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, anyhow};
+use clap::Args;
+
+use super::{
+    SettingsArgs,
+    render::{Method, SamplingArgs},
+};
+use crate::{
+    renderer::{Renderer, context::GpuContext, settings::GiMethod},
+    scene::preset::{SceneSource, open_scene},
+    sheet::{SheetJob, compose},
+};
+
+#[derive(Args, Debug)]
+pub struct SheetArgs {
+    /// `default`, a .gltf/.glb file, or a preset .toml.
+    #[arg(long, default_value = "default")]
+    pub scene: String,
+    #[arg(long)]
+    pub camera: Option<String>,
+    #[arg(long, default_value_t = 320)]
+    pub width: u32,
+    #[arg(long, default_value_t = 200)]
+    pub height: u32,
+    /// The columns, in order (tree samplers or the converged reference).
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "slc,rtslc,sst")]
+    pub methods: Vec<Method>,
+    /// The sheet (PNG; a JSON of the metrics is written beside it).
+    #[arg(long, default_value = "screenshots/sheet.png")]
+    pub out: PathBuf,
+    #[arg(long)]
+    pub vpls: Option<u32>,
+    #[arg(long)]
+    pub seed: Option<u32>,
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+    /// Sampler settings; --frames is the frames each method accumulates.
+    #[command(flatten)]
+    pub sampling: SamplingArgs,
+}
+
+pub fn run(args: &SheetArgs) -> anyhow::Result<()> {
+    let opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
+    let mut settings = args.settings.resolve(opened.exposure_ev)?;
+    args.sampling.apply(&mut settings);
+    if let Some(v) = args.vpls {
+        settings.vpl.count = v;
+    }
+    if let Some(v) = args.seed {
+        settings.vpl.seed = v;
+    }
+    settings.validate().map_err(|e| anyhow!("{e}"))?;
+    let methods: Vec<GiMethod> = args
+        .methods
+        .iter()
+        .map(|m| match m {
+            Method::Slc => Ok(GiMethod::Slc),
+            Method::Sst => Ok(GiMethod::Sst),
+            Method::Rtslc => Ok(GiMethod::Rtslc),
+            Method::Reference => Ok(GiMethod::Reference),
+            other => Err(anyhow!(
+                "--methods: {other:?} cannot be a sheet column (slc, sst, rtslc, reference)"
+            )),
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let cam_name = args.camera.clone().or(opened.camera_name.clone());
+    let camera = opened
+        .scene
+        .camera_or_default(cam_name.as_deref())
+        .map_err(|e| anyhow!("{e}"))?;
+    let title = format!("{} · camera {}", args.scene, camera.name);
+    let job = SheetJob::new(
+        settings.clone(),
+        methods,
+        args.sampling.frames,
+        Some(1 << 26),
+        title,
+    )
+    .map_err(|e| anyhow!("{e}"))?;
+    if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    let ctx = GpuContext::new_headless()?;
+    println!("adapter: {}", ctx.describe());
+    let mut r = Renderer::new(ctx, &opened.scene, (args.width, args.height), settings)?;
+    let mut last = -1.0f32;
+    let sheet = job
+        .run(&mut r, &camera, &opened.scene.lights, |f, label| {
+            if f - last >= 0.1 {
+                eprintln!("{:3.0}% {label}", 100.0 * f);
+                last = f;
+            }
+        })
+        .map_err(|e| anyhow!("{e}"))?;
+    let canvas = compose(&sheet).map_err(|e| anyhow!("{e}"))?;
+    crate::export::write_png(&args.out, canvas.width, canvas.height, &canvas.rgba)?;
+    for c in &sheet.columns {
+        let m = &c.metrics;
+        println!(
+            "{:<16} RMSE {:.4e} (rel. {:.4}) · SSIM {:.4} · FLIP {:.4} · mean ratio {:.4} · GPU {} ms/frame",
+            c.method.name(),
+            m.rmse,
+            m.relative_rmse,
+            m.ssim,
+            m.flip,
+            m.mean_ratio,
+            c.gpu_ms.map_or("n/a".into(), |t| format!("{t:.2}"))
+        );
+    }
+    let jpath = args.out.with_extension("json");
+    std::fs::write(&jpath, crate::sheet::metrics_json(&sheet))
+        .with_context(|| format!("cannot write {}", jpath.display()))?;
+    println!("wrote {} and {}", args.out.display(), jpath.display());
+    Ok(())
+}
