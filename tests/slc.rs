@@ -366,7 +366,11 @@ fn mock_level_matches_the_thesis_example() {
 fn the_comparison_ground_truth_equals_the_ground_truth_method() {
     let Some(ctx) = common::gpu() else { return };
     let mut st = setup(&ctx, settings(GiMethod::Slc));
-    st.set(|s| s.gi.rays_per_frame = 1 << 22);
+    st.set(|s| {
+        s.gi.rays_per_frame = 1 << 22;
+        // Accumulating: the sampler's composite scale (1/frames) must not reach the ground truth's.
+        s.sampling.accumulate = true;
+    });
     st.r.set_compare_ground_truth(true);
     let mut frames = 0;
     while !st.r.compare_progress().is_some_and(|p| p.finished()) {

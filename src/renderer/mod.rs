@@ -153,6 +153,9 @@ pub struct Renderer {
     compare_on: bool,
     compare: Option<CompareState>,
     compare_views: passes::compare::CompareViewsPass,
+    /// The comparison ground truth's composite: its own pass (and parameter buffer), since the
+    /// sampler's composite with scale 1/frames is recorded in the same encoder.
+    compare_composite: CompositePass,
     slc_half: passes::slc_half::HalfPass,
     half: Option<passes::slc_half::HalfTargets>,
     vpl_buffers: VplBuffers,
@@ -263,6 +266,7 @@ impl Renderer {
             compare_on: false,
             compare: None,
             compare_views: passes::compare::CompareViewsPass::new(device)?,
+            compare_composite: CompositePass::new(device)?,
             slc_half: passes::slc_half::HalfPass::new(device)?,
             half: None,
             vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
@@ -315,14 +319,15 @@ impl Renderer {
                 SlcPass::new(device),
                 passes::compare::CompareViewsPass::new(device),
                 passes::slc_half::HalfPass::new(device),
+                CompositePass::new(device),
             ),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
         }
-        let (g, s, d, disp, v, (vg, gt, c, rf, sp, so, b, ov, sl, cv, hp)) = passes;
+        let (g, s, d, disp, v, (vg, gt, c, rf, sp, so, b, ov, sl, cv, hp, cc)) = passes;
         let new = (
-            g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?, so?, b?, ov?, sl?, cv?, hp?,
+            g?, s?, d?, disp?, v?, vg?, gt?, c?, rf?, sp?, so?, b?, ov?, sl?, cv?, hp?, cc?,
         );
         (
             self.gbuffer,
@@ -341,6 +346,7 @@ impl Renderer {
             self.slc,
             self.compare_views,
             self.slc_half,
+            self.compare_composite,
         ) = new;
         Ok(())
     }
@@ -814,7 +820,7 @@ impl Renderer {
         };
         let accum = cmp.targets.gi_accum.clone();
         self.advance_ground_truth(enc, &mut cmp.gt, key, &accum, size);
-        self.composite.record(
+        self.compare_composite.record(
             &device,
             &queue,
             enc,
