@@ -431,3 +431,35 @@ fn the_sun_sweep_rebuilds_every_frame_and_pause_freezes_the_image() {
     assert_ne!(c, shown_pixels(&h), "a step rendered nothing new");
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }
+
+#[test]
+fn four_view_layout_snapshot() {
+    let Some(_) = common::gpu() else { return };
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1100.0, 700.0))
+        .wgpu_setup(setup())
+        .build_eframe(|cc| {
+            WorkbenchApp::new(
+                cc,
+                AppOptions {
+                    scene: "default".into(),
+                    views: vec![
+                        ViewBuffer::Final,
+                        ViewBuffer::Normal,
+                        ViewBuffer::Albedo,
+                        ViewBuffer::Depth,
+                    ],
+                    reset_layout: true,
+                    ..Default::default()
+                },
+            )
+        });
+    h.run_steps(4);
+    assert_eq!(h.state().layout().view_count(), 4);
+    let status = h.get_by_label_contains("GPU: ").rect();
+    h.mask(egui::Rect::from_min_max(
+        egui::pos2(0.0, status.min.y - 4.0),
+        egui::pos2(1100.0, 700.0),
+    ));
+    h.snapshot("four_views");
+}

@@ -508,9 +508,11 @@ impl WorkbenchApp {
                     open.camera.yfov = fov.to_radians();
                 }
                 ui.horizontal(|ui| {
-                    ui.add(egui::TextEdit::singleline(&mut self.bookmark_name).desired_width(110.0));
+                    let l = ui.label("bookmark");
+                    ui.add(egui::TextEdit::singleline(&mut self.bookmark_name).desired_width(100.0))
+                        .labelled_by(l.id);
                     if ui
-                        .button("save bookmark")
+                        .button("save")
                         .on_hover_text("adds this camera to the list; a preset scene keeps it in its .toml")
                         .clicked()
                     {
@@ -853,8 +855,9 @@ impl WorkbenchApp {
             ui.separator();
             ui.heading("Export");
             ui.horizontal(|ui| {
-                ui.label("folder");
-                ui.add(egui::TextEdit::singleline(&mut self.export_dir).desired_width(170.0));
+                let l = ui.label("folder");
+                ui.add(egui::TextEdit::singleline(&mut self.export_dir).desired_width(170.0))
+                    .labelled_by(l.id);
             });
             ui.label(egui::RichText::new("each view: export menu (PNG as displayed, EXR of its buffer)").small());
             ui.label("comparison sheet (same VPLs, vs their ground truth):");
