@@ -343,7 +343,7 @@ impl Canvas {
 /// Relative error |lum(a) - lum(b)| / lum(b), log10 false colour from 1e-2 to 1e1 (the
 /// relative-error view's map); black where both are black.
 pub fn relative_error_rgb8(a: [f32; 4], b: [f32; 4]) -> [u8; 3] {
-    let l = |p: [f32; 4]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let l = |p: [f32; 4]| display::luminance(glam::Vec3::new(p[0], p[1], p[2]));
     let (la, lb) = (l(a), l(b));
     if la <= 0.0 && lb <= 0.0 {
         return [0, 0, 0];
@@ -439,10 +439,10 @@ pub fn compose(sheet: &Sheet) -> Result<Canvas, String> {
         y += ch + 6;
         let lines: Vec<String> = if col == 0 {
             vec!["every VPL, one shadow ray each".into(), {
-                let m = sheet.reference_indirect.mean_rgb();
+                let m = sheet.reference_indirect.mean_rgb().map(|v| v as f32);
                 format!(
                     "GI mean {:.4e} W/(m² sr) (lum.)",
-                    0.2126 * m[0] + 0.7152 * m[1] + 0.0722 * m[2]
+                    display::luminance(glam::Vec3::from(m))
                 )
             }]
         } else {

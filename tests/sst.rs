@@ -360,6 +360,17 @@ fn frame_tree_reclassifies_without_rebuilding() {
     let leaves = r.tree_buffers().1.leaves as usize;
     assert_eq!(nodes.len(), 2 * leaves);
     assert_eq!(flags, classify(&nodes, 0.7, 0.3));
+    // Reading some nodes alone (the pixel story) gives the same nodes; ids past the tree are
+    // empty.
+    let ids = [1u32, 7, 2, (2 * leaves - 1) as u32, (2 * leaves) as u32, 300];
+    let (some, some_flags) = r.read_tree_nodes(&ids).unwrap();
+    assert_eq!(some_flags, flags);
+    for (&i, n) in ids.iter().zip(&some) {
+        match nodes.get(i as usize) {
+            Some(want) => assert_eq!(n, want, "node {i}"),
+            None => assert!(n.is_empty(), "node {i} past the tree"),
+        }
+    }
     // The frame's tree equals the CPU build of its own sorted VPLs.
     let sorted = read_sorted_vpls(&ctx, r.tree_buffers().1).unwrap();
     let cpu = build_with_leaves(&sorted, leaves);

@@ -19,22 +19,36 @@ fn setup() -> egui_wgpu::WgpuSetup {
     egui_wgpu::WgpuSetup::CreateNew(s)
 }
 
-fn harness() -> Option<Harness<'static, WorkbenchApp>> {
+/// The app on the default scene with `options` (scene set here), in a `size` window.
+fn harness_with(size: egui::Vec2, options: AppOptions) -> Option<Harness<'static, WorkbenchApp>> {
     common::gpu()?;
     Some(
         Harness::builder()
-            .with_size(egui::vec2(1100.0, 700.0))
+            .with_size(size)
             .wgpu_setup(setup())
-            .build_eframe(|cc| {
+            .build_eframe(move |cc| {
                 WorkbenchApp::new(
                     cc,
                     AppOptions {
                         scene: "default".into(),
-                        ..Default::default()
+                        ..options.clone()
                     },
                 )
             }),
     )
+}
+
+fn harness() -> Option<Harness<'static, WorkbenchApp>> {
+    harness_with(egui::vec2(1100.0, 700.0), AppOptions::default())
+}
+
+/// SLC with 1024 VPLs and cuts of 16.
+fn slc_settings() -> lightcut::renderer::settings::RenderSettings {
+    let mut s = lightcut::renderer::settings::RenderSettings::default();
+    s.gi.method = lightcut::renderer::settings::GiMethod::Slc;
+    s.vpl.count = 1024;
+    s.sampling.cut_size = 16;
+    s
 }
 
 fn shown_pixels(h: &Harness<'_, WorkbenchApp>) -> Vec<u8> {
@@ -86,20 +100,10 @@ fn main_window_snapshot() {
 
 #[test]
 fn light_tree_overlay_and_statistics_window() {
-    let Some(_) = common::gpu() else { return };
     // Tall, so that the whole side panel (the light-tree section is near its end) is visible.
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1100.0, 1700.0))
-        .wgpu_setup(setup())
-        .build_eframe(|cc| {
-            WorkbenchApp::new(
-                cc,
-                AppOptions {
-                    scene: "default".into(),
-                    ..Default::default()
-                },
-            )
-        });
+    let Some(mut h) = harness_with(egui::vec2(1100.0, 1700.0), AppOptions::default()) else {
+        return;
+    };
     h.run_steps(3);
     let before = shown_pixels(&h);
     h.get_by_role_and_label(Role::ComboBox, "tree overlay").click();
@@ -118,39 +122,18 @@ fn light_tree_overlay_and_statistics_window() {
 
 #[test]
 fn clicking_a_block_in_the_cut_view_lists_its_cut() {
-    let Some(_) = common::gpu() else { return };
-    let mut s = lightcut::renderer::settings::RenderSettings::default();
-    s.gi.method = lightcut::renderer::settings::GiMethod::Slc;
-    s.vpl.count = 1024;
-    s.sampling.cut_size = 16;
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1100.0, 700.0))
-        .wgpu_setup(setup())
-        .build_eframe(move |cc| {
-            WorkbenchApp::new(
-                cc,
-                AppOptions {
-                    scene: "default".into(),
-                    settings: Some(s.clone()),
-                    view: Some(ViewBuffer::CutBlocks),
-                    ..Default::default()
-                },
-            )
-        });
+    let options = AppOptions {
+        settings: Some(slc_settings()),
+        view: Some(ViewBuffer::CutBlocks),
+        ..Default::default()
+    };
+    let Some(mut h) = harness_with(egui::vec2(1100.0, 700.0), options) else {
+        return;
+    };
     h.run_steps(3);
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
     // Click the middle of the viewport (right of the side panel): the floor / wall.
-    let pos = egui::pos2(700.0, 420.0);
-    for pressed in [true, false] {
-        h.input_mut().events.push(egui::Event::PointerMoved(pos));
-        h.input_mut().events.push(egui::Event::PointerButton {
-            pos,
-            button: egui::PointerButton::Primary,
-            pressed,
-            modifiers: Default::default(),
-        });
-        h.run_steps(1);
-    }
+    click(&mut h, egui::pos2(700.0, 420.0));
     h.run_steps(2);
     // The window names the block and lists a full cut (16 nodes) with levels and flags.
     h.get_by_label_contains("Cut of block (");
@@ -160,20 +143,13 @@ fn clicking_a_block_in_the_cut_view_lists_its_cut() {
 
 #[test]
 fn hovering_a_pass_in_the_timings_window_shows_its_output() {
-    let Some(_) = common::gpu() else { return };
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1100.0, 700.0))
-        .wgpu_setup(setup())
-        .build_eframe(|cc| {
-            WorkbenchApp::new(
-                cc,
-                AppOptions {
-                    scene: "default".into(),
-                    timings: true,
-                    ..Default::default()
-                },
-            )
-        });
+    let options = AppOptions {
+        timings: true,
+        ..Default::default()
+    };
+    let Some(mut h) = harness_with(egui::vec2(1100.0, 700.0), options) else {
+        return;
+    };
     h.run_steps(6);
     // The window lists the passes once timestamps came back.
     h.get_by_label_contains("ms GPU over");
@@ -229,28 +205,13 @@ fn the_pixel_values_window_lists_every_buffer_under_the_pointer() {
 }
 
 fn slc_harness(views: Vec<ViewBuffer>, size: egui::Vec2) -> Option<Harness<'static, WorkbenchApp>> {
-    common::gpu()?;
-    let mut s = lightcut::renderer::settings::RenderSettings::default();
-    s.gi.method = lightcut::renderer::settings::GiMethod::Slc;
-    s.vpl.count = 1024;
-    s.sampling.cut_size = 16;
-    Some(
-        Harness::builder()
-            .with_size(size)
-            .wgpu_setup(setup())
-            .build_eframe(move |cc| {
-                WorkbenchApp::new(
-                    cc,
-                    AppOptions {
-                        scene: "default".into(),
-                        settings: Some(s.clone()),
-                        views: views.clone(),
-                        reset_layout: true,
-                        ..Default::default()
-                    },
-                )
-            }),
-    )
+    let options = AppOptions {
+        settings: Some(slc_settings()),
+        views,
+        reset_layout: true,
+        ..Default::default()
+    };
+    harness_with(size, options)
 }
 
 fn click(h: &mut Harness<'_, WorkbenchApp>, pos: egui::Pos2) {
@@ -434,26 +395,19 @@ fn the_sun_sweep_rebuilds_every_frame_and_pause_freezes_the_image() {
 
 #[test]
 fn four_view_layout_snapshot() {
-    let Some(_) = common::gpu() else { return };
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1100.0, 700.0))
-        .wgpu_setup(setup())
-        .build_eframe(|cc| {
-            WorkbenchApp::new(
-                cc,
-                AppOptions {
-                    scene: "default".into(),
-                    views: vec![
-                        ViewBuffer::Final,
-                        ViewBuffer::Normal,
-                        ViewBuffer::Albedo,
-                        ViewBuffer::Depth,
-                    ],
-                    reset_layout: true,
-                    ..Default::default()
-                },
-            )
-        });
+    let options = AppOptions {
+        views: vec![
+            ViewBuffer::Final,
+            ViewBuffer::Normal,
+            ViewBuffer::Albedo,
+            ViewBuffer::Depth,
+        ],
+        reset_layout: true,
+        ..Default::default()
+    };
+    let Some(mut h) = harness_with(egui::vec2(1100.0, 700.0), options) else {
+        return;
+    };
     h.run_steps(4);
     assert_eq!(h.state().layout().view_count(), 4);
     let status = h.get_by_label_contains("GPU: ").rect();
@@ -462,4 +416,132 @@ fn four_view_layout_snapshot() {
         egui::pos2(1100.0, 700.0),
     ));
     h.snapshot("four_views");
+}
+
+fn key(h: &mut Harness<'_, WorkbenchApp>, key: egui::Key) {
+    for pressed in [true, false] {
+        h.input_mut().events.push(egui::Event::Key {
+            key,
+            physical_key: None,
+            pressed,
+            repeat: false,
+            modifiers: Default::default(),
+        });
+    }
+    h.run_steps(1);
+}
+
+#[test]
+fn views_zoom_together_and_an_ab_view_measures_a_rectangle_and_toggles() {
+    use lightcut::renderer::views::{AbMode, AbSource};
+    let Some(mut h) = slc_harness(
+        vec![ViewBuffer::Final, ViewBuffer::AbCompare],
+        egui::vec2(1100.0, 700.0),
+    ) else {
+        return;
+    };
+    // A/B of two live buffers (no ground truth needed): final vs direct.
+    for p in h.state_mut().layout_mut().panes_mut() {
+        p.spec.ab.a = AbSource::Final;
+        p.spec.ab.b = AbSource::Direct;
+    }
+    h.run_steps(3);
+    // Ctrl + wheel over view 1 zooms every view; F fits again.
+    let v1 = h.get_by_label("view 1").rect().center() + egui::vec2(0.0, 150.0);
+    h.input_mut().events.push(egui::Event::PointerMoved(v1));
+    h.input_mut().events.push(egui::Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: egui::vec2(0.0, 60.0),
+        phase: egui::TouchPhase::Move,
+        source: egui::MouseWheelSource::Unknown,
+        modifiers: egui::Modifiers::COMMAND,
+    });
+    h.run_steps(2);
+    let zoom = h.state().layout().transform.zoom;
+    assert!(zoom > 1.0, "ctrl + wheel did not zoom ({zoom})");
+    key(&mut h, egui::Key::F);
+    assert_eq!(h.state().layout().transform.zoom, 1.0, "F did not fit");
+    // 1: one texel per screen pixel: zoom = render width / fitted width in pixels (software
+    // adapters render at half the views' pixels, so about 0.5 there).
+    key(&mut h, egui::Key::Num1);
+    let z1 = h.state().layout().transform.zoom;
+    let (rw, rh) = h.state().renderer().unwrap().size();
+    let px = h.state().layout().panes()[0].rt.size_px.unwrap();
+    let fit_x = px.x.min(px.y * rw as f32 / rh as f32);
+    let want = rw as f32 / fit_x;
+    assert!((z1 - want).abs() < 0.02 * want, "1 set zoom {z1}, want {want}");
+    key(&mut h, egui::Key::F);
+    // Shift + drag on the A/B view selects a rectangle; its metrics follow.
+    let v2 = h.get_by_label("view 2").rect().center() + egui::vec2(0.0, 220.0);
+    h.input_mut()
+        .events
+        .push(egui::Event::ModifiersChanged(egui::Modifiers::SHIFT));
+    h.input_mut().events.push(egui::Event::PointerMoved(v2));
+    h.input_mut().events.push(egui::Event::PointerButton {
+        pos: v2,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::SHIFT,
+    });
+    h.run_steps(1);
+    for k in 1..=6 {
+        h.input_mut().events.push(egui::Event::PointerMoved(
+            v2 + egui::vec2(12.0 * k as f32, 8.0 * k as f32),
+        ));
+        h.run_steps(1);
+    }
+    let end = v2 + egui::vec2(72.0, 48.0);
+    h.input_mut().events.push(egui::Event::PointerButton {
+        pos: end,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::SHIFT,
+    });
+    h.run_steps(1);
+    h.input_mut()
+        .events
+        .push(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.run_steps(2);
+    let ab = h
+        .state()
+        .layout()
+        .panes()
+        .into_iter()
+        .find(|p| p.spec.buffer == ViewBuffer::AbCompare)
+        .unwrap();
+    let [x0, y0, x1, y1] = ab.rect.expect("shift + drag selected no rectangle");
+    assert!(x1 > x0 + 4 && y1 > y0 + 4, "rectangle {:?}", ab.rect);
+    let (whole, part) = ab.rt.metrics.expect("no A/B metrics");
+    let part = part.expect("no metrics of the rectangle");
+    // Final = direct + GI, so A is brighter than B on average.
+    assert!(whole.mean_ratio >= 1.0, "{whole:?}");
+    // The rectangle is measured on its own (it may be unlit: then the ratios are NaN).
+    assert!(
+        part.rmse.is_finite() && part.ssim.is_finite() && part.flip.is_finite(),
+        "{part:?}"
+    );
+    assert_ne!(
+        part.rmse, whole.rmse,
+        "the rectangle's metrics are the whole image's"
+    );
+    // T over the view flips A and B.
+    for p in h.state_mut().layout_mut().panes_mut() {
+        p.spec.ab.mode = AbMode::A;
+    }
+    h.input_mut().events.push(egui::Event::PointerMoved(v2));
+    h.run_steps(1);
+    key(&mut h, egui::Key::T);
+    let mode = |h: &Harness<'_, WorkbenchApp>| {
+        h.state()
+            .layout()
+            .panes()
+            .into_iter()
+            .find(|p| p.spec.buffer == ViewBuffer::AbCompare)
+            .unwrap()
+            .spec
+            .ab
+            .mode
+    };
+    assert_eq!(mode(&h), AbMode::B, "T did not toggle");
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }

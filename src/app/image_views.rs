@@ -181,9 +181,10 @@ impl Layout {
     /// replaces the main view's buffer) and each pane's slot.
     pub fn assign_slots(&mut self, main_override: Option<ViewBuffer>) -> Vec<ViewSpec> {
         let ids = self.pane_ids();
+        let active = self.tree.active_tiles();
         let mut specs = Vec::new();
         for (k, (_, tid)) in ids.iter().enumerate() {
-            let visible = self.tree.is_visible(*tid) && self.tree.active_tiles().contains(tid);
+            let visible = self.tree.is_visible(*tid) && active.contains(tid);
             if let Some(egui_tiles::Tile::Pane(p)) = self.tree.tiles.get_mut(*tid) {
                 if visible || (k == 0 && specs.is_empty()) {
                     let mut spec = p.spec;
@@ -726,17 +727,11 @@ fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
             egui::Color32::from_gray(220),
         );
     }
-    draw_legend(cx, ui, &painter, rect, pane);
+    draw_legend(cx, &painter, rect, pane);
     response
 }
 
-fn draw_legend(
-    cx: &PaneContext<'_>,
-    ui: &egui::Ui,
-    painter: &egui::Painter,
-    rect: egui::Rect,
-    pane: &ViewPane,
-) {
+fn draw_legend(cx: &PaneContext<'_>, painter: &egui::Painter, rect: egui::Rect, pane: &ViewPane) {
     use super::{Scale, legend_with};
     let shown = pane.spec.buffer;
     let look = pane.spec.look;
@@ -749,7 +744,6 @@ fn draw_legend(
             | ViewBuffer::GroundTruthIndirect
     );
     let ab = pane.spec.effective_ab();
-    let _ = ui;
     if radiance && look.false_color {
         let what = match look.channel {
             Channel::Rgb | Channel::Luminance => "luminance",

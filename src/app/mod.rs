@@ -1078,16 +1078,16 @@ impl WorkbenchApp {
             && renderer.compare_progress().is_some_and(|p| p.finished())
         {
             self.last_metrics_time = now;
-            match (
-                renderer.read(crate::renderer::Buffer::Indirect),
-                renderer.read(crate::renderer::Buffer::GroundTruthIndirect),
+            let look = crate::renderer::views::ViewLook::from_display(&self.settings.display);
+            match ab_metrics(
+                renderer,
+                AbSource::Indirect,
+                AbSource::GroundTruthIndirect,
+                &look,
+                None,
             ) {
-                (Ok(a), Ok(b)) if (a.width, a.height) == (b.width, b.height) => {
-                    let d = &self.settings.display;
-                    self.compare_metrics = Some(crate::metrics::compare(&a, &b, d.exposure_ev, d.tonemap));
-                }
-                (Err(e), _) | (_, Err(e)) => self.errors.push(format!("comparison readback: {e}")),
-                _ => {}
+                Ok(m) => self.compare_metrics = m.map(|m| m.0),
+                Err(e) => self.errors.push(format!("comparison readback: {e}")),
             }
         } else if !comparing {
             self.compare_metrics = None;
@@ -1167,21 +1167,16 @@ impl WorkbenchApp {
                     _ => {}
                 }
             }
-            p.rt.metrics = match (renderer.read_ab_source(ab.a), renderer.read_ab_source(ab.b)) {
-                (Ok(Some(a)), Ok(Some(b))) if (a.width, a.height) == (b.width, b.height) => {
-                    let l = p.spec.look;
-                    let whole = crate::metrics::compare(&a, &b, l.exposure_ev, l.tonemap);
-                    let part = p.rect.filter(|r| r[2] > r[0] && r[3] > r[1]).map(|r| {
-                        let (ca, cb) = (crate::metrics::crop(&a, r), crate::metrics::crop(&b, r));
-                        crate::metrics::compare(&ca, &cb, l.exposure_ev, l.tonemap)
-                    });
-                    Some((whole, part))
+            p.rt.metrics = match ab_metrics(renderer, ab.a, ab.b, &p.spec.look, p.rect) {
+                Ok(None) => {
+                    p.rt.metrics_note = Some("no metrics: A or B is missing, or their sizes differ".into());
+                    None
                 }
-                (Err(e), _) | (_, Err(e)) => {
+                Ok(m) => m,
+                Err(e) => {
                     self.errors.push(format!("A/B readback: {e}"));
                     None
                 }
-                _ => None,
             };
         }
         // Pixel values under the pointer (camera-space views; P pins / unpins, a click pins).
@@ -1536,6 +1531,29 @@ fn lights_with_sun(scene: &Scene, sun: Option<&SunControls>) -> Vec<DirectionalL
         *l0 = sun.to_light(&l0.name);
     }
     lights
+}
+
+/// Metrics of A against B (the display transform of `look` for SSIM and FLIP), and of the
+/// rectangle [x0, y0, x1, y1] when one is given; None when either image does not exist now.
+type AbMetrics = (crate::metrics::Metrics, Option<crate::metrics::Metrics>);
+fn ab_metrics(
+    r: &Renderer,
+    a: AbSource,
+    b: AbSource,
+    look: &crate::renderer::views::ViewLook,
+    rect: Option<[u32; 4]>,
+) -> Result<Option<AbMetrics>, crate::renderer::context::GpuError> {
+    let (Some(a), Some(b)) = (r.read_ab_source(a)?, r.read_ab_source(b)?) else {
+        return Ok(None);
+    };
+    if (a.width, a.height) != (b.width, b.height) {
+        return Ok(None);
+    }
+    let m = |a: &_, b: &_| crate::metrics::compare(a, b, look.exposure_ev, look.tonemap);
+    let part = rect
+        .filter(|r| r[2] > r[0] && r[3] > r[1])
+        .map(|r| m(&crate::metrics::crop(&a, r), &crate::metrics::crop(&b, r)));
+    Ok(Some((m(&a, &b), part)))
 }
 
 /// A file name in `dir` that does not exist yet: `stem_NNN.ext`.

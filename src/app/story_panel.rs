@@ -31,9 +31,10 @@ pub struct StoryPanel {
     normal: Vec3,
     albedo: Vec3,
     gi: Vec3,
-    /// The tree of the traced frame.
-    nodes: Vec<SstNode>,
+    /// The nodes on the traced paths (read alone, not the whole tree) and the usable flags.
+    nodes: std::collections::HashMap<u32, SstNode>,
     flags: Vec<u32>,
+    leaves: u32,
     /// (nodes, usable) per level.
     levels: Vec<(u32, u32)>,
     read_at: f64,
@@ -80,9 +81,29 @@ impl StoryPanel {
             self.note = "no story: the pixel sees no geometry (or the frame has not run yet)".into();
             return Ok(());
         }
-        let (nodes, flags) = r.read_tree().map_err(|e| e.to_string())?;
-        self.levels = crate::reference::sst_tree::stats(&nodes, &flags).per_level;
-        self.nodes = nodes;
+        // Only the nodes the samples visited (a large tree is not read back twice a second).
+        let mut ids: Vec<u32> = self
+            .trace
+            .iter()
+            .flat_map(|t| &t.samples)
+            .flat_map(|s| std::iter::once(s.start).chain(s.path.iter().map(|p| p.0)))
+            .filter(|&n| n != 0)
+            .collect();
+        ids.sort_unstable();
+        ids.dedup();
+        let (nodes, flags) = r.read_tree_nodes(&ids).map_err(|e| e.to_string())?;
+        self.leaves = r.tree_buffers().1.leaves;
+        let levels = self.leaves.max(1).ilog2() + 1;
+        // Per level: its nodes (padding included) and how many are usable.
+        self.levels = (0..levels)
+            .map(|l| {
+                let usable = ((1u32 << l)..(2u32 << l))
+                    .filter(|&n| flag(&flags, n as usize))
+                    .count() as u32;
+                (1 << l, usable)
+            })
+            .collect();
+        self.nodes = ids.into_iter().zip(nodes).collect();
         self.flags = flags;
         if let Some((x, y)) = pixel {
             let rows = r.read_pixel(x, y).map_err(|e| e.to_string())?;
@@ -100,11 +121,11 @@ impl StoryPanel {
     }
 
     fn node(&self, n: u32) -> SstNode {
-        self.nodes.get(n as usize).copied().unwrap_or(SstNode::EMPTY)
+        self.nodes.get(&n).copied().unwrap_or(SstNode::EMPTY)
     }
 
     fn leaves(&self) -> u32 {
-        (self.nodes.len() / 2) as u32
+        self.leaves
     }
 
     fn usable(&self, n: u32) -> bool {

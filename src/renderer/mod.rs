@@ -1210,6 +1210,28 @@ impl Renderer {
         Ok((nodes.iter().map(SstNode::decode).collect(), flags))
     }
 
+    /// Nodes `ids` of the frame's tree (one submission; ids past the tree read as empty)
+    /// and the usable flags, without reading the whole tree back.
+    pub fn read_tree_nodes(&self, ids: &[u32]) -> Result<(Vec<SstNode>, Vec<u32>), GpuError> {
+        const NODE: u64 = std::mem::size_of::<gpu_data::GpuSstNode>() as u64;
+        let count = self.tree.nodes.size() / NODE;
+        let inside: Vec<u32> = ids.iter().copied().filter(|&i| (i as u64) < count).collect();
+        let ranges: Vec<(u64, u64)> = inside.iter().map(|&i| (i as u64 * NODE, NODE)).collect();
+        let bytes = readback::read_buffer_ranges(&self.ctx, &self.tree.nodes, &ranges)?;
+        let mut decoded = bytes
+            .iter()
+            .map(|b| SstNode::decode(&bytemuck::pod_read_unaligned(b)));
+        let nodes = ids
+            .iter()
+            .map(|&i| match (i as u64) < count {
+                true => decoded.next().unwrap_or(SstNode::EMPTY),
+                false => SstNode::EMPTY,
+            })
+            .collect();
+        let flags = passes::sst_build::read_flags(&self.ctx, &self.tree)?;
+        Ok((nodes, flags))
+    }
+
     /// Freezes (or thaws) the VPLs and the light tree: while frozen, frames reuse the last
     /// VPLs, sort and tree (the camera can move around them), and a change of v_min /
     /// sigma_max re-runs only the classify pass.
@@ -1563,23 +1585,22 @@ impl Renderer {
     /// The texture of view `slot` of the last `render_views` (0 = [`Renderer::view_texture`]);
     /// None past the views rendered.
     pub fn view_texture_at(&self, slot: usize) -> Option<(&wgpu::Texture, &wgpu::TextureView, u64)> {
-        let t = if slot == 0 {
-            &self.targets.view
-        } else {
-            self.extra_views.get(slot - 1)?
-        };
+        let t = self.view_target(slot)?;
         Some((&t.texture, &t.view, t.generation))
+    }
+
+    fn view_target(&self, slot: usize) -> Option<&ViewTarget> {
+        match slot {
+            0 => Some(&self.targets.view),
+            _ => self.extra_views.get(slot - 1),
+        }
     }
 
     /// Reads view `slot` (sRGB-encoded RGBA8, as shown).
     pub fn read_view_rgba8_at(&self, slot: usize) -> Result<(u32, u32, Vec<u8>), GpuError> {
-        let t = if slot == 0 {
-            &self.targets.view
-        } else {
-            self.extra_views
-                .get(slot - 1)
-                .ok_or_else(|| GpuError::Readback(format!("no view {slot}")))?
-        };
+        let t = self
+            .view_target(slot)
+            .ok_or_else(|| GpuError::Readback(format!("no view {slot}")))?;
         let bytes = readback::read_texture_bytes(&self.ctx, &t.texture, 0)?;
         Ok((t.size.0, t.size.1, bytes))
     }
@@ -1587,31 +1608,11 @@ impl Renderer {
     /// Copies a live radiance buffer into a new snapshot (replacing the oldest past
     /// [`views::MAX_SNAPSHOTS`]); returns its index.
     pub fn take_snapshot(&mut self, src: AbSource, label: String) -> Result<u32, String> {
-        let (tex, size) = {
-            let l = &self.targets.lighting;
-            let cmp = self
-                .compare
-                .as_ref()
-                .filter(|c| c.targets_size == self.targets.size);
-            match src {
-                AbSource::Final => (&l.final_, self.targets.size),
-                AbSource::Direct => (&l.direct, self.targets.size),
-                AbSource::Indirect => (&l.indirect, self.targets.size),
-                AbSource::GroundTruthIndirect => (
-                    &cmp.ok_or("the ground-truth comparison is not running")?
-                        .targets
-                        .indirect,
-                    self.targets.size,
-                ),
-                AbSource::GroundTruthFinal => (
-                    &cmp.ok_or("the ground-truth comparison is not running")?
-                        .targets
-                        .final_,
-                    self.targets.size,
-                ),
-                AbSource::Snapshot(_) => return Err("a snapshot of a snapshot is the snapshot".into()),
-            }
-        };
+        if matches!(src, AbSource::Snapshot(_)) {
+            return Err("a snapshot of a snapshot is the snapshot".into());
+        }
+        let (tex, _, size) = ab_texture(&self.targets, self.compare.as_ref(), &self.snapshots, src)
+            .ok_or("the ground-truth comparison is not running")?;
         let device = &self.ctx.device;
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("views::snapshot"),
@@ -1656,29 +1657,10 @@ impl Renderer {
 
     /// Reads an A/B source back as linear floats (None: it does not exist now).
     pub fn read_ab_source(&self, src: AbSource) -> Result<Option<ImageF32>, GpuError> {
-        let cmp = self
-            .compare
-            .as_ref()
-            .filter(|c| c.targets_size == self.targets.size);
-        let l = &self.targets.lighting;
-        let tex = match src {
-            AbSource::Final => &l.final_,
-            AbSource::Direct => &l.direct,
-            AbSource::Indirect => &l.indirect,
-            AbSource::GroundTruthIndirect => match cmp {
-                Some(c) => &c.targets.indirect,
-                None => return Ok(None),
-            },
-            AbSource::GroundTruthFinal => match cmp {
-                Some(c) => &c.targets.final_,
-                None => return Ok(None),
-            },
-            AbSource::Snapshot(i) => match self.snapshots.get(i as usize) {
-                Some(s) => &s.texture,
-                None => return Ok(None),
-            },
-        };
-        readback::read_texture_f32(&self.ctx, tex, 0).map(Some)
+        match ab_texture(&self.targets, self.compare.as_ref(), &self.snapshots, src) {
+            Some((tex, _, _)) => readback::read_texture_f32(&self.ctx, tex, 0).map(Some),
+            None => Ok(None),
+        }
     }
 
     /// Picks up finished readbacks (timings, flux total) without blocking; returns the latest
@@ -1741,9 +1723,7 @@ impl Renderer {
 
     /// Reads the view texture (sRGB-encoded RGBA8, as shown).
     pub fn read_view_rgba8(&self) -> Result<(u32, u32, Vec<u8>), GpuError> {
-        let t = &self.targets.view;
-        let bytes = readback::read_texture_bytes(&self.ctx, &t.texture, 0)?;
-        Ok((t.size.0, t.size.1, bytes))
+        self.read_view_rgba8_at(0)
     }
 }
 
@@ -1768,22 +1748,35 @@ fn clear_view(enc: &mut wgpu::CommandEncoder, view: &wgpu::TextureView) {
 }
 
 /// The radiance texture of an A/B source and its size (None: it does not exist now).
+/// An A/B source's radiance texture, its view and its size (None: it does not exist now).
+/// A free function so that `record_view` can borrow the passes mutably beside it.
+fn ab_texture<'a>(
+    targets: &'a FrameTargets,
+    compare: Option<&'a CompareState>,
+    snapshots: &'a [views::Snapshot],
+    src: AbSource,
+) -> Option<(&'a wgpu::Texture, &'a wgpu::TextureView, (u32, u32))> {
+    let l = &targets.lighting;
+    let cmp = || compare.filter(|c| c.targets_size == targets.size);
+    let size = targets.size;
+    match src {
+        AbSource::Final => Some((&l.final_, &l.final_view, size)),
+        AbSource::Direct => Some((&l.direct, &l.direct_view, size)),
+        AbSource::Indirect => Some((&l.indirect, &l.indirect_view, size)),
+        AbSource::GroundTruthIndirect => cmp().map(|c| (&c.targets.indirect, &c.targets.indirect_view, size)),
+        AbSource::GroundTruthFinal => cmp().map(|c| (&c.targets.final_, &c.targets.final_view, size)),
+        AbSource::Snapshot(i) => snapshots.get(i as usize).map(|s| (&s.texture, &s.view, s.size)),
+    }
+}
+
+/// The view and size of an A/B source (see [`ab_texture`]).
 fn ab_source<'a>(
     targets: &'a FrameTargets,
     compare: Option<&'a CompareState>,
     snapshots: &'a [views::Snapshot],
     src: AbSource,
 ) -> Option<(&'a wgpu::TextureView, (u32, u32))> {
-    let l = &targets.lighting;
-    let cmp = || compare.filter(|c| c.targets_size == targets.size);
-    match src {
-        AbSource::Final => Some((&l.final_view, targets.size)),
-        AbSource::Direct => Some((&l.direct_view, targets.size)),
-        AbSource::Indirect => Some((&l.indirect_view, targets.size)),
-        AbSource::GroundTruthIndirect => cmp().map(|c| (&c.targets.indirect_view, targets.size)),
-        AbSource::GroundTruthFinal => cmp().map(|c| (&c.targets.final_view, targets.size)),
-        AbSource::Snapshot(i) => snapshots.get(i as usize).map(|s| (&s.view, s.size)),
-    }
+    ab_texture(targets, compare, snapshots, src).map(|(_, v, size)| (v, size))
 }
 
 /// Hashes what a frame's image depends on besides the settings: camera, lights, size.

@@ -241,9 +241,22 @@ pub fn read_buffer_range(
     offset: u64,
     size: u64,
 ) -> Result<Vec<u8>, GpuError> {
+    Ok(read_buffer_ranges(ctx, src, &[(offset, size)])?
+        .pop()
+        .unwrap_or_default())
+}
+
+/// Reads several (offset, size) ranges (multiples of 4) of a storage buffer with one
+/// submission, in order.
+pub fn read_buffer_ranges(
+    ctx: &GpuContext,
+    src: &wgpu::Buffer,
+    ranges: &[(u64, u64)],
+) -> Result<Vec<Vec<u8>>, GpuError> {
+    let total: u64 = ranges.iter().map(|r| r.1).sum();
     let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback::range"),
-        size: size.max(4),
+        size: total.max(4),
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
@@ -252,9 +265,22 @@ pub fn read_buffer_range(
         .create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("readback::encoder"),
         });
-    enc.copy_buffer_to_buffer(src, offset, &staging, 0, size);
+    let mut at = 0;
+    for &(offset, size) in ranges {
+        enc.copy_buffer_to_buffer(src, offset, &staging, at, size);
+        at += size;
+    }
     ctx.queue.submit([enc.finish()]);
-    read_buffer_bytes(ctx, &staging)
+    let bytes = read_buffer_bytes(ctx, &staging)?;
+    let mut at = 0usize;
+    Ok(ranges
+        .iter()
+        .map(|&(_, size)| {
+            let v = bytes[at..at + size as usize].to_vec();
+            at += size as usize;
+            v
+        })
+        .collect())
 }
 
 /// Reads a float colour or depth texture as RGBA f32 (depth goes to all of rgb, a = 1;

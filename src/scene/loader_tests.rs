@@ -1016,6 +1016,14 @@ fn camera_bookmarks_append_to_a_preset_and_load_as_cameras() {
     assert_eq!(pr.bookmarks.len(), 2);
     let b = &pr.bookmarks[0];
     assert_eq!(b.name, "desk view");
+    // Opening the preset lists the bookmarks among the scene's cameras.
+    one_triangle().write(&dir, "m", ONE_NODE);
+    let opened = open_scene(&SceneSource::Preset(p.clone())).unwrap();
+    let names: Vec<&str> = opened.scene.cameras.iter().map(|c| c.name.as_str()).collect();
+    assert!(
+        names.contains(&"desk view") && names.contains(&"second"),
+        "{names:?}"
+    );
     let back = b.camera(100.0);
     assert!((back.position - cam.position).length() < 1e-3);
     assert!((back.forward - cam.forward).length() < 1e-3);
