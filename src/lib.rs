@@ -4,6 +4,7 @@
 pub mod app;
 pub mod cli;
 pub mod export;
+pub mod harness;
 pub mod metrics;
 #[doc(hidden)]
 pub mod reference;

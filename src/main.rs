@@ -3,7 +3,7 @@
 use clap::Parser;
 use lightcut::{
     app::{AppOptions, run_gui},
-    cli::{Cli, Command, bench, compare, export_scene, render, sheet},
+    cli::{Cli, Command, bench, compare, export_scene, render, results, sheet},
 };
 
 fn main() {
@@ -19,6 +19,7 @@ fn main() {
         Some(Command::ExportScene(args)) => export_scene::run(args),
         Some(Command::Compare(args)) => compare::run(args),
         Some(Command::Sheet(args)) => sheet::run(args),
+        Some(Command::Results(args)) => results::run(args),
         None => {
             let settings = cli.settings.as_ref().map(|p| {
                 lightcut::cli::SettingsArgs {

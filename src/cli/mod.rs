@@ -4,6 +4,7 @@ pub mod bench;
 pub mod compare;
 pub mod export_scene;
 pub mod render;
+pub mod results;
 pub mod sheet;
 
 use clap::{Args, Parser, Subcommand};
@@ -82,6 +83,10 @@ pub enum Command {
     /// A comparison sheet: methods side by side on the same VPLs, their error maps against
     /// the ground truth, and captions (method, settings, RMSE, SSIM, FLIP, GPU time).
     Sheet(sheet::SheetArgs),
+    /// Thesis chapter 7's evaluation, one figure per name (timings, equal-time, steps,
+    /// blocks, blending, upsampling, scaling): CSV, PNG plots and images per scene, the
+    /// ratio checks in checks.csv.
+    Results(results::ResultsArgs),
 }
 
 /// Settings flags shared by the commands (override a settings file, which overrides defaults).

@@ -1665,6 +1665,11 @@ impl Renderer {
 
     /// Picks up finished readbacks (timings, flux total) without blocking; returns the latest
     /// per-pass GPU timings, or None if not (yet) available.
+    /// Blocks until the GPU has finished all submitted work (wall-clock timing of frames).
+    pub fn wait_idle(&self) {
+        let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+    }
+
     pub fn poll_timings(&mut self) -> Option<PassTimings> {
         let t = self.timer.collect(&self.ctx.device).cloned();
         self.take_flux_total();

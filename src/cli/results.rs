@@ -1,0 +1,278 @@
+//! `results`: thesis chapter 7's evaluation, one figure per name (`crate::harness::figures`),
+//! on one or more scenes, into `<out>/<scene>/` (CSV, PNG plots, images), with the issue's
+//! ratio checks in `<out>/checks.csv` and a `<out>/run.json` of the machine and settings.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, anyhow, bail};
+use clap::{Args, ValueEnum};
+
+use super::SettingsArgs;
+use crate::{
+    harness::{
+        Bench, Csv,
+        figures::{self, Check, Opts},
+        num,
+    },
+    renderer::{Renderer, context::GpuContext},
+    scene::preset::{SceneSource, open_scene},
+};
+
+/// A figure of thesis chapter 7.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Figure {
+    /// Every figure below.
+    All,
+    /// Table 7.1: GPU time per pass (mean and spread over many frames).
+    Timings,
+    /// Fig. 7.1 / 7.3: RMSE and SSIM over frame time for SLC, RTSLC, SST; equal-time table.
+    EqualTime,
+    /// Fig. 7.2: traversal steps per pixel of the three samplers, heat maps.
+    Steps,
+    /// Fig. 7.5: block size sweep (cut build time, frame time, RMSE).
+    Blocks,
+    /// Fig. 7.4 / 7.6: no blending vs blending; mock cut vs averaging vs root vs recomputed cut.
+    Blending,
+    /// Table 7.2: full vs half GI resolution.
+    Upsampling,
+    /// VPL count sweep: tree build time, GI time, RMSE.
+    Scaling,
+}
+
+const ORDER: [Figure; 7] = [
+    Figure::Timings,
+    Figure::Steps,
+    Figure::EqualTime,
+    Figure::Blocks,
+    Figure::Blending,
+    Figure::Upsampling,
+    Figure::Scaling,
+];
+
+#[derive(Args, Debug)]
+pub struct ResultsArgs {
+    /// Figures to make (comma-separated).
+    #[arg(value_enum, value_delimiter = ',', default_value = "all")]
+    pub figures: Vec<Figure>,
+    /// Scenes, comma-separated: presets (.toml), glTF files or `default`.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "scenes/sponza.toml,scenes/breakfast_room.toml"
+    )]
+    pub scenes: Vec<String>,
+    #[arg(long, default_value_t = 192)]
+    pub width: u32,
+    #[arg(long, default_value_t = 108)]
+    pub height: u32,
+    /// Independent frames per configuration (metrics are per-frame means; the first frame
+    /// of a configuration is not timed when there are two or more).
+    #[arg(long, default_value_t = 4)]
+    pub frames: u32,
+    /// Frames of the per-pass timing table.
+    #[arg(long, default_value_t = 20)]
+    pub timing_frames: u32,
+    /// Samples per pixel of the equal-time sweep (the base cut size is always added).
+    #[arg(long, value_delimiter = ',', default_value = "2,4,8,16,32,64")]
+    pub spp: Vec<u32>,
+    /// Block sizes of the block sweep.
+    #[arg(long, value_delimiter = ',', default_value = "1,2,4,8,16,32")]
+    pub blocks: Vec<u32>,
+    /// log2 of the VPL counts of the scaling sweep.
+    #[arg(long, value_delimiter = ',', default_value = "10,11,12,13,14,15,16")]
+    pub vpl_exponents: Vec<u32>,
+    /// Frame size of the scaling sweep (it needs a ground truth per VPL count).
+    #[arg(long, default_value_t = 80)]
+    pub scaling_width: u32,
+    #[arg(long, default_value_t = 45)]
+    pub scaling_height: u32,
+    /// Frame sizes of the upsampling table, as multiples of --width/--height.
+    #[arg(long, value_delimiter = ',', default_value = "1,1.5")]
+    pub upsampling_scales: Vec<f32>,
+    /// Results folder (one sub-folder per scene).
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    /// Number of VPLs (default 4096, as the thesis).
+    #[arg(long)]
+    pub vpls: Option<u32>,
+    #[arg(long)]
+    pub seed: Option<u32>,
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+}
+
+impl ResultsArgs {
+    fn opts(&self) -> anyhow::Result<Opts> {
+        if !(16..=4096).contains(&self.width) || !(16..=4096).contains(&self.height) {
+            bail!(
+                "--width/--height must be 16..=4096 (got {}x{})",
+                self.width,
+                self.height
+            );
+        }
+        if !(8..=4096).contains(&self.scaling_width) || !(8..=4096).contains(&self.scaling_height) {
+            bail!("--scaling-width/--scaling-height must be 8..=4096");
+        }
+        if !(1..=1000).contains(&self.frames) || !(1..=10000).contains(&self.timing_frames) {
+            bail!("--frames must be 1..=1000 and --timing-frames 1..=10000");
+        }
+        if self.spp.is_empty() || self.spp.iter().any(|n| !(1..=64).contains(n)) {
+            bail!("--spp: samples per pixel must be 1..=64 (the cut size limit)");
+        }
+        if self.blocks.is_empty() || self.blocks.iter().any(|k| !(1..=64).contains(k)) {
+            bail!("--blocks: block sizes must be 1..=64");
+        }
+        if self.vpl_exponents.is_empty() || self.vpl_exponents.iter().any(|e| !(4..=20).contains(e)) {
+            bail!("--vpl-exponents must be 4..=20 (16 .. 2^20 VPLs)");
+        }
+        if self.upsampling_scales.is_empty()
+            || self.upsampling_scales.iter().any(|s| !(0.25..=8.0).contains(s))
+        {
+            bail!("--upsampling-scales must be 0.25..=8");
+        }
+        Ok(Opts {
+            size: (self.width, self.height),
+            frames: self.frames,
+            timing_frames: self.timing_frames,
+            spp: self.spp.clone(),
+            blocks: self.blocks.clone(),
+            vpl_exponents: self.vpl_exponents.clone(),
+            scaling_size: (self.scaling_width, self.scaling_height),
+            upsampling_scales: self.upsampling_scales.clone(),
+        })
+    }
+}
+
+/// The folder name of a scene argument.
+fn scene_label(arg: &str) -> String {
+    std::path::Path::new(arg)
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scene")
+        .to_string()
+}
+
+pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
+    let o = args.opts()?;
+    let figures: Vec<Figure> = if args.figures.contains(&Figure::All) {
+        ORDER.to_vec()
+    } else {
+        ORDER
+            .iter()
+            .copied()
+            .filter(|f| args.figures.contains(f))
+            .collect()
+    };
+    // Open every scene first, so that a broken one fails before hours of work.
+    let mut opened = Vec::new();
+    for s in &args.scenes {
+        let sc = open_scene(&SceneSource::from_arg(s)).map_err(|e| anyhow!("{s}: {e}"))?;
+        opened.push((s.clone(), sc));
+    }
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let mut checks: Vec<Check> = Vec::new();
+    let mut run_info = Vec::new();
+    let started = std::time::Instant::now();
+    for (arg, sc) in opened {
+        let label = scene_label(&arg);
+        let dir = args.out.join(&label);
+        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let mut settings = args.settings.resolve(sc.exposure_ev)?;
+        if let Some(v) = args.vpls {
+            settings.vpl.count = v;
+        }
+        if let Some(v) = args.seed {
+            settings.vpl.seed = v;
+        }
+        settings.validate().map_err(|e| anyhow!("{e}"))?;
+        let camera = sc
+            .scene
+            .camera_or_default(sc.camera_name.as_deref())
+            .map_err(|e| anyhow!("{e}"))?;
+        let ctx = GpuContext::new_headless()?;
+        let adapter = ctx.describe();
+        println!(
+            "== {label}: {}x{}, camera '{}', adapter {adapter}",
+            o.size.0, o.size.1, camera.name
+        );
+        let r = Renderer::new(ctx, &sc.scene, o.size, settings.clone())?;
+        let mut b = Bench::new(
+            r,
+            camera.clone(),
+            sc.scene.lights.clone(),
+            settings,
+            label.clone(),
+            adapter.clone(),
+        );
+        for f in &figures {
+            let t = std::time::Instant::now();
+            let rep = match f {
+                Figure::Timings => figures::timings(&mut b, &o, &dir)?,
+                Figure::EqualTime => figures::equal_time(&mut b, &o, &dir)?,
+                Figure::Steps => figures::steps(&mut b, &o, &dir)?,
+                Figure::Blocks => figures::blocks(&mut b, &o, &dir)?,
+                Figure::Blending => figures::blending(&mut b, &o, &dir)?,
+                Figure::Upsampling => figures::upsampling(&mut b, &o, &dir)?,
+                Figure::Scaling => figures::scaling(&mut b, &o, &dir)?,
+                Figure::All => unreachable!("expanded above"),
+            };
+            print!("{}", rep.table);
+            for c in &rep.checks {
+                println!("  check: {}", c.line());
+            }
+            println!("  ({:?} took {:.0} s)", f, t.elapsed().as_secs_f64());
+            checks.extend(rep.checks);
+        }
+        run_info.push(serde_json::json!({
+            "scene": label,
+            "scene_arg": arg,
+            "camera": camera.name,
+            "triangles": sc.scene.triangle_count(),
+            "adapter": adapter,
+            "settings": b.base,
+            "gi_exposure_ev": b.gi_exposure,
+        }));
+    }
+    let mut csv = Csv::new(&["scene", "check", "value", "limit", "kind", "met", "detail"]);
+    for c in &checks {
+        csv.row(vec![
+            c.scene.clone(),
+            c.name.clone(),
+            num(c.value),
+            num(c.limit),
+            if c.at_least { "at least" } else { "at most" }.into(),
+            c.pass().to_string(),
+            c.detail.clone(),
+        ]);
+    }
+    if !checks.is_empty() {
+        csv.write(&args.out.join("checks.csv"))?;
+        println!("== checks (value vs limit):");
+        for c in &checks {
+            println!("  {}", c.line());
+        }
+    }
+    let info = serde_json::json!({
+        "command": std::env::args().collect::<Vec<_>>().join(" "),
+        "width": o.size.0,
+        "height": o.size.1,
+        "frames": o.frames,
+        "timing_frames": o.timing_frames,
+        "spp": o.spp,
+        "blocks": o.blocks,
+        "vpl_exponents": o.vpl_exponents,
+        "scaling_size": [o.scaling_size.0, o.scaling_size.1],
+        "upsampling_scales": o.upsampling_scales,
+        "seconds": started.elapsed().as_secs_f64(),
+        "scenes": run_info,
+    });
+    let p = args.out.join("run.json");
+    std::fs::write(&p, serde_json::to_string_pretty(&info)?)
+        .with_context(|| format!("cannot write {}", p.display()))?;
+    println!(
+        "wrote {} ({:.0} s)",
+        args.out.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}

@@ -1,0 +1,445 @@
+//! The research harness: thesis chapter 7's evaluation regenerated headlessly, one function per
+//! figure ([`figures`]), each writing CSV + PNG plots ([`plot`]) + images into a results folder
+//! and returning a short table and the ratio checks of issue 7.
+//!
+//! [`Bench`] owns a renderer on one scene and measures configurations: `frames` independent
+//! frames each (new random numbers per frame, nothing accumulated: a real-time frame's error),
+//! with per-pass GPU timestamps, the wall-clock time of each frame (render, submit, wait until
+//! the GPU is idle) and the RMSE / SSIM of each frame's GI against the ground truth of the same
+//! VPLs (every VPL at every pixel with a shadow ray, thesis chapter 7). The VPLs do not animate,
+//! so every frame regenerates the same VPLs and tree; a checksum of the VPLs taken with the
+//! ground truth is compared after every configuration, so a mismatch cannot go unnoticed.
+
+pub mod figures;
+pub mod plot;
+
+use std::{collections::HashMap, path::Path, time::Instant};
+
+use anyhow::{Context, anyhow, bail};
+
+use crate::{
+    metrics,
+    reference::display,
+    renderer::{
+        Buffer, FrameInput, Renderer,
+        passes::slc::SamplingStats,
+        readback::ImageF32,
+        settings::{GiMethod, RenderSettings, ViewBuffer},
+    },
+    scene::{Camera, DirectionalLight},
+};
+
+/// GPU passes grouped as the columns of thesis table 7.1.
+pub const PASS_GROUPS: [(&str, &[&str]); 8] = [
+    ("G-buffer", &["gbuffer"]),
+    ("shadow map", &["rsm"]),
+    (
+        "VPL generation",
+        &["brsm_importance", "brsm_filter", "pdf_pyramid", "vpl_warp"],
+    ),
+    ("sort VPLs", &["sst_keys", "sst_sort"]),
+    ("build SST", &["sst_build", "sst_classify"]),
+    ("light cuts", &["slc_cuts"]),
+    (
+        "GI",
+        &[
+            "slc_sample",
+            "sst_sample",
+            "rtslc_sample",
+            "gi_downsample",
+            "gi_upsample",
+        ],
+    ),
+    ("direct light", &["direct"]),
+];
+
+/// The GI passes of a tree sampler (cuts included).
+pub const GI_PASSES: [&str; 6] = [
+    "slc_cuts",
+    "slc_sample",
+    "sst_sample",
+    "rtslc_sample",
+    "gi_downsample",
+    "gi_upsample",
+];
+
+/// Mean and sample standard deviation.
+pub fn mean_std(v: &[f64]) -> (f64, f64) {
+    if v.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let var = if v.len() > 1 {
+        v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)
+    } else {
+        0.0
+    };
+    (m, var.sqrt())
+}
+
+/// What one configuration measured over its frames.
+#[derive(Clone, Debug, Default)]
+pub struct Measured {
+    /// Wall-clock ms per frame (render + submit + wait), timed frames only.
+    pub frame_ms: Vec<f64>,
+    /// GPU timestamps per pass, one entry per timed frame.
+    pub passes: Vec<Vec<(String, f64)>>,
+    /// Per frame: GI against the ground truth (tree samplers with a ground truth).
+    pub rmse: Vec<f64>,
+    pub ssim: Vec<f64>,
+    pub flip: Vec<f64>,
+    pub mean_ratio: Vec<f64>,
+    /// Per frame: RMSE over the pixels without a similar cut only (NaN when there are none).
+    pub rmse_fallback: Vec<f64>,
+    /// Sampler statistics summed over the frames.
+    pub stats: Option<SamplingStats>,
+    /// The last frame's GI.
+    pub indirect: Option<ImageF32>,
+    /// The last frame's traversal steps per traversal, per GI pixel (NaN without geometry).
+    pub steps: Option<(u32, u32, Vec<f32>)>,
+    /// The last frame's pixels without a similar cut.
+    pub fallback: Option<Vec<bool>>,
+}
+
+impl Measured {
+    pub fn frame_ms(&self) -> (f64, f64) {
+        mean_std(&self.frame_ms)
+    }
+    /// Mean GPU time of a group of passes over the timed frames.
+    pub fn pass_ms(&self, names: &[&str]) -> (f64, f64) {
+        let per_frame: Vec<f64> = self
+            .passes
+            .iter()
+            .map(|f| {
+                f.iter()
+                    .filter(|(n, _)| names.contains(&n.as_str()))
+                    .map(|(_, t)| t)
+                    .sum()
+            })
+            .collect();
+        mean_std(&per_frame)
+    }
+    pub fn rmse(&self) -> (f64, f64) {
+        mean_std(&self.rmse)
+    }
+    pub fn ssim(&self) -> (f64, f64) {
+        mean_std(&self.ssim)
+    }
+    pub fn steps_per_traversal(&self) -> f64 {
+        self.stats.map_or(f64::NAN, |s| s.steps_per_traversal())
+    }
+    pub fn steps_per_pixel(&self) -> f64 {
+        self.stats.map_or(f64::NAN, |s| s.steps_per_pixel())
+    }
+    pub fn fallback_fraction(&self) -> f64 {
+        self.stats.map_or(f64::NAN, |s| s.fallback_fraction())
+    }
+}
+
+/// A renderer on one scene and camera, with the base settings of every figure and a cache of
+/// ground truths (per VPL count and resolution).
+pub struct Bench {
+    pub r: Renderer,
+    pub camera: Camera,
+    pub lights: Vec<DirectionalLight>,
+    pub base: RenderSettings,
+    /// Scene label (file stem), for file names and tables.
+    pub scene: String,
+    /// Exposure (EV) of the GI-only images and of SSIM / FLIP (the GI is much darker than the
+    /// final image).
+    pub gi_exposure: f32,
+    pub adapter: String,
+    gt: HashMap<(u32, u32, u32), (ImageF32, u64)>,
+    /// Progress lines to stderr.
+    pub verbose: bool,
+}
+
+impl Bench {
+    pub fn new(
+        r: Renderer,
+        camera: Camera,
+        lights: Vec<DirectionalLight>,
+        mut base: RenderSettings,
+        scene: String,
+        adapter: String,
+    ) -> Self {
+        // Same VPLs every frame (the ground truth must match them); a new sampler seed per
+        // frame (independent frames).
+        base.vpl.animate = false;
+        base.sampling.accumulate = false;
+        base.sampling.fixed_seed = false;
+        let gi_exposure = base.display.exposure_ev + 3.0;
+        Self {
+            r,
+            camera,
+            lights,
+            base,
+            scene,
+            gi_exposure,
+            adapter,
+            gt: HashMap::new(),
+            verbose: true,
+        }
+    }
+
+    fn say(&self, s: &str) {
+        if self.verbose {
+            eprintln!("[{}] {s}", self.scene);
+        }
+    }
+
+    fn frame(&mut self) {
+        let lights = self.lights.clone();
+        self.r.render(&FrameInput {
+            camera: &self.camera,
+            lights: &lights,
+            view: ViewBuffer::Final,
+        });
+    }
+
+    fn apply(&mut self, s: &RenderSettings, size: (u32, u32)) -> anyhow::Result<()> {
+        s.validate().map_err(|e| anyhow!("{e}"))?;
+        if self.r.size() != size {
+            self.r.resize(size.0, size.1)?;
+        }
+        self.r.set_settings(s.clone())?;
+        Ok(())
+    }
+
+    /// A checksum of the current VPLs (positions, normals, flux).
+    fn vpl_hash(&self) -> anyhow::Result<u64> {
+        let v = self.r.read_vpls()?;
+        let bytes: &[u8] = bytemuck::cast_slice(&v);
+        // FNV-1a.
+        let mut h = 0xcbf2_9ce4_8422_2325u64;
+        for b in bytes {
+            h ^= *b as u64;
+            h = h.wrapping_mul(0x100_0000_01b3);
+        }
+        Ok(h)
+    }
+
+    /// The ground truth's GI for settings `s` at `size` (cached per VPL count, seed and size).
+    pub fn ground_truth(&mut self, s: &RenderSettings, size: (u32, u32)) -> anyhow::Result<ImageF32> {
+        let key = (s.vpl.count, s.vpl.seed, size.0 | size.1 << 16);
+        if let Some((img, _)) = self.gt.get(&key) {
+            return Ok(img.clone());
+        }
+        let mut g = s.clone();
+        g.gi.method = GiMethod::GroundTruth;
+        g.gi.rays_per_frame = 1 << 26;
+        self.apply(&g, size)?;
+        self.say(&format!(
+            "ground truth: {} VPLs at every pixel of {}x{}",
+            g.vpl.count, size.0, size.1
+        ));
+        let t = Instant::now();
+        let mut frames = 0;
+        loop {
+            self.frame();
+            frames += 1;
+            let p = self.r.gi_progress().unwrap_or_default();
+            if p.finished() && frames > 1 {
+                break;
+            }
+            if frames > 100_000 {
+                bail!("the ground truth did not finish");
+            }
+        }
+        let img = self.r.read(Buffer::Indirect)?;
+        let hash = self.vpl_hash()?;
+        self.say(&format!(
+            "ground truth done in {:.1} s",
+            t.elapsed().as_secs_f64()
+        ));
+        self.gt.insert(key, (img.clone(), hash));
+        Ok(img)
+    }
+
+    /// Renders `frames` independent frames with settings `s` at `size`. With `gt`, every
+    /// frame's GI is compared with the ground truth of the same VPLs. The first frame after
+    /// the settings change is not timed when there are two or more (pipelines, buffers).
+    pub fn measure(
+        &mut self,
+        s: &RenderSettings,
+        size: (u32, u32),
+        frames: u32,
+        with_gt: bool,
+    ) -> anyhow::Result<Measured> {
+        let gt = if with_gt && s.gi.method.samples_tree() {
+            Some(self.ground_truth(s, size)?)
+        } else {
+            None
+        };
+        self.apply(s, size)?;
+        let mut m = Measured::default();
+        let mut stats: Option<SamplingStats> = None;
+        for f in 0..frames.max(1) {
+            // Drain any pending timestamp readback so this frame is timed.
+            let _ = self.r.wait_timings();
+            let t0 = Instant::now();
+            self.frame();
+            self.r.wait_idle();
+            let ms = t0.elapsed().as_secs_f64() * 1e3;
+            let timings = self.r.wait_timings();
+            if f > 0 || frames == 1 {
+                m.frame_ms.push(ms);
+                if let Some(t) = timings {
+                    m.passes.push(t.passes.clone());
+                }
+            }
+            if s.gi.method.samples_tree() {
+                if let Some(st) = self.r.sampling_stats_blocking() {
+                    stats = Some(match stats {
+                        None => st,
+                        Some(a) => SamplingStats {
+                            pixels: a.pixels + st.pixels,
+                            fallback_pixels: a.fallback_pixels + st.fallback_pixels,
+                            steps: a.steps + st.steps,
+                            traversals: a.traversals + st.traversals,
+                            dead: a.dead + st.dead,
+                        },
+                    });
+                }
+                if let Some(gt) = &gt {
+                    let ind = self.r.read(Buffer::Indirect)?;
+                    let c = metrics::compare(&ind, gt, self.gi_exposure, self.base.display.tonemap);
+                    m.rmse.push(c.rmse);
+                    m.ssim.push(c.ssim);
+                    m.flip.push(c.flip);
+                    m.mean_ratio.push(c.mean_ratio);
+                    if !s.sampling.half_resolution {
+                        let (_, _, _, fb) = self.read_steps()?;
+                        m.rmse_fallback.push(if fb.iter().any(|f| *f) {
+                            metrics::rmse(&ind, gt, Some(&fb))
+                        } else {
+                            f64::NAN
+                        });
+                    }
+                }
+            }
+        }
+        m.stats = stats;
+        if s.gi.method.samples_tree() {
+            m.indirect = Some(self.r.read(Buffer::Indirect)?);
+            if !s.sampling.half_resolution {
+                let (w, h, steps, fb) = self.read_steps()?;
+                m.steps = Some((w, h, steps));
+                m.fallback = Some(fb);
+            }
+        }
+        if let Some((_, hash)) = self
+            .gt
+            .get(&(s.vpl.count, s.vpl.seed, size.0 | size.1 << 16))
+            .filter(|_| gt.is_some())
+        {
+            let hash = *hash;
+            if self.vpl_hash()? != hash {
+                bail!(
+                    "the VPLs changed between the ground truth and the measurement (non-deterministic VPL generation?)"
+                );
+            }
+        }
+        Ok(m)
+    }
+
+    /// Traversal steps per traversal of the last frame, per pixel (NaN where no geometry), and
+    /// the pixels without a similar cut.
+    fn read_steps(&self) -> anyhow::Result<(u32, u32, Vec<f32>, Vec<bool>)> {
+        let (w, h) = self.r.size();
+        let diag = self.r.read_f32_buffer(&self.r.slc_buffers().diag)?;
+        let pos = self.r.read(Buffer::Position)?;
+        let n = (w * h) as usize;
+        if diag.len() < 4 * n || pos.pixels.len() < n {
+            bail!("diagnostics buffer smaller than the frame");
+        }
+        let v = (0..n)
+            .map(|i| {
+                if pos.pixels[i][3] > 0.0 {
+                    diag[4 * i]
+                } else {
+                    f32::NAN
+                }
+            })
+            .collect();
+        let fb = (0..n)
+            .map(|i| pos.pixels[i][3] > 0.0 && diag[4 * i + 1] > 0.5)
+            .collect();
+        Ok((w, h, v, fb))
+    }
+
+    /// Writes the GI as an sRGB PNG at the GI exposure.
+    pub fn write_gi_png(&self, path: &Path, img: &ImageF32) -> anyhow::Result<()> {
+        let tm = self.base.display.tonemap;
+        let rgba: Vec<u8> = img
+            .pixels
+            .iter()
+            .flat_map(|p| display::encode(*p, self.gi_exposure, tm))
+            .collect();
+        crate::export::write_png(path, img.width, img.height, &rgba)
+            .with_context(|| format!("cannot write {}", path.display()))
+    }
+
+    /// Writes the relative error |a - b| / b of the GI (log false colour, as the sheets).
+    pub fn write_error_png(&self, path: &Path, img: &ImageF32, gt: &ImageF32) -> anyhow::Result<()> {
+        let rgba: Vec<u8> = img
+            .pixels
+            .iter()
+            .zip(&gt.pixels)
+            .flat_map(|(a, b)| {
+                let c = crate::sheet::relative_error_rgb8(*a, *b);
+                [c[0], c[1], c[2], 255]
+            })
+            .collect();
+        crate::export::write_png(path, img.width, img.height, &rgba)
+            .with_context(|| format!("cannot write {}", path.display()))
+    }
+}
+
+/// A CSV table: a header and rows of cells.
+pub struct Csv {
+    pub header: Vec<&'static str>,
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Csv {
+    pub fn new(header: &[&'static str]) -> Self {
+        Self {
+            header: header.to_vec(),
+            rows: Vec::new(),
+        }
+    }
+    pub fn row(&mut self, cells: Vec<String>) {
+        debug_assert_eq!(cells.len(), self.header.len());
+        self.rows.push(cells);
+    }
+    pub fn write(&self, path: &Path) -> anyhow::Result<()> {
+        let mut s = self.header.join(",");
+        s.push('\n');
+        for r in &self.rows {
+            let cells: Vec<String> = r
+                .iter()
+                .map(|c| {
+                    if c.contains(',') || c.contains('"') {
+                        format!("\"{}\"", c.replace('"', "\"\""))
+                    } else {
+                        c.clone()
+                    }
+                })
+                .collect();
+            s.push_str(&cells.join(","));
+            s.push('\n');
+        }
+        std::fs::write(path, s).with_context(|| format!("cannot write {}", path.display()))
+    }
+}
+
+/// A number for a CSV cell (full precision, "nan" for missing).
+pub fn num(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v}")
+    } else {
+        "nan".into()
+    }
+}

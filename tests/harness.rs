@@ -1,0 +1,283 @@
+//! The research harness (`results`) end to end at a tiny size: every figure's CSV has its
+//! columns and finite values, the plots and images decode, the checks are written; bad
+//! options give one clear line.
+
+mod common;
+
+use std::{collections::HashMap, path::Path, process::Command};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_lightcut-workbench"))
+}
+
+/// Header and rows of a CSV written by the harness (no quoted cells in numeric columns).
+fn read_csv(path: &Path) -> (Vec<String>, Vec<HashMap<String, String>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(str::to_string).collect();
+    let rows = lines
+        .map(|l| {
+            // Split on commas outside quotes.
+            let mut cells = Vec::new();
+            let (mut cur, mut quoted) = (String::new(), false);
+            for ch in l.chars() {
+                match ch {
+                    '"' => quoted = !quoted,
+                    ',' if !quoted => cells.push(std::mem::take(&mut cur)),
+                    c => cur.push(c),
+                }
+            }
+            cells.push(cur);
+            assert_eq!(cells.len(), header.len(), "{}: {l}", path.display());
+            header.iter().cloned().zip(cells).collect()
+        })
+        .collect();
+    (header, rows)
+}
+
+/// Asserts the columns exist, there are `min_rows` rows, and `finite` columns hold finite
+/// numbers in every row.
+fn check_csv(dir: &Path, file: &str, columns: &[&str], finite: &[&str], min_rows: usize) {
+    let (header, rows) = read_csv(&dir.join(file));
+    for c in columns.iter().chain(finite) {
+        assert!(
+            header.iter().any(|h| h == c),
+            "{file}: no column {c} in {header:?}"
+        );
+    }
+    assert!(
+        rows.len() >= min_rows,
+        "{file}: {} rows, expected >= {min_rows}",
+        rows.len()
+    );
+    for r in &rows {
+        for c in finite {
+            let v: f64 = r[*c].parse().unwrap_or(f64::NAN);
+            assert!(
+                v.is_finite(),
+                "{file}: {c} = {} is not a finite number ({r:?})",
+                r[*c]
+            );
+        }
+    }
+}
+
+fn decodes(path: &Path) {
+    let img = image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(img.width() >= 32 && img.height() >= 24, "{}", path.display());
+}
+
+#[test]
+fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = std::env::temp_dir().join(format!("lightcut-results-{}", std::process::id()));
+    let o = bin()
+        .args([
+            "results",
+            "all",
+            "--scenes",
+            "default",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--frames",
+            "2",
+            "--timing-frames",
+            "3",
+            "--spp",
+            "2,8",
+            "--blocks",
+            "1,8",
+            "--vpl-exponents",
+            "10,11",
+            "--scaling-width",
+            "32",
+            "--scaling-height",
+            "24",
+            "--upsampling-scales",
+            "1",
+            "--vpls",
+            "1024",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "stdout: {stdout}\nstderr: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let d = out.join("default");
+    check_csv(
+        &d,
+        "timings.csv",
+        &["scene", "group", "passes", "frames"],
+        &["mean_ms", "std_ms", "min_ms", "max_ms"],
+        10,
+    );
+    let (_, rows) = read_csv(&d.join("timings.csv"));
+    let groups: Vec<&str> = rows.iter().map(|r| r["group"].as_str()).collect();
+    for g in [
+        "G-buffer",
+        "shadow map",
+        "VPL generation",
+        "sort VPLs",
+        "build SST",
+        "light cuts",
+        "GI",
+        "direct light",
+    ] {
+        assert!(groups.contains(&g), "timings.csv lacks {g}: {groups:?}");
+    }
+    // 3 methods x spp {2, 8, 32 (the base cut size is added)}.
+    check_csv(
+        &d,
+        "equal_time.csv",
+        &["method", "spp"],
+        &[
+            "frame_ms",
+            "rmse",
+            "ssim",
+            "flip",
+            "steps_per_traversal",
+            "steps_per_pixel",
+        ],
+        9,
+    );
+    check_csv(
+        &d,
+        "equal_time_matched.csv",
+        &["method", "extrapolated", "spp_at_matched_time"],
+        &[
+            "matched_ms",
+            "rmse_interpolated",
+            "measured_frame_ms",
+            "measured_rmse",
+        ],
+        3,
+    );
+    check_csv(
+        &d,
+        "steps.csv",
+        &["method"],
+        &[
+            "steps_per_traversal",
+            "steps_per_pixel",
+            "pixel_median",
+            "pixel_p90",
+        ],
+        3,
+    );
+    check_csv(
+        &d,
+        "blocks.csv",
+        &["block", "cuts"],
+        &["cuts_gpu_ms", "frame_ms", "rmse", "ssim"],
+        2,
+    );
+    check_csv(
+        &d,
+        "blending.csv",
+        &["config", "blending", "fallback"],
+        &["frame_ms", "gi_gpu_ms", "rmse", "ssim", "fallback_fraction"],
+        5,
+    );
+    check_csv(
+        &d,
+        "upsampling.csv",
+        &["width", "height", "gi_resolution"],
+        &["rmse", "ssim", "frame_ms", "gi_ms"],
+        2,
+    );
+    check_csv(
+        &d,
+        "scaling.csv",
+        &["vpls"],
+        &["tree_gpu_ms", "gi_gpu_ms", "frame_ms", "rmse", "ssim"],
+        2,
+    );
+    check_csv(
+        &out,
+        "checks.csv",
+        &["scene", "check", "kind", "met"],
+        &["value", "limit"],
+        8,
+    );
+    for p in [
+        "timings.png",
+        "equal_time_rmse.png",
+        "equal_time_ssim.png",
+        "steps.png",
+        "steps_hist.png",
+        "blocks_rmse.png",
+        "blocks_time.png",
+        "blending_rmse.png",
+        "blending_time.png",
+        "upsampling.png",
+        "scaling_time.png",
+        "scaling_rmse.png",
+        "images/ground_truth.png",
+        "images/equal_time_slc.png",
+        "images/equal_time_sst_error.png",
+        "images/steps_rtslc.png",
+        "images/block_1.png",
+        "images/blend_no_blending.png",
+        "images/blend_recompute_error.png",
+        "images/fallback_pixels.png",
+        "images/upsampling_half.png",
+    ] {
+        decodes(&d.join(p));
+    }
+    let run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(run["width"], 64);
+    assert!(
+        run["scenes"][0]["adapter"]
+            .as_str()
+            .is_some_and(|a| !a.is_empty())
+    );
+    assert!(stdout.contains("checks"), "{stdout}");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn one_figure_alone_and_bad_options_give_one_clear_line() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = std::env::temp_dir().join(format!("lightcut-results-steps-{}", std::process::id()));
+    let o = bin()
+        .args([
+            "results", "steps", "--scenes", "default", "--width", "48", "--height", "32", "--frames", "1",
+            "--vpls", "512", "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let d = out.join("default");
+    assert!(d.join("steps.csv").exists());
+    assert!(!d.join("timings.csv").exists(), "only the asked figure runs");
+    let _ = std::fs::remove_dir_all(&out);
+    for (args, needle) in [
+        (vec!["results", "--spp", "0"], "--spp"),
+        (vec!["results", "--blocks", "65"], "--blocks"),
+        (vec!["results", "--width", "8"], "--width"),
+        (
+            vec!["results", "--scenes", "/nonexistent/x.gltf"],
+            "/nonexistent/x.gltf",
+        ),
+    ] {
+        let o = bin().args(&args).output().unwrap();
+        assert!(!o.status.success(), "{args:?} should fail");
+        let err = String::from_utf8_lossy(&o.stderr);
+        let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
+        assert_eq!(lines.len(), 1, "{args:?}: {err}");
+        assert!(lines[0].contains(needle), "{args:?}: {err}");
+    }
+}
