@@ -5,13 +5,18 @@
 
 const SLC_MAX_CUT: u32 = 64u;
 
-// w = luminance(I) x box_term (eq. 5.2 over the node's box, common/box_term.wgsl); 0 when
-// the node is empty or nothing in it can light x.
+// w = luminance(I) x (average clamped cosine to the box corners, eq. 5.2) / max(d^2, eps^2)
+// with d the distance to the node's intensity-weighted mean position: the quadratic falloff
+// of Lightcuts' cluster approximation (eq. 5.1) towards its representative point. 0 when the
+// node is empty or nothing in it can light x (the support, hence unbiasedness, is that of
+// the box term). See docs/results.md for why not the distance to the box.
 fn slc_node_weight(node: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32) -> f32 {
     if sst_is_empty(node) {
         return 0.0;
     }
-    return luminance(node.intensity) * box_term(node.bbox_min, node.bbox_max, x, n, eps);
+    let g = box_cos(node.bbox_min, node.bbox_max, x, n);
+    let d = node.position - x;
+    return luminance(node.intensity) * (g / max(dot(d, d), eps * eps));
 }
 
 fn slc_keep(i: u32, w: f32, cull: bool) -> bool {

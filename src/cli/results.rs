@@ -253,7 +253,11 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         }
     }
     let info = serde_json::json!({
-        "command": std::env::args().collect::<Vec<_>>().join(" "),
+        // The program's own path is left out (it names a folder of this machine).
+        "command": std::iter::once("lightcut-workbench".to_string())
+            .chain(std::env::args().skip(1))
+            .collect::<Vec<_>>()
+            .join(" "),
         "width": o.size.0,
         "height": o.size.1,
         "frames": o.frames,

@@ -4,9 +4,11 @@
 //!
 //! Weight of node C at shading point x with normal n (thesis eq. 5.5 with M = 1 for diffuse
 //! surfaces, V = 1, and the geometric term of eq. 5.2):
-//!   w = luminance(I_C) x (1/8 sum_corners max(n . (c - x)/|c - x|, 0)) / max(d_min^2, eps^2)
-//! with d_min the distance from x to the node's box (0 inside) and eps the distance bound of
-//! the ground truth (`gi.distance_epsilon`). w = 0 exactly when the node is empty or every
+//!   w = luminance(I_C) x (1/8 sum_corners max(n . (c - x)/|c - x|, 0)) / max(d^2, eps^2)
+//! with d the distance from x to the node's intensity-weighted mean position (the quadratic
+//! falloff of Lightcuts' representative point, eq. 5.1) and eps the distance bound of the
+//! ground truth (`gi.distance_epsilon`). (Until issue 7 d was the distance to the box, 0
+//! inside it: every box around x then weighed I/eps^2, see docs/results.md.) w = 0 exactly when the node is empty or every
 //! corner lies on or behind x's tangent plane, i.e. when no VPL below can light x.
 
 use glam::Vec3;
@@ -16,9 +18,10 @@ use super::sst_tree::{SstNode, luminance};
 /// Largest cut (samples per pixel) the GPU kernels hold in registers.
 pub const MAX_CUT: u32 = 64;
 
-/// Eq. 5.2 over the box [lo, hi] with the inverse squared distance to it (see the module
-/// doc). Same operations, in the same order, as `box_term` in `common/box_term.wgsl`.
-pub fn box_term(lo: Vec3, hi: Vec3, x: Vec3, n: Vec3, eps: f32) -> f32 {
+/// The average clamped cosine of eq. 5.2: 1/8 sum over the box corners of
+/// max(n . (c - x)/|c - x|, 0). Same operations, in the same order, as `box_cos` in
+/// `common/box_term.wgsl`.
+pub fn box_cos(lo: Vec3, hi: Vec3, x: Vec3, n: Vec3) -> f32 {
     let mut cos_sum = 0.0f32;
     for c in 0..8u32 {
         let p = Vec3::new(
@@ -32,17 +35,32 @@ pub fn box_term(lo: Vec3, hi: Vec3, x: Vec3, n: Vec3, eps: f32) -> f32 {
     if cos_sum.is_nan() || cos_sum <= 0.0 {
         return 0.0;
     }
-    let q = x.clamp(lo, hi);
-    let d2 = (q - x).dot(q - x);
-    cos_sum * 0.125 / d2.max(eps * eps)
+    cos_sum * 0.125
 }
 
-/// Eq. 5.5 with eq. 5.2 (see the module doc): `slc_node_weight` in `common/slc.wgsl`.
+/// Eq. 5.2 over the box [lo, hi] with the inverse squared distance to it (see the module
+/// doc): `box_term` in `common/box_term.wgsl` (the converged reference's pyramid descent).
+pub fn box_term(lo: Vec3, hi: Vec3, x: Vec3, n: Vec3, eps: f32) -> f32 {
+    let g = box_cos(lo, hi, x, n);
+    if g == 0.0 {
+        return 0.0;
+    }
+    let q = x.clamp(lo, hi);
+    let d2 = (q - x).dot(q - x);
+    g / d2.max(eps * eps)
+}
+
+/// Eq. 5.5: luminance(I) x eq. 5.2's average clamped cosine over the node's box /
+/// max(d^2, eps^2), d = the distance to the node's intensity-weighted mean position (the
+/// quadratic falloff of Lightcuts' representative point, eq. 5.1): `slc_node_weight` in
+/// `common/slc.wgsl`. Zero exactly where the box term is.
 pub fn node_weight(node: &SstNode, x: Vec3, n: Vec3, eps: f32) -> f32 {
     if node.is_empty() {
         return 0.0;
     }
-    luminance(node.intensity) * box_term(node.bbox_min, node.bbox_max, x, n, eps)
+    let g = box_cos(node.bbox_min, node.bbox_max, x, n);
+    let d = node.position - x;
+    luminance(node.intensity) * (g / d.dot(d).max(eps * eps))
 }
 
 /// Whether a node may enter a cut (as a split's child): not empty, and (with culling) not
@@ -286,17 +304,31 @@ mod tests {
         n.intensity = Vec3::ONE;
         n.bbox_min = Vec3::new(0.0, 2.0, 0.0);
         n.bbox_max = n.bbox_min;
+        n.position = n.bbox_min;
         assert!((node_weight(&n, Vec3::ZERO, Vec3::Y, 0.05) - 0.25).abs() < 1e-6);
         // Below the surface: 0; at 0.01 m: bounded by eps = 0.05 -> 1/0.0025.
         assert_eq!(node_weight(&n, Vec3::ZERO, -Vec3::Y, 0.05), 0.0);
         n.bbox_min = Vec3::new(0.0, 0.01, 0.0);
         n.bbox_max = n.bbox_min;
+        n.position = n.bbox_min;
         assert!((node_weight(&n, Vec3::ZERO, Vec3::Y, 0.05) - 400.0).abs() < 1e-2);
         // A box straddling the tangent plane: half its corners count.
         n.bbox_min = Vec3::new(-1.0, -1.0, -1.0);
         n.bbox_max = Vec3::new(1.0, 1.0, 1.0);
+        n.position = Vec3::ZERO;
         let w = node_weight(&n, Vec3::new(0.0, 0.0, 5.0), Vec3::Y, 0.05);
         assert!(w > 0.0);
+        // A box around x: the falloff is towards the mean position (3 m away), not the box
+        // (distance 0), so a large cluster around x does not weigh 1/eps^2.
+        n.bbox_min = Vec3::splat(-4.0);
+        n.bbox_max = Vec3::splat(4.0);
+        n.position = Vec3::new(0.0, 3.0, 0.0);
+        let w = node_weight(&n, Vec3::ZERO, Vec3::Y, 0.05);
+        let g = box_cos(n.bbox_min, n.bbox_max, Vec3::ZERO, Vec3::Y);
+        // The 4 upper corners at cos 4/sqrt(48) each, the 4 lower ones 0.
+        assert!((g - 0.5 * 4.0 / 48f32.sqrt()).abs() < 1e-6, "{g}");
+        assert!((w - g / 9.0).abs() < 1e-6, "{w}");
+        assert!(box_term(n.bbox_min, n.bbox_max, Vec3::ZERO, Vec3::Y, 0.05) > 100.0 * w);
     }
 
     #[test]
