@@ -116,26 +116,11 @@ pub fn timings(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         o.size.1,
         b.adapter
     );
-    let per_frame = |names: &[&str]| -> Vec<f64> {
-        m.passes
-            .iter()
-            .map(|f| {
-                f.iter()
-                    .filter(|(n, _)| names.contains(&n.as_str()))
-                    .map(|(_, t)| t)
-                    .sum()
-            })
-            .collect()
-    };
     let mut rows: Vec<(String, String, Vec<f64>)> = PASS_GROUPS
         .iter()
-        .map(|(g, names)| (g.to_string(), names.join("+"), per_frame(names)))
+        .map(|(g, names)| (g.to_string(), names.join("+"), m.pass_ms_per_frame(Some(names))))
         .collect();
-    rows.push((
-        "all passes (GPU)".into(),
-        "sum".into(),
-        m.passes.iter().map(|f| f.iter().map(|(_, t)| t).sum()).collect(),
-    ));
+    rows.push(("all passes (GPU)".into(), "sum".into(), m.pass_ms_per_frame(None)));
     rows.push((
         "frame (wall clock)".into(),
         "render+submit+wait".into(),
@@ -242,7 +227,7 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
         "steps_per_pixel",
     ]);
     let mut curves: Vec<Vec<SweepPoint>> = Vec::new();
-    for (mi, (method, label)) in METHODS.iter().enumerate() {
+    for (method, label) in METHODS.iter() {
         let mut pts = Vec::new();
         for &n in &spp {
             let s = with(b, |s| {
@@ -274,7 +259,6 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
             );
             pts.push((t, r, q, n));
         }
-        let _ = mi;
         curves.push(pts);
     }
     csv.write(&dir.join("equal_time.csv"))?;

@@ -106,19 +106,21 @@ impl Measured {
     pub fn frame_ms(&self) -> (f64, f64) {
         mean_std(&self.frame_ms)
     }
-    /// Mean GPU time of a group of passes over the timed frames.
-    pub fn pass_ms(&self, names: &[&str]) -> (f64, f64) {
-        let per_frame: Vec<f64> = self
-            .passes
+    /// GPU time of a group of passes in each timed frame (`None`: every pass).
+    pub fn pass_ms_per_frame(&self, names: Option<&[&str]>) -> Vec<f64> {
+        self.passes
             .iter()
             .map(|f| {
                 f.iter()
-                    .filter(|(n, _)| names.contains(&n.as_str()))
+                    .filter(|(n, _)| names.is_none_or(|names| names.contains(&n.as_str())))
                     .map(|(_, t)| t)
                     .sum()
             })
-            .collect();
-        mean_std(&per_frame)
+            .collect()
+    }
+    /// Mean GPU time of a group of passes over the timed frames.
+    pub fn pass_ms(&self, names: &[&str]) -> (f64, f64) {
+        mean_std(&self.pass_ms_per_frame(Some(names)))
     }
     pub fn rmse(&self) -> (f64, f64) {
         mean_std(&self.rmse)
@@ -222,9 +224,18 @@ impl Bench {
 
     /// The ground truth's GI for settings `s` at `size` (cached per VPL count, seed and size).
     pub fn ground_truth(&mut self, s: &RenderSettings, size: (u32, u32)) -> anyhow::Result<ImageF32> {
+        Ok(self.ground_truth_and_hash(s, size)?.0)
+    }
+
+    /// The ground truth and the checksum of the VPLs it evaluated.
+    fn ground_truth_and_hash(
+        &mut self,
+        s: &RenderSettings,
+        size: (u32, u32),
+    ) -> anyhow::Result<(ImageF32, u64)> {
         let key = (s.vpl.count, s.vpl.seed, size.0 | size.1 << 16);
-        if let Some((img, _)) = self.gt.get(&key) {
-            return Ok(img.clone());
+        if let Some(cached) = self.gt.get(&key) {
+            return Ok(cached.clone());
         }
         let mut g = s.clone();
         g.gi.method = GiMethod::GroundTruth;
@@ -254,10 +265,10 @@ impl Bench {
             t.elapsed().as_secs_f64()
         ));
         self.gt.insert(key, (img.clone(), hash));
-        Ok(img)
+        Ok((img, hash))
     }
 
-    /// Renders `frames` independent frames with settings `s` at `size`. With `gt`, every
+    /// Renders `frames` independent frames with settings `s` at `size`. With `with_gt`, every
     /// frame's GI is compared with the ground truth of the same VPLs. The first frame after
     /// the settings change is not timed when there are two or more (pipelines, buffers).
     pub fn measure(
@@ -267,14 +278,14 @@ impl Bench {
         frames: u32,
         with_gt: bool,
     ) -> anyhow::Result<Measured> {
-        let gt = if with_gt && s.gi.method.samples_tree() {
-            Some(self.ground_truth(s, size)?)
+        let tree = s.gi.method.samples_tree();
+        let gt = if with_gt && tree {
+            Some(self.ground_truth_and_hash(s, size)?)
         } else {
             None
         };
         self.apply(s, size)?;
         let mut m = Measured::default();
-        let mut stats: Option<SamplingStats> = None;
         for f in 0..frames.max(1) {
             // Drain any pending timestamp readback so this frame is timed.
             let _ = self.r.wait_timings();
@@ -289,57 +300,51 @@ impl Bench {
                     m.passes.push(t.passes.clone());
                 }
             }
-            if s.gi.method.samples_tree() {
-                if let Some(st) = self.r.sampling_stats_blocking() {
-                    stats = Some(match stats {
-                        None => st,
-                        Some(a) => SamplingStats {
-                            pixels: a.pixels + st.pixels,
-                            fallback_pixels: a.fallback_pixels + st.fallback_pixels,
-                            steps: a.steps + st.steps,
-                            traversals: a.traversals + st.traversals,
-                            dead: a.dead + st.dead,
-                        },
+            if !tree {
+                continue;
+            }
+            if let Some(st) = self.r.sampling_stats_blocking() {
+                m.stats = Some(m.stats.map_or(st, |a| SamplingStats {
+                    pixels: a.pixels + st.pixels,
+                    fallback_pixels: a.fallback_pixels + st.fallback_pixels,
+                    steps: a.steps + st.steps,
+                    traversals: a.traversals + st.traversals,
+                    dead: a.dead + st.dead,
+                }));
+            }
+            let ind = self.r.read(Buffer::Indirect)?;
+            // Steps and fallback flags are per GI pixel: read at full GI resolution only.
+            let diag = if s.sampling.half_resolution {
+                None
+            } else {
+                Some(self.read_steps()?)
+            };
+            if let Some((gt, _)) = &gt {
+                let c = metrics::compare(&ind, gt, self.gi_exposure, self.base.display.tonemap);
+                m.rmse.push(c.rmse);
+                m.ssim.push(c.ssim);
+                m.flip.push(c.flip);
+                m.mean_ratio.push(c.mean_ratio);
+                if let Some((_, _, _, fb)) = &diag {
+                    m.rmse_fallback.push(if fb.iter().any(|f| *f) {
+                        metrics::rmse(&ind, gt, Some(fb))
+                    } else {
+                        f64::NAN
                     });
                 }
-                if let Some(gt) = &gt {
-                    let ind = self.r.read(Buffer::Indirect)?;
-                    let c = metrics::compare(&ind, gt, self.gi_exposure, self.base.display.tonemap);
-                    m.rmse.push(c.rmse);
-                    m.ssim.push(c.ssim);
-                    m.flip.push(c.flip);
-                    m.mean_ratio.push(c.mean_ratio);
-                    if !s.sampling.half_resolution {
-                        let (_, _, _, fb) = self.read_steps()?;
-                        m.rmse_fallback.push(if fb.iter().any(|f| *f) {
-                            metrics::rmse(&ind, gt, Some(&fb))
-                        } else {
-                            f64::NAN
-                        });
-                    }
-                }
             }
-        }
-        m.stats = stats;
-        if s.gi.method.samples_tree() {
-            m.indirect = Some(self.r.read(Buffer::Indirect)?);
-            if !s.sampling.half_resolution {
-                let (w, h, steps, fb) = self.read_steps()?;
+            m.indirect = Some(ind);
+            if let Some((w, h, steps, fb)) = diag {
                 m.steps = Some((w, h, steps));
                 m.fallback = Some(fb);
             }
         }
-        if let Some((_, hash)) = self
-            .gt
-            .get(&(s.vpl.count, s.vpl.seed, size.0 | size.1 << 16))
-            .filter(|_| gt.is_some())
+        if let Some((_, hash)) = gt
+            && self.vpl_hash()? != hash
         {
-            let hash = *hash;
-            if self.vpl_hash()? != hash {
-                bail!(
-                    "the VPLs changed between the ground truth and the measurement (non-deterministic VPL generation?)"
-                );
-            }
+            bail!(
+                "the VPLs changed between the ground truth and the measurement (non-deterministic VPL generation?)"
+            );
         }
         Ok(m)
     }

@@ -46,12 +46,13 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
-fn write(path: &Path, buf: &[u8]) -> anyhow::Result<()> {
+/// Writes an RGB8 plot buffer of `size` as a PNG.
+fn write(path: &Path, size: (u32, u32), buf: &[u8]) -> anyhow::Result<()> {
     let rgba: Vec<u8> = buf
         .chunks_exact(3)
         .flat_map(|c| [c[0], c[1], c[2], 255])
         .collect();
-    crate::export::write_png(path, SIZE.0, SIZE.1, &rgba)
+    crate::export::write_png(path, size.0, size.1, &rgba)
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
@@ -183,7 +184,7 @@ pub fn lines(
         }
         root.present().map_err(|e| anyhow!("plot: {e:?}"))?;
     }
-    write(path, &buf)
+    write(path, SIZE, &buf)
 }
 
 /// One bar: category label, value, spread (drawn as an error bar when > 0), colour index.
@@ -278,7 +279,7 @@ pub fn bars(path: &Path, title: &str, y_label: &str, bars: &[Bar], log_y: bool) 
         }
         root.present().map_err(|e| anyhow!("plot: {e:?}"))?;
     }
-    write(path, &buf)
+    write(path, SIZE, &buf)
 }
 
 /// A heat map image of per-pixel values with a shared scale `0..max` (NaN: dark grey), and a
@@ -327,10 +328,5 @@ pub fn heatmap(path: &Path, title: &str, w: u32, h: u32, v: &[f32], max: f32) ->
             .map_err(e)?;
         root.present().map_err(e)?;
     }
-    let rgba: Vec<u8> = buf
-        .chunks_exact(3)
-        .flat_map(|c| [c[0], c[1], c[2], 255])
-        .collect();
-    crate::export::write_png(path, size.0, size.1, &rgba)
-        .with_context(|| format!("cannot write {}", path.display()))
+    write(path, size, &buf)
 }
