@@ -14,7 +14,7 @@ struct GtParams {
     height: u32,
     epsilon: f32,
     ray_offset: f32,
-    _pad0: u32,
+    shadow_rays: u32, // 1 trace shadow rays, 0 every VPL visible
     _pad1: u32,
 };
 
@@ -33,7 +33,7 @@ fn vpl_irradiance_term(v: Vpl, x: vec3<f32>, nx: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     let g = vpl_geometry(v.position.xyz, v.normal, x, nx, params.epsilon);
-    if g <= 0.0 || !vpl_visible(v.position.xyz, v.normal, x, nx, params.ray_offset) {
+    if g <= 0.0 || (params.shadow_rays != 0u && !vpl_visible(v.position.xyz, v.normal, x, nx, params.ray_offset)) {
         return vec3<f32>(0.0);
     }
     return v.flux.rgb / PI * g;

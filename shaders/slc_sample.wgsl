@@ -1,7 +1,8 @@
 // Stages 12-15 (thesis 5.1.3-5.3) and the baselines: per pixel, choose a cut per slot from
 // the 4 surrounding blocks (bilinear weight x similarity S, Algorithm 1) or fall back (mock
 // cut by default), traverse from each chosen node with p_left = w_left / (w_left + w_right)
-// until a usable node (SLC), a leaf (RTSLC), or from the root (SST), and evaluate the cluster:
+// until a usable node far enough from x (SLC; slc_far_enough), a leaf (RTSLC), or from the
+// root (SST, same stop rule as SLC), and evaluate the cluster:
 // a point drawn from its substitute distribution (Gaussian in the node's frame, clamped to its
 // box; the VPL itself at a leaf) shaded as a VPL of the node's total flux, one shadow ray,
 // divided by the probability of the path. Sum over slots (SST: mean over its samples).
@@ -67,7 +68,8 @@ fn traverse(start: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb:
     var prob = 1.0;
     var steps = 0u;
     loop {
-        if node >= sp.leaves || (sp.method != 2u && is_usable(node)) {
+        if node >= sp.leaves || (sp.method != 2u && is_usable(node)
+            && slc_far_enough(tree[node], x, sp.epsilon, sp.near_field)) {
             break;
         }
         let wl = slc_node_weight(tree[2u * node], x, n, sp.epsilon);
@@ -126,7 +128,7 @@ fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: 
         flux = c.intensity;
     }
     let geo = vpl_geometry(pv, nv, x, n, sp.epsilon);
-    let lit = geo > 0.0 && vpl_visible(pv, nv, x, n, sp.ray_offset);
+    let lit = geo > 0.0 && (sp.shadow_rays == 0u || vpl_visible(pv, nv, x, n, sp.ray_offset));
     if tb != NO_TRACE {
         trace[tb + 6u] = bitcast<u32>(pv.x);
         trace[tb + 7u] = bitcast<u32>(pv.y);

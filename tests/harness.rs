@@ -170,6 +170,9 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "steps_per_pixel",
             "pixel_median",
             "pixel_p90",
+            "sample_pass_ms",
+            "sample_pass_ms_no_shadow_rays",
+            "shadow_ray_share",
         ],
         3,
     );

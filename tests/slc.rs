@@ -495,6 +495,11 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
         let nrm = st.r.read(Buffer::Normal).unwrap();
         let alb = st.r.read(Buffer::Albedo).unwrap();
         let eps = st.r.settings().gi.distance_epsilon;
+        let near_field = st.r.settings().sampling.near_field;
+        assert!(
+            near_field > 0.0,
+            "the story checks the near-field rule (on by default)"
+        );
         let cut_size = st.r.settings().sampling.cut_size;
         let pixels: Vec<(u32, u32)> = [(10, 30), (33, 21), (50, 12), (5, 5), (60, 38)]
             .into_iter()
@@ -502,6 +507,8 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
             .collect();
         assert!(pixels.len() >= 3, "too few pixels with geometry");
         let mut evaluated = 0;
+        // Usable nodes passed because x is too close to them (the near-field rule at work).
+        let mut near_passes = 0;
         for (x, y) in pixels {
             st.r.set_trace_pixel(Some((x, y)));
             st.frame();
@@ -544,9 +551,14 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
                 let mut prob = 1.0f64;
                 for &(child, pc) in &smp.path {
                     assert_eq!(child / 2, parent, "path is not a chain of children");
+                    if flag(&flags, parent as usize) && method != GiMethod::Rtslc {
+                        near_passes += 1;
+                    }
                     assert!(
-                        !flag(&flags, parent as usize) || method == GiMethod::Rtslc,
-                        "passed a usable node"
+                        method == GiMethod::Rtslc
+                            || !(flag(&flags, parent as usize)
+                                && slc::far_enough(&nodes[parent as usize], p, eps, near_field)),
+                        "passed a node the CPU rule stops at"
                     );
                     let wl = slc::node_weight(&nodes[2 * parent as usize], p, n, eps);
                     let wr = slc::node_weight(&nodes[2 * parent as usize + 1], p, n, eps);
@@ -566,7 +578,12 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
                 match (method, smp.stop) {
                     (GiMethod::Rtslc, s) => assert_eq!(s, StopReason::Leaf),
                     (_, StopReason::Leaf) => assert!(smp.end >= leaves),
-                    (_, _) => assert!(flag(&flags, smp.end as usize) && smp.end < leaves),
+                    (_, _) => assert!(
+                        flag(&flags, smp.end as usize)
+                            && smp.end < leaves
+                            && slc::far_enough(&nodes[smp.end as usize], p, eps, near_field),
+                        "stopped where the CPU rule does not"
+                    ),
                 }
             }
             // The samples' sum is the pixel's estimate this frame.
@@ -582,6 +599,44 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
             );
         }
         assert!(evaluated > 0, "{method:?}: no sample was evaluated");
+        eprintln!("{method:?}: {near_passes} usable nodes passed as too near");
+        assert!(
+            method == GiMethod::Rtslc || near_passes > 0,
+            "{method:?}: the near-field rule never acted on these pixels"
+        );
+    }
+    assert!(ctx.errors.take().is_empty());
+}
+
+#[test]
+fn without_shadow_rays_the_same_samples_only_gain_light() {
+    // Fixed seed: the same cuts, traversals and sample points with and without shadow rays,
+    // so every pixel can only gain light (never blocked), and some must.
+    let Some(ctx) = common::gpu() else { return };
+    for method in [GiMethod::Slc, GiMethod::Rtslc, GiMethod::Sst] {
+        let run = |rays: bool| -> ImageF32 {
+            let mut s = settings(method);
+            s.sampling.fixed_seed = true;
+            s.gi.shadow_rays = rays;
+            let mut st = setup(&ctx, s);
+            st.frame();
+            st.indirect()
+        };
+        let (on, off) = (run(true), run(false));
+        let mut gained = 0;
+        for (a, b) in on.pixels.iter().zip(&off.pixels) {
+            for c in 0..3 {
+                assert!(
+                    b[c] >= a[c] - 1e-6 * a[c].abs().max(1.0),
+                    "{method:?}: {b:?} < {a:?}"
+                );
+            }
+            gained += (b[0] > 1.001 * a[0] + 1e-7) as usize;
+        }
+        assert!(
+            gained > 50,
+            "{method:?}: only {gained} pixels gain light without shadow rays"
+        );
     }
     assert!(ctx.errors.take().is_empty());
 }

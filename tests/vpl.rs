@@ -219,14 +219,39 @@ fn gpu_filter_pyramid_and_warping_match_the_cpu_reference() {
 
 #[test]
 fn ground_truth_on_the_gpu_equals_a_cpu_evaluation_of_the_same_vpls() {
+    // With shadow rays, and without (every VPL visible: more light where something occludes).
+    let Some(shadowed) = ground_truth_against_cpu(true) else {
+        return;
+    };
+    let Some(open) = ground_truth_against_cpu(false) else {
+        return;
+    };
+    let brighter = shadowed
+        .iter()
+        .zip(&open)
+        .filter(|(s, o)| o.max_element() > 1.01 * s.max_element() + 1e-6)
+        .count();
+    assert!(
+        shadowed.iter().zip(&open).all(|(s, o)| o.cmpge(*s - 1e-5).all()),
+        "no shadow ray can add light"
+    );
+    assert!(
+        brighter > 10,
+        "only {brighter} pixels gain light without shadow rays"
+    );
+}
+
+/// The GPU ground truth against `reference::gi::exact_indirect` at every 7th pixel; returns
+/// the GPU's checked pixels (None without a GPU).
+fn ground_truth_against_cpu(shadow_rays: bool) -> Option<Vec<Vec3>> {
     let mut settings = RenderSettings::default();
     settings.vpl.count = 256;
     settings.shadow.resolution = 256;
     settings.gi.method = GiMethod::GroundTruth;
+    settings.gi.shadow_rays = shadow_rays;
     let (w, h) = (64u32, 40u32);
-    let Some((mut r, scene)) = setup(settings.clone(), (w, h)) else {
-        return;
-    };
+    let (mut r, scene) = setup(settings.clone(), (w, h))?;
+    let mut out = Vec::new();
     for _ in 0..4 {
         frame(&mut r, &scene);
         if r.gi_progress().is_some_and(|p| p.finished()) {
@@ -263,9 +288,10 @@ fn ground_truth_on_the_gpu_equals_a_cpu_evaluation_of_the_same_vpls() {
             Vec3::from_slice(&alb.pixels[k][..3]),
             &emitters,
             settings.gi.distance_epsilon,
-            settings.gi.ray_offset,
+            settings.gi.shadow_rays.then_some(settings.gi.ray_offset),
         );
         let got = Vec3::from_slice(&ind.pixels[k][..3]);
+        out.push(got);
         let tol = 1e-3 * want.max_element().max(1e-6);
         assert!(
             (got - want).abs().max_element() <= tol,
@@ -276,6 +302,7 @@ fn ground_truth_on_the_gpu_equals_a_cpu_evaluation_of_the_same_vpls() {
     }
     assert!(checked > 100 && lit > 50, "checked {checked}, lit {lit}");
     assert!(r.ctx.errors.take().is_empty());
+    Some(out)
 }
 
 #[test]
@@ -344,7 +371,7 @@ fn converged_reference_converges_to_the_exact_sum_over_all_texels() {
             Vec3::from_slice(&alb.pixels[k][..3]),
             &texels,
             settings.gi.distance_epsilon,
-            settings.gi.ray_offset,
+            Some(settings.gi.ray_offset),
         );
         exact_sum += lum(e.to_array());
     }

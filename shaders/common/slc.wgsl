@@ -19,6 +19,19 @@ fn slc_node_weight(node: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32) -> f32 {
     return luminance(node.intensity) * (g / max(dot(d, d), eps * eps));
 }
 
+// Near-field refinement (ours; theta = 0 turns it off, the thesis's rule): a usable node is
+// sampled only when x lies at least max(eps, theta x |box diagonal|) from its box, an opening
+// criterion like Barnes-Hut's. Closer, its substitute samples land off the real surfaces
+// and 1/d^2 turns them into fireflies, so the traversal descends instead.
+fn slc_far_enough(node: SstNode, x: vec3<f32>, eps: f32, theta: f32) -> bool {
+    if theta <= 0.0 {
+        return true;
+    }
+    let q = clamp(x, node.bbox_min, node.bbox_max) - x;
+    let r = max(eps, theta * length(node.bbox_max - node.bbox_min));
+    return dot(q, q) >= r * r;
+}
+
 fn slc_keep(i: u32, w: f32, cull: bool) -> bool {
     return !sst_is_empty(tree[i]) && (!cull || w > 0.0);
 }

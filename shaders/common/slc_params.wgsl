@@ -21,6 +21,10 @@ struct SlcParams {
     d_max: f32,      // eq. 5.3, metres
     demodulate: u32, // 1: write the estimate without the albedo (half-resolution GI)
     trace_pixel: u32, // x | y << 16: the pixel whose samples slc_sample records (pixel story); ~0 none
+    near_field: f32, // near-field refinement factor (0 = off): see slc_far_enough
+    shadow_rays: u32, // 1 trace shadow rays, 0 every sample visible
+    pad1: u32,
+    pad2: u32,
 };
 
 // The pixel whose G-buffer sample builds block b's cut.

@@ -712,6 +712,15 @@ impl WorkbenchApp {
                     }
                 });
             }
+            if matches!(
+                g.method,
+                GiMethod::GroundTruth | GiMethod::Slc | GiMethod::Sst | GiMethod::Rtslc
+            ) {
+                ui.checkbox(&mut g.shadow_rays, "shadow rays").on_hover_text(
+                    "off: every VPL and cluster sample counts as visible (unshadowed GI: light \
+                     through walls; the GPU timings then show the cost without visibility)",
+                );
+            }
             match g.method {
                 GiMethod::GroundTruth => {
                     ui.add(
@@ -760,6 +769,14 @@ impl WorkbenchApp {
                             });
                         ui.checkbox(&mut sm.cull_behind, "cull nodes behind the block centre")
                             .on_hover_text("thesis 5.1; off keeps every cut complete (unbiased)");
+                    }
+                    if g.method != GiMethod::Rtslc {
+                        ui.add(egui::Slider::new(&mut sm.near_field, 0.0..=4.0).text("near-field refinement"))
+                            .on_hover_text(
+                                "stop at a usable node only when the point is at least this many box \
+                                 diagonals from its box (0 = the thesis's rule): substitute samples \
+                                 next to the point turn into fireflies",
+                            );
                     }
                     ui.checkbox(&mut sm.half_resolution, "half-resolution GI (bilateral upsampling)");
                     ui.checkbox(&mut sm.accumulate, "accumulate frames while static");

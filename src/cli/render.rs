@@ -69,6 +69,13 @@ pub struct SamplingArgs {
     /// Keep nodes behind the block centre's surface in the cuts (complete cuts).
     #[arg(long)]
     pub no_cull: bool,
+    /// Near-field refinement of SLC/SST: stop at a usable node only when the shaded point is
+    /// at least this many box diagonals from its box (0 = off, the thesis's rule; default 1).
+    #[arg(long)]
+    pub near_field: Option<f32>,
+    /// No shadow rays for the ground truth and the tree samplers (every VPL / sample visible).
+    #[arg(long)]
+    pub no_shadow_rays: bool,
     /// GI at half resolution, joint-bilateral upsampled with the similarity S.
     #[arg(long)]
     pub half_res: bool,
@@ -118,6 +125,12 @@ impl SamplingArgs {
         }
         if self.no_cull {
             s.sampling.cull_behind = false;
+        }
+        if let Some(v) = self.near_field {
+            s.sampling.near_field = v;
+        }
+        if self.no_shadow_rays {
+            s.gi.shadow_rays = false;
         }
         if self.half_res {
             s.sampling.half_resolution = true;

@@ -387,11 +387,25 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "pixel_p90",
         "dead_branch_fraction",
         "fallback_fraction",
+        "sample_pass_ms",
+        "sample_pass_ms_no_shadow_rays",
+        "shadow_ray_share",
     ]);
+    // What each method spends: its sampling pass with shadow rays, and without them (the
+    // same traversals and evaluations, every sample visible).
+    const SAMPLE_PASSES: [&str; 3] = ["slc_sample", "sst_sample", "rtslc_sample"];
     let mut ms: Vec<Measured> = Vec::new();
+    let mut cost = Vec::new();
     for (method, _) in METHODS {
         let s = with(b, |s| s.gi.method = method);
-        ms.push(b.measure(&s, o.size, o.frames, false)?);
+        let m = b.measure(&s, o.size, o.frames, false)?;
+        let no_rays = with(b, |s| {
+            s.gi.method = method;
+            s.gi.shadow_rays = false;
+        });
+        let open = b.measure(&no_rays, o.size, o.frames, false)?;
+        cost.push((m.pass_ms(&SAMPLE_PASSES).0, open.pass_ms(&SAMPLE_PASSES).0));
+        ms.push(m);
     }
     let quant = |v: &[f32], q: f64| -> f64 {
         let mut f: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
@@ -409,7 +423,7 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let mut table = format!("traversal steps ({} spp):\n", b.base.sampling.cut_size);
     let mut bars = Vec::new();
     let mut hist = Vec::new();
-    for (i, (m, (_, label))) in ms.iter().zip(METHODS).enumerate() {
+    for (i, ((m, (_, label)), (with_rays, no_rays))) in ms.iter().zip(METHODS).zip(&cost).enumerate() {
         let (med, p90) = m
             .steps
             .as_ref()
@@ -427,9 +441,13 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             num(p90),
             num(dead),
             num(m.fallback_fraction()),
+            num(*with_rays),
+            num(*no_rays),
+            num(1.0 - no_rays / with_rays),
         ]);
         table.push_str(&format!(
-            "  {label:<6} {:>6.2} per traversal, {:>7.1} per pixel (median pixel {med:.2}, p90 {p90:.2})\n",
+            "  {label:<6} {:>6.2} per traversal, {:>7.1} per pixel (median pixel {med:.2}, p90 {p90:.2}); \
+             sampling pass {with_rays:.1} ms, {no_rays:.1} ms without shadow rays\n",
             m.steps_per_traversal(),
             m.steps_per_pixel()
         ));

@@ -13,7 +13,9 @@ pub struct Texel {
     pub flux: Vec3,
 }
 
-/// rho/pi x sum over texels of flux/pi x cos_x x cos_t / max(d^2, eps^2) x V.
+/// rho/pi x sum over texels of flux/pi x cos_x x cos_t / max(d^2, eps^2) x V, with V from a
+/// shadow ray whose end points are offset along their normals by `shadow_rays` (None: V = 1,
+/// `GiSettings::shadow_rays` off).
 pub fn exact_indirect(
     bvh: &Bvh,
     x: Vec3,
@@ -21,7 +23,7 @@ pub fn exact_indirect(
     albedo: Vec3,
     texels: &[Texel],
     eps: f32,
-    offset: f32,
+    shadow_rays: Option<f32>,
 ) -> Vec3 {
     let pi = std::f32::consts::PI;
     let mut sum = Vec3::ZERO;
@@ -36,15 +38,17 @@ pub fn exact_indirect(
         if cx <= 0.0 || ct <= 0.0 {
             continue;
         }
-        let o = x + n * offset;
-        let e = t.position + t.normal * offset;
-        if bvh.any_hit(&Ray {
-            origin: o,
-            dir: e - o,
-            tmin: 1e-4,
-            tmax: 1.0 - 1e-4,
-        }) {
-            continue;
+        if let Some(offset) = shadow_rays {
+            let o = x + n * offset;
+            let e = t.position + t.normal * offset;
+            if bvh.any_hit(&Ray {
+                origin: o,
+                dir: e - o,
+                tmin: 1e-4,
+                tmax: 1.0 - 1e-4,
+            }) {
+                continue;
+            }
         }
         sum += t.flux / pi * (cx * ct / dist2.max(eps * eps));
     }

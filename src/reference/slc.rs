@@ -123,6 +123,19 @@ pub fn build_cut(nodes: &[SstNode], x: Vec3, n: Vec3, eps: f32, cut_size: u32, c
     ids
 }
 
+/// Near-field refinement (ours; `theta` = 0 is the thesis's rule): whether the traversal
+/// may stop at usable node `node` for shaded point `x`, i.e. x lies at least
+/// max(eps, theta x the box diagonal) from the node's box. `slc_far_enough` in
+/// `common/slc.wgsl`.
+pub fn far_enough(node: &SstNode, x: Vec3, eps: f32, theta: f32) -> bool {
+    if theta <= 0.0 {
+        return true;
+    }
+    let q = x.clamp(node.bbox_min, node.bbox_max) - x;
+    let r = eps.max(theta * (node.bbox_max - node.bbox_min).length());
+    q.dot(q) >= r * r
+}
+
 /// Eq. 5.3: the normals agree (dot > n_min) and the points are closer than d_max (metres).
 pub fn similar(px: Vec3, nx: Vec3, py: Vec3, ny: Vec3, n_min: f32, d_max: f32) -> bool {
     nx.dot(ny) > n_min && px.distance(py) < d_max
@@ -269,6 +282,35 @@ mod tests {
     use super::*;
     use crate::reference::sst_tree::{build, sort_vpls};
     use crate::renderer::gpu_data::GpuVpl;
+
+    #[test]
+    fn near_field_rule_by_hand() {
+        // A 1 x 1 x 0 box (diagonal sqrt 2) on the floor.
+        let node = SstNode {
+            bbox_min: Vec3::ZERO,
+            bbox_max: Vec3::new(1.0, 1.0, 0.0),
+            ..SstNode::EMPTY
+        };
+        let eps = 0.05;
+        // Off: every usable node is a stop, even with x inside its box.
+        assert!(far_enough(&node, Vec3::new(0.5, 0.5, 0.0), eps, 0.0));
+        // Inside or on the box: never a stop.
+        assert!(!far_enough(&node, Vec3::new(0.5, 0.5, 0.0), eps, 1.0));
+        assert!(!far_enough(&node, Vec3::new(1.0, 0.0, 0.0), eps, 1e-6));
+        // theta = 1: at least sqrt 2 from the box.
+        assert!(!far_enough(&node, Vec3::new(0.5, 0.5, 1.4), eps, 1.0));
+        assert!(far_enough(&node, Vec3::new(0.5, 0.5, 1.42), eps, 1.0));
+        assert!(far_enough(&node, Vec3::new(2.0, 2.0, 0.0), eps, 1.0));
+        assert!(!far_enough(&node, Vec3::new(2.0, 2.0, 0.0), eps, 1.0 + 1e-3));
+        // A tiny box: eps bounds the radius from below.
+        let dot = SstNode {
+            bbox_min: Vec3::ZERO,
+            bbox_max: Vec3::splat(1e-3),
+            ..SstNode::EMPTY
+        };
+        assert!(!far_enough(&dot, Vec3::new(0.0, 0.0, 0.04), eps, 1.0));
+        assert!(far_enough(&dot, Vec3::new(0.0, 0.0, 0.052), eps, 1.0));
+    }
 
     fn floor_and_wall(n: usize) -> Vec<SstNode> {
         let mut s = 7u32;

@@ -296,6 +296,11 @@ pub struct GpuSlcParams {
     /// x | y << 16 of the pixel whose samples are recorded (`passes::slc::PixelTrace`);
     /// `u32::MAX` = none.
     pub trace_pixel: u32,
+    /// Near-field refinement factor (`SamplingSettings::near_field`; 0 = off).
+    pub near_field: f32,
+    /// 1: shadow rays, 0: every sample visible (`GiSettings::shadow_rays`).
+    pub shadow_rays: u32,
+    pub _pad: [u32; 2],
 }
 
 /// A node of the Stochastic Substitute Tree, 64 bytes (one cache line; the SST paper's node
@@ -338,7 +343,9 @@ pub struct GpuGtParams {
     pub height: u32,
     pub epsilon: f32,
     pub ray_offset: f32,
-    pub _pad: [u32; 2],
+    /// 1: shadow rays, 0: every VPL visible (`GiSettings::shadow_rays`).
+    pub shadow_rays: u32,
+    pub _pad: u32,
 }
 
 #[cfg(test)]
@@ -497,8 +504,8 @@ mod tests {
                     offset_of!(GpuGtParams, height),
                     offset_of!(GpuGtParams, epsilon),
                     offset_of!(GpuGtParams, ray_offset),
+                    offset_of!(GpuGtParams, shadow_rays),
                     offset_of!(GpuGtParams, _pad),
-                    offset_of!(GpuGtParams, _pad) + 4,
                 ],
             ),
             (
@@ -526,6 +533,10 @@ mod tests {
                     offset_of!(GpuSlcParams, d_max),
                     offset_of!(GpuSlcParams, demodulate),
                     offset_of!(GpuSlcParams, trace_pixel),
+                    offset_of!(GpuSlcParams, near_field),
+                    offset_of!(GpuSlcParams, shadow_rays),
+                    offset_of!(GpuSlcParams, _pad),
+                    offset_of!(GpuSlcParams, _pad) + 4,
                 ],
             ),
             (

@@ -760,7 +760,8 @@ impl Renderer {
             height: size.1,
             epsilon: self.settings.gi.distance_epsilon,
             ray_offset: self.settings.gi.ray_offset,
-            _pad: [0; 2],
+            shadow_rays: self.settings.gi.shadow_rays as u32,
+            _pad: 0,
         };
         let reached = self.ground_truth.record(
             &device,
@@ -977,6 +978,9 @@ impl Renderer {
                 Some((x, y)) => x | y << 16,
                 None => u32::MAX,
             },
+            near_field: sm.near_field,
+            shadow_rays: s.gi.shadow_rays as u32,
+            _pad: [0; 2],
         };
         let (gbuffer, accum) = match &half_targets {
             Some(h) => (&h.gbuffer, &h.accum),

@@ -198,6 +198,11 @@ pub struct GiSettings {
     pub distance_epsilon: f32,
     /// Offset of shadow-ray end points along their surfaces' normals (metres).
     pub ray_offset: f32,
+    /// Shadow rays of the VPL methods (ground truth, SLC, SST, RTSLC). Off treats every VPL
+    /// and cluster sample as visible: the unshadowed estimate, to see what the shadow rays
+    /// remove (light through walls) and what they cost (the GI pass without them is the
+    /// cost of traversal and evaluation alone). The converged reference always traces.
+    pub shadow_rays: bool,
 }
 
 impl Default for GiSettings {
@@ -210,6 +215,7 @@ impl Default for GiSettings {
             reference_flux_mix: 0.25,
             distance_epsilon: 0.05,
             ray_offset: 1e-3,
+            shadow_rays: true,
         }
     }
 }
@@ -304,6 +310,14 @@ pub struct SamplingSettings {
     /// surface (thesis 5.1). Pixels of a block that face differently can then miss light
     /// from those nodes (bias, bounded by the similarity test); off keeps the cuts complete.
     pub cull_behind: bool,
+    /// Near-field refinement (ours, not in the thesis; 0 = the thesis's rule): SLC and SST
+    /// stop at a usable node only when the shaded point lies at least max(distance epsilon,
+    /// `near_field` x the node's box diagonal) from the node's box, and descend otherwise (to
+    /// a leaf at most). A substitute distribution stands for its VPLs only seen from afar:
+    /// next to it, its samples land off the real surfaces (through thin walls, in front of
+    /// the shaded surface) and the 1/d^2 term turns them into fireflies. Higher refines more
+    /// (fewer fireflies, more steps). See docs/results.md.
+    pub near_field: f32,
     pub blending: CutBlending,
     pub fallback: CutFallback,
     /// Average successive frames while the view, lights and settings stay (progressive);
@@ -323,6 +337,9 @@ impl Default for SamplingSettings {
             block_size: 8,
             cut_size: 32,
             cull_behind: true,
+            // Measured on Sponza and Breakfast Room (docs/results.md): 1 removes the
+            // substitute fireflies for a few % more steps; 0.5 leaves some, 2 costs more.
+            near_field: 1.0,
             blending: CutBlending::Stochastic,
             fallback: CutFallback::MockCut,
             accumulate: false,
@@ -592,6 +609,12 @@ impl RenderSettings {
             return Err(format!(
                 "sampling.cut_size {} is out of range (1..=64)",
                 sm.cut_size
+            ));
+        }
+        if !(0.0..=100.0).contains(&sm.near_field) {
+            return Err(format!(
+                "sampling.near_field {} is out of range (0..=100; 0 = off)",
+                sm.near_field
             ));
         }
         let t = &self.tree;
