@@ -545,3 +545,31 @@ fn views_zoom_together_and_an_ab_view_measures_a_rectangle_and_toggles() {
     assert_eq!(mode(&h), AbMode::B, "T did not toggle");
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }
+
+#[test]
+fn tree_sampler_controls_reach_the_renderer() {
+    // Tall, so that the global-illumination section's sampler controls are on screen.
+    let options = AppOptions {
+        settings: Some(slc_settings()),
+        ..Default::default()
+    };
+    let Some(mut h) = harness_with(egui::vec2(1100.0, 1700.0), options) else {
+        return;
+    };
+    h.run_steps(3);
+    let settings = |h: &Harness<'_, WorkbenchApp>| h.state().renderer().expect("renderer").settings().clone();
+    assert!(settings(&h).gi.shadow_rays);
+    assert_eq!(settings(&h).sampling.near_field, 1.0);
+    assert!(
+        h.query_all_by_label("near-field refinement").next().is_some(),
+        "no near-field slider for SLC"
+    );
+    // (get_by_* panics when no such node is shown, or several are.)
+    h.get_by_label("shadow rays").click();
+    h.run_steps(3);
+    assert!(
+        !settings(&h).gi.shadow_rays,
+        "the shadow-ray checkbox did not reach the renderer"
+    );
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+}

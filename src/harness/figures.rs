@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::{Bench, Csv, GI_PASSES, Measured, PASS_GROUPS, mean_std, num, plot};
+use super::{Bench, Csv, GI_PASSES, Measured, PASS_GROUPS, SAMPLE_PASSES, mean_std, num, plot};
 use crate::renderer::settings::{CutBlending, CutFallback, GiMethod, RenderSettings};
 
 /// What every figure needs besides the bench.
@@ -393,16 +393,13 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     ]);
     // What each method spends: its sampling pass with shadow rays, and without them (the
     // same traversals and evaluations, every sample visible).
-    const SAMPLE_PASSES: [&str; 3] = ["slc_sample", "sst_sample", "rtslc_sample"];
     let mut ms: Vec<Measured> = Vec::new();
     let mut cost = Vec::new();
     for (method, _) in METHODS {
         let s = with(b, |s| s.gi.method = method);
         let m = b.measure(&s, o.size, o.frames, false)?;
-        let no_rays = with(b, |s| {
-            s.gi.method = method;
-            s.gi.shadow_rays = false;
-        });
+        let mut no_rays = s.clone();
+        no_rays.gi.shadow_rays = false;
         let open = b.measure(&no_rays, o.size, o.frames, false)?;
         cost.push((m.pass_ms(&SAMPLE_PASSES).0, open.pass_ms(&SAMPLE_PASSES).0));
         ms.push(m);

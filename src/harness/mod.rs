@@ -63,6 +63,9 @@ pub const GI_PASSES: [&str; 6] = [
     "gi_upsample",
 ];
 
+/// The tree samplers' sampling passes alone (traversal, evaluation, shadow rays).
+pub const SAMPLE_PASSES: [&str; 3] = ["slc_sample", "sst_sample", "rtslc_sample"];
+
 /// Mean and sample standard deviation.
 pub fn mean_std(v: &[f64]) -> (f64, f64) {
     if v.is_empty() {

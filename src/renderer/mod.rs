@@ -1756,7 +1756,6 @@ fn clear_view(enc: &mut wgpu::CommandEncoder, view: &wgpu::TextureView) {
     });
 }
 
-/// The radiance texture of an A/B source and its size (None: it does not exist now).
 /// An A/B source's radiance texture, its view and its size (None: it does not exist now).
 /// A free function so that `record_view` can borrow the passes mutably beside it.
 fn ab_texture<'a>(
