@@ -4,7 +4,8 @@
 // until a usable node far enough from x (SLC; slc_far_enough), a leaf (RTSLC), or from the
 // root (SST, same stop rule as SLC), and evaluate the cluster:
 // a point drawn from its substitute distribution (Gaussian in the node's frame, clamped to its
-// box; the VPL itself at a leaf) shaded as a VPL of the node's total flux, one shadow ray,
+// box; the VPL itself at a leaf) shaded as a VPL of the node's total flux, one shadow ray
+// (a substitute's ending sampling.substitute_offset short of it: slc_substitute_end),
 // divided by the probability of the path. Sum over slots (SST: mean over its samples).
 // Writes the estimate (or adds it), and per-pixel diagnostics.
 // CPU twin: src/reference/slc.rs (cuts, weights, blending); tests check the estimator
@@ -128,7 +129,15 @@ fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: 
         flux = c.intensity;
     }
     let geo = vpl_geometry(pv, nv, x, n, sp.epsilon);
-    let lit = geo > 0.0 && (sp.shadow_rays == 0u || vpl_visible(pv, nv, x, n, sp.ray_offset));
+    var lit = geo > 0.0;
+    if lit && sp.shadow_rays != 0u {
+        let o = x + n * sp.ray_offset;
+        var e = pv + nv * sp.ray_offset;
+        if node < sp.leaves {
+            e = slc_substitute_end(e, o, sp.substitute_offset);
+        }
+        lit = segment_visible(o, e);
+    }
     if tb != NO_TRACE {
         trace[tb + 6u] = bitcast<u32>(pv.x);
         trace[tb + 7u] = bitcast<u32>(pv.y);

@@ -172,6 +172,21 @@ pub fn ssim(a: &[f32], b: &[f32], w: usize, h: usize) -> f64 {
 }
 
 /// Every metric of `image` against `reference` (same size), SSIM on the display transform.
+/// Splits the error of F independent frames against a reference into bias and noise:
+/// E[mse of a frame] = b^2 + s^2 and E[mse of the frames' mean] = b^2 + s^2 / F, so
+///   b^2 = (F mse_mean - mean(mse_frame)) / (F - 1),  s^2 = mean(mse_frame) - b^2,
+/// both unbiased. Returns (b, s) as RMSEs (negative estimates, possible from noise, clamp to
+/// 0); NaN with fewer than 2 frames.
+pub fn bias_noise(frame_mse: &[f64], mean_mse: f64) -> (f64, f64) {
+    let f = frame_mse.len() as f64;
+    if frame_mse.len() < 2 {
+        return (f64::NAN, f64::NAN);
+    }
+    let m = frame_mse.iter().sum::<f64>() / f;
+    let b2 = (f * mean_mse - m) / (f - 1.0);
+    (b2.max(0.0).sqrt(), (m - b2).max(0.0).sqrt())
+}
+
 pub fn compare(image: &ImageF32, reference: &ImageF32, exposure_ev: f32, tonemap: Tonemap) -> Metrics {
     let rm = rmse(image, reference, None);
     let mean_ref = mean_rgb(reference, None);
@@ -200,6 +215,49 @@ pub fn compare(image: &ImageF32, reference: &ImageF32, exposure_ev: f32, tonemap
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bias_and_noise_are_recovered_from_independent_frames() {
+        // Frames = reference + bias b + Gaussian noise of deviation s (exactly known), many
+        // pixels: the estimates land within a few percent.
+        let (w, h, frames, b, s) = (64u32, 64u32, 8usize, 0.03f32, 0.1f32);
+        let reference = img(w, h, |x, y| 0.2 + 0.01 * ((x + 3 * y) % 7) as f32);
+        let mut state = 0x1234_5678u32;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            (state as f64 + 0.5) / 4_294_967_296.0
+        };
+        let mut gauss = move || {
+            let (u1, u2) = (uniform(), uniform());
+            ((-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()) as f32
+        };
+        let mut mean = reference.clone();
+        mean.pixels.iter_mut().for_each(|p| *p = [0.0; 4]);
+        let mut mses = Vec::new();
+        for _ in 0..frames {
+            let mut f = reference.clone();
+            for p in &mut f.pixels {
+                for c in &mut p[..3] {
+                    *c += b + s * gauss();
+                }
+            }
+            mses.push(rmse(&f, &reference, None).powi(2));
+            for (m, p) in mean.pixels.iter_mut().zip(&f.pixels) {
+                for c in 0..3 {
+                    m[c] += p[c] / frames as f32;
+                }
+            }
+        }
+        let (eb, es) = bias_noise(&mses, rmse(&mean, &reference, None).powi(2));
+        assert!((eb / b as f64 - 1.0).abs() < 0.05, "bias {eb} vs {b}");
+        assert!((es / s as f64 - 1.0).abs() < 0.02, "noise {es} vs {s}");
+        // Unbiased frames: the bias estimate is noise-sized, far below the noise.
+        let (eb0, _) = bias_noise(&[0.01, 0.01], 0.005);
+        assert_eq!(eb0, 0.0);
+        assert!(bias_noise(&[0.01], 0.01).0.is_nan());
+    }
 
     #[test]
     fn flip_is_zero_for_equal_images_and_grows_with_the_difference() {

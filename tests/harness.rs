@@ -144,6 +144,9 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "rmse",
             "ssim",
             "flip",
+            "mean_ratio",
+            "bias_rmse",
+            "noise_rmse",
             "steps_per_traversal",
             "steps_per_pixel",
         ],
@@ -158,6 +161,8 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "rmse_interpolated",
             "measured_frame_ms",
             "measured_rmse",
+            "measured_mean_ratio",
+            "measured_bias_rmse",
         ],
         3,
     );

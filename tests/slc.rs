@@ -485,7 +485,8 @@ fn pixel_values_equal_the_full_buffers() {
 #[test]
 fn the_pixel_story_matches_the_frame_and_the_tree() {
     use lightcut::reference::sst_tree::flag;
-    use lightcut::renderer::passes::slc::StopReason;
+    use lightcut::renderer::passes::slc::{SampleVisibility, StopReason};
+    use lightcut::scene::bvh::{Bvh, Ray};
     let Some(ctx) = common::gpu() else { return };
     for method in [GiMethod::Slc, GiMethod::Rtslc, GiMethod::Sst] {
         let mut st = setup(&ctx, settings(method));
@@ -501,12 +502,26 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
             "the story checks the near-field rule (on by default)"
         );
         let cut_size = st.r.settings().sampling.cut_size;
+        // Five hand-picked pixels and a 4 x 3 grid (enough substitute samples to trace).
+        let grid = (0..12).map(|i| (4 + 16 * (i % 4), 4 + 12 * (i / 4)));
         let pixels: Vec<(u32, u32)> = [(10, 30), (33, 21), (50, 12), (5, 5), (60, 38)]
             .into_iter()
+            .chain(grid)
             .filter(|&(x, y)| pos.get(x, y)[3] > 0.0)
             .collect();
         assert!(pixels.len() >= 3, "too few pixels with geometry");
         let mut evaluated = 0;
+        // Substitute samples whose shadow ray the CPU traced too, and how many it judged alike.
+        let (mut rays, mut rays_alike) = (0, 0);
+        let bvh = Bvh::build(&st.scene.positions, &st.scene.indices);
+        let (ray_offset, sub_offset) = (
+            st.r.settings().gi.ray_offset,
+            st.r.settings().sampling.substitute_offset,
+        );
+        assert!(
+            sub_offset > 0.0,
+            "the story checks the substitute ray offset (on by default)"
+        );
         // Usable nodes passed because x is too close to them (the near-field rule at work).
         let mut near_passes = 0;
         for (x, y) in pixels {
@@ -575,6 +590,22 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
                     ((smp.prob as f64) - prob).abs() <= 1e-5 * prob,
                     "path probability"
                 );
+                // A substitute sample's shadow ray: the CPU twin of its end point, same verdict.
+                if let (StopReason::Usable, Some((pv, vis))) = (smp.stop, smp.point)
+                    && vis != SampleVisibility::FacingAway
+                {
+                    let o = p + n * ray_offset;
+                    let e = pv + nodes[smp.end as usize].normal * ray_offset;
+                    let e = slc::substitute_ray_end(e, o, sub_offset);
+                    let blocked = bvh.any_hit(&Ray {
+                        origin: o,
+                        dir: e - o,
+                        tmin: 1e-4,
+                        tmax: 1.0 - 1e-4,
+                    });
+                    rays += 1;
+                    rays_alike += (blocked == (vis == SampleVisibility::Blocked)) as usize;
+                }
                 match (method, smp.stop) {
                     (GiMethod::Rtslc, s) => assert_eq!(s, StopReason::Leaf),
                     (_, StopReason::Leaf) => assert!(smp.end >= leaves),
@@ -599,6 +630,12 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
             );
         }
         assert!(evaluated > 0, "{method:?}: no sample was evaluated");
+        // Grazing rays may go either way between the GPU's and the CPU's float arithmetic.
+        eprintln!("{method:?}: {rays_alike} of {rays} substitute shadow rays as the CPU's");
+        assert!(
+            method == GiMethod::Rtslc || (rays >= 10 && rays - rays_alike <= rays / 50),
+            "{method:?}: only {rays_alike} of {rays} substitute shadow rays agree with the CPU"
+        );
         eprintln!("{method:?}: {near_passes} usable nodes passed as too near");
         assert!(
             method == GiMethod::Rtslc || near_passes > 0,
@@ -636,6 +673,45 @@ fn without_shadow_rays_the_same_samples_only_gain_light() {
         assert!(
             gained > 50,
             "{method:?}: only {gained} pixels gain light without shadow rays"
+        );
+    }
+    assert!(ctx.errors.take().is_empty());
+}
+
+#[test]
+fn the_substitute_ray_offset_only_shortens_substitute_shadow_rays() {
+    // Fixed seed: the same samples with and without the offset. Each substitute ray's segment
+    // lies within the one without it (`substitute_ray_end`), so a pixel can only gain light;
+    // leaf VPLs' rays are untouched, so RTSLC is bit for bit the same.
+    let Some(ctx) = common::gpu() else { return };
+    for method in [GiMethod::Slc, GiMethod::Sst, GiMethod::Rtslc] {
+        let run = |offset: f32| -> ImageF32 {
+            let mut s = settings(method);
+            s.sampling.fixed_seed = true;
+            s.sampling.substitute_offset = offset;
+            let mut st = setup(&ctx, s);
+            st.frame();
+            st.indirect()
+        };
+        let (off, on) = (run(0.0), run(0.5));
+        let mut gained = 0;
+        for (a, b) in off.pixels.iter().zip(&on.pixels) {
+            if method == GiMethod::Rtslc {
+                assert_eq!(a, b, "RTSLC has no substitute samples");
+                continue;
+            }
+            for c in 0..3 {
+                assert!(
+                    b[c] >= a[c] - 1e-6 * a[c].abs().max(1.0),
+                    "{method:?}: {b:?} < {a:?}"
+                );
+            }
+            gained += (b[0] > 1.001 * a[0] + 1e-7) as usize;
+        }
+        eprintln!("{method:?}: {gained} pixels gain light with a 0.5 m substitute ray offset");
+        assert!(
+            method == GiMethod::Rtslc || gained > 10,
+            "{method:?}: only {gained} pixels gain light with the offset"
         );
     }
     assert!(ctx.errors.take().is_empty());

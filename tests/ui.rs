@@ -564,6 +564,11 @@ fn tree_sampler_controls_reach_the_renderer() {
         h.query_all_by_label("near-field refinement").next().is_some(),
         "no near-field slider for SLC"
     );
+    assert_eq!(settings(&h).sampling.substitute_offset, 0.05);
+    assert!(
+        h.query_all_by_label("substitute ray offset").next().is_some(),
+        "no substitute ray offset slider for SLC"
+    );
     // (get_by_* panics when no such node is shown, or several are.)
     h.get_by_label("shadow rays").click();
     h.run_steps(3);

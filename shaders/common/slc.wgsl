@@ -32,6 +32,18 @@ fn slc_far_enough(node: SstNode, x: vec3<f32>, eps: f32, theta: f32) -> bool {
     return dot(q, q) >= r * r;
 }
 
+// Where the shadow ray of a substitute sample ends (the SST paper's scene-size epsilon,
+// section 5: drawn points may lie slightly inside geometry): e, the drawn point moved
+// gi.ray_offset along the node's normal, moved a further d towards the ray's origin o, at
+// most half way. The segment o-e' lies within o-e, so it can only see more.
+fn slc_substitute_end(e: vec3<f32>, o: vec3<f32>, d: f32) -> vec3<f32> {
+    let l = length(o - e);
+    if l <= 0.0 || d <= 0.0 {
+        return e;
+    }
+    return e + (o - e) * min(d / l, 0.5);
+}
+
 fn slc_keep(i: u32, w: f32, cull: bool) -> bool {
     return !sst_is_empty(tree[i]) && (!cull || w > 0.0);
 }

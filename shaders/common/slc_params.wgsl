@@ -23,8 +23,8 @@ struct SlcParams {
     trace_pixel: u32, // x | y << 16: the pixel whose samples slc_sample records (pixel story); ~0 none
     near_field: f32, // near-field refinement factor (0 = off): see slc_far_enough
     shadow_rays: u32, // 1 trace shadow rays, 0 every sample visible
+    substitute_offset: f32, // m: substitute samples' shadow rays end this far short (slc_substitute_end)
     pad1: u32,
-    pad2: u32,
 };
 
 // The pixel whose G-buffer sample builds block b's cut.

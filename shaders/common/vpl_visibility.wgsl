@@ -9,3 +9,8 @@ fn vpl_visible(pv: vec3<f32>, nv: vec3<f32>, x: vec3<f32>, nx: vec3<f32>, offset
     let e = pv + nv * offset;
     return !bvh_any_hit(o, e - o, 1e-4, 1.0 - 1e-4);
 }
+
+// True when nothing blocks the segment from o to e (end points already offset).
+fn segment_visible(o: vec3<f32>, e: vec3<f32>) -> bool {
+    return !bvh_any_hit(o, e - o, 1e-4, 1.0 - 1e-4);
+}

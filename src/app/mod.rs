@@ -777,6 +777,16 @@ impl WorkbenchApp {
                                  diagonals from its box (0 = the thesis's rule): substitute samples \
                                  next to the point turn into fireflies",
                             );
+                        ui.add(
+                            egui::Slider::new(&mut sm.substitute_offset, 0.0..=0.3)
+                                .suffix(" m")
+                                .text("substitute ray offset"),
+                        )
+                        .on_hover_text(
+                            "substitute samples' shadow rays end this far short of the drawn point \
+                             (the SST paper's scene-size epsilon; 0 = the thesis): drawn points land \
+                             slightly inside geometry; too large leaks light through thin walls",
+                        );
                     }
                     ui.checkbox(&mut sm.half_resolution, "half-resolution GI (bilateral upsampling)");
                     ui.checkbox(&mut sm.accumulate, "accumulate frames while static");

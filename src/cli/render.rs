@@ -73,6 +73,10 @@ pub struct SamplingArgs {
     /// at least this many box diagonals from its box (0 = off, the thesis's rule; default 1).
     #[arg(long)]
     pub near_field: Option<f32>,
+    /// Metres by which SLC/SST substitute samples' shadow rays stop short of the drawn point
+    /// (the SST paper's scene-size epsilon; 0 = off, the thesis; default 0.05).
+    #[arg(long)]
+    pub substitute_offset: Option<f32>,
     /// No shadow rays for the ground truth and the tree samplers (every VPL / sample visible).
     #[arg(long)]
     pub no_shadow_rays: bool,
@@ -128,6 +132,9 @@ impl SamplingArgs {
         }
         if let Some(v) = self.near_field {
             s.sampling.near_field = v;
+        }
+        if let Some(v) = self.substitute_offset {
+            s.sampling.substitute_offset = v;
         }
         if self.no_shadow_rays {
             s.gi.shadow_rays = false;

@@ -223,6 +223,9 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
         "ssim",
         "ssim_std",
         "flip",
+        "mean_ratio",
+        "bias_rmse",
+        "noise_rmse",
         "steps_per_traversal",
         "steps_per_pixel",
     ]);
@@ -250,12 +253,18 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
                 num(q),
                 num(qs),
                 num(mean_std(&m.flip).0),
+                num(mean_std(&m.mean_ratio).0),
+                num(m.bias_rmse),
+                num(m.noise_rmse),
                 num(m.steps_per_traversal()),
                 num(m.steps_per_pixel()),
             ]);
             eprintln!(
-                "[{}] {label} {n} spp: {t:.1} ms, RMSE {r:.4e}, SSIM {q:.3}",
-                b.scene
+                "[{}] {label} {n} spp: {t:.1} ms, RMSE {r:.4e} (bias {:.2e}, noise {:.2e}, mean ratio {:.3}), SSIM {q:.3}",
+                b.scene,
+                m.bias_rmse,
+                m.noise_rmse,
+                mean_std(&m.mean_ratio).0
             );
             pts.push((t, r, q, n));
         }
@@ -309,6 +318,8 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
         "measured_frame_ms",
         "measured_rmse",
         "measured_ssim",
+        "measured_mean_ratio",
+        "measured_bias_rmse",
     ]);
     let gt = b.ground_truth(&b.base.clone(), o.size)?;
     let img = images(dir)?;
@@ -349,12 +360,16 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
             num(m.frame_ms().0),
             num(m.rmse().0),
             num(m.ssim().0),
+            num(mean_std(&m.mean_ratio).0),
+            num(m.bias_rmse),
         ]);
         table.push_str(&format!(
-            "  {label:<6} RMSE {r:.4e}{} SSIM {q:.3} · {n} spp at that time (measured: {:.1} ms, RMSE {:.4e})\n",
+            "  {label:<6} RMSE {r:.4e}{} SSIM {q:.3} · {n} spp at that time (measured: {:.1} ms, RMSE {:.4e}, of it bias {:.2e}, mean {:.3}x GT)\n",
             if ex { " (extrapolated)" } else { "" },
             m.frame_ms().0,
-            m.rmse().0
+            m.rmse().0,
+            m.bias_rmse,
+            mean_std(&m.mean_ratio).0
         ));
         at.push(r);
     }

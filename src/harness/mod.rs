@@ -93,6 +93,10 @@ pub struct Measured {
     pub ssim: Vec<f64>,
     pub flip: Vec<f64>,
     pub mean_ratio: Vec<f64>,
+    /// The frames' error split into bias and noise (`metrics::bias_noise`: RMSEs of the
+    /// frames' mean and of a frame around it); NaN without a ground truth or with one frame.
+    pub bias_rmse: f64,
+    pub noise_rmse: f64,
     /// Per frame: RMSE over the pixels without a similar cut only (NaN when there are none).
     pub rmse_fallback: Vec<f64>,
     /// Sampler statistics summed over the frames.
@@ -288,7 +292,13 @@ impl Bench {
             None
         };
         self.apply(s, size)?;
-        let mut m = Measured::default();
+        let mut m = Measured {
+            bias_rmse: f64::NAN,
+            noise_rmse: f64::NAN,
+            ..Default::default()
+        };
+        // Sum of the frames' GI (for the bias / noise split).
+        let mut sum: Option<ImageF32> = None;
         for f in 0..frames.max(1) {
             // Drain any pending timestamp readback so this frame is timed.
             let _ = self.r.wait_timings();
@@ -328,6 +338,15 @@ impl Bench {
                 m.ssim.push(c.ssim);
                 m.flip.push(c.flip);
                 m.mean_ratio.push(c.mean_ratio);
+                let acc = sum.get_or_insert_with(|| ImageF32 {
+                    pixels: vec![[0.0; 4]; ind.pixels.len()],
+                    ..ind.clone()
+                });
+                for (a, p) in acc.pixels.iter_mut().zip(&ind.pixels) {
+                    for c in 0..3 {
+                        a[c] += p[c];
+                    }
+                }
                 if let Some((_, _, _, fb)) = &diag {
                     m.rmse_fallback.push(if fb.iter().any(|f| *f) {
                         metrics::rmse(&ind, gt, Some(fb))
@@ -341,6 +360,14 @@ impl Bench {
                 m.steps = Some((w, h, steps));
                 m.fallback = Some(fb);
             }
+        }
+        if let (Some((gt, _)), Some(mut mean)) = (&gt, sum) {
+            let k = m.rmse.len() as f32;
+            mean.pixels
+                .iter_mut()
+                .for_each(|p| p[..3].iter_mut().for_each(|c| *c /= k));
+            let mses: Vec<f64> = m.rmse.iter().map(|r| r * r).collect();
+            (m.bias_rmse, m.noise_rmse) = metrics::bias_noise(&mses, metrics::rmse(&mean, gt, None).powi(2));
         }
         if let Some((_, hash)) = gt
             && self.vpl_hash()? != hash

@@ -136,6 +136,18 @@ pub fn far_enough(node: &SstNode, x: Vec3, eps: f32, theta: f32) -> bool {
     q.dot(q) >= r * r
 }
 
+/// Where the shadow ray of a substitute sample ends (`slc_substitute_end` in
+/// `common/slc.wgsl`; the SST paper's scene-size epsilon, section 5): `e`, the drawn point
+/// already moved `gi.ray_offset` along the node's normal, moved `d` further towards the ray's
+/// origin `o`, at most half way. The segment o-e' lies within o-e, so it can only see more.
+pub fn substitute_ray_end(e: Vec3, o: Vec3, d: f32) -> Vec3 {
+    let l = (o - e).length();
+    if l <= 0.0 || d <= 0.0 {
+        return e;
+    }
+    e + (o - e) * (d / l).min(0.5)
+}
+
 /// Eq. 5.3: the normals agree (dot > n_min) and the points are closer than d_max (metres).
 pub fn similar(px: Vec3, nx: Vec3, py: Vec3, ny: Vec3, n_min: f32, d_max: f32) -> bool {
     nx.dot(ny) > n_min && px.distance(py) < d_max
@@ -310,6 +322,19 @@ mod tests {
         };
         assert!(!far_enough(&dot, Vec3::new(0.0, 0.0, 0.04), eps, 1.0));
         assert!(far_enough(&dot, Vec3::new(0.0, 0.0, 0.052), eps, 1.0));
+    }
+
+    #[test]
+    fn substitute_rays_end_short_of_the_point_at_most_half_way() {
+        let (e, o) = (Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 2.0, 0.0));
+        assert_eq!(substitute_ray_end(e, o, 0.0), e);
+        assert!((substitute_ray_end(e, o, 0.05) - Vec3::new(1.0, 0.05, 0.0)).length() < 1e-6);
+        // Capped at half the segment: the ray never collapses onto the shaded point.
+        assert!((substitute_ray_end(e, o, 5.0) - Vec3::new(1.0, 1.0, 0.0)).length() < 1e-6);
+        assert_eq!(substitute_ray_end(e, e, 0.05), e);
+        // The shortened segment lies within the original one.
+        let f = substitute_ray_end(e, o, 0.3);
+        assert!(((f - e).length() + (o - f).length() - (o - e).length()).abs() < 1e-6);
     }
 
     fn floor_and_wall(n: usize) -> Vec<SstNode> {

@@ -300,7 +300,10 @@ pub struct GpuSlcParams {
     pub near_field: f32,
     /// 1: shadow rays, 0: every sample visible (`GiSettings::shadow_rays`).
     pub shadow_rays: u32,
-    pub _pad: [u32; 2],
+    /// Metres by which substitute samples' shadow rays stop short of the drawn point
+    /// (`SamplingSettings::substitute_offset`).
+    pub substitute_offset: f32,
+    pub _pad: u32,
 }
 
 /// A node of the Stochastic Substitute Tree, 64 bytes (one cache line; the SST paper's node
@@ -535,8 +538,8 @@ mod tests {
                     offset_of!(GpuSlcParams, trace_pixel),
                     offset_of!(GpuSlcParams, near_field),
                     offset_of!(GpuSlcParams, shadow_rays),
+                    offset_of!(GpuSlcParams, substitute_offset),
                     offset_of!(GpuSlcParams, _pad),
-                    offset_of!(GpuSlcParams, _pad) + 4,
                 ],
             ),
             (

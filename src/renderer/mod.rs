@@ -980,7 +980,8 @@ impl Renderer {
             },
             near_field: sm.near_field,
             shadow_rays: s.gi.shadow_rays as u32,
-            _pad: [0; 2],
+            substitute_offset: sm.substitute_offset,
+            _pad: 0,
         };
         let (gbuffer, accum) = match &half_targets {
             Some(h) => (&h.gbuffer, &h.accum),
