@@ -73,13 +73,11 @@ fn traverse(start: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb:
             && slc_far_enough(tree[node], x, sp.epsilon, sp.near_field)) {
             break;
         }
-        let wl = slc_node_weight(tree[2u * node], x, n, sp.epsilon);
-        let wr = slc_node_weight(tree[2u * node + 1u], x, n, sp.epsilon);
-        let s = wl + wr;
-        if !(s > 0.0) {
+        let pl = slc_child_prob(tree[2u * node], tree[2u * node + 1u], x, n, sp.epsilon,
+            sp.child_probability);
+        if pl < 0.0 {
             return Walk(0u, 0.0, steps);
         }
-        let pl = wl / s;
         var pc = pl;
         if rng_next(rng) < pl {
             node = 2u * node;

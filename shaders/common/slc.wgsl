@@ -19,6 +19,35 @@ fn slc_node_weight(node: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32) -> f32 {
     return luminance(node.intensity) * (g / max(dot(d, d), eps * eps));
 }
 
+// Probability of taking the left child of a traversal step (stage 14); < 0: dead branch (both
+// children weigh 0). mode 0, the thesis: wl / (wl + wr) with slc_node_weight. mode 1, RTSLC's
+// "MinMax": the average of the two normalisations of lum(I) x box_cos / max(d^2, eps^2) with d
+// the distance to each child's box (0 inside) and to its farthest point. Both have the
+// support of box_cos, so either is unbiased wherever eq. 5.5 is.
+fn slc_child_prob(l: SstNode, r: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32, mode: u32) -> f32 {
+    if mode == 0u {
+        let wl = slc_node_weight(l, x, n, eps);
+        let wr = slc_node_weight(r, x, n, eps);
+        let s = wl + wr;
+        return select(-1.0, wl / s, s > 0.0);
+    }
+    let gl = select(luminance(l.intensity) * box_cos(l.bbox_min, l.bbox_max, x, n), 0.0, sst_is_empty(l));
+    let gr = select(luminance(r.intensity) * box_cos(r.bbox_min, r.bbox_max, x, n), 0.0, sst_is_empty(r));
+    if !(gl + gr > 0.0) {
+        return -1.0;
+    }
+    let e2 = eps * eps;
+    let ql = clamp(x, l.bbox_min, l.bbox_max) - x;
+    let qr = clamp(x, r.bbox_min, r.bbox_max) - x;
+    let fl = max(abs(x - l.bbox_min), abs(x - l.bbox_max));
+    let fr = max(abs(x - r.bbox_min), abs(x - r.bbox_max));
+    let nl = gl / max(dot(ql, ql), e2);
+    let nr = gr / max(dot(qr, qr), e2);
+    let xl = gl / max(dot(fl, fl), e2);
+    let xr = gr / max(dot(fr, fr), e2);
+    return 0.5 * (nl / (nl + nr) + xl / (xl + xr));
+}
+
 // Near-field refinement (ours; theta = 0 turns it off, the thesis's rule): a usable node is
 // sampled only when x lies at least max(eps, theta x |box diagonal|) from its box, an opening
 // criterion like Barnes-Hut's. Closer, its substitute samples land off the real surfaces

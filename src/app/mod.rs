@@ -24,7 +24,10 @@ use crate::{
     renderer::{
         FrameInput, Renderer,
         context::{GpuContext, describe_adapter},
-        settings::{CutBlending, CutFallback, GiMethod, RenderSettings, Tonemap, ViewBuffer, VplMode},
+        settings::{
+            ChildProbability, CutBlending, CutFallback, GiMethod, RenderSettings, Tonemap, ViewBuffer,
+            VplMode,
+        },
         timing::PassTimings,
     },
     scene::{
@@ -788,6 +791,19 @@ impl WorkbenchApp {
                              slightly inside geometry; too large leaks light through thin walls",
                         );
                     }
+                    egui::ComboBox::from_label("child probability")
+                        .selected_text(sm.child_probability.name())
+                        .show_ui(ui, |ui| {
+                            for c in ChildProbability::ALL {
+                                ui.selectable_value(&mut sm.child_probability, c, c.name());
+                            }
+                        })
+                        .response
+                        .on_hover_text(
+                            "how a traversal step picks a child: eq. 5.5's weights with the distance to \
+                             each child's mean (thesis), or RTSLC's average of the closest- and \
+                             farthest-point box distances (bounds the weights of near VPLs)",
+                        );
                     ui.checkbox(&mut sm.half_resolution, "half-resolution GI (bilateral upsampling)");
                     ui.checkbox(&mut sm.accumulate, "accumulate frames while static");
                     ui.checkbox(&mut self.compare_gt, "compare with the ground truth")

@@ -53,6 +53,15 @@ pub enum FallbackArg {
     Recompute,
 }
 
+/// Child probability for `--child-probability`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ChildProbabilityArg {
+    /// eq. 5.5 with the distance to each child's mean position (the thesis).
+    Mean,
+    /// RTSLC's average of the closest- and farthest-point box distances.
+    MinMax,
+}
+
 /// Settings of the tree samplers (override `--settings`).
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct SamplingArgs {
@@ -77,6 +86,9 @@ pub struct SamplingArgs {
     /// (the SST paper's scene-size epsilon; 0 = off, the thesis; default 0.05).
     #[arg(long)]
     pub substitute_offset: Option<f32>,
+    /// How a traversal step picks a child (SLC, SST, RTSLC).
+    #[arg(long, value_enum)]
+    pub child_probability: Option<ChildProbabilityArg>,
     /// No shadow rays for the ground truth and the tree samplers (every VPL / sample visible).
     #[arg(long)]
     pub no_shadow_rays: bool,
@@ -106,7 +118,7 @@ pub struct SamplingArgs {
 
 impl SamplingArgs {
     pub fn apply(&self, s: &mut crate::renderer::settings::RenderSettings) {
-        use crate::renderer::settings::{CutBlending, CutFallback};
+        use crate::renderer::settings::{ChildProbability, CutBlending, CutFallback};
         if let Some(v) = self.block {
             s.sampling.block_size = v;
         }
@@ -135,6 +147,12 @@ impl SamplingArgs {
         }
         if let Some(v) = self.substitute_offset {
             s.sampling.substitute_offset = v;
+        }
+        if let Some(c) = self.child_probability {
+            s.sampling.child_probability = match c {
+                ChildProbabilityArg::Mean => ChildProbability::Mean,
+                ChildProbabilityArg::MinMax => ChildProbability::MinMax,
+            };
         }
         if self.no_shadow_rays {
             s.gi.shadow_rays = false;

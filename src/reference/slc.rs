@@ -63,6 +63,43 @@ pub fn node_weight(node: &SstNode, x: Vec3, n: Vec3, eps: f32) -> f32 {
     luminance(node.intensity) * (g / d.dot(d).max(eps * eps))
 }
 
+/// Probability of taking the left child in a traversal step (stage 14), None for a dead
+/// branch: `slc_child_prob` in `common/slc.wgsl`. `min_max` false, the thesis: wl / (wl + wr)
+/// with [`node_weight`]; true, RTSLC's "MinMax": the average of the two normalisations of
+/// lum(I) x box_cos / max(d^2, eps^2) with d the distance to each child's box (0 inside) and
+/// to its farthest point.
+pub fn child_probability(l: &SstNode, r: &SstNode, x: Vec3, n: Vec3, eps: f32, min_max: bool) -> Option<f32> {
+    if !min_max {
+        let (wl, wr) = (node_weight(l, x, n, eps), node_weight(r, x, n, eps));
+        let s = wl + wr;
+        return (s > 0.0).then(|| wl / s);
+    }
+    let g = |c: &SstNode| {
+        if c.is_empty() {
+            0.0
+        } else {
+            luminance(c.intensity) * box_cos(c.bbox_min, c.bbox_max, x, n)
+        }
+    };
+    let (gl, gr) = (g(l), g(r));
+    // (Also None for NaN.)
+    if (gl + gr).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    let e2 = eps * eps;
+    let near = |c: &SstNode| {
+        let q = x.clamp(c.bbox_min, c.bbox_max) - x;
+        q.dot(q).max(e2)
+    };
+    let far = |c: &SstNode| {
+        let f = (x - c.bbox_min).abs().max((x - c.bbox_max).abs());
+        f.dot(f).max(e2)
+    };
+    let (nl, nr) = (gl / near(l), gr / near(r));
+    let (xl, xr) = (gl / far(l), gr / far(r));
+    Some(0.5 * (nl / (nl + nr) + xl / (xl + xr)))
+}
+
 /// Whether a node may enter a cut (as a split's child): not empty, and (with culling) not
 /// wholly behind the surface.
 fn keep(node: &SstNode, w: f32, cull: bool) -> bool {
@@ -294,6 +331,51 @@ mod tests {
     use super::*;
     use crate::reference::sst_tree::{build, sort_vpls};
     use crate::renderer::gpu_data::GpuVpl;
+
+    #[test]
+    fn child_probabilities_by_hand() {
+        // Two floor patches under a point looking down: the left one is long with its mean at
+        // the far end (x sits right above its near end), the right one is small and 2 m away.
+        let patch = |lo: Vec3, hi: Vec3, mean: Vec3| SstNode {
+            position: mean,
+            intensity: Vec3::ONE,
+            bbox_min: lo,
+            bbox_max: hi,
+            ..SstNode::EMPTY
+        };
+        let l = patch(Vec3::ZERO, Vec3::new(4.0, 1.0, 0.0), Vec3::new(3.5, 0.5, 0.0));
+        let r = patch(
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(1.0, 3.0, 0.0),
+            Vec3::new(0.5, 2.5, 0.0),
+        );
+        let (x, n, eps) = (Vec3::new(0.0, 0.5, 0.2), Vec3::NEG_Z, 0.05);
+        let mean = child_probability(&l, &r, x, n, eps, false).unwrap();
+        let (wl, wr) = (node_weight(&l, x, n, eps), node_weight(&r, x, n, eps));
+        assert!((mean - wl / (wl + wr)).abs() < 1e-7);
+        // MinMax keeps at least half of the closest-point share (0.2 m vs 1.5 m away: > 0.9), so
+        // the near patch gets more than eq. 5.5 with its far mean gives it.
+        let mm = child_probability(&l, &r, x, n, eps, true).unwrap();
+        assert!(
+            mm > 0.45 && mm < 1.0 && mm > mean + 0.25,
+            "min-max {mm}, mean {mean}"
+        );
+        // By hand: closest points at d^2 = 0.04 and 2.29, farthest at 16 + 0.25 + 0.04 and
+        // 1 + 6.25 + 0.04.
+        let (gl, gr) = (
+            box_cos(l.bbox_min, l.bbox_max, x, n),
+            box_cos(r.bbox_min, r.bbox_max, x, n),
+        );
+        let (nl, nr, fl, fr) = (gl / 0.04, gr / 2.29, gl / 16.29, gr / 7.29);
+        let want = 0.5 * (nl / (nl + nr) + fl / (fl + fr));
+        assert!((mm - want).abs() < 1e-5, "{mm} vs {want}");
+        // An empty or unseen child gets nothing; nothing seen: a dead branch.
+        let empty = SstNode::EMPTY;
+        assert_eq!(child_probability(&l, &empty, x, n, eps, true), Some(1.0));
+        assert_eq!(child_probability(&l, &empty, x, n, eps, false), Some(1.0));
+        assert_eq!(child_probability(&l, &r, x, Vec3::Z, eps, true), None);
+        assert_eq!(child_probability(&l, &r, x, Vec3::Z, eps, false), None);
+    }
 
     #[test]
     fn near_field_rule_by_hand() {

@@ -303,7 +303,8 @@ pub struct GpuSlcParams {
     /// Metres by which substitute samples' shadow rays stop short of the drawn point
     /// (`SamplingSettings::substitute_offset`).
     pub substitute_offset: f32,
-    pub _pad: u32,
+    /// 0 mean position (eq. 5.5), 1 min-max box distance (`ChildProbability`).
+    pub child_probability: u32,
 }
 
 /// A node of the Stochastic Substitute Tree, 64 bytes (one cache line; the SST paper's node
@@ -539,7 +540,7 @@ mod tests {
                     offset_of!(GpuSlcParams, near_field),
                     offset_of!(GpuSlcParams, shadow_rays),
                     offset_of!(GpuSlcParams, substitute_offset),
-                    offset_of!(GpuSlcParams, _pad),
+                    offset_of!(GpuSlcParams, child_probability),
                 ],
             ),
             (

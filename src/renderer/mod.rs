@@ -981,7 +981,10 @@ impl Renderer {
             near_field: sm.near_field,
             shadow_rays: s.gi.shadow_rays as u32,
             substitute_offset: sm.substitute_offset,
-            _pad: 0,
+            child_probability: match sm.child_probability {
+                settings::ChildProbability::Mean => 0,
+                settings::ChildProbability::MinMax => 1,
+            },
         };
         let (gbuffer, accum) = match &half_targets {
             Some(h) => (&h.gbuffer, &h.accum),

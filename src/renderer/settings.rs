@@ -296,6 +296,30 @@ impl CutFallback {
     }
 }
 
+/// How a traversal step splits its probability between the two children (stage 14).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ChildProbability {
+    /// p_left = w_left / (w_left + w_right), w of eq. 5.5 with the distance to each child's
+    /// intensity-weighted mean (the thesis).
+    #[default]
+    Mean,
+    /// RTSLC's default ("MinMax", Lin & Yuksel 2020's public code): the average of the two
+    /// normalisations with the closest-point and the farthest-point squared distance to each
+    /// child's box (same cosine term). A child holding VPLs close to x keeps at least half its
+    /// closest-point share, which bounds the samples' weights (fewer fireflies).
+    MinMax,
+}
+
+impl ChildProbability {
+    pub const ALL: [ChildProbability; 2] = [ChildProbability::Mean, ChildProbability::MinMax];
+    pub fn name(self) -> &'static str {
+        match self {
+            ChildProbability::Mean => "mean position (thesis)",
+            ChildProbability::MinMax => "min-max box distance (RTSLC)",
+        }
+    }
+}
+
 /// Sampling the tree (stages 11-16, thesis chapter 5): used by the SLC, SST and RTSLC methods.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -326,6 +350,9 @@ pub struct SamplingSettings {
     /// `gi.ray_offset`, the thesis) left SLC 8.6% dark in the Breakfast Room. Too large leaks
     /// light through walls thinner than it. See docs/results.md.
     pub substitute_offset: f32,
+    /// How a traversal step splits its probability between the children (all three
+    /// samplers; the cuts are built the same either way).
+    pub child_probability: ChildProbability,
     pub blending: CutBlending,
     pub fallback: CutFallback,
     /// Average successive frames while the view, lights and settings stay (progressive);
@@ -352,6 +379,7 @@ impl Default for SamplingSettings {
             // Measured (16-frame means vs the ground truth, docs/results.md): 0.05 m brings
             // SLC from 0.915x to 0.98x in the Breakfast Room; 0.1 m overshoots (light leaks).
             substitute_offset: 0.05,
+            child_probability: ChildProbability::Mean,
             blending: CutBlending::Stochastic,
             fallback: CutFallback::MockCut,
             accumulate: false,
