@@ -171,7 +171,6 @@ pub fn ssim(a: &[f32], b: &[f32], w: usize, h: usize) -> f64 {
     total / (w * h).max(1) as f64
 }
 
-/// Every metric of `image` against `reference` (same size), SSIM on the display transform.
 /// Splits the error of F independent frames against a reference into bias and noise:
 /// E[mse of a frame] = b^2 + s^2 and E[mse of the frames' mean] = b^2 + s^2 / F, so
 ///   b^2 = (F mse_mean - mean(mse_frame)) / (F - 1),  s^2 = mean(mse_frame) - b^2,
@@ -187,6 +186,7 @@ pub fn bias_noise(frame_mse: &[f64], mean_mse: f64) -> (f64, f64) {
     (b2.max(0.0).sqrt(), (m - b2).max(0.0).sqrt())
 }
 
+/// Every metric of `image` against `reference` (same size), SSIM on the display transform.
 pub fn compare(image: &ImageF32, reference: &ImageF32, exposure_ev: f32, tonemap: Tonemap) -> Metrics {
     let rm = rmse(image, reference, None);
     let mean_ref = mean_rgb(reference, None);

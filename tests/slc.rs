@@ -669,31 +669,42 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
     assert!(ctx.errors.take().is_empty());
 }
 
+/// One frame of `method` with a fixed seed (the same cuts, traversals and sample points every
+/// run) after `f` changes the settings.
+fn fixed_seed_frame(ctx: &GpuContext, method: GiMethod, f: impl FnOnce(&mut RenderSettings)) -> ImageF32 {
+    let mut s = settings(method);
+    s.sampling.fixed_seed = true;
+    f(&mut s);
+    let mut st = setup(ctx, s);
+    st.frame();
+    st.indirect()
+}
+
+/// Asserts no pixel of `after` is darker than in `before` (float rounding aside); returns
+/// how many are brighter.
+fn pixels_only_gain(method: GiMethod, before: &ImageF32, after: &ImageF32) -> usize {
+    let mut gained = 0;
+    for (a, b) in before.pixels.iter().zip(&after.pixels) {
+        for c in 0..3 {
+            assert!(
+                b[c] >= a[c] - 1e-6 * a[c].abs().max(1.0),
+                "{method:?}: {b:?} < {a:?}"
+            );
+        }
+        gained += (b[0] > 1.001 * a[0] + 1e-7) as usize;
+    }
+    gained
+}
+
 #[test]
 fn without_shadow_rays_the_same_samples_only_gain_light() {
     // Fixed seed: the same cuts, traversals and sample points with and without shadow rays,
     // so every pixel can only gain light (never blocked), and some must.
     let Some(ctx) = common::gpu() else { return };
     for method in [GiMethod::Slc, GiMethod::Rtslc, GiMethod::Sst] {
-        let run = |rays: bool| -> ImageF32 {
-            let mut s = settings(method);
-            s.sampling.fixed_seed = true;
-            s.gi.shadow_rays = rays;
-            let mut st = setup(&ctx, s);
-            st.frame();
-            st.indirect()
-        };
-        let (on, off) = (run(true), run(false));
-        let mut gained = 0;
-        for (a, b) in on.pixels.iter().zip(&off.pixels) {
-            for c in 0..3 {
-                assert!(
-                    b[c] >= a[c] - 1e-6 * a[c].abs().max(1.0),
-                    "{method:?}: {b:?} < {a:?}"
-                );
-            }
-            gained += (b[0] > 1.001 * a[0] + 1e-7) as usize;
-        }
+        let on = fixed_seed_frame(&ctx, method, |_| {});
+        let off = fixed_seed_frame(&ctx, method, |s| s.gi.shadow_rays = false);
+        let gained = pixels_only_gain(method, &on, &off);
         assert!(
             gained > 50,
             "{method:?}: only {gained} pixels gain light without shadow rays"
@@ -709,32 +720,16 @@ fn the_substitute_ray_offset_only_shortens_substitute_shadow_rays() {
     // leaf VPLs' rays are untouched, so RTSLC is bit for bit the same.
     let Some(ctx) = common::gpu() else { return };
     for method in [GiMethod::Slc, GiMethod::Sst, GiMethod::Rtslc] {
-        let run = |offset: f32| -> ImageF32 {
-            let mut s = settings(method);
-            s.sampling.fixed_seed = true;
-            s.sampling.substitute_offset = offset;
-            let mut st = setup(&ctx, s);
-            st.frame();
-            st.indirect()
-        };
-        let (off, on) = (run(0.0), run(0.5));
-        let mut gained = 0;
-        for (a, b) in off.pixels.iter().zip(&on.pixels) {
-            if method == GiMethod::Rtslc {
-                assert_eq!(a, b, "RTSLC has no substitute samples");
-                continue;
-            }
-            for c in 0..3 {
-                assert!(
-                    b[c] >= a[c] - 1e-6 * a[c].abs().max(1.0),
-                    "{method:?}: {b:?} < {a:?}"
-                );
-            }
-            gained += (b[0] > 1.001 * a[0] + 1e-7) as usize;
+        let off = fixed_seed_frame(&ctx, method, |s| s.sampling.substitute_offset = 0.0);
+        let on = fixed_seed_frame(&ctx, method, |s| s.sampling.substitute_offset = 0.5);
+        if method == GiMethod::Rtslc {
+            assert_eq!(off.pixels, on.pixels, "RTSLC has no substitute samples");
+            continue;
         }
+        let gained = pixels_only_gain(method, &off, &on);
         eprintln!("{method:?}: {gained} pixels gain light with a 0.5 m substitute ray offset");
         assert!(
-            method == GiMethod::Rtslc || gained > 10,
+            gained > 10,
             "{method:?}: only {gained} pixels gain light with the offset"
         );
     }

@@ -5,9 +5,7 @@
 // True when nothing blocks the segment between x and the VPL at pv, both end points moved
 // `offset` along their normals (nx, nv) off their surfaces.
 fn vpl_visible(pv: vec3<f32>, nv: vec3<f32>, x: vec3<f32>, nx: vec3<f32>, offset: f32) -> bool {
-    let o = x + nx * offset;
-    let e = pv + nv * offset;
-    return !bvh_any_hit(o, e - o, 1e-4, 1.0 - 1e-4);
+    return segment_visible(x + nx * offset, pv + nv * offset);
 }
 
 // True when nothing blocks the segment from o to e (end points already offset).
