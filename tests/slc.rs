@@ -273,8 +273,8 @@ fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
     // cut nodes that face away from the block centre are never refined, and traversals from
     // such large nodes rarely find the VPLs right next to the pixel. It converges, slowly:
     // relative RMSE 2.9 / 1.2 / 0.65 after 64 / 1024 / 4096 frames on this view.)
-    // Both child probabilities (the thesis's, RTSLC's MinMax) have the support of the box
-    // term, so both converge.
+    // Every child probability (the thesis's, RTSLC's MinMax, the defensive mix) has the
+    // support of the box term, so each converges.
     for cp in ChildProbability::ALL {
         let mut st = setup(&ctx, settings(GiMethod::Rtslc));
         let gt = st.ground_truth();
@@ -502,13 +502,15 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
     use lightcut::renderer::passes::slc::{SampleVisibility, StopReason};
     use lightcut::scene::bvh::{Bvh, Ray};
     let Some(ctx) = common::gpu() else { return };
-    use ChildProbability::{Mean, MinMax};
+    use ChildProbability::{Defensive, Mean, MinMax};
     for (method, cp) in [
         (GiMethod::Slc, Mean),
         (GiMethod::Rtslc, Mean),
         (GiMethod::Sst, Mean),
         (GiMethod::Slc, MinMax),
         (GiMethod::Rtslc, MinMax),
+        (GiMethod::Slc, Defensive),
+        (GiMethod::Rtslc, Defensive),
     ] {
         let mut st = setup(&ctx, settings(method));
         st.set(|s| {
@@ -600,7 +602,7 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
                         "passed a node the CPU rule stops at"
                     );
                     let (l, r) = (&nodes[2 * parent as usize], &nodes[2 * parent as usize + 1]);
-                    let pl = slc::child_probability(l, r, p, n, eps, cp == MinMax).expect("a live branch");
+                    let pl = slc::child_probability(l, r, p, n, eps, cp).expect("a live branch");
                     let want = if child % 2 == 0 { pl } else { 1.0 - pl };
                     assert!(
                         (pc - want).abs() < 1e-3 * want.max(1e-3),

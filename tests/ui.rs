@@ -9,7 +9,7 @@ use egui::accesskit::Role;
 use egui_kittest::{Harness, kittest::Queryable};
 use lightcut::{
     app::{AppOptions, WorkbenchApp},
-    renderer::settings::ViewBuffer,
+    renderer::settings::{ChildProbability, ViewBuffer},
 };
 
 fn setup() -> egui_wgpu::WgpuSetup {
@@ -569,7 +569,19 @@ fn tree_sampler_controls_reach_the_renderer() {
         h.query_all_by_label("substitute ray offset").next().is_some(),
         "no substitute ray offset slider for SLC"
     );
+    // The child-probability combo: open it, pick the thesis's.
+    let want = ChildProbability::Mean;
+    assert_ne!(settings(&h).sampling.child_probability, want);
+    h.get_by_label("child probability").click();
+    h.run_steps(2);
     // (get_by_* panics when no such node is shown, or several are.)
+    h.get_by_label(want.name()).click();
+    h.run_steps(3);
+    assert_eq!(
+        settings(&h).sampling.child_probability,
+        want,
+        "the child-probability combo did not reach the renderer"
+    );
     h.get_by_label("shadow rays").click();
     h.run_steps(3);
     assert!(

@@ -19,11 +19,17 @@ fn slc_node_weight(node: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32) -> f32 {
     return luminance(node.intensity) * (g / max(dot(d, d), eps * eps));
 }
 
+// Share of the closest-point normalisation in the defensive child probability (twin:
+// `reference::slc::DEFENSIVE`).
+const SLC_DEFENSIVE: f32 = 0.2;
+
 // Probability of taking the left child of a traversal step (stage 14); < 0: dead branch (both
 // children weigh 0). mode 0, the thesis: wl / (wl + wr) with slc_node_weight. mode 1, RTSLC's
 // "MinMax": the average of the two normalisations of lum(I) x box_cos / max(d^2, eps^2) with d
-// the distance to each child's box (0 inside) and to its farthest point. Both have the
-// support of box_cos, so either is unbiased wherever eq. 5.5 is.
+// the distance to each child's box (0 inside) and to its farthest point. mode 2, "defensive"
+// (ours): (1 - SLC_DEFENSIVE) x the thesis's + SLC_DEFENSIVE x the closest-point
+// normalisation. All have the support of box_cos (lum(I) x box_cos = 0 <=> w = 0), so each
+// is unbiased wherever eq. 5.5 is.
 fn slc_child_prob(l: SstNode, r: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32, mode: u32) -> f32 {
     if mode == 0u {
         let wl = slc_node_weight(l, x, n, eps);
@@ -39,10 +45,15 @@ fn slc_child_prob(l: SstNode, r: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32, 
     let e2 = eps * eps;
     let ql = clamp(x, l.bbox_min, l.bbox_max) - x;
     let qr = clamp(x, r.bbox_min, r.bbox_max) - x;
-    let fl = max(abs(x - l.bbox_min), abs(x - l.bbox_max));
-    let fr = max(abs(x - r.bbox_min), abs(x - r.bbox_max));
     let nl = gl / max(dot(ql, ql), e2);
     let nr = gr / max(dot(qr, qr), e2);
+    if mode == 2u {
+        let wl = slc_node_weight(l, x, n, eps);
+        let thesis = wl / (wl + slc_node_weight(r, x, n, eps));
+        return mix(thesis, nl / (nl + nr), SLC_DEFENSIVE);
+    }
+    let fl = max(abs(x - l.bbox_min), abs(x - l.bbox_max));
+    let fr = max(abs(x - r.bbox_min), abs(x - r.bbox_max));
     let xl = gl / max(dot(fl, fl), e2);
     let xr = gr / max(dot(fr, fr), e2);
     return 0.5 * (nl / (nl + nr) + xl / (xl + xr));

@@ -801,8 +801,10 @@ impl WorkbenchApp {
                         .response
                         .on_hover_text(
                             "how a traversal step picks a child: eq. 5.5's weights with the distance to \
-                             each child's mean (thesis), or RTSLC's average of the closest- and \
-                             farthest-point box distances (bounds the weights of near VPLs)",
+                             each child's mean (thesis); RTSLC's average of the closest- and \
+                             farthest-point box distances; or (default) the thesis's mixed with 20% \
+                             of the closest-point one, which keeps VPLs next to the point from being \
+                             drawn rarely (fireflies)",
                         );
                     ui.checkbox(&mut sm.half_resolution, "half-resolution GI (bilateral upsampling)");
                     ui.checkbox(&mut sm.accumulate, "accumulate frames while static");

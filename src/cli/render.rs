@@ -60,6 +60,8 @@ pub enum ChildProbabilityArg {
     Mean,
     /// RTSLC's average of the closest- and farthest-point box distances.
     MinMax,
+    /// 0.8 x the thesis's + 0.2 x the closest-point box distance's probability (the default).
+    Defensive,
 }
 
 /// Settings of the tree samplers (override `--settings`).
@@ -152,6 +154,7 @@ impl SamplingArgs {
             s.sampling.child_probability = match c {
                 ChildProbabilityArg::Mean => ChildProbability::Mean,
                 ChildProbabilityArg::MinMax => ChildProbability::MinMax,
+                ChildProbabilityArg::Defensive => ChildProbability::Defensive,
             };
         }
         if self.no_shadow_rays {

@@ -14,6 +14,7 @@
 use glam::Vec3;
 
 use super::sst_tree::{SstNode, luminance};
+use crate::renderer::settings::ChildProbability;
 
 /// Largest cut (samples per pixel) the GPU kernels hold in registers.
 pub const MAX_CUT: u32 = 64;
@@ -63,16 +64,31 @@ pub fn node_weight(node: &SstNode, x: Vec3, n: Vec3, eps: f32) -> f32 {
     luminance(node.intensity) * (g / d.dot(d).max(eps * eps))
 }
 
+/// Share of the closest-point normalisation in [`ChildProbability::Defensive`] (twin:
+/// `SLC_DEFENSIVE` in `common/slc.wgsl`).
+pub const DEFENSIVE: f32 = 0.2;
+
 /// Probability of taking the left child in a traversal step (stage 14), None for a dead
-/// branch: `slc_child_prob` in `common/slc.wgsl`. `min_max` false, the thesis: wl / (wl + wr)
-/// with [`node_weight`]; true, RTSLC's "MinMax": the average of the two normalisations of
+/// branch: `slc_child_prob` in `common/slc.wgsl`. `Mean`, the thesis: wl / (wl + wr) with
+/// [`node_weight`]; `MinMax` (RTSLC): the average of the two normalisations of
 /// lum(I) x box_cos / max(d^2, eps^2) with d the distance to each child's box (0 inside) and
-/// to its farthest point.
-pub fn child_probability(l: &SstNode, r: &SstNode, x: Vec3, n: Vec3, eps: f32, min_max: bool) -> Option<f32> {
-    if !min_max {
+/// to its farthest point; `Defensive`: the thesis's and the closest-point normalisation,
+/// weighted 1 - [`DEFENSIVE`] and [`DEFENSIVE`].
+pub fn child_probability(
+    l: &SstNode,
+    r: &SstNode,
+    x: Vec3,
+    n: Vec3,
+    eps: f32,
+    mode: ChildProbability,
+) -> Option<f32> {
+    let thesis = || {
         let (wl, wr) = (node_weight(l, x, n, eps), node_weight(r, x, n, eps));
         let s = wl + wr;
-        return (s > 0.0).then(|| wl / s);
+        (s > 0.0).then(|| wl / s)
+    };
+    if mode == ChildProbability::Mean {
+        return thesis();
     }
     let g = |c: &SstNode| {
         if c.is_empty() {
@@ -91,11 +107,15 @@ pub fn child_probability(l: &SstNode, r: &SstNode, x: Vec3, n: Vec3, eps: f32, m
         let q = x.clamp(c.bbox_min, c.bbox_max) - x;
         q.dot(q).max(e2)
     };
+    let (nl, nr) = (gl / near(l), gr / near(r));
+    if mode == ChildProbability::Defensive {
+        let t = thesis()?;
+        return Some(t + (nl / (nl + nr) - t) * DEFENSIVE);
+    }
     let far = |c: &SstNode| {
         let f = (x - c.bbox_min).abs().max((x - c.bbox_max).abs());
         f.dot(f).max(e2)
     };
-    let (nl, nr) = (gl / near(l), gr / near(r));
     let (xl, xr) = (gl / far(l), gr / far(r));
     Some(0.5 * (nl / (nl + nr) + xl / (xl + xr)))
 }
@@ -334,6 +354,7 @@ mod tests {
 
     #[test]
     fn child_probabilities_by_hand() {
+        use ChildProbability::{Defensive, Mean, MinMax};
         // Two floor patches under a point looking down: the left one is long with its mean at
         // the far end (x sits right above its near end), the right one is small and 2 m away.
         let patch = |lo: Vec3, hi: Vec3, mean: Vec3| SstNode {
@@ -350,12 +371,12 @@ mod tests {
             Vec3::new(0.5, 2.5, 0.0),
         );
         let (x, n, eps) = (Vec3::new(0.0, 0.5, 0.2), Vec3::NEG_Z, 0.05);
-        let mean = child_probability(&l, &r, x, n, eps, false).unwrap();
+        let mean = child_probability(&l, &r, x, n, eps, Mean).unwrap();
         let (wl, wr) = (node_weight(&l, x, n, eps), node_weight(&r, x, n, eps));
         assert!((mean - wl / (wl + wr)).abs() < 1e-7);
         // MinMax keeps at least half of the closest-point share (0.2 m vs 1.5 m away: > 0.9), so
         // the near patch gets more than eq. 5.5 with its far mean gives it.
-        let mm = child_probability(&l, &r, x, n, eps, true).unwrap();
+        let mm = child_probability(&l, &r, x, n, eps, MinMax).unwrap();
         assert!(
             mm > 0.45 && mm < 1.0 && mm > mean + 0.25,
             "min-max {mm}, mean {mean}"
@@ -369,12 +390,19 @@ mod tests {
         let (nl, nr, fl, fr) = (gl / 0.04, gr / 2.29, gl / 16.29, gr / 7.29);
         let want = 0.5 * (nl / (nl + nr) + fl / (fl + fr));
         assert!((mm - want).abs() < 1e-5, "{mm} vs {want}");
+        // Defensive: 0.8 x the thesis's share + 0.2 x the closest-point one (> 0.9 x 0.2).
+        let def = child_probability(&l, &r, x, n, eps, Defensive).unwrap();
+        let want = 0.8 * mean + 0.2 * nl / (nl + nr);
+        assert!((def - want).abs() < 1e-5, "{def} vs {want}");
+        assert!(def > mean + 0.1 && def > 0.18, "defensive {def}, mean {mean}");
         // An empty or unseen child gets nothing; nothing seen: a dead branch.
         let empty = SstNode::EMPTY;
-        assert_eq!(child_probability(&l, &empty, x, n, eps, true), Some(1.0));
-        assert_eq!(child_probability(&l, &empty, x, n, eps, false), Some(1.0));
-        assert_eq!(child_probability(&l, &r, x, Vec3::Z, eps, true), None);
-        assert_eq!(child_probability(&l, &r, x, Vec3::Z, eps, false), None);
+        assert_eq!(child_probability(&l, &empty, x, n, eps, MinMax), Some(1.0));
+        assert_eq!(child_probability(&l, &empty, x, n, eps, Mean), Some(1.0));
+        assert_eq!(child_probability(&l, &empty, x, n, eps, Defensive), Some(1.0));
+        assert_eq!(child_probability(&l, &r, x, Vec3::Z, eps, MinMax), None);
+        assert_eq!(child_probability(&l, &r, x, Vec3::Z, eps, Mean), None);
+        assert_eq!(child_probability(&l, &r, x, Vec3::Z, eps, Defensive), None);
     }
 
     #[test]

@@ -303,7 +303,7 @@ pub struct GpuSlcParams {
     /// Metres by which substitute samples' shadow rays stop short of the drawn point
     /// (`SamplingSettings::substitute_offset`).
     pub substitute_offset: f32,
-    /// 0 mean position (eq. 5.5), 1 min-max box distance (`ChildProbability`).
+    /// 0 mean position (eq. 5.5), 1 min-max box distance, 2 defensive (`ChildProbability`).
     pub child_probability: u32,
 }
 

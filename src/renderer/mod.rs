@@ -984,6 +984,7 @@ impl Renderer {
             child_probability: match sm.child_probability {
                 settings::ChildProbability::Mean => 0,
                 settings::ChildProbability::MinMax => 1,
+                settings::ChildProbability::Defensive => 2,
             },
         };
         let (gbuffer, accum) = match &half_targets {
