@@ -48,9 +48,13 @@ fn slc_child_prob(l: SstNode, r: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32, 
     let nl = gl / max(dot(ql, ql), e2);
     let nr = gr / max(dot(qr, qr), e2);
     if mode == 2u {
-        let wl = slc_node_weight(l, x, n, eps);
-        let thesis = wl / (wl + slc_node_weight(r, x, n, eps));
-        return mix(thesis, nl / (nl + nr), SLC_DEFENSIVE);
+        // eq. 5.5's weights from the cosine terms above (slc_node_weight without computing
+        // box_cos again).
+        let dl = l.position - x;
+        let dr = r.position - x;
+        let ml = gl / max(dot(dl, dl), e2);
+        let mr = gr / max(dot(dr, dr), e2);
+        return mix(ml / (ml + mr), nl / (nl + nr), SLC_DEFENSIVE);
     }
     let fl = max(abs(x - l.bbox_min), abs(x - l.bbox_max));
     let fr = max(abs(x - r.bbox_min), abs(x - r.bbox_max));

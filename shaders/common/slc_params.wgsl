@@ -24,7 +24,7 @@ struct SlcParams {
     near_field: f32, // near-field refinement factor (0 = off): see slc_far_enough
     shadow_rays: u32, // 1 trace shadow rays, 0 every sample visible
     substitute_offset: f32, // m: substitute samples' shadow rays end this far short (slc_substitute_end)
-    child_probability: u32, // 0 mean position (eq. 5.5), 1 min-max box distance (RTSLC's): slc_child_prob
+    child_probability: u32, // 0 mean position (eq. 5.5), 1 min-max box distance (RTSLC's), 2 defensive: slc_child_prob
 };
 
 // The pixel whose G-buffer sample builds block b's cut.

@@ -82,13 +82,10 @@ pub fn child_probability(
     eps: f32,
     mode: ChildProbability,
 ) -> Option<f32> {
-    let thesis = || {
+    if mode == ChildProbability::Mean {
         let (wl, wr) = (node_weight(l, x, n, eps), node_weight(r, x, n, eps));
         let s = wl + wr;
-        (s > 0.0).then(|| wl / s)
-    };
-    if mode == ChildProbability::Mean {
-        return thesis();
+        return (s > 0.0).then(|| wl / s);
     }
     let g = |c: &SstNode| {
         if c.is_empty() {
@@ -109,7 +106,11 @@ pub fn child_probability(
     };
     let (nl, nr) = (gl / near(l), gr / near(r));
     if mode == ChildProbability::Defensive {
-        let t = thesis()?;
+        // eq. 5.5's weights from the cosine terms above ([`node_weight`] without computing
+        // box_cos again).
+        let mean = |c: &SstNode, g: f32| g / (c.position - x).length_squared().max(e2);
+        let (ml, mr) = (mean(l, gl), mean(r, gr));
+        let t = ml / (ml + mr);
         return Some(t + (nl / (nl + nr) - t) * DEFENSIVE);
     }
     let far = |c: &SstNode| {
