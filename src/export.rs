@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::renderer::readback::ImageF32;
+use crate::base::image::ImageF32;
 
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {

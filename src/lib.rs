@@ -2,11 +2,13 @@
 //! illumination (Stochastic Light Cut Exploration). See ARCHITECTURE.md for the module map.
 
 pub mod app;
+pub mod base;
 pub mod cli;
 pub mod export;
 pub mod harness;
-pub mod metrics;
 #[doc(hidden)]
+pub mod methods;
+pub mod metrics;
 pub mod reference;
 pub mod renderer;
 pub mod scene;

@@ -16,9 +16,9 @@
 
 use glam::Vec3;
 
-use crate::{
-    reference::display,
-    renderer::{readback::ImageF32, settings::Tonemap},
+use crate::base::{
+    display::{self, Tonemap},
+    image::ImageF32,
 };
 
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]

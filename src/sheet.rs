@@ -10,19 +10,19 @@
 use ab_glyph::{Font, FontRef, PxScale, ScaleFont};
 
 use crate::{
+    base::{colormap::false_color, display},
     metrics::{self, Metrics},
-    reference::{display, visualise::false_color},
     renderer::{
         Buffer, FrameInput, Renderer,
         readback::ImageF32,
-        settings::{GiMethod, RenderSettings, ViewBuffer},
+        settings::{MethodId, RenderSettings, ViewBuffer},
     },
     scene::{Camera, DirectionalLight},
 };
 
 /// One method's column.
 pub struct SheetColumn {
-    pub method: GiMethod,
+    pub method: MethodId,
     pub final_: ImageF32,
     pub indirect: ImageF32,
     /// Its GI against the ground truth's.
@@ -66,7 +66,7 @@ pub enum Step {
 /// and tree are then frozen), then every method for `frames` accumulated frames.
 pub struct SheetJob {
     base: RenderSettings,
-    methods: Vec<GiMethod>,
+    methods: Vec<MethodId>,
     frames: u32,
     gt_rays_per_frame: Option<u32>,
     stage: Stage,
@@ -80,7 +80,7 @@ impl SheetJob {
     /// `gt_rays_per_frame` speeds the ground truth up where interactivity does not matter.
     pub fn new(
         base: RenderSettings,
-        methods: Vec<GiMethod>,
+        methods: Vec<MethodId>,
         frames: u32,
         gt_rays_per_frame: Option<u32>,
         title: String,
@@ -88,13 +88,13 @@ impl SheetJob {
         if methods.is_empty() {
             return Err("a sheet needs at least one method".into());
         }
-        if let Some(m) = methods
-            .iter()
-            .find(|m| !(m.samples_tree() || **m == GiMethod::Reference))
-        {
+        let columns = crate::methods::sheet_columns();
+        if let Some(m) = methods.iter().find(|m| !columns.contains(m)) {
+            let names: Vec<&str> = columns.iter().map(|c| c.name()).collect();
             return Err(format!(
-                "'{}' cannot be a sheet column (use SLC, SST, RTSLC or the reference)",
-                m.name()
+                "'{}' cannot be a sheet column (use {})",
+                m.name(),
+                names.join(", ")
             ));
         }
         if frames == 0 || frames > 4096 {
@@ -131,7 +131,7 @@ impl SheetJob {
             Stage::GroundTruth { frame: f } => {
                 if *f == 0 {
                     let mut s = self.base.clone();
-                    s.gi.method = GiMethod::GroundTruth;
+                    s.gi.method = crate::methods::comparison_truth();
                     if let Some(rays) = self.gt_rays_per_frame {
                         s.gi.rays_per_frame = rays;
                     }

@@ -16,7 +16,7 @@ fn render_default_scene_writes_exrs_pngs_and_timings() {
     let out = std::env::temp_dir().join(format!("lightcut-cli-{}", std::process::id()));
     let o = bin()
         .args([
-            "render", "--scene", "default", "--width", "96", "--height", "64", "--out",
+            "render", "--scene", "default", "--width", "96", "--height", "64", "--method", "off", "--out",
         ])
         .arg(&out)
         .output()

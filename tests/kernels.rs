@@ -143,7 +143,7 @@ fn display_pass_matches_reference_within_one_lsb() {
         let got = read_texture_bytes(&ctx, &dst, 0).unwrap();
         let want: Vec<u8> = px
             .iter()
-            .flat_map(|p| reference::display::encode_look(*p, &look))
+            .flat_map(|p| lightcut::base::display::encode_look(*p, &look))
             .collect();
         let nan = if look.nan_highlight {
             [255, 0, 255, 255]
@@ -201,11 +201,11 @@ fn visualise_uint_ids_and_heat_match_reference() {
         let want: Vec<u8> = ids
             .iter()
             .flat_map(|&id| match mode {
-                VisMode::UintHeat => {
-                    reference::visualise::to_unorm8(reference::visualise::false_color(id as f32 / max))
-                }
+                VisMode::UintHeat => lightcut::base::colormap::to_unorm8(
+                    lightcut::base::colormap::false_color(id as f32 / max),
+                ),
                 _ if id == 0 => [0, 0, 0, 255],
-                _ => reference::visualise::to_unorm8(reference::visualise::id_color(id)),
+                _ => lightcut::base::colormap::to_unorm8(lightcut::base::colormap::id_color(id)),
             })
             .collect();
         assert!(max_lsb_diff(&got, &want) <= 1, "{mode:?}");

@@ -5,6 +5,7 @@
 mod common;
 
 use glam::Vec3;
+use lightcut::methods::tree_samplers::{RTSLC, SLC, SST};
 use lightcut::{
     metrics,
     reference::{
@@ -15,7 +16,7 @@ use lightcut::{
         Buffer, FrameInput, Renderer,
         context::GpuContext,
         readback::{ImageF32, read_storage_buffer},
-        settings::{ChildProbability, GiMethod, RenderSettings, ViewBuffer},
+        settings::{ChildProbability, MethodId, RenderSettings, ViewBuffer},
     },
     scene::{Camera, Scene, default_scene},
 };
@@ -59,7 +60,7 @@ impl Setup {
     /// The ground truth of the frame's VPLs (runs it to the end).
     fn ground_truth(&mut self) -> ImageF32 {
         self.set(|s| {
-            s.gi.method = GiMethod::GroundTruth;
+            s.gi.method = lightcut::methods::ground_truth::ID;
             s.gi.rays_per_frame = 1 << 26;
         });
         loop {
@@ -72,7 +73,7 @@ impl Setup {
     }
 }
 
-fn settings(method: GiMethod) -> RenderSettings {
+fn settings(method: MethodId) -> RenderSettings {
     let mut s = RenderSettings::default();
     s.gi.method = method;
     s.vpl.count = 1024;
@@ -89,7 +90,7 @@ fn v3(p: [f32; 4]) -> Vec3 {
 fn gpu_cuts_equal_the_cpu_cuts_and_are_valid() {
     let Some(ctx) = common::gpu() else { return };
     for (cull, cut_size) in [(true, 16), (false, 16), (true, 64), (true, 1)] {
-        let mut st = setup(&ctx, settings(GiMethod::Slc));
+        let mut st = setup(&ctx, settings(SLC));
         st.set(|s| {
             s.sampling.cull_behind = cull;
             s.sampling.cut_size = cut_size;
@@ -139,7 +140,7 @@ fn gpu_cuts_equal_the_cpu_cuts_and_are_valid() {
 #[test]
 fn blending_picks_cuts_by_their_weights_and_falls_back_to_the_mock_cut() {
     let Some(ctx) = common::gpu() else { return };
-    let mut st = setup(&ctx, settings(GiMethod::Slc));
+    let mut st = setup(&ctx, settings(SLC));
     st.frame();
     let pos = st.r.read(Buffer::Position).unwrap();
     let nrm = st.r.read(Buffer::Normal).unwrap();
@@ -276,10 +277,10 @@ fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
     // Every child probability (the thesis's, RTSLC's MinMax, the defensive mix) has the
     // support of the box term, so each converges.
     for cp in ChildProbability::ALL {
-        let mut st = setup(&ctx, settings(GiMethod::Rtslc));
+        let mut st = setup(&ctx, settings(RTSLC));
         let gt = st.ground_truth();
         st.set(|s| {
-            s.gi.method = GiMethod::Rtslc;
+            s.gi.method = RTSLC;
             s.sampling.block_size = 1;
             s.sampling.accumulate = true;
             s.sampling.child_probability = cp;
@@ -318,7 +319,7 @@ fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
 #[test]
 fn slc_without_usable_inner_nodes_equals_rtslc_and_steps_order_as_the_thesis_says() {
     let Some(ctx) = common::gpu() else { return };
-    let mut st = setup(&ctx, settings(GiMethod::Rtslc));
+    let mut st = setup(&ctx, settings(RTSLC));
     st.set(|s| {
         s.tree.v_min = 1.0;
         s.tree.sigma_max = 0.0;
@@ -334,7 +335,7 @@ fn slc_without_usable_inner_nodes_equals_rtslc_and_steps_order_as_the_thesis_say
     assert_eq!(flags, classify(&nodes, 1.0, 0.0));
     // Same seed (the frame counter) for both: render RTSLC and SLC at the same frame index by
     // re-creating the renderer.
-    let run = |method: GiMethod| -> ImageF32 {
+    let run = |method: MethodId| -> ImageF32 {
         let mut s = settings(method);
         s.tree.v_min = 1.0;
         s.tree.sigma_max = 0.0;
@@ -342,22 +343,22 @@ fn slc_without_usable_inner_nodes_equals_rtslc_and_steps_order_as_the_thesis_say
         st.frame();
         st.indirect()
     };
-    let a = run(GiMethod::Rtslc);
-    let b = run(GiMethod::Slc);
+    let a = run(RTSLC);
+    let b = run(SLC);
     assert_eq!(
         a.pixels, b.pixels,
         "SLC with no usable inner node must traverse like RTSLC"
     );
 
     // Steps per traversal at the defaults: SLC < RTSLC and SLC < SST.
-    let steps = |method: GiMethod| -> f64 {
+    let steps = |method: MethodId| -> f64 {
         let mut s = RenderSettings::default();
         s.gi.method = method;
         let mut st = setup(&ctx, s);
         st.frame();
         st.r.sampling_stats_blocking().unwrap().steps_per_traversal()
     };
-    let (slc_s, sst_s, rtslc_s) = (steps(GiMethod::Slc), steps(GiMethod::Sst), steps(GiMethod::Rtslc));
+    let (slc_s, sst_s, rtslc_s) = (steps(SLC), steps(SST), steps(RTSLC));
     eprintln!("steps per traversal: SLC {slc_s:.2}, SST {sst_s:.2}, RTSLC {rtslc_s:.2}");
     assert!(
         slc_s < sst_s && slc_s < rtslc_s,
@@ -379,7 +380,7 @@ fn mock_level_matches_the_thesis_example() {
 #[test]
 fn the_comparison_ground_truth_equals_the_ground_truth_method() {
     let Some(ctx) = common::gpu() else { return };
-    let mut st = setup(&ctx, settings(GiMethod::Slc));
+    let mut st = setup(&ctx, settings(SLC));
     st.set(|s| {
         s.gi.rays_per_frame = 1 << 22;
         // Accumulating: the sampler's composite scale (1/frames) must not reach the ground truth's.
@@ -428,7 +429,7 @@ fn the_comparison_ground_truth_equals_the_ground_truth_method() {
 #[test]
 fn half_resolution_upsampling_equals_the_cpu_reference() {
     let Some(ctx) = common::gpu() else { return };
-    let mut st = setup(&ctx, settings(GiMethod::Slc));
+    let mut st = setup(&ctx, settings(SLC));
     st.set(|s| s.sampling.half_resolution = true);
     st.frame();
     let (hpos, hnrm, hacc) = st.r.read_half_resolution().unwrap().expect("half resolution on");
@@ -474,7 +475,7 @@ fn half_resolution_upsampling_equals_the_cpu_reference() {
 #[test]
 fn pixel_values_equal_the_full_buffers() {
     let Some(ctx) = common::gpu() else { return };
-    let mut st = setup(&ctx, settings(GiMethod::Slc));
+    let mut st = setup(&ctx, settings(SLC));
     st.frame();
     let fin = st.r.read(Buffer::Final).unwrap();
     let pos = st.r.read(Buffer::Position).unwrap();
@@ -498,19 +499,19 @@ fn pixel_values_equal_the_full_buffers() {
 /// or a leaf; RTSLC: a leaf; SST starts at the root).
 #[test]
 fn the_pixel_story_matches_the_frame_and_the_tree() {
+    use lightcut::methods::tree_samplers::pass::{SampleVisibility, StopReason};
     use lightcut::reference::sst_tree::flag;
-    use lightcut::renderer::passes::slc::{SampleVisibility, StopReason};
     use lightcut::scene::bvh::{Bvh, Ray};
     let Some(ctx) = common::gpu() else { return };
     use ChildProbability::{Defensive, Mean, MinMax};
     for (method, cp) in [
-        (GiMethod::Slc, Mean),
-        (GiMethod::Rtslc, Mean),
-        (GiMethod::Sst, Mean),
-        (GiMethod::Slc, MinMax),
-        (GiMethod::Rtslc, MinMax),
-        (GiMethod::Slc, Defensive),
-        (GiMethod::Rtslc, Defensive),
+        (SLC, Mean),
+        (RTSLC, Mean),
+        (SST, Mean),
+        (SLC, MinMax),
+        (RTSLC, MinMax),
+        (SLC, Defensive),
+        (RTSLC, Defensive),
     ] {
         let mut st = setup(&ctx, settings(method));
         st.set(|s| {
@@ -561,7 +562,7 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
             let (p, n) = (v3(pos.get(x, y)), v3(nrm.get(x, y)).normalize());
             assert_eq!(trace.cut_size, cut_size);
             assert_eq!(trace.samples.len(), cut_size as usize);
-            if method == GiMethod::Slc && trace.mode == 0 {
+            if method == SLC && trace.mode == 0 {
                 let cpu = bilinear_blocks(x, y, b.block, b.grid);
                 for (i, (got, want)) in trace.bilinear.iter().zip(cpu).enumerate() {
                     assert!((got - want.1).abs() < 1e-5, "bilinear weight {i}");
@@ -571,7 +572,7 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
             for (i, smp) in trace.samples.iter().enumerate() {
                 sum += smp.contribution;
                 match method {
-                    GiMethod::Sst => assert_eq!(smp.start, 1, "SST starts at the root"),
+                    SST => assert_eq!(smp.start, 1, "SST starts at the root"),
                     _ if trace.mode == 0 => {
                         let slot = smp.slot.expect("a blended sample names its block");
                         let blk = trace.blocks[slot] as usize;
@@ -592,11 +593,11 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
                 let mut prob = 1.0f64;
                 for &(child, pc) in &smp.path {
                     assert_eq!(child / 2, parent, "path is not a chain of children");
-                    if flag(&flags, parent as usize) && method != GiMethod::Rtslc {
+                    if flag(&flags, parent as usize) && method != RTSLC {
                         near_passes += 1;
                     }
                     assert!(
-                        method == GiMethod::Rtslc
+                        method == RTSLC
                             || !(flag(&flags, parent as usize)
                                 && slc::far_enough(&nodes[parent as usize], p, eps, near_field)),
                         "passed a node the CPU rule stops at"
@@ -633,7 +634,7 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
                     rays_alike += (blocked == (vis == SampleVisibility::Blocked)) as usize;
                 }
                 match (method, smp.stop) {
-                    (GiMethod::Rtslc, s) => assert_eq!(s, StopReason::Leaf),
+                    (RTSLC, s) => assert_eq!(s, StopReason::Leaf),
                     (_, StopReason::Leaf) => assert!(smp.end >= leaves),
                     (_, _) => assert!(
                         flag(&flags, smp.end as usize)
@@ -659,12 +660,12 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
         // Grazing rays may go either way between the GPU's and the CPU's float arithmetic.
         eprintln!("{method:?}: {rays_alike} of {rays} substitute shadow rays as the CPU's");
         assert!(
-            method == GiMethod::Rtslc || (rays >= 10 && rays - rays_alike <= rays / 50),
+            method == RTSLC || (rays >= 10 && rays - rays_alike <= rays / 50),
             "{method:?}: only {rays_alike} of {rays} substitute shadow rays agree with the CPU"
         );
         eprintln!("{method:?}: {near_passes} usable nodes passed as too near");
         assert!(
-            method == GiMethod::Rtslc || near_passes > 0,
+            method == RTSLC || near_passes > 0,
             "{method:?}: the near-field rule never acted on these pixels"
         );
     }
@@ -673,7 +674,7 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
 
 /// One frame of `method` with a fixed seed (the same cuts, traversals and sample points every
 /// run) after `f` changes the settings.
-fn fixed_seed_frame(ctx: &GpuContext, method: GiMethod, f: impl FnOnce(&mut RenderSettings)) -> ImageF32 {
+fn fixed_seed_frame(ctx: &GpuContext, method: MethodId, f: impl FnOnce(&mut RenderSettings)) -> ImageF32 {
     let mut s = settings(method);
     s.sampling.fixed_seed = true;
     f(&mut s);
@@ -684,7 +685,7 @@ fn fixed_seed_frame(ctx: &GpuContext, method: GiMethod, f: impl FnOnce(&mut Rend
 
 /// Asserts no pixel of `after` is darker than in `before` (float rounding aside); returns
 /// how many are brighter.
-fn pixels_only_gain(method: GiMethod, before: &ImageF32, after: &ImageF32) -> usize {
+fn pixels_only_gain(method: MethodId, before: &ImageF32, after: &ImageF32) -> usize {
     let mut gained = 0;
     for (a, b) in before.pixels.iter().zip(&after.pixels) {
         for c in 0..3 {
@@ -703,7 +704,7 @@ fn without_shadow_rays_the_same_samples_only_gain_light() {
     // Fixed seed: the same cuts, traversals and sample points with and without shadow rays,
     // so every pixel can only gain light (never blocked), and some must.
     let Some(ctx) = common::gpu() else { return };
-    for method in [GiMethod::Slc, GiMethod::Rtslc, GiMethod::Sst] {
+    for method in [SLC, RTSLC, SST] {
         let on = fixed_seed_frame(&ctx, method, |_| {});
         let off = fixed_seed_frame(&ctx, method, |s| s.gi.shadow_rays = false);
         let gained = pixels_only_gain(method, &on, &off);
@@ -721,10 +722,10 @@ fn the_substitute_ray_offset_only_shortens_substitute_shadow_rays() {
     // lies within the one without it (`substitute_ray_end`), so a pixel can only gain light;
     // leaf VPLs' rays are untouched, so RTSLC is bit for bit the same.
     let Some(ctx) = common::gpu() else { return };
-    for method in [GiMethod::Slc, GiMethod::Sst, GiMethod::Rtslc] {
+    for method in [SLC, SST, RTSLC] {
         let off = fixed_seed_frame(&ctx, method, |s| s.sampling.substitute_offset = 0.0);
         let on = fixed_seed_frame(&ctx, method, |s| s.sampling.substitute_offset = 0.5);
-        if method == GiMethod::Rtslc {
+        if method == RTSLC {
             assert_eq!(off.pixels, on.pixels, "RTSLC has no substitute samples");
             continue;
         }

@@ -3,6 +3,7 @@
 
 mod common;
 
+use lightcut::methods::tree_samplers::{RTSLC, SLC};
 use std::sync::Arc;
 
 use egui::accesskit::Role;
@@ -19,9 +20,19 @@ fn setup() -> egui_wgpu::WgpuSetup {
     egui_wgpu::WgpuSetup::CreateNew(s)
 }
 
-/// The app on the default scene with `options` (scene set here), in a `size` window.
+/// The app on the default scene with `options` (scene set here), in a `size` window. Without
+/// settings in `options`, direct light only: the app opens on SLC, which these tests of the
+/// window's mechanics do not need (it would cost lavapipe seconds per frame).
 fn harness_with(size: egui::Vec2, options: AppOptions) -> Option<Harness<'static, WorkbenchApp>> {
     common::gpu()?;
+    let options = AppOptions {
+        settings: options.settings.clone().or_else(|| {
+            let mut s = lightcut::renderer::settings::RenderSettings::default();
+            s.gi.method = lightcut::methods::direct_only::ID;
+            Some(s)
+        }),
+        ..options
+    };
     Some(
         Harness::builder()
             .with_size(size)
@@ -45,7 +56,7 @@ fn harness() -> Option<Harness<'static, WorkbenchApp>> {
 /// SLC with 1024 VPLs and cuts of 16.
 fn slc_settings() -> lightcut::renderer::settings::RenderSettings {
     let mut s = lightcut::renderer::settings::RenderSettings::default();
-    s.gi.method = lightcut::renderer::settings::GiMethod::Slc;
+    s.gi.method = SLC;
     s.vpl.count = 1024;
     s.sampling.cut_size = 16;
     s
@@ -124,7 +135,7 @@ fn light_tree_overlay_and_statistics_window() {
 fn clicking_a_block_in_the_cut_view_lists_its_cut() {
     let options = AppOptions {
         settings: Some(slc_settings()),
-        view: Some(ViewBuffer::CutBlocks),
+        view: Some(ViewBuffer::Method(lightcut::methods::tree_samplers::CUT_BLOCKS)),
         ..Default::default()
     };
     let Some(mut h) = harness_with(egui::vec2(1100.0, 700.0), options) else {
@@ -229,15 +240,15 @@ fn click(h: &mut Harness<'_, WorkbenchApp>, pos: egui::Pos2) {
 
 #[test]
 fn clicking_a_view_pins_the_pixel_and_tells_its_story() {
-    use lightcut::renderer::passes::slc::StopReason;
+    use lightcut::methods::tree_samplers::pass::StopReason;
     let Some(mut h) = slc_harness(vec![ViewBuffer::Final], egui::vec2(1100.0, 700.0)) else {
         return;
     };
     h.run_steps(3);
     h.get_by_label("pixel story window").click();
     h.run_steps(1);
-    // The floor, right of the side panel.
-    click(&mut h, egui::pos2(760.0, 560.0));
+    // The floor, between the side panel and the tool dock (where the story now docks).
+    click(&mut h, egui::pos2(515.0, 560.0));
     h.run_steps(4);
     h.get_by_label_contains("last frame ·");
     h.get_by_label_contains("16 samples; their estimate");
@@ -272,7 +283,10 @@ fn clicking_a_view_pins_the_pixel_and_tells_its_story() {
 
 #[test]
 fn raising_v_min_changes_the_traversal_steps_image() {
-    let Some(mut h) = slc_harness(vec![ViewBuffer::TraversalSteps], egui::vec2(1100.0, 700.0)) else {
+    let Some(mut h) = slc_harness(
+        vec![ViewBuffer::Method(lightcut::methods::tree_samplers::STEPS)],
+        egui::vec2(1100.0, 700.0),
+    ) else {
         return;
     };
     h.run_steps(4);
@@ -334,7 +348,6 @@ fn several_views_render_their_buffers_and_export_files_that_decode() {
 
 #[test]
 fn the_comparison_sheet_runs_in_the_gui_and_can_be_cancelled() {
-    use lightcut::renderer::settings::GiMethod;
     let Some(mut h) = slc_harness(vec![ViewBuffer::Final], egui::vec2(700.0, 500.0)) else {
         return;
     };
@@ -346,16 +359,16 @@ fn the_comparison_sheet_runs_in_the_gui_and_can_be_cancelled() {
     let _ = std::fs::remove_dir_all(&dir);
     h.state_mut().set_export_dir(dir.to_str().unwrap());
     // Cancelled: nothing is written, the settings are back.
-    h.state_mut().start_sheet(vec![GiMethod::Slc, GiMethod::Rtslc], 2);
+    h.state_mut().start_sheet(vec![SLC, RTSLC], 2);
     h.run_steps(1);
     assert!(h.state().sheet_progress().is_some(), "the sheet shows progress");
     h.state_mut().cancel_sheet();
     h.run_steps(2);
     assert!(h.state().sheet_progress().is_none());
     assert!(!dir.exists(), "a cancelled sheet wrote files");
-    assert_eq!(h.state().renderer().unwrap().settings().gi.method, GiMethod::Slc);
+    assert_eq!(h.state().renderer().unwrap().settings().gi.method, SLC);
     // Run to the end.
-    h.state_mut().start_sheet(vec![GiMethod::Slc, GiMethod::Rtslc], 2);
+    h.state_mut().start_sheet(vec![SLC, RTSLC], 2);
     let mut steps = 0;
     while h.state().sheet_progress().is_some() && steps < 200 {
         h.run_steps(1);
@@ -367,7 +380,7 @@ fn the_comparison_sheet_runs_in_the_gui_and_can_be_cancelled() {
     let png = written.split(", ").next().unwrap();
     let img = image::open(png).expect("the sheet decodes");
     assert!(img.width() > 3 * 320);
-    assert_eq!(h.state().renderer().unwrap().settings().gi.method, GiMethod::Slc);
+    assert_eq!(h.state().renderer().unwrap().settings().gi.method, SLC);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -9,7 +9,7 @@ use lightcut::{
         Buffer, FrameInput, Renderer,
         gpu_data::{GpuVpl, VPL_NONE},
         passes::vpl_gen::pyramid_layout,
-        settings::{GiMethod, RenderSettings, ViewBuffer, VplMode},
+        settings::{RenderSettings, ViewBuffer, VplMode},
     },
     scene::{Bvh, Scene, default_scene},
 };
@@ -247,7 +247,7 @@ fn ground_truth_against_cpu(shadow_rays: bool) -> Option<Vec<Vec3>> {
     let mut settings = RenderSettings::default();
     settings.vpl.count = 256;
     settings.shadow.resolution = 256;
-    settings.gi.method = GiMethod::GroundTruth;
+    settings.gi.method = lightcut::methods::ground_truth::ID;
     settings.gi.shadow_rays = shadow_rays;
     let (w, h) = (64u32, 40u32);
     let (mut r, scene) = setup(settings.clone(), (w, h))?;
@@ -310,7 +310,7 @@ fn converged_reference_converges_to_the_exact_sum_over_all_texels() {
     // A small RSM (64 x 64 texels) so that the exact CPU sum is affordable.
     let mut settings = RenderSettings::default();
     settings.shadow.resolution = 64;
-    settings.gi.method = GiMethod::Reference;
+    settings.gi.method = lightcut::methods::reference::ID;
     settings.gi.reference_samples = 256;
     settings.gi.reference_spp_per_frame = 64;
     let (w, h) = (48u32, 32u32);
@@ -450,7 +450,7 @@ fn two_lights_split_the_budget_by_brightness_and_each_light_stays_unbiased() {
 fn raising_the_reference_target_continues_and_a_view_change_restarts() {
     let mut settings = RenderSettings::default();
     settings.shadow.resolution = 64;
-    settings.gi.method = GiMethod::Reference;
+    settings.gi.method = lightcut::methods::reference::ID;
     settings.gi.reference_samples = 64;
     settings.gi.reference_spp_per_frame = 32;
     let Some((mut r, scene)) = setup(settings.clone(), (32, 24)) else {

@@ -8,11 +8,9 @@
 use glam::Vec3;
 
 use super::image_views::Prim;
-use crate::reference::sst_tree::{SstNode, basis, flag, luminance};
-use crate::renderer::{
-    Renderer,
-    passes::slc::{PixelTrace, SampleVisibility, StopReason},
-};
+use crate::base::sst_node::{SstNode, basis, flag, luminance};
+use crate::methods::tree_samplers::pass::{PixelTrace, SampleVisibility, StopReason};
+use crate::renderer::Renderer;
 
 /// Colours shared by the window and the overlays.
 pub const VISIBLE: egui::Color32 = egui::Color32::from_rgb(90, 230, 120);
@@ -63,9 +61,18 @@ impl StoryPanel {
             self.note = "click a camera view to pin a pixel".into();
             return Ok(());
         }
-        if !r.settings().gi.method.samples_tree() {
+        if !r.settings().gi.method.info().story {
             self.trace = None;
-            self.note = "the story needs a tree sampler (GI method SLC, SST or RTSLC)".into();
+            let tellers: Vec<&str> = crate::methods::REGISTRY
+                .iter()
+                .filter(|m| m.story)
+                .map(|m| m.short)
+                .collect();
+            self.note = format!(
+                "{} tells no pixel story; the methods that do: {}",
+                r.settings().gi.method.name(),
+                tellers.join(", ")
+            );
             return Ok(());
         }
         if pixel == self.pixel && now - self.read_at < 0.5 {
@@ -173,23 +180,8 @@ impl StoryPanel {
         out
     }
 
-    pub fn window(&mut self, ctx: &egui::Context) {
-        if !self.show {
-            return;
-        }
-        let mut open = true;
-        egui::Window::new("Pixel story")
-            .open(&mut open)
-            .default_width(560.0)
-            .default_height(520.0)
-            .vscroll(true)
-            .show(ctx, |ui| self.contents(ui));
-        if !open {
-            self.show = false;
-        }
-    }
-
-    fn contents(&mut self, ui: &mut egui::Ui) {
+    /// The story (shown in the tool dock or its floating window).
+    pub fn contents(&mut self, ui: &mut egui::Ui) {
         let Some(t) = self.trace.clone() else {
             ui.label(&self.note);
             return;

@@ -20,11 +20,18 @@ pub fn pass_output(pass: &str) -> Option<ViewBuffer> {
         "brsm_importance" => ViewBuffer::ImportanceRaw,
         "brsm_filter" => ViewBuffer::ImportanceFiltered,
         "pdf_pyramid" => ViewBuffer::PdfPyramid,
-        "slc_cuts" => ViewBuffer::CutBlocks,
-        "slc_sample" | "sst_sample" | "rtslc_sample" => ViewBuffer::TraversalSteps,
-        "ground_truth" | "reference" | "gi_upsample" => ViewBuffer::Indirect,
+        "gi_upsample" => ViewBuffer::Indirect,
         "composite" | "display" => ViewBuffer::Final,
-        _ => return None,
+        // A method's pass: the view it declares for it, else its GI.
+        p => {
+            let m = crate::methods::REGISTRY
+                .iter()
+                .find(|m| m.timed_passes.contains(&p) || m.views.iter().any(|v| v.passes.contains(&p)))?;
+            match m.views.iter().find(|v| v.passes.contains(&p)) {
+                Some(v) => ViewBuffer::Method(crate::methods::MethodView::new(v.name)),
+                None => ViewBuffer::Indirect,
+            }
+        }
     })
 }
 
@@ -61,21 +68,8 @@ impl TimingsPanel {
         self.history.is_empty()
     }
 
-    /// The window; returns the view to show while a bar is hovered.
-    pub fn window(&mut self, ctx: &egui::Context) -> Option<ViewBuffer> {
-        let mut open = self.show;
-        let mut hovered = None;
-        let right = ctx.content_rect().right();
-        egui::Window::new("GPU timings")
-            .open(&mut open)
-            .default_width(460.0)
-            .default_pos(egui::pos2(right - 480.0, 30.0))
-            .show(ctx, |ui| hovered = self.contents(ui));
-        self.show = open;
-        hovered
-    }
-
-    fn contents(&self, ui: &mut egui::Ui) -> Option<ViewBuffer> {
+    /// The bars and the history; returns the view to show while a bar is hovered.
+    pub fn contents(&self, ui: &mut egui::Ui) -> Option<ViewBuffer> {
         let Some(last) = self.history.back() else {
             ui.label("no timings yet (or timestamps not supported on this adapter)");
             return None;

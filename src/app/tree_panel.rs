@@ -5,7 +5,7 @@
 use egui_plot::{Bar, BarChart, Plot, VLine};
 
 use crate::{
-    reference::sst_tree::{TreeStats, level_count, luminance, stats},
+    base::sst_node::{TreeStats, level_count, luminance, stats},
     renderer::{
         Renderer,
         settings::{RenderSettings, TreeColor, TreeOverlay},

@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod compare;
 pub mod export_scene;
+pub mod methods;
 pub mod render;
 pub mod results;
 pub mod sheet;
@@ -56,6 +57,53 @@ pub struct Cli {
     pub pin: Option<(u32, u32)>,
 }
 
+/// The GUI's start-up options from the command line (no subcommand): the settings file, the
+/// views by name, the first screen ([`crate::app::FIRST_SCREEN`]) when no view is named and
+/// no layout is saved.
+pub fn gui_options(cli: &Cli) -> anyhow::Result<crate::app::AppOptions> {
+    use crate::renderer::settings::ViewBuffer;
+    let settings = cli
+        .settings
+        .as_ref()
+        .map(|p| {
+            SettingsArgs {
+                settings: Some(p.clone()),
+                ..Default::default()
+            }
+            .resolve(0.0)
+        })
+        .transpose()?;
+    let view = cli
+        .view
+        .as_deref()
+        .map(ViewBuffer::from_name)
+        .transpose()
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let views = cli
+        .views
+        .as_deref()
+        .unwrap_or("")
+        .split(';')
+        .filter(|s| !s.trim().is_empty())
+        .map(|s| ViewBuffer::from_name(s).map_err(|e| anyhow::anyhow!("{e}")))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    Ok(crate::app::AppOptions {
+        scene: cli.scene.clone(),
+        camera: cli.camera.clone(),
+        exit_after_frames: cli.frames,
+        screenshot: cli.screenshot.clone(),
+        settings,
+        tree_stats: cli.tree_stats,
+        view,
+        compare_gt: cli.compare_gt,
+        timings: cli.timings,
+        views,
+        default_views: crate::app::FIRST_SCREEN.to_vec(),
+        reset_layout: cli.reset_layout,
+        pin: cli.pin,
+    })
+}
+
 /// "X,Y" as two pixel coordinates.
 fn parse_pixel(s: &str) -> Result<(u32, u32), String> {
     let (x, y) = s
@@ -87,6 +135,9 @@ pub enum Command {
     /// blocks, blending, upsampling, scaling): CSV, PNG plots and images per scene, the
     /// ratio checks in checks.csv.
     Results(results::ResultsArgs),
+    /// The GI methods this build knows (`render --method`, `sheet --methods`): name, kind,
+    /// views, timed GPU passes and the tests that check each.
+    Methods,
 }
 
 /// Settings flags shared by the commands (override a settings file, which overrides defaults).

@@ -14,27 +14,14 @@ use crate::{
         Buffer, FrameInput, Renderer,
         context::GpuContext,
         readback::ImageF32,
-        settings::{GiMethod, TreeColor, TreeOverlay, ViewBuffer},
+        settings::{MethodId, MethodView, TreeColor, TreeOverlay, ViewBuffer},
     },
     scene::preset::{SceneSource, open_scene},
 };
 
-/// The indirect-light method of a headless render.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Method {
-    /// Direct light only (indirect.exr is black).
-    Off,
-    /// Every VPL of the frame at every pixel with a shadow ray (the thesis's ground truth).
-    GroundTruth,
-    /// Every RSM texel as a VPL, per-pixel Monte Carlo (converged reference).
-    Reference,
-    /// The thesis's method: shallow per-block cuts, stochastic blending, traversal stopping
-    /// at usable SST nodes.
-    Slc,
-    /// Baseline: traversals from the root, stopping at usable SST nodes (Tatzgern et al.).
-    Sst,
-    /// Baseline: the same cuts and blending, traversal down to leaf VPLs (Lin and Yuksel).
-    Rtslc,
+/// `--method NAME`: a registered GI method by its CLI name (`crate::methods::REGISTRY`).
+pub fn parse_method(name: &str) -> Result<MethodId, String> {
+    MethodId::parse(name)
 }
 
 /// Cut blending for `--blending`.
@@ -214,9 +201,11 @@ pub struct RenderArgs {
     /// Frames to render before reading timings (the first frames include pipeline warm-up).
     #[arg(long, default_value_t = 3)]
     pub timing_frames: u32,
-    /// Indirect-light method.
-    #[arg(long, value_enum, default_value = "off")]
-    pub method: Method,
+    /// GI method by its CLI name: slc (the thesis; default), sst, rtslc, ground-truth,
+    /// reference, off (direct light only). `lightcut-workbench methods` lists them.
+    /// Without it: the settings file's method (default slc).
+    #[arg(long, value_parser = parse_method)]
+    pub method: Option<MethodId>,
     /// What to write (comma-separated).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "all")]
     pub output: Vec<Output>,
@@ -250,7 +239,7 @@ fn write_metrics(
     let s = r.settings().clone();
     let st = r.sampling_stats_blocking().unwrap_or_default();
     let mut json = serde_json::json!({
-        "method": format!("{:?}", s.gi.method),
+        "method": s.gi.method.cli(),
         "width": args.width,
         "height": args.height,
         "vpls": r.vpl_frame().count,
@@ -270,7 +259,7 @@ fn write_metrics(
     });
     if args.sampling.compare_gt {
         let mut g = s.clone();
-        g.gi.method = GiMethod::GroundTruth;
+        g.gi.method = crate::methods::comparison_truth();
         g.gi.rays_per_frame = 1 << 26;
         r.set_settings(g)?;
         loop {
@@ -301,15 +290,13 @@ fn write_metrics(
     Ok(())
 }
 
-fn settings_method(r: &Renderer) -> GiMethod {
+fn settings_method(r: &Renderer) -> MethodId {
     r.settings().gi.method
 }
 
-fn gi_label(m: Method) -> &'static str {
-    match m {
-        Method::Reference => "converged reference (samples per pixel)",
-        _ => "ground truth (VPLs)",
-    }
+/// GPU time of `method`'s own passes in one frame's timings.
+fn method_ms(t: &crate::renderer::timing::PassTimings, method: MethodId) -> f64 {
+    method.info().timed_passes.iter().filter_map(|p| t.get(p)).sum()
 }
 
 /// Linear view depth (metres along the camera forward; 0 where there is no geometry).
@@ -335,14 +322,10 @@ fn linear_depth(position: &ImageF32, eye: glam::Vec3, fwd: glam::Vec3) -> ImageF
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
     let mut settings = args.settings.resolve(opened.exposure_ev)?;
-    settings.gi.method = match args.method {
-        Method::Off => GiMethod::Off,
-        Method::GroundTruth => GiMethod::GroundTruth,
-        Method::Reference => GiMethod::Reference,
-        Method::Slc => GiMethod::Slc,
-        Method::Sst => GiMethod::Sst,
-        Method::Rtslc => GiMethod::Rtslc,
-    };
+    if let Some(m) = args.method {
+        settings.gi.method = m;
+    }
+    let method = settings.gi.method;
     args.sampling.apply(&mut settings);
     if args.sampling.frames == 0 {
         return Err(anyhow!("--frames must be at least 1"));
@@ -408,10 +391,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
     }
     // Progressive GI: keep rendering the same frame until it has seen every VPL / sample.
-    let mut gi_ms = timings
-        .as_ref()
-        .and_then(|t| t.get("ground_truth").or(t.get("reference")))
-        .unwrap_or(0.0);
+    let info = method.info();
+    let mut gi_ms = timings.as_ref().map_or(0.0, |t| method_ms(t, method));
     while let Some(p) = r.gi_progress() {
         if p.finished() {
             break;
@@ -419,12 +400,13 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         frame(&mut r, ViewBuffer::Final);
         r.ctx.wait_idle()?;
         if let Some(t) = r.wait_timings() {
-            gi_ms += t.get("ground_truth").or(t.get("reference")).unwrap_or(0.0);
+            gi_ms += method_ms(&t, method);
         }
         if let Some(p) = r.gi_progress() {
             eprint!(
-                "\r{}: {:5.1}% of {}",
-                gi_label(args.method),
+                "\r{} ({}): {:5.1}% of {}",
+                info.label,
+                info.progress_unit,
                 100.0 * p.fraction(),
                 p.total
             );
@@ -432,10 +414,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     if let Some(p) = r.gi_progress() {
         eprintln!();
-        let what = match args.method {
-            Method::Reference => format!("converged reference: {} samples per pixel", p.total),
-            _ => format!("ground truth: {} VPLs", r.vpl_frame().count),
-        };
+        let what = format!("{}: {} {}", info.short, p.total, info.progress_unit);
         println!(
             "{what} x {}x{} pixels in {:.2} s wall (from the first frame), {:.1} ms GPU",
             args.width,
@@ -504,20 +483,15 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             let (w, h, bytes) = r.read_view_rgba8()?;
             write_png(&out.join(name), w, h, &bytes)?;
         }
-        // The tree samplers' diagnostics (thesis figs. 7.2, 7.4, 7.6).
-        if settings_method(&r).samples_tree() {
+        // The method's own views (the tree samplers': thesis figs. 7.2, 7.4, 7.6).
+        if !info.views.is_empty() {
             let mut s3 = r.settings().clone();
             s3.display.vpl_overlay = false;
             r.set_settings(s3)?;
-            for (view, name) in [
-                (ViewBuffer::TraversalSteps, "traversal_steps.png"),
-                (ViewBuffer::CutFallback, "cut_fallback.png"),
-                (ViewBuffer::CutBlocks, "cut_blocks.png"),
-                (ViewBuffer::CutDepth, "cut_depth.png"),
-            ] {
-                frame(&mut r, view);
+            for v in info.views {
+                frame(&mut r, ViewBuffer::Method(MethodView::new(v.name)));
                 let (w, h, bytes) = r.read_view_rgba8()?;
-                write_png(&out.join(name), w, h, &bytes)?;
+                write_png(&out.join(format!("{}.png", v.file)), w, h, &bytes)?;
             }
         }
         // The light tree over the albedo (which shows the geometry): distributions by flux

@@ -8,10 +8,10 @@ use clap::Args;
 
 use super::{
     SettingsArgs,
-    render::{Method, SamplingArgs},
+    render::{SamplingArgs, parse_method},
 };
 use crate::{
-    renderer::{Renderer, context::GpuContext, settings::GiMethod},
+    renderer::{Renderer, context::GpuContext, settings::MethodId},
     scene::preset::{SceneSource, open_scene},
     sheet::{SheetJob, compose},
 };
@@ -27,9 +27,10 @@ pub struct SheetArgs {
     pub width: u32,
     #[arg(long, default_value_t = 200)]
     pub height: u32,
-    /// The columns, in order (tree samplers or the converged reference).
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "slc,rtslc,sst")]
-    pub methods: Vec<Method>,
+    /// The columns, in order: any method but the ground truth (the sheet's first column)
+    /// and `off`, by CLI name.
+    #[arg(long, value_parser = parse_method, value_delimiter = ',', default_value = "slc,rtslc,sst")]
+    pub methods: Vec<MethodId>,
     /// The sheet (PNG; a JSON of the metrics is written beside it).
     #[arg(long, default_value = "screenshots/sheet.png")]
     pub out: PathBuf,
@@ -55,17 +56,20 @@ pub fn run(args: &SheetArgs) -> anyhow::Result<()> {
         settings.vpl.seed = v;
     }
     settings.validate().map_err(|e| anyhow!("{e}"))?;
-    let methods: Vec<GiMethod> = args
+    let columns = crate::methods::sheet_columns();
+    let methods: Vec<MethodId> = args
         .methods
         .iter()
-        .map(|m| match m {
-            Method::Slc => Ok(GiMethod::Slc),
-            Method::Sst => Ok(GiMethod::Sst),
-            Method::Rtslc => Ok(GiMethod::Rtslc),
-            Method::Reference => Ok(GiMethod::Reference),
-            other => Err(anyhow!(
-                "--methods: {other:?} cannot be a sheet column (slc, sst, rtslc, reference)"
-            )),
+        .map(|&m| {
+            if columns.contains(&m) {
+                Ok(m)
+            } else {
+                let names: Vec<&str> = columns.iter().map(|c| c.cli()).collect();
+                Err(anyhow!(
+                    "--methods: {m} cannot be a sheet column ({})",
+                    names.join(", ")
+                ))
+            }
         })
         .collect::<anyhow::Result<_>>()?;
     let cam_name = args.camera.clone().or(opened.camera_name.clone());

@@ -18,13 +18,13 @@ use std::{collections::HashMap, path::Path, time::Instant};
 use anyhow::{Context, anyhow, bail};
 
 use crate::{
+    base::display,
+    methods::tree_samplers::pass::SamplingStats,
     metrics,
-    reference::display,
     renderer::{
         Buffer, FrameInput, Renderer,
-        passes::slc::SamplingStats,
         readback::ImageF32,
-        settings::{GiMethod, RenderSettings, ViewBuffer},
+        settings::{RenderSettings, ViewBuffer},
     },
     scene::{Camera, DirectionalLight},
 };
@@ -53,15 +53,23 @@ pub const PASS_GROUPS: [(&str, &[&str]); 8] = [
     ("direct light", &["direct"]),
 ];
 
-/// The GI passes of a tree sampler (cuts included).
-pub const GI_PASSES: [&str; 6] = [
-    "slc_cuts",
-    "slc_sample",
-    "sst_sample",
-    "rtslc_sample",
-    "gi_downsample",
-    "gi_upsample",
-];
+/// The GI passes of every per-frame method (`MethodInfo::timed_passes`: cuts, sampling,
+/// half-resolution down- and upsampling), each once. A frame runs one method, so their sum
+/// is that method's GI cost.
+pub fn gi_passes() -> Vec<&'static str> {
+    let mut v: Vec<&'static str> = Vec::new();
+    for m in crate::methods::REGISTRY
+        .iter()
+        .filter(|m| m.kind == crate::methods::Kind::PerFrame)
+    {
+        for p in m.timed_passes {
+            if !v.contains(p) {
+                v.push(p);
+            }
+        }
+    }
+    v
+}
 
 /// The tree samplers' sampling passes alone (traversal, evaluation, shadow rays).
 pub const SAMPLE_PASSES: [&str; 3] = ["slc_sample", "sst_sample", "rtslc_sample"];
@@ -245,7 +253,7 @@ impl Bench {
             return Ok(cached.clone());
         }
         let mut g = s.clone();
-        g.gi.method = GiMethod::GroundTruth;
+        g.gi.method = crate::methods::comparison_truth();
         g.gi.rays_per_frame = 1 << 26;
         self.apply(&g, size)?;
         self.say(&format!(
@@ -285,7 +293,7 @@ impl Bench {
         frames: u32,
         with_gt: bool,
     ) -> anyhow::Result<Measured> {
-        let tree = s.gi.method.samples_tree();
+        let tree = s.gi.method.per_frame();
         let gt = if with_gt && tree {
             Some(self.ground_truth_and_hash(s, size)?)
         } else {

@@ -299,7 +299,7 @@ pub fn heatmap(path: &Path, title: &str, w: u32, h: u32, v: &[f32], max: f32) ->
             for x in 0..iw {
                 let t = v[((y / scale) * w + x / scale) as usize];
                 let c = if t.is_finite() {
-                    let c = crate::reference::visualise::false_color((t / max.max(1e-6)).clamp(0.0, 1.0));
+                    let c = crate::base::colormap::false_color((t / max.max(1e-6)).clamp(0.0, 1.0));
                     RGBColor((c[0] * 255.0) as u8, (c[1] * 255.0) as u8, (c[2] * 255.0) as u8)
                 } else {
                     RGBColor(40, 40, 40)
@@ -309,7 +309,7 @@ pub fn heatmap(path: &Path, title: &str, w: u32, h: u32, v: &[f32], max: f32) ->
         }
         let bw = size.0 - 40;
         for x in 0..bw {
-            let c = crate::reference::visualise::false_color(x as f32 / (bw - 1) as f32);
+            let c = crate::base::colormap::false_color(x as f32 / (bw - 1) as f32);
             let c = RGBColor((c[0] * 255.0) as u8, (c[1] * 255.0) as u8, (c[2] * 255.0) as u8);
             bar.draw(&Rectangle::new(
                 [(20 + x as i32, 8), (21 + x as i32, 26)],

@@ -1,20 +1,21 @@
-//! Plain-Rust CPU references of the GPU kernels, written for clarity, not speed. Only tests use
-//! them (they live in the library so that integration tests can reach them).
+//! Plain-Rust CPU references of the GPU kernels (the "twins"), written for clarity, not speed.
+//! Only tests use them (they live in the library so that integration tests can reach them);
+//! they stand on `crate::base` alone. The CPU pieces the running workbench shares (display
+//! encoding, colour maps, the node layout) live in `crate::base`, which is also the twin of
+//! the display and visualise passes.
 //!
 //! | GPU kernel | reference |
 //! |---|---|
 //! | `gbuffer.wgsl` (raster) | [`gbuffer::raycast`]: a BVH ray through each pixel centre |
 //! | `direct.wgsl` | [`direct::radiance`] with exact ray-traced visibility |
-//! | `display.wgsl` | [`display::encode`] |
-//! | `visualise.wgsl` (`vis_uint`) | [`visualise::id_color`], [`visualise::false_color`] |
+//! | `display.wgsl` | `base::display::encode` |
+//! | `visualise.wgsl` (`vis_uint`) | `base::colormap::{id_color, false_color}` |
 //! | `common/bvh.wgsl` | `scene::bvh::Bvh::{closest_hit, any_hit}` (and brute force) |
 
 pub mod direct;
-pub mod display;
 pub mod gbuffer;
 pub mod gi;
 pub mod slc;
 pub mod sst;
 pub mod sst_tree;
-pub mod visualise;
 pub mod vpl;

@@ -14,7 +14,7 @@
 use glam::Vec3;
 
 use super::sst_tree::{SstNode, luminance};
-use crate::renderer::settings::ChildProbability;
+use crate::base::sampling::ChildProbability;
 
 /// Largest cut (samples per pixel) the GPU kernels hold in registers.
 pub const MAX_CUT: u32 = 64;
@@ -350,8 +350,8 @@ pub fn upsample_pixel(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::base::gpu_layout::GpuVpl;
     use crate::reference::sst_tree::{build, sort_vpls};
-    use crate::renderer::gpu_data::GpuVpl;
 
     #[test]
     fn child_probabilities_by_hand() {

@@ -3,6 +3,8 @@
 //! layout of the WGSL struct, so the two cannot drift apart silently.
 
 use bytemuck::{Pod, Zeroable};
+
+pub use crate::base::gpu_layout::{GpuSstNode, GpuVpl, VPL_NONE};
 use glam::{Mat4, Vec3};
 
 use crate::scene::{Aabb, Camera, DirectionalLight};
@@ -251,21 +253,6 @@ pub struct GpuVplParams {
     pub level_offsets: [[u32; 4]; 4],
 }
 
-/// Twin: `Vpl` in `shaders/common/vpl.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
-pub struct GpuVpl {
-    /// xyz = position, w = pmf of its texel.
-    pub position: [f32; 4],
-    pub normal: [f32; 3],
-    /// light layer << 24 | texel index, or `VPL_NONE`.
-    pub id: u32,
-    /// rgb = flux (W), w = 1 when valid.
-    pub flux: [f32; 4],
-}
-
-pub const VPL_NONE: u32 = u32::MAX;
-
 /// Twin: `SlcParams` in `shaders/common/slc_params.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
@@ -293,7 +280,7 @@ pub struct GpuSlcParams {
     pub d_max: f32,
     /// 1: the estimate without the albedo (half-resolution GI, upsampled at full resolution).
     pub demodulate: u32,
-    /// x | y << 16 of the pixel whose samples are recorded (`passes::slc::PixelTrace`);
+    /// x | y << 16 of the pixel whose samples are recorded (`methods::tree_samplers::pass::PixelTrace`);
     /// `u32::MAX` = none.
     pub trace_pixel: u32,
     /// Near-field refinement factor (`SamplingSettings::near_field`; 0 = off).
@@ -305,36 +292,6 @@ pub struct GpuSlcParams {
     pub substitute_offset: f32,
     /// 0 mean position (eq. 5.5), 1 min-max box distance, 2 defensive (`ChildProbability`).
     pub child_probability: u32,
-}
-
-/// A node of the Stochastic Substitute Tree, 64 bytes (one cache line; the SST paper's node
-/// is 96 B, RTSLC's 32 B). Twin: `SstNode` in `shaders/common/sst_node.wgsl`; decoded by
-/// `reference::sst_tree::SstNode::decode`.
-///
-/// | bytes | field |
-/// |---|---|
-/// | 0-11 | intensity-weighted position (eq. 4.1), f32 x 3 |
-/// | 12-15 | normal similarity v (eq. 4.3), f32 |
-/// | 16-27 | summed RGB flux of the cluster (W), f32 x 3 |
-/// | 28-31 | normal, octahedral, 2 x 16 bits (x low; u = round(32767 v) + 32767) |
-/// | 32-43 | bounding box min, f32 x 3 (+f32::MAX for an empty node) |
-/// | 44-47 | variance along the normal sigma_z^2 (eq. 4.2), f32 |
-/// | 48-59 | bounding box max, f32 x 3 (-f32::MAX for an empty node) |
-/// | 60-63 | variances along tangent and bitangent, 2 x f16 (x low) |
-///
-/// The "usable for sampling" flag lives outside the node, one bit per node in a separate
-/// word array, so that a change of v_min / sigma_max only re-runs the classify pass.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
-pub struct GpuSstNode {
-    pub position: [f32; 3],
-    pub v: f32,
-    pub intensity: [f32; 3],
-    pub normal: u32,
-    pub bbox_min: [f32; 3],
-    pub var_z: f32,
-    pub bbox_max: [f32; 3],
-    pub var_xy: u32,
 }
 
 /// Twin: `GtParams` in `shaders/ground_truth.wgsl`.
@@ -498,7 +455,7 @@ mod tests {
                 ],
             ),
             (
-                "ground_truth.wgsl",
+                "methods/ground_truth/ground_truth.wgsl",
                 "GtParams",
                 size_of::<GpuGtParams>(),
                 vec![
@@ -513,7 +470,7 @@ mod tests {
                 ],
             ),
             (
-                "slc_sample.wgsl",
+                "methods/tree_samplers/slc_sample.wgsl",
                 "SlcParams",
                 size_of::<GpuSlcParams>(),
                 vec![

@@ -14,6 +14,32 @@ pub struct RenderSettings {
     pub sampling: SamplingSettings,
     pub display: DisplaySettings,
     pub textures: TextureSettings,
+    /// Settings of the methods that own no section above: `[methods.<cli name>]` tables, each
+    /// read and written as the method's own serde struct ([`RenderSettings::method`]), so a
+    /// new method brings its settings in its folder without a field here.
+    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub methods: std::collections::BTreeMap<String, toml::Table>,
+}
+
+impl RenderSettings {
+    /// A method's settings from its `[methods.<cli name>]` table (its defaults where the table
+    /// or a field is absent); the error names the table and the field.
+    pub fn method<T: serde::de::DeserializeOwned + Default>(&self, id: MethodId) -> Result<T, String> {
+        match self.methods.get(id.cli()) {
+            None => Ok(T::default()),
+            Some(t) => t
+                .clone()
+                .try_into()
+                .map_err(|e: toml::de::Error| format!("methods.{}: {}", id.cli(), e.message())),
+        }
+    }
+
+    /// Stores a method's settings as its `[methods.<cli name>]` table.
+    pub fn set_method<T: Serialize>(&mut self, id: MethodId, value: &T) -> Result<(), String> {
+        let t = toml::Table::try_from(value).map_err(|e| format!("methods.{}: {e}", id.cli()))?;
+        self.methods.insert(id.cli().to_string(), t);
+        Ok(())
+    }
 }
 
 /// Directional shadow map (one square layer per light, covering the scene bounds).
@@ -126,60 +152,15 @@ impl Default for VplSettings {
     }
 }
 
-/// Which indirect (one-bounce) light the frame computes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum GiMethod {
-    /// Direct light only.
-    #[default]
-    Off,
-    /// The thesis's ground truth: every VPL of the frame at every pixel with a shadow ray,
-    /// accumulated over frames in VPL batches (progressive; restarts when the view changes).
-    GroundTruth,
-    /// Converged reference: every RSM texel as a VPL, per-pixel Monte Carlo over the RSM
-    /// pyramids, accumulated over frames until `reference_samples` per pixel.
-    Reference,
-    /// The thesis's method (Stochastic Light Cut Exploration): shallow per-block cuts,
-    /// stochastic cut blending, traversal from each cut node that stops at usable SST nodes,
-    /// substitute-distribution samples.
-    Slc,
-    /// Baseline, Tatzgern et al. 2020: `cut_size` traversals per pixel from the root, each
-    /// stopping at a usable SST node.
-    Sst,
-    /// Baseline, Lin and Yuksel 2020: the same cuts and blending, traversal always down to a
-    /// leaf VPL (no substitutes).
-    Rtslc,
-}
-
-impl GiMethod {
-    pub const ALL: [GiMethod; 6] = [
-        GiMethod::Off,
-        GiMethod::Slc,
-        GiMethod::Sst,
-        GiMethod::Rtslc,
-        GiMethod::GroundTruth,
-        GiMethod::Reference,
-    ];
-    pub fn name(self) -> &'static str {
-        match self {
-            GiMethod::Off => "off (direct only)",
-            GiMethod::GroundTruth => "ground truth (all VPLs)",
-            GiMethod::Reference => "converged reference (all texels)",
-            GiMethod::Slc => "SLC (thesis)",
-            GiMethod::Sst => "SST (baseline)",
-            GiMethod::Rtslc => "RTSLC (baseline)",
-        }
-    }
-    /// The tree samplers (one estimate per frame), as opposed to the progressive references.
-    pub fn samples_tree(self) -> bool {
-        matches!(self, GiMethod::Slc | GiMethod::Sst | GiMethod::Rtslc)
-    }
-}
+pub use crate::methods::{MethodId, MethodView};
 
 /// Shading of VPLs (shared by every GI method and the references).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct GiSettings {
-    pub method: GiMethod,
+    /// The GI method (`crate::methods::REGISTRY`; its CLI name, e.g. "slc", "ground-truth",
+    /// "off"). Default: the thesis's SLC.
+    pub method: MethodId,
     /// Shadow rays the ground truth may trace per frame in the GUI (it continues next frame).
     /// Higher finishes sooner but makes frames slower.
     pub rays_per_frame: u32,
@@ -208,7 +189,7 @@ pub struct GiSettings {
 impl Default for GiSettings {
     fn default() -> Self {
         Self {
-            method: GiMethod::Off,
+            method: MethodId::default(),
             rays_per_frame: 1 << 20,
             reference_samples: 4096,
             reference_spp_per_frame: 1,
@@ -245,162 +226,9 @@ impl Default for TreeSettings {
     }
 }
 
-/// How a pixel picks a cut per slot (thesis 5.1.3, fig. 7.4).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum CutBlending {
-    /// Algorithm 1: per slot, one of the 4 surrounding blocks' cuts by bilinear weight x S.
-    #[default]
-    Stochastic,
-    /// No blending: the cut of the pixel's own block (if similar, else the fallback).
-    Off,
-}
-
-impl CutBlending {
-    pub const ALL: [CutBlending; 2] = [CutBlending::Stochastic, CutBlending::Off];
-    pub fn name(self) -> &'static str {
-        match self {
-            CutBlending::Stochastic => "stochastic (Algorithm 1)",
-            CutBlending::Off => "off (own block)",
-        }
-    }
-}
-
-/// What a pixel does when no surrounding cut is similar (thesis 5.1.4, fig. 7.6).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum CutFallback {
-    /// All nodes of tree level floor(log2(cut_size)).
-    #[default]
-    MockCut,
-    /// Blend the dissimilar cuts anyway, by bilinear weight alone.
-    Average,
-    /// `cut_size` traversals from the root (as SST).
-    Root,
-    /// Build a cut at the pixel itself (costly).
-    Recompute,
-}
-
-impl CutFallback {
-    pub const ALL: [CutFallback; 4] = [
-        CutFallback::MockCut,
-        CutFallback::Average,
-        CutFallback::Root,
-        CutFallback::Recompute,
-    ];
-    pub fn name(self) -> &'static str {
-        match self {
-            CutFallback::MockCut => "mock cut",
-            CutFallback::Average => "average the cuts",
-            CutFallback::Root => "traverse from the root",
-            CutFallback::Recompute => "recompute a cut",
-        }
-    }
-}
-
-/// How a traversal step splits its probability between the two children (stage 14).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum ChildProbability {
-    /// p_left = w_left / (w_left + w_right), w of eq. 5.5 with the distance to each child's
-    /// intensity-weighted mean (the thesis).
-    Mean,
-    /// RTSLC's default ("MinMax", Lin & Yuksel 2020's public code): the average of the two
-    /// normalisations with the closest-point and the farthest-point squared distance to each
-    /// child's box (same cosine term). A child holding VPLs close to x keeps at least half its
-    /// closest-point share, which bounds the samples' weights (fewer fireflies).
-    MinMax,
-    /// Ours (the default): 0.8 x the thesis's p_left + 0.2 x the closest-point
-    /// normalisation (a "defensive mixture", Hesterberg 1995; `reference::slc::DEFENSIVE`).
-    /// Keeps eq. 5.5's choices where the children's means represent them, and a fifth of the
-    /// closest-point share where they do not: the perfect binary tree over Morton-sorted VPLs
-    /// pairs some VPLs with far partners (Sponza: 10% of the leaf pairs span more than 1.4 m,
-    /// the widest 38 m), and eq. 5.5 then gives a VPL next to x the probability of its
-    /// cluster's far mean, a firefly when drawn (docs/results.md, *What changed* 5).
-    #[default]
-    Defensive,
-}
-
-impl ChildProbability {
-    pub const ALL: [ChildProbability; 3] = [
-        ChildProbability::Mean,
-        ChildProbability::MinMax,
-        ChildProbability::Defensive,
-    ];
-    pub fn name(self) -> &'static str {
-        match self {
-            ChildProbability::Mean => "mean position (thesis)",
-            ChildProbability::MinMax => "min-max box distance (RTSLC)",
-            ChildProbability::Defensive => "mean + 20% closest point (defensive)",
-        }
-    }
-}
-
-/// Sampling the tree (stages 11-16, thesis chapter 5): used by the SLC, SST and RTSLC methods.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct SamplingSettings {
-    /// k: one shallow light cut per k x k block of GI pixels (1 = a cut per pixel). Larger
-    /// blocks cost less and blur the cut choice across edges (blending hides the seams).
-    pub block_size: u32,
-    /// Nodes per cut = cluster evaluations (shadow rays) per pixel; SST takes this many
-    /// traversals from the root.
-    pub cut_size: u32,
-    /// Leave out of the cuts children whose box lies wholly behind the block centre's
-    /// surface (thesis 5.1). Pixels of a block that face differently can then miss light
-    /// from those nodes (bias, bounded by the similarity test); off keeps the cuts complete.
-    pub cull_behind: bool,
-    /// Near-field refinement (ours, not in the thesis; 0 = the thesis's rule): SLC and SST
-    /// stop at a usable node only when the shaded point lies at least max(distance epsilon,
-    /// `near_field` x the node's box diagonal) from the node's box, and descend otherwise (to
-    /// a leaf at most). A substitute distribution stands for its VPLs only seen from afar:
-    /// next to it, its samples land off the real surfaces (through thin walls, in front of
-    /// the shaded surface) and the 1/d^2 term turns them into fireflies. Higher refines more
-    /// (fewer fireflies, more steps). See docs/results.md.
-    pub near_field: f32,
-    /// Shadow rays of substitute samples (SLC/SST inner nodes, never leaf VPLs) end this far
-    /// (m) short of the drawn point, towards the shaded point and at most half way: the SST
-    /// paper's "scene size dependent epsilon" (Tatzgern et al. 2020, section 5, Sampling: drawn points
-    /// "may be slightly inside geometry"). A Gaussian draw clamped to the box lands behind
-    /// walls and under neighbouring surfaces, where the node's real VPLs are not; 0 (only
-    /// `gi.ray_offset`, the thesis) left SLC 8.6% dark in the Breakfast Room. Too large leaks
-    /// light through walls thinner than it. See docs/results.md.
-    pub substitute_offset: f32,
-    /// How a traversal step splits its probability between the children (all three
-    /// samplers; the cuts are built the same either way).
-    pub child_probability: ChildProbability,
-    pub blending: CutBlending,
-    pub fallback: CutFallback,
-    /// Average successive frames while the view, lights and settings stay (progressive);
-    /// off shows each frame's estimate alone, as a real-time renderer would.
-    pub accumulate: bool,
-    /// Render GI at half resolution and upsample it with a joint bilateral filter using S.
-    pub half_resolution: bool,
-    /// The samplers' random numbers are the same every frame (debugging: a pixel's story
-    /// repeats); off, the seed changes per frame (needed to accumulate).
-    pub fixed_seed: bool,
-}
-
-impl Default for SamplingSettings {
-    fn default() -> Self {
-        // The thesis's defaults: 8 x 8 blocks, 32 samples per pixel.
-        Self {
-            block_size: 8,
-            cut_size: 32,
-            cull_behind: true,
-            // Measured on Sponza and Breakfast Room (docs/results.md): 1 removes the
-            // substitute fireflies for 3-11% more steps; 0.5 and 2 are within noise of it in
-            // error, for fewer / more steps.
-            near_field: 1.0,
-            // Measured (16-frame means vs the ground truth, docs/results.md): 0.05 m brings
-            // SLC from 0.915x to 0.98x in the Breakfast Room; 0.1 m overshoots (light leaks).
-            substitute_offset: 0.05,
-            child_probability: ChildProbability::Defensive,
-            blending: CutBlending::Stochastic,
-            fallback: CutFallback::MockCut,
-            accumulate: false,
-            half_resolution: false,
-            fixed_seed: false,
-        }
-    }
-}
+pub use crate::methods::tree_samplers::settings::{
+    ChildProbability, CutBlending, CutFallback, SamplingSettings,
+};
 
 /// What the light-tree overlay draws over the camera view.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -448,35 +276,7 @@ impl TreeColor {
     }
 }
 
-/// Tonemapping operator of the display pass.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Tonemap {
-    /// Clamp to [0, 1]: shows linear values faithfully up to 1.
-    Clamp,
-    /// Reinhard on luminance: keeps hue, compresses highlights gently.
-    Reinhard,
-    /// ACES filmic fit (Narkowicz 2015): contrasty, saturates highlights.
-    #[default]
-    Aces,
-}
-
-impl Tonemap {
-    pub const ALL: [Tonemap; 3] = [Tonemap::Clamp, Tonemap::Reinhard, Tonemap::Aces];
-    pub fn gpu_id(self) -> u32 {
-        match self {
-            Tonemap::Clamp => 0,
-            Tonemap::Reinhard => 1,
-            Tonemap::Aces => 2,
-        }
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            Tonemap::Clamp => "clamp",
-            Tonemap::Reinhard => "Reinhard",
-            Tonemap::Aces => "ACES",
-        }
-    }
-}
+pub use crate::base::display::Tonemap;
 
 /// Display of linear radiance (exports to EXR are never affected).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -625,20 +425,6 @@ impl RenderSettings {
             return Err(format!("vpl.flux_mix {} is out of range (0..=1)", v.flux_mix));
         }
         let g = &self.gi;
-        if !(g.reference_flux_mix > 0.0 && g.reference_flux_mix <= 1.0) {
-            return Err(format!(
-                "gi.reference_flux_mix {} is out of range (0..=1, > 0)",
-                g.reference_flux_mix
-            ));
-        }
-        if g.reference_samples == 0 || !(1..=4096).contains(&g.reference_spp_per_frame) {
-            return Err(
-                "gi.reference_samples must be >= 1 and gi.reference_spp_per_frame in 1..=4096".into(),
-            );
-        }
-        if g.rays_per_frame == 0 {
-            return Err("gi.rays_per_frame must be at least 1".into());
-        }
         if !(g.distance_epsilon > 0.0 && g.distance_epsilon <= 100.0) {
             return Err(format!(
                 "gi.distance_epsilon {} is out of range (0..=100 m, > 0)",
@@ -649,31 +435,6 @@ impl RenderSettings {
             return Err(format!(
                 "gi.ray_offset {} is out of range (0..=1 m)",
                 g.ray_offset
-            ));
-        }
-        let sm = &self.sampling;
-        if !(1..=64).contains(&sm.block_size) {
-            return Err(format!(
-                "sampling.block_size {} is out of range (1..=64)",
-                sm.block_size
-            ));
-        }
-        if !(1..=64).contains(&sm.cut_size) {
-            return Err(format!(
-                "sampling.cut_size {} is out of range (1..=64)",
-                sm.cut_size
-            ));
-        }
-        if !(0.0..=100.0).contains(&sm.near_field) {
-            return Err(format!(
-                "sampling.near_field {} is out of range (0..=100; 0 = off)",
-                sm.near_field
-            ));
-        }
-        if !(0.0..=1.0).contains(&sm.substitute_offset) {
-            return Err(format!(
-                "sampling.substitute_offset {} is out of range (0..=1 m; 0 = off)",
-                sm.substitute_offset
             ));
         }
         let t = &self.tree;
@@ -704,7 +465,19 @@ impl RenderSettings {
                 self.textures.anisotropy
             ));
         }
-        Ok(())
+        // Each GI method checks its own settings (the tree samplers' [sampling], the
+        // progressive methods' budgets, the [methods.<name>] tables).
+        if let Some(k) = self
+            .methods
+            .keys()
+            .find(|k| MethodId::parse(k).map(|m| m.cli()) != Ok(k.as_str()))
+        {
+            return Err(format!(
+                "methods.{k}: no such method (the methods: {})",
+                crate::methods::cli_names().join(", ")
+            ));
+        }
+        crate::methods::validate_all(self)
     }
 }
 
@@ -742,14 +515,6 @@ pub enum ViewBuffer {
     MaterialId,
     /// The shadow map of light 0 (near = white).
     ShadowMap,
-    /// Tree samplers: traversal steps per traversal, per pixel (heat map, thesis fig. 7.2).
-    TraversalSteps,
-    /// Tree samplers: pixels without a similar surrounding cut (red over the grey final).
-    CutFallback,
-    /// Tree samplers: the per-block cuts, a colour per cut, over the grey final.
-    CutBlocks,
-    /// Tree samplers: the per-block cuts coloured by their mean node depth.
-    CutDepth,
     /// The ground truth of the same VPLs beside a tree sampler: GI only (comparison on).
     GroundTruthIndirect,
     /// The ground truth of the same VPLs beside a tree sampler: direct + GI (comparison on).
@@ -763,10 +528,14 @@ pub enum ViewBuffer {
     /// Any two radiance images (live buffers or snapshots) compared: split, side by side, A,
     /// B, difference x N, relative error (`views::AbSpec`).
     AbCompare,
+    /// A view a GI method draws (`MethodInfo::views`: the tree samplers' traversal steps,
+    /// cuts, ...), by its name.
+    Method(MethodView),
 }
 
 impl ViewBuffer {
-    pub const ALL: [ViewBuffer; 25] = [
+    /// The views every method shares; [`ViewBuffer::all`] adds the methods' own.
+    pub const ALL: [ViewBuffer; 21] = [
         ViewBuffer::Final,
         ViewBuffer::Direct,
         ViewBuffer::Indirect,
@@ -782,10 +551,6 @@ impl ViewBuffer {
         ViewBuffer::Position,
         ViewBuffer::MaterialId,
         ViewBuffer::ShadowMap,
-        ViewBuffer::TraversalSteps,
-        ViewBuffer::CutFallback,
-        ViewBuffer::CutBlocks,
-        ViewBuffer::CutDepth,
         ViewBuffer::GroundTruthIndirect,
         ViewBuffer::GroundTruthFinal,
         ViewBuffer::SplitIndirect,
@@ -810,25 +575,29 @@ impl ViewBuffer {
             ViewBuffer::Position => "position",
             ViewBuffer::MaterialId => "material id",
             ViewBuffer::ShadowMap => "shadow map",
-            ViewBuffer::TraversalSteps => "traversal steps",
-            ViewBuffer::CutFallback => "pixels without a similar cut",
-            ViewBuffer::CutBlocks => "cuts per block",
-            ViewBuffer::CutDepth => "cut depth per block",
             ViewBuffer::GroundTruthIndirect => "ground truth: GI only",
             ViewBuffer::GroundTruthFinal => "ground truth: final",
             ViewBuffer::SplitIndirect => "split: method | ground truth (GI)",
             ViewBuffer::SideBySide => "side by side: method | ground truth (GI)",
             ViewBuffer::RelativeError => "relative error vs ground truth",
             ViewBuffer::AbCompare => "A/B comparison",
+            ViewBuffer::Method(v) => v.name(),
         }
+    }
+    /// Every view: the shared ones, then each registered method's.
+    pub fn all() -> Vec<ViewBuffer> {
+        let mut v = ViewBuffer::ALL.to_vec();
+        v.extend(MethodView::all().into_iter().map(ViewBuffer::Method));
+        v
     }
     /// The view called `name` (as [`ViewBuffer::name`] spells it, case-insensitive).
     pub fn from_name(name: &str) -> Result<ViewBuffer, String> {
-        ViewBuffer::ALL
-            .into_iter()
+        let all = ViewBuffer::all();
+        all.iter()
+            .copied()
             .find(|v| v.name().eq_ignore_ascii_case(name.trim()))
             .ok_or_else(|| {
-                let names: Vec<&str> = ViewBuffer::ALL.iter().map(|v| v.name()).collect();
+                let names: Vec<&str> = all.iter().map(|v| v.name()).collect();
                 format!("unknown view '{name}'; the views are: {}", names.join(", "))
             })
     }
@@ -844,17 +613,6 @@ impl ViewBuffer {
                 | ViewBuffer::ImportanceFiltered
                 | ViewBuffer::PdfPyramid
                 | ViewBuffer::ShadowMap
-        )
-    }
-
-    /// True for the views of the tree samplers' diagnostics.
-    pub fn is_sampling_view(self) -> bool {
-        matches!(
-            self,
-            ViewBuffer::TraversalSteps
-                | ViewBuffer::CutFallback
-                | ViewBuffer::CutBlocks
-                | ViewBuffer::CutDepth
         )
     }
 
@@ -890,6 +648,31 @@ mod tests {
         let text = toml::to_string(&s).unwrap();
         let back: RenderSettings = toml::from_str(&text).unwrap();
         assert_eq!(s, back);
+    }
+
+    #[test]
+    fn a_methods_own_table_round_trips_and_errors_name_it() {
+        #[derive(Debug, Default, PartialEq, Serialize, Deserialize)]
+        #[serde(default, deny_unknown_fields)]
+        struct Knobs {
+            threshold: f32,
+            cap: u32,
+        }
+        let id = crate::methods::tree_samplers::SLC;
+        let mut s = RenderSettings::default();
+        assert_eq!(s.method::<Knobs>(id), Ok(Knobs::default()));
+        let k = Knobs {
+            threshold: 0.02,
+            cap: 256,
+        };
+        s.set_method(id, &k).unwrap();
+        let back: RenderSettings = toml::from_str(&toml::to_string(&s).unwrap()).unwrap();
+        assert_eq!(back.method::<Knobs>(id), Ok(k));
+        assert!(s.validate().is_ok());
+        let bad: RenderSettings = toml::from_str("[methods.slc]\ncap = \"many\"").unwrap();
+        assert!(bad.method::<Knobs>(id).unwrap_err().contains("methods.slc"));
+        let unknown: RenderSettings = toml::from_str("[methods.nope]\ncap = 1").unwrap();
+        assert!(unknown.validate().unwrap_err().contains("methods.nope"));
     }
 
     #[test]

@@ -9,7 +9,9 @@ use std::collections::HashSet;
 
 use thiserror::Error;
 
-/// Every WGSL file of the project, by its path under `shaders/`.
+/// The WGSL files of the frame's shared passes and includes, by their path under `shaders/`.
+/// Each GI method declares its own files (`MethodInfo::shaders`, under
+/// `shaders/methods/<method>/`); [`all_files`] joins the two.
 pub const SHADER_FILES: &[(&str, &str)] = &[
     ("common/bvh.wgsl", include_str!("../../shaders/common/bvh.wgsl")),
     (
@@ -64,23 +66,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         include_str!("../../shaders/common/rsm_pyramid.wgsl"),
     ),
     ("vpl_gen.wgsl", include_str!("../../shaders/vpl_gen.wgsl")),
-    (
-        "ground_truth.wgsl",
-        include_str!("../../shaders/ground_truth.wgsl"),
-    ),
     ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),
-    ("reference.wgsl", include_str!("../../shaders/reference.wgsl")),
     ("vpl_splat.wgsl", include_str!("../../shaders/vpl_splat.wgsl")),
     ("sst_sort.wgsl", include_str!("../../shaders/sst_sort.wgsl")),
     ("sst_build.wgsl", include_str!("../../shaders/sst_build.wgsl")),
-    ("slc_cuts.wgsl", include_str!("../../shaders/slc_cuts.wgsl")),
-    ("slc_sample.wgsl", include_str!("../../shaders/slc_sample.wgsl")),
-    ("slc_views.wgsl", include_str!("../../shaders/slc_views.wgsl")),
-    ("slc_half.wgsl", include_str!("../../shaders/slc_half.wgsl")),
-    (
-        "slc_upsample.wgsl",
-        include_str!("../../shaders/slc_upsample.wgsl"),
-    ),
     (
         "compare_views.wgsl",
         include_str!("../../shaders/compare_views.wgsl"),
@@ -98,7 +87,8 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("bvh_rays.wgsl", include_str!("../../shaders/bvh_rays.wgsl")),
 ];
 
-/// The shaders that are entry points (not include-only files).
+/// The shared shaders that are entry points (not include-only files); [`entry_shaders`] adds
+/// the methods'.
 pub const ENTRY_SHADERS: &[&str] = &[
     "gbuffer.wgsl",
     "rsm.wgsl",
@@ -107,21 +97,32 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "visualise.wgsl",
     "bvh_rays.wgsl",
     "vpl_gen.wgsl",
-    "ground_truth.wgsl",
     "composite.wgsl",
-    "reference.wgsl",
     "vpl_splat.wgsl",
     "sst_sort.wgsl",
     "sst_build.wgsl",
     "sst_classify.wgsl",
     "sst_overlay.wgsl",
-    "slc_cuts.wgsl",
-    "slc_sample.wgsl",
-    "slc_views.wgsl",
     "compare_views.wgsl",
-    "slc_half.wgsl",
-    "slc_upsample.wgsl",
 ];
+
+/// Every WGSL file: the shared ones and those the registered GI methods declare.
+pub fn all_files() -> impl Iterator<Item = (&'static str, &'static str)> {
+    SHADER_FILES.iter().copied().chain(
+        crate::methods::modules()
+            .into_iter()
+            .flat_map(|m| m.shaders.iter().copied()),
+    )
+}
+
+/// Every entry-point shader: the shared ones and the methods' (each file once).
+pub fn entry_shaders() -> Vec<&'static str> {
+    let mut v: Vec<&'static str> = ENTRY_SHADERS.to_vec();
+    for m in crate::methods::modules() {
+        v.extend(m.entry_shaders.iter().copied());
+    }
+    v
+}
 
 #[derive(Debug, Error, PartialEq)]
 pub enum ShaderError {
@@ -143,10 +144,7 @@ pub struct Embedded;
 
 impl ShaderSource for Embedded {
     fn get(&self, name: &str) -> Option<String> {
-        SHADER_FILES
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, s)| s.to_string())
+        all_files().find(|(n, _)| *n == name).map(|(_, s)| s.to_string())
     }
 }
 
@@ -295,7 +293,7 @@ mod tests {
 
     #[test]
     fn every_shader_passes_naga() {
-        for name in ENTRY_SHADERS {
+        for name in entry_shaders() {
             if let Err(e) = load_validated(&Embedded, name) {
                 panic!("{e}");
             }

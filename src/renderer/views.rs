@@ -10,63 +10,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::settings::{DisplaySettings, Tonemap, ViewBuffer};
+use super::settings::{DisplaySettings, ViewBuffer};
 
-/// Channel isolation of radiance views.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Channel {
-    #[default]
-    Rgb,
-    R,
-    G,
-    B,
-    /// Rec. 709 luminance (as grey).
-    Luminance,
-}
-
-impl Channel {
-    pub const ALL: [Channel; 5] = [
-        Channel::Rgb,
-        Channel::R,
-        Channel::G,
-        Channel::B,
-        Channel::Luminance,
-    ];
-    pub fn gpu_id(self) -> u32 {
-        match self {
-            Channel::Rgb => 0,
-            Channel::R => 1,
-            Channel::G => 2,
-            Channel::B => 3,
-            Channel::Luminance => 4,
-        }
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            Channel::Rgb => "RGB",
-            Channel::R => "R",
-            Channel::G => "G",
-            Channel::B => "B",
-            Channel::Luminance => "luminance",
-        }
-    }
-}
-
-/// How a view turns linear radiance into display pixels.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct ViewLook {
-    /// Radiance is multiplied by 2^EV before the tonemap.
-    pub exposure_ev: f32,
-    pub tonemap: Tonemap,
-    pub channel: Channel,
-    /// Show the channel's value (luminance for RGB) in false colour, log10 over
-    /// `range_log10` in W/(m^2 sr); the exposure does not apply (the legend reads radiance).
-    pub false_color: bool,
-    pub range_log10: [f32; 2],
-    /// NaN/Inf as magenta (off: black).
-    pub nan_highlight: bool,
-}
+pub use crate::base::display::{Channel, ViewLook};
 
 impl Default for ViewLook {
     fn default() -> Self {
@@ -296,20 +242,7 @@ impl super::Renderer {
                     pixels: v.iter().map(|&x| [x, x, x, 1.0]).collect(),
                 }));
             }
-            v if v.is_sampling_view() => {
-                let b = &self.slc_buffers;
-                let n = b.size.0 as u64 * b.size.1 as u64;
-                if !self.settings.gi.method.samples_tree() || n <= 1 {
-                    return Ok(None);
-                }
-                let bytes = readback::read_buffer_range(&self.ctx, &b.diag, 0, 16 * n)?;
-                let v: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
-                return Ok(Some(readback::ImageF32 {
-                    width: b.size.0,
-                    height: b.size.1,
-                    pixels: v,
-                }));
-            }
+            ViewBuffer::Method(v) => return self.read_method_view(v),
             _ => return Ok(None),
         };
         self.read(buffer).map(Some)

@@ -7,11 +7,7 @@ pub mod composite;
 pub mod direct;
 pub mod display;
 pub mod gbuffer;
-pub mod ground_truth;
-pub mod reference;
 pub mod rsm;
-pub mod slc;
-pub mod slc_half;
 pub mod sst_build;
 pub mod sst_overlay;
 pub mod sst_sort;
@@ -213,11 +209,11 @@ pub(crate) fn bind_group_seq(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::renderer::shaders::{ENTRY_SHADERS, Embedded, preprocess, validate};
+    use crate::renderer::shaders::{Embedded, entry_shaders, preprocess, validate};
 
     #[test]
     fn workgroup_sizes_match_wgsl() {
-        for file in ENTRY_SHADERS {
+        for file in entry_shaders() {
             let text = preprocess(&Embedded, file).unwrap();
             let module = validate(file, &text).unwrap();
             for ep in &module.entry_points {

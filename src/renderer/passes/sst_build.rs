@@ -6,7 +6,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::{
-    reference::sst_tree::{leaf_count, level_count},
+    base::sst_node::{leaf_count, level_count},
     renderer::{
         context::{GpuContext, GpuError},
         gpu_data::{GpuSstNode, GpuVpl},

@@ -1,5 +1,5 @@
 //! Converged reference (stage 19): every RSM texel as a VPL, estimated per pixel by Monte
-//! Carlo through the RSM pyramids and accumulated over frames (see `shaders/reference.wgsl`).
+//! Carlo through the RSM pyramids and accumulated over frames (see `shaders/methods/reference/reference.wgsl`).
 //! Reads: VPL-stage pyramids and parameters, RSM, G-buffer, BVH. Writes: the GI accumulation.
 
 use bytemuck::{Pod, Zeroable};
@@ -11,12 +11,12 @@ use crate::renderer::{
     timing::GpuTimer,
 };
 
-use super::{
+use crate::renderer::passes::{
     compute_pipeline, float_array_texture_entry, float_texture_entry, groups_image, run_compute,
     storage_entry, uniform_buffer, uniform_entry, vpl_gen::VplBuffers,
 };
 
-/// Twin: `RefParams` in `shaders/reference.wgsl`.
+/// Twin: `RefParams` in `shaders/methods/reference/reference.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuRefParams {
@@ -38,7 +38,7 @@ pub struct ReferencePass {
 
 impl ReferencePass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "reference.wgsl")?;
+        let module = shaders::create_module(device, "methods/reference/reference.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("reference::layout"),

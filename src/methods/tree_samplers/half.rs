@@ -10,7 +10,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::renderer::{frame::GbufferTargets, shaders, timing::GpuTimer};
 
-use super::{
+use crate::renderer::passes::{
     bind_group_seq, compute_pipeline, float_texture_entry, groups_image, run_compute, storage_entry,
     storage_texture_entry, uniform_buffer, uniform_entry,
 };
@@ -69,7 +69,7 @@ pub struct HalfPass {
 impl HalfPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let c = wgpu::ShaderStages::COMPUTE;
-        let dmod = shaders::create_module(device, "slc_half.wgsl")?;
+        let dmod = shaders::create_module(device, "methods/tree_samplers/slc_half.wgsl")?;
         let down_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("slc_half::layout"),
             entries: &[
@@ -77,12 +77,12 @@ impl HalfPass {
                 float_texture_entry(1),
                 float_texture_entry(2),
                 float_texture_entry(3),
-                storage_texture_entry(4, super::gbuffer::POSITION_FORMAT),
-                storage_texture_entry(5, super::gbuffer::NORMAL_FORMAT),
-                storage_texture_entry(6, super::gbuffer::ALBEDO_FORMAT),
+                storage_texture_entry(4, crate::renderer::passes::gbuffer::POSITION_FORMAT),
+                storage_texture_entry(5, crate::renderer::passes::gbuffer::NORMAL_FORMAT),
+                storage_texture_entry(6, crate::renderer::passes::gbuffer::ALBEDO_FORMAT),
             ],
         });
-        let umod = shaders::create_module(device, "slc_upsample.wgsl")?;
+        let umod = shaders::create_module(device, "methods/tree_samplers/slc_upsample.wgsl")?;
         let up_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("slc_upsample::layout"),
             entries: &[

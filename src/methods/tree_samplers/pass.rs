@@ -10,7 +10,7 @@ use crate::renderer::{
     timing::GpuTimer,
 };
 
-use super::{
+use crate::renderer::passes::{
     WG_1D, bind_group_seq, compute_pipeline, float_texture_entry, groups_image, run_compute,
     sst_build::TreeBuffers, storage_entry, storage_texture_entry, uniform_entry,
 };
@@ -57,7 +57,7 @@ impl SamplingStats {
     }
 }
 
-/// Layout of the pixel story (twin of the constants in `shaders/slc_sample.wgsl`).
+/// Layout of the pixel story (twin of the constants in `shaders/methods/tree_samplers/slc_sample.wgsl`).
 pub const TRACE_HEADER: usize = 32;
 pub const TRACE_RECORD: usize = 64;
 pub const TRACE_SAMPLES: usize = 64;
@@ -298,7 +298,7 @@ pub struct SlcPass {
 impl SlcPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let c = wgpu::ShaderStages::COMPUTE;
-        let cmod = shaders::create_module(device, "slc_cuts.wgsl")?;
+        let cmod = shaders::create_module(device, "methods/tree_samplers/slc_cuts.wgsl")?;
         let cuts_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("slc_cuts::layout"),
             entries: &[
@@ -309,7 +309,7 @@ impl SlcPass {
                 storage_entry(4, c, false),
             ],
         });
-        let smod = shaders::create_module(device, "slc_sample.wgsl")?;
+        let smod = shaders::create_module(device, "methods/tree_samplers/slc_sample.wgsl")?;
         let sample_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("slc_sample::layout"),
             entries: &[
@@ -329,7 +329,7 @@ impl SlcPass {
                 storage_entry(13, c, false),
             ],
         });
-        let vmod = shaders::create_module(device, "slc_views.wgsl")?;
+        let vmod = shaders::create_module(device, "methods/tree_samplers/slc_views.wgsl")?;
         let views_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("slc_views::layout"),
             entries: &[
@@ -338,16 +338,19 @@ impl SlcPass {
                 float_texture_entry(2),
                 storage_entry(3, c, true),
                 storage_entry(4, c, true),
-                storage_texture_entry(5, super::display::VIEW_FORMAT),
+                storage_texture_entry(5, crate::renderer::passes::display::VIEW_FORMAT),
             ],
         });
         Ok(Self {
             views: compute_pipeline(device, "slc_views", &[Some(&views_layout)], &vmod, "main"),
             views_layout,
-            view_params: super::uniform_buffer::<GpuSlcViewParams>(device, "slc_views::params"),
+            view_params: crate::renderer::passes::uniform_buffer::<GpuSlcViewParams>(
+                device,
+                "slc_views::params",
+            ),
             cuts: compute_pipeline(device, "slc_cuts", &[Some(&cuts_layout)], &cmod, "build_cuts"),
             sample: compute_pipeline(device, "slc_sample", &[Some(&sample_layout)], &smod, "main"),
-            params: super::uniform_buffer::<GpuSlcParams>(device, "slc::params"),
+            params: crate::renderer::passes::uniform_buffer::<GpuSlcParams>(device, "slc::params"),
             stats_readback: AsyncReadback::new(device, "slc::stats_readback", (STATS * 4) as u64),
             last_stats: None,
             cuts_layout,
@@ -463,6 +466,11 @@ impl SlcPass {
     /// Call after the frame's submit: starts the counters' readback.
     pub fn after_submit(&self) {
         self.stats_readback.after_submit();
+    }
+
+    /// The counters last read back (without polling).
+    pub fn last_stats(&self) -> Option<SamplingStats> {
+        self.last_stats
     }
 
     /// The counters of the latest frame read back (non-blocking).

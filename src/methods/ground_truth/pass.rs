@@ -6,7 +6,9 @@ use crate::renderer::{
     frame::GbufferTargets, gpu_data::GpuGtParams, scene_gpu::SceneGpu, shaders, timing::GpuTimer,
 };
 
-use super::{compute_pipeline, dynamic_uniform_entry, float_texture_entry, groups_2d, storage_entry};
+use crate::renderer::passes::{
+    compute_pipeline, dynamic_uniform_entry, float_texture_entry, groups_2d, storage_entry,
+};
 
 /// Dynamic-offset stride of the per-batch uniforms; most batches per recorded call.
 const STRIDE: u64 = 256;
@@ -20,7 +22,7 @@ pub struct GroundTruthPass {
 
 impl GroundTruthPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "ground_truth.wgsl")?;
+        let module = shaders::create_module(device, "methods/ground_truth/ground_truth.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ground_truth::layout"),

@@ -1,0 +1,90 @@
+//! Files the workbench writes and finds: view exports (PNG as displayed, EXR of the buffer),
+//! comparison sheets, fresh file names, the scene presets.
+
+use super::*;
+
+/// A file name in `dir` that does not exist yet: `stem_NNN.ext`.
+pub(super) fn fresh_path(dir: &std::path::Path, stem: &str, ext: &str) -> PathBuf {
+    let slug: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let mut n = 0;
+    loop {
+        let p = dir.join(format!("{slug}_{n:03}.{ext}"));
+        if !p.exists() {
+            return p;
+        }
+        n += 1;
+    }
+}
+
+/// Writes a comparison sheet (PNG + JSON of its metrics) into `dir`; returns the paths.
+pub fn write_sheet(sheet: &crate::sheet::Sheet, dir: &std::path::Path) -> Result<String, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let canvas = crate::sheet::compose(sheet)?;
+    let png = fresh_path(dir, "comparison sheet", "png");
+    crate::export::write_png(&png, canvas.width, canvas.height, &canvas.rgba).map_err(|e| e.to_string())?;
+    let json = png.with_extension("json");
+    std::fs::write(&json, crate::sheet::metrics_json(sheet))
+        .map_err(|e| format!("cannot write {}: {e}", json.display()))?;
+    Ok(format!("{}, {}", png.display(), json.display()))
+}
+
+/// The files of one view export (see [`WorkbenchApp::export_view`]).
+pub fn export_view_files(
+    r: &Renderer,
+    slot: usize,
+    spec: &crate::renderer::views::ViewSpec,
+    kind: ExportKind,
+    dir: &std::path::Path,
+) -> Result<Vec<PathBuf>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let name = spec.buffer.name();
+    match kind {
+        ExportKind::Png => {
+            let (w, h, bytes) = r.read_view_rgba8_at(slot).map_err(|e| e.to_string())?;
+            let path = fresh_path(dir, name, "png");
+            crate::export::write_png(&path, w, h, &bytes).map_err(|e| e.to_string())?;
+            Ok(vec![path])
+        }
+        ExportKind::Exr => {
+            let images = match spec.effective_ab() {
+                Some(ab) => vec![
+                    (format!("{name} A {}", ab.a.name()), r.read_ab_source(ab.a)),
+                    (format!("{name} B {}", ab.b.name()), r.read_ab_source(ab.b)),
+                ],
+                None => vec![(name.to_string(), r.read_view_buffer(spec.buffer))],
+            };
+            let mut files = Vec::new();
+            for (stem, img) in images {
+                let img = img.map_err(|e| e.to_string())?.ok_or_else(|| {
+                    format!("'{stem}' has no linear image now (PNG export shows it as displayed)")
+                })?;
+                let path = fresh_path(dir, &stem, "exr");
+                crate::export::write_exr(&path, &img).map_err(|e| e.to_string())?;
+                files.push(path);
+            }
+            Ok(files)
+        }
+    }
+}
+
+/// Preset files shipped under `scenes/` (next to the executable's working directory).
+pub fn preset_files() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir("scenes")
+        .map(|rd| {
+            rd.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}

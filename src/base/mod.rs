@@ -1,0 +1,13 @@
+//! The floor every other module stands on: plain CPU types and functions with no GPU, UI or
+//! method knowledge. The image type, display encoding and tonemaps, colour maps, the GPU
+//! record layouts of a VPL and a tree node (and the node's decoding and merge), and the
+//! choices shared by settings and CPU references. `renderer`, `reference`, `methods`,
+//! `metrics`, `export`, `harness`, `sheet` and `app` import from here; nothing here imports
+//! from them.
+
+pub mod colormap;
+pub mod display;
+pub mod gpu_layout;
+pub mod image;
+pub mod sampling;
+pub mod sst_node;

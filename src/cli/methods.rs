@@ -1,0 +1,30 @@
+//! `methods`: the GI-method registry as a table (CLI name, kind, label, the views each draws,
+//! its timed GPU passes, and the tests that check it).
+
+use crate::methods::{Kind, REGISTRY};
+
+pub fn run() -> anyhow::Result<()> {
+    println!("{:<14} {:<12} {:<34} about", "method", "kind", "label");
+    for m in REGISTRY {
+        let kind = match m.kind {
+            Kind::DirectOnly => "direct only",
+            Kind::Progressive => "progressive",
+            Kind::PerFrame => "per frame",
+        };
+        println!("{:<14} {:<12} {:<34} {}", m.id.cli(), kind, m.label, m.about);
+        if !m.views.is_empty() {
+            let v: Vec<&str> = m.views.iter().map(|v| v.name).collect();
+            println!("{:<14} views: {}", "", v.join("; "));
+        }
+        if !m.timed_passes.is_empty() {
+            println!("{:<14} GPU passes: {}", "", m.timed_passes.join(", "));
+        }
+        if m.story {
+            println!("{:<14} pixel story: yes", "");
+        }
+        if !m.tests.is_empty() {
+            println!("{:<14} checked by: {}", "", m.tests.join(", "));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,414 @@
+//! One function per figure of thesis chapter 7. Each measures on a [`Bench`], writes
+//! `<figure>.csv`, PNG plots and images into the scene's results folder, and returns a
+//! [`Report`]: a short text table and the ratio checks of issue 7 it covers.
+
+mod resolution;
+mod sampling;
+
+pub use resolution::{scaling, upsampling};
+pub use sampling::{blending, blocks, steps};
+
+use std::path::Path;
+
+use anyhow::Context;
+
+use super::{Bench, Csv, Measured, PASS_GROUPS, SAMPLE_PASSES, gi_passes, mean_std, num, plot};
+use crate::methods::{self as gi_methods, MethodId, direct_only, tree_samplers::SLC};
+use crate::renderer::settings::{CutBlending, CutFallback, RenderSettings};
+
+/// What every figure needs besides the bench.
+#[derive(Clone, Debug)]
+pub struct Opts {
+    /// Frame size of every figure but the scaling one.
+    pub size: (u32, u32),
+    /// Independent frames per configuration (the first is not timed when >= 2).
+    pub frames: u32,
+    /// Frames of the per-pass timing table.
+    pub timing_frames: u32,
+    /// Samples per pixel (cut size) of the equal-time sweep.
+    pub spp: Vec<u32>,
+    /// Block sizes k of the block sweep.
+    pub blocks: Vec<u32>,
+    /// log2 of the VPL counts of the scaling sweep.
+    pub vpl_exponents: Vec<u32>,
+    /// Frame size of the scaling sweep (a ground truth per VPL count).
+    pub scaling_size: (u32, u32),
+    /// Frame sizes of the upsampling table, as multiples of `size`.
+    pub upsampling_scales: Vec<f32>,
+}
+
+/// A ratio the issue asks for: `value` must be <= `limit` (or >= it with `at_least`).
+#[derive(Clone, Debug)]
+pub struct Check {
+    pub scene: String,
+    pub name: String,
+    pub value: f64,
+    pub limit: f64,
+    pub at_least: bool,
+    /// How the value was measured.
+    pub detail: String,
+}
+
+impl Check {
+    pub fn pass(&self) -> bool {
+        if self.at_least {
+            self.value >= self.limit
+        } else {
+            self.value <= self.limit
+        }
+    }
+    pub fn line(&self) -> String {
+        format!(
+            "{:<16} {:<44} {:>8.3} {} {:<6} {}",
+            self.scene,
+            self.name,
+            self.value,
+            if self.at_least { ">=" } else { "<=" },
+            self.limit,
+            if self.pass() { "met" } else { "MISSED" }
+        )
+    }
+}
+
+/// What a figure prints and checks.
+#[derive(Default)]
+pub struct Report {
+    pub table: String,
+    pub checks: Vec<Check>,
+}
+
+/// The three samplers, in the order (and colours) of every plot.
+pub fn methods() -> Vec<(MethodId, &'static str)> {
+    gi_methods::per_frame()
+        .into_iter()
+        .map(|m| (m, m.info().short))
+        .collect()
+}
+
+fn with(b: &Bench, f: impl FnOnce(&mut RenderSettings)) -> RenderSettings {
+    let mut s = b.base.clone();
+    f(&mut s);
+    s
+}
+
+fn images(dir: &Path) -> anyhow::Result<std::path::PathBuf> {
+    let d = dir.join("images");
+    std::fs::create_dir_all(&d).with_context(|| format!("cannot create {}", d.display()))?;
+    Ok(d)
+}
+
+fn check(b: &Bench, name: &str, value: f64, limit: f64, at_least: bool, detail: String) -> Check {
+    Check {
+        scene: b.scene.clone(),
+        name: name.into(),
+        value,
+        limit,
+        at_least,
+        detail,
+    }
+}
+
+/// Thesis table 7.1: GPU time per pass group, mean and spread over `timing_frames` frames of
+/// SLC at the base settings, plus the wall-clock frame time.
+pub fn timings(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
+    let s = with(b, |s| s.gi.method = SLC);
+    let m = b.measure(&s, o.size, o.timing_frames.max(2), false)?;
+    let mut csv = Csv::new(&[
+        "scene", "group", "passes", "mean_ms", "std_ms", "min_ms", "max_ms", "frames",
+    ]);
+    let mut bars = Vec::new();
+    let mut table = format!(
+        "per-pass GPU time, {} frames of SLC at {}x{} ({}):\n",
+        m.passes.len(),
+        o.size.0,
+        o.size.1,
+        b.adapter
+    );
+    let mut rows: Vec<(String, String, Vec<f64>)> = PASS_GROUPS
+        .iter()
+        .map(|(g, names)| (g.to_string(), names.join("+"), m.pass_ms_per_frame(Some(names))))
+        .collect();
+    rows.push(("all passes (GPU)".into(), "sum".into(), m.pass_ms_per_frame(None)));
+    rows.push((
+        "frame (wall clock)".into(),
+        "render+submit+wait".into(),
+        m.frame_ms.clone(),
+    ));
+    for (i, (g, passes, v)) in rows.iter().enumerate() {
+        let (mean, std) = mean_std(v);
+        let min = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        csv.row(vec![
+            b.scene.clone(),
+            g.clone(),
+            passes.clone(),
+            num(mean),
+            num(std),
+            num(min),
+            num(max),
+            v.len().to_string(),
+        ]);
+        table.push_str(&format!("  {g:<20} {mean:>10.3} ms ± {std:>8.3}\n"));
+        if i < PASS_GROUPS.len() {
+            bars.push(plot::Bar {
+                label: g.clone(),
+                value: mean,
+                spread: std,
+                color: 0,
+            });
+        }
+    }
+    csv.write(&dir.join("timings.csv"))?;
+    plot::bars(
+        &dir.join("timings.png"),
+        &format!("{}: GPU time per pass ({}x{})", b.scene, o.size.0, o.size.1),
+        "ms (log)",
+        &bars,
+        true,
+    )?;
+    Ok(Report {
+        table,
+        checks: Vec::new(),
+    })
+}
+
+/// Piecewise-linear interpolation of log(y) over log(x) through points sorted by x; outside
+/// the range the nearest segment is extended. Returns (y, extrapolated).
+pub fn interp_loglog(points: &[(f64, f64)], x: f64) -> (f64, bool) {
+    let mut p: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|(a, b)| *a > 0.0 && *b > 0.0 && a.is_finite() && b.is_finite())
+        .map(|(a, b)| (a.ln(), b.ln()))
+        .collect();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if p.is_empty() || x <= 0.0 {
+        return (f64::NAN, true);
+    }
+    if p.len() == 1 {
+        return (p[0].1.exp(), (p[0].0 - x.ln()).abs() > 1e-9);
+    }
+    let lx = x.ln();
+    let outside = lx < p[0].0 || lx > p[p.len() - 1].0;
+    let i = p
+        .iter()
+        .position(|q| q.0 >= lx)
+        .unwrap_or(p.len() - 1)
+        .clamp(1, p.len() - 1);
+    let (a, c) = (p[i - 1], p[i]);
+    let t = if (c.0 - a.0).abs() < 1e-12 {
+        0.0
+    } else {
+        (lx - a.0) / (c.0 - a.0)
+    };
+    ((a.1 + t * (c.1 - a.1)).exp(), outside)
+}
+
+/// One point of the equal-time sweep: frame ms, RMSE, SSIM, samples per pixel.
+type SweepPoint = (f64, f64, f64, u32);
+
+/// Thesis fig. 7.1 and 7.3: every sampler over a sweep of samples per pixel; RMSE and SSIM
+/// against the ground truth of the same VPLs over the frame time; the equal-time table
+/// (each method's RMSE interpolated at SLC's frame time at the base cut size), and the
+/// images and error maps of each method at its sample count for that time.
+pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
+    let base_spp = b.base.sampling.cut_size;
+    let mut spp = o.spp.clone();
+    if !spp.contains(&base_spp) {
+        spp.push(base_spp);
+    }
+    spp.sort_unstable();
+    spp.dedup();
+    let mut csv = Csv::new(&[
+        "scene",
+        "method",
+        "spp",
+        "frame_ms",
+        "frame_ms_std",
+        "gi_gpu_ms",
+        "rmse",
+        "rmse_std",
+        "ssim",
+        "ssim_std",
+        "flip",
+        "mean_ratio",
+        "bias_rmse",
+        "noise_rmse",
+        "steps_per_traversal",
+        "steps_per_pixel",
+    ]);
+    let mut curves: Vec<Vec<SweepPoint>> = Vec::new();
+    for (method, label) in methods().iter() {
+        let mut pts = Vec::new();
+        for &n in &spp {
+            let s = with(b, |s| {
+                s.gi.method = *method;
+                s.sampling.cut_size = n;
+            });
+            let m = b.measure(&s, o.size, o.frames, true)?;
+            let (t, ts) = m.frame_ms();
+            let (r, rs) = m.rmse();
+            let (q, qs) = m.ssim();
+            csv.row(vec![
+                b.scene.clone(),
+                label.to_string(),
+                n.to_string(),
+                num(t),
+                num(ts),
+                num(m.pass_ms(&gi_passes()).0),
+                num(r),
+                num(rs),
+                num(q),
+                num(qs),
+                num(mean_std(&m.flip).0),
+                num(mean_std(&m.mean_ratio).0),
+                num(m.bias_rmse),
+                num(m.noise_rmse),
+                num(m.steps_per_traversal()),
+                num(m.steps_per_pixel()),
+            ]);
+            eprintln!(
+                "[{}] {label} {n} spp: {t:.1} ms, RMSE {r:.4e} (bias {:.2e}, noise {:.2e}, mean ratio {:.3}), SSIM {q:.3}",
+                b.scene,
+                m.bias_rmse,
+                m.noise_rmse,
+                mean_std(&m.mean_ratio).0
+            );
+            pts.push((t, r, q, n));
+        }
+        curves.push(pts);
+    }
+    csv.write(&dir.join("equal_time.csv"))?;
+    let series = |f: &dyn Fn(&SweepPoint) -> (f64, f64)| -> Vec<plot::Series> {
+        methods()
+            .iter()
+            .enumerate()
+            .map(|(i, (_, l))| plot::Series {
+                name: l.to_string(),
+                color: i,
+                points: curves[i].iter().map(f).collect(),
+            })
+            .collect()
+    };
+    plot::lines(
+        &dir.join("equal_time_rmse.png"),
+        &format!("{}: RMSE vs frame time (spp {:?})", b.scene, spp),
+        "frame time (ms, wall clock)",
+        "RMSE of one frame's GI (W/(m² sr))",
+        &series(&|p| (p.0, p.1)),
+        true,
+        true,
+    )?;
+    plot::lines(
+        &dir.join("equal_time_ssim.png"),
+        &format!("{}: SSIM vs frame time", b.scene),
+        "frame time (ms, wall clock)",
+        "SSIM of one frame's GI",
+        &series(&|p| (p.0, p.2)),
+        true,
+        false,
+    )?;
+    // The matched time: SLC at the base cut size.
+    let t_match = curves[0]
+        .iter()
+        .find(|p| p.3 == base_spp)
+        .map_or(f64::NAN, |p| p.0);
+    let mut table = format!("equal time: {t_match:.1} ms per frame (SLC at {base_spp} spp)\n");
+    let mut at = Vec::new();
+    let mut matched = Csv::new(&[
+        "scene",
+        "method",
+        "matched_ms",
+        "rmse_interpolated",
+        "ssim_interpolated",
+        "extrapolated",
+        "spp_at_matched_time",
+        "measured_frame_ms",
+        "measured_rmse",
+        "measured_ssim",
+        "measured_mean_ratio",
+        "measured_bias_rmse",
+    ]);
+    let gt = b.ground_truth(&b.base.clone(), o.size)?;
+    let img = images(dir)?;
+    b.write_gi_png(&img.join("ground_truth.png"), &gt)?;
+    for (i, (method, label)) in methods().iter().enumerate() {
+        let rt: Vec<(f64, f64)> = curves[i].iter().map(|p| (p.0, p.1)).collect();
+        let qt: Vec<(f64, f64)> = curves[i].iter().map(|p| (p.0, p.2)).collect();
+        let st: Vec<(f64, f64)> = curves[i].iter().map(|p| (p.0, p.3 as f64)).collect();
+        let (r, ex) = interp_loglog(&rt, t_match);
+        let (q, _) = interp_loglog(&qt, t_match);
+        let (n, _) = interp_loglog(&st, t_match);
+        let n = if n.is_finite() {
+            (n.round() as u32).clamp(1, 64)
+        } else {
+            base_spp
+        };
+        let s = with(b, |s| {
+            s.gi.method = *method;
+            s.sampling.cut_size = n;
+        });
+        let m = b.measure(&s, o.size, o.frames, true)?;
+        if let Some(ind) = &m.indirect {
+            b.write_gi_png(&img.join(format!("equal_time_{}.png", label.to_lowercase())), ind)?;
+            b.write_error_png(
+                &img.join(format!("equal_time_{}_error.png", label.to_lowercase())),
+                ind,
+                &gt,
+            )?;
+        }
+        matched.row(vec![
+            b.scene.clone(),
+            label.to_string(),
+            num(t_match),
+            num(r),
+            num(q),
+            ex.to_string(),
+            n.to_string(),
+            num(m.frame_ms().0),
+            num(m.rmse().0),
+            num(m.ssim().0),
+            num(mean_std(&m.mean_ratio).0),
+            num(m.bias_rmse),
+        ]);
+        table.push_str(&format!(
+            "  {label:<6} RMSE {r:.4e}{} SSIM {q:.3} · {n} spp at that time (measured: {:.1} ms, RMSE {:.4e}, of it bias {:.2e}, mean {:.3}x GT)\n",
+            if ex { " (extrapolated)" } else { "" },
+            m.frame_ms().0,
+            m.rmse().0,
+            m.bias_rmse,
+            mean_std(&m.mean_ratio).0
+        ));
+        at.push(r);
+    }
+    matched.write(&dir.join("equal_time_matched.csv"))?;
+    let detail = format!("RMSE interpolated (log-log) at SLC's frame time with {base_spp} spp");
+    let checks = vec![
+        check(
+            b,
+            "equal-time RMSE SLC / RTSLC",
+            at[0] / at[1],
+            0.8,
+            false,
+            detail.clone(),
+        ),
+        check(b, "equal-time RMSE SLC / SST", at[0] / at[2], 0.6, false, detail),
+    ];
+    Ok(Report { table, checks })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::interp_loglog;
+
+    #[test]
+    fn loglog_interpolation() {
+        // y = x^-0.5 is a line in log-log.
+        let p: Vec<(f64, f64)> = [1.0f64, 4.0, 16.0].iter().map(|x| (*x, x.powf(-0.5))).collect();
+        let (y, ex) = interp_loglog(&p, 8.0);
+        assert!((y - 8f64.powf(-0.5)).abs() < 1e-12 && !ex);
+        let (y, ex) = interp_loglog(&p, 64.0);
+        assert!((y - 64f64.powf(-0.5)).abs() < 1e-12 && ex);
+        assert!(interp_loglog(&[], 1.0).0.is_nan());
+    }
+}

@@ -1,0 +1,196 @@
+//! Thesis figures of resolution: half-resolution GI with upsampling (7.8) and VPL scaling.
+
+use super::*;
+
+/// Thesis table 7.2: full vs half GI resolution at one or more frame sizes: RMSE, SSIM, frame
+/// time and GI time (the frame's wall-clock time minus that of a frame without GI).
+pub fn upsampling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
+    let mut csv = Csv::new(&[
+        "scene",
+        "width",
+        "height",
+        "gi_resolution",
+        "rmse",
+        "rmse_std",
+        "ssim",
+        "frame_ms",
+        "gi_ms",
+        "gi_gpu_ms",
+    ]);
+    let img = images(dir)?;
+    let mut table = "upsampling (SLC):\n".to_string();
+    let mut checks = Vec::new();
+    let mut bars = Vec::new();
+    for (si, &scale) in o.upsampling_scales.iter().enumerate() {
+        let size = (
+            ((o.size.0 as f32 * scale).round() as u32).max(8),
+            ((o.size.1 as f32 * scale).round() as u32).max(8),
+        );
+        let off = with(b, |s| s.gi.method = direct_only::ID);
+        let base_ms = b.measure(&off, size, o.frames, false)?.frame_ms().0;
+        let mut res = Vec::new();
+        for half in [false, true] {
+            let s = with(b, |s| {
+                s.gi.method = SLC;
+                s.sampling.half_resolution = half;
+            });
+            let m = b.measure(&s, size, o.frames, true)?;
+            let (r, rs) = m.rmse();
+            let t = m.frame_ms().0;
+            let gi = t - base_ms;
+            let label = if half { "half" } else { "full" };
+            csv.row(vec![
+                b.scene.clone(),
+                size.0.to_string(),
+                size.1.to_string(),
+                label.into(),
+                num(r),
+                num(rs),
+                num(m.ssim().0),
+                num(t),
+                num(gi),
+                num(m.pass_ms(&gi_passes()).0),
+            ]);
+            table.push_str(&format!(
+                "  {}x{} {label:<4} GI: RMSE {r:.4e}, SSIM {:.3}, frame {t:.1} ms, GI {gi:.1} ms\n",
+                size.0,
+                size.1,
+                m.ssim().0
+            ));
+            if si == 0
+                && let Some(ind) = &m.indirect
+            {
+                b.write_gi_png(&img.join(format!("upsampling_{label}.png")), ind)?;
+            }
+            bars.push(plot::Bar {
+                label: format!("{}x{} {label}", size.0, size.1),
+                value: gi,
+                spread: 0.0,
+                color: half as usize,
+            });
+            res.push((r, gi));
+        }
+        if si == 0 {
+            let detail = format!(
+                "{}x{}: GI time = wall-clock frame time minus that of a frame without GI",
+                size.0, size.1
+            );
+            checks.push(check(
+                b,
+                "half-res GI time / full",
+                res[1].1 / res[0].1,
+                0.4,
+                false,
+                detail,
+            ));
+            checks.push(check(
+                b,
+                "half-res RMSE / full",
+                res[1].0 / res[0].0,
+                1.05,
+                false,
+                "mean per-frame RMSE of the GI".into(),
+            ));
+        }
+    }
+    csv.write(&dir.join("upsampling.csv"))?;
+    plot::bars(
+        &dir.join("upsampling.png"),
+        &format!("{}: GI time, full vs half GI resolution", b.scene),
+        "GI ms (wall clock)",
+        &bars,
+        false,
+    )?;
+    Ok(Report { table, checks })
+}
+
+/// VPL count 2^10 .. 2^16: tree build GPU time (keys, sort, build, classify), GI GPU time and
+/// RMSE against the ground truth of each count.
+pub fn scaling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
+    let mut csv = Csv::new(&[
+        "scene",
+        "vpls",
+        "sort_gpu_ms",
+        "build_gpu_ms",
+        "tree_gpu_ms",
+        "gi_gpu_ms",
+        "frame_ms",
+        "rmse",
+        "rmse_std",
+        "ssim",
+        "steps_per_traversal",
+    ]);
+    let mut table = format!("VPL scaling (SLC, {}x{}):\n", o.scaling_size.0, o.scaling_size.1);
+    let mut rows = Vec::new();
+    for &e in &o.vpl_exponents {
+        let n = 1u32 << e;
+        let s = with(b, |s| {
+            s.gi.method = SLC;
+            s.vpl.count = n;
+        });
+        let m = b.measure(&s, o.scaling_size, o.frames, true)?;
+        let sort = m.pass_ms(&["sst_keys", "sst_sort"]).0;
+        let build = m.pass_ms(&["sst_build", "sst_classify"]).0;
+        let gi = m.pass_ms(&gi_passes()).0;
+        let (r, rs) = m.rmse();
+        csv.row(vec![
+            b.scene.clone(),
+            n.to_string(),
+            num(sort),
+            num(build),
+            num(sort + build),
+            num(gi),
+            num(m.frame_ms().0),
+            num(r),
+            num(rs),
+            num(m.ssim().0),
+            num(m.steps_per_traversal()),
+        ]);
+        table.push_str(&format!(
+            "  {n:>6} VPLs: tree {:>8.3} ms (sort {sort:.3} + build {build:.3}), GI {gi:>8.1} ms, RMSE {r:.4e}\n",
+            sort + build
+        ));
+        rows.push((n as f64, sort + build, gi, r));
+    }
+    csv.write(&dir.join("scaling.csv"))?;
+    plot::lines(
+        &dir.join("scaling_time.png"),
+        &format!("{}: GPU time over the VPL count", b.scene),
+        "VPLs",
+        "ms",
+        &[
+            plot::Series {
+                name: "tree (keys + sort + build + classify)".into(),
+                color: 3,
+                points: rows.iter().map(|r| (r.0, r.1)).collect(),
+            },
+            plot::Series {
+                name: "GI (cuts + sampling)".into(),
+                color: 0,
+                points: rows.iter().map(|r| (r.0, r.2)).collect(),
+            },
+        ],
+        true,
+        true,
+    )?;
+    plot::lines(
+        &dir.join("scaling_rmse.png"),
+        &format!(
+            "{}: RMSE over the VPL count (vs. each count's ground truth)",
+            b.scene
+        ),
+        "VPLs",
+        "RMSE of one frame's GI",
+        &[plot::Series {
+            name: "SLC".into(),
+            color: 0,
+            points: rows.iter().map(|r| (r.0, r.3)).collect(),
+        }],
+        true,
+        false,
+    )?;
+    Ok(Report {
+        table,
+        checks: Vec::new(),
+    })
+}

@@ -1,0 +1,47 @@
+//! Direct light only: no indirect term (the GI buffer stays black). A method like the others
+//! so that "GI off" is a choice in every list, not a special case.
+
+use super::{FrameCx, Kind, Method, MethodId, MethodInfo, Module};
+use crate::renderer::{settings::RenderSettings, shaders::ShaderError};
+
+pub const ID: MethodId = MethodId::new("off");
+
+pub static MODULE: Module = Module {
+    name: "direct_only",
+    create,
+    shaders: &[],
+    entry_shaders: &[],
+};
+
+pub static INFO: MethodInfo = MethodInfo {
+    id: ID,
+    aliases: &["direct", "direct-only", "none"],
+    label: "off (direct only)",
+    short: "direct only",
+    about: "No indirect light: the final image is the direct sunlight with shadow maps.",
+    progress_unit: "",
+    kind: Kind::DirectOnly,
+    module: &MODULE,
+    reads: &[],
+    views: &[],
+    timed_passes: &[],
+    story: false,
+    shadow_ray_switch: false,
+    truth_of_vpls: false,
+    validate: |_: &RenderSettings| Ok(()),
+    invalid_example: None,
+    ui: |_, _, _| {},
+    tests: &["direct_light::lit_quad_matches_rho_over_pi_e_cos_and_shadow_is_zero"],
+};
+
+struct DirectOnly;
+
+fn create(_: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
+    Ok(Box::new(DirectOnly))
+}
+
+impl Method for DirectOnly {
+    fn record(&mut self, _cx: &mut FrameCx<'_>, _enc: &mut wgpu::CommandEncoder) -> f32 {
+        0.0
+    }
+}

@@ -1,0 +1,444 @@
+//! GI methods: one folder each, one line each in [`REGISTRY`].
+//!
+//! A method is a [`MethodInfo`] (what it is and what it offers: name, label, CLI name, kind,
+//! the frame resources it reads, the named views it draws, its timed GPU passes, its pixel
+//! story, its settings' validation and UI, its shaders, the tests that check it) and a
+//! [`Method`] instance (its pipelines and state between frames) that records its passes after
+//! the frame's G-buffer, VPLs and light tree exist and writes the GI accumulation buffer.
+//! The shape follows Falcor's render passes (`reflect()` = the declared resources and views,
+//! `execute()` = [`Method::record`], `renderUI()` = [`MethodInfo::ui`]).
+//!
+//! Everything that lists methods (the renderer, the GUI's method combo and settings, `render
+//! --method`, `sheet --methods`, `results`, the comparison ground truth, the shader table and
+//! the registry test) enumerates [`REGISTRY`]; ARCHITECTURE.md, *Adding a method*, walks
+//! through a new one.
+
+pub mod direct_only;
+pub mod ground_truth;
+pub mod reference;
+pub mod tree_samplers;
+
+use std::any::Any;
+use std::fmt;
+
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use crate::renderer::{
+    GiProgress,
+    context::{ErrorSink, GpuContext, GpuError},
+    frame::FrameTargets,
+    passes::{
+        sst_build::TreeBuffers,
+        vpl_gen::{VplBuffers, VplFrame},
+    },
+    readback::ImageF32,
+    scene_gpu::SceneGpu,
+    settings::RenderSettings,
+    shaders::ShaderError,
+    timing::GpuTimer,
+    views::ViewLook,
+};
+
+/// Every GI method, in the order the GUI lists them. Adding a method: its folder and one
+/// line here.
+pub static REGISTRY: &[&MethodInfo] = &[
+    &tree_samplers::SLC_INFO,
+    &tree_samplers::SST_INFO,
+    &tree_samplers::RTSLC_INFO,
+    &ground_truth::INFO,
+    &reference::INFO,
+    &direct_only::INFO,
+];
+
+/// A method's identity: its CLI name (`render --method <cli>`), stable across versions.
+/// Settings files store it as that string (the older enum spellings `Slc`, `GroundTruth`, ...
+/// are accepted when read).
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct MethodId(&'static str);
+
+impl MethodId {
+    pub const fn new(cli: &'static str) -> Self {
+        Self(cli)
+    }
+    /// The name on the command line and in settings files.
+    pub fn cli(self) -> &'static str {
+        self.0
+    }
+    /// Its registry entry (every id in use comes from the registry; an id that is not
+    /// registered falls back to the first method's entry).
+    pub fn info(self) -> &'static MethodInfo {
+        REGISTRY
+            .iter()
+            .copied()
+            .find(|m| m.id == self)
+            .unwrap_or(REGISTRY[0])
+    }
+    /// The label the GUI shows.
+    pub fn name(self) -> &'static str {
+        self.info().label
+    }
+    pub fn kind(self) -> Kind {
+        self.info().kind
+    }
+    /// Per-frame estimators (compared with the ground truth, timed at equal time).
+    pub fn per_frame(self) -> bool {
+        self.kind() == Kind::PerFrame
+    }
+    /// The tree samplers (SLC, SST, RTSLC): one estimate per frame from the light tree, with
+    /// the traversal diagnostics and the pixel story.
+    pub fn samples_tree(self) -> bool {
+        self.info().module.name == tree_samplers::MODULE.name
+    }
+    /// The method named `name` on the command line or in a settings file (case-insensitive;
+    /// `-` and `_` ignored, so `ground-truth`, `GroundTruth` and `ground_truth` are one).
+    pub fn parse(name: &str) -> Result<MethodId, String> {
+        let norm = |s: &str| {
+            s.chars()
+                .filter(|c| *c != '-' && *c != '_' && !c.is_whitespace())
+                .flat_map(char::to_lowercase)
+                .collect::<String>()
+        };
+        let want = norm(name);
+        REGISTRY
+            .iter()
+            .find(|m| norm(m.id.cli()) == want || m.aliases.iter().any(|a| norm(a) == want))
+            .map(|m| m.id)
+            .ok_or_else(|| {
+                format!(
+                    "unknown GI method '{name}'; the methods are: {}",
+                    cli_names().join(", ")
+                )
+            })
+    }
+}
+
+impl Default for MethodId {
+    /// The thesis's method: the workbench opens on it and `render` renders it.
+    fn default() -> Self {
+        tree_samplers::SLC
+    }
+}
+
+impl fmt::Debug for MethodId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.0)
+    }
+}
+
+impl fmt::Display for MethodId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.0)
+    }
+}
+
+impl Serialize for MethodId {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.0)
+    }
+}
+
+impl<'de> Deserialize<'de> for MethodId {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        MethodId::parse(&s).map_err(serde::de::Error::custom)
+    }
+}
+
+/// The CLI names of every registered method.
+pub fn cli_names() -> Vec<&'static str> {
+    REGISTRY.iter().map(|m| m.id.cli()).collect()
+}
+
+/// The per-frame methods (what `results` and the sheets compare), in registry order.
+pub fn per_frame() -> Vec<MethodId> {
+    REGISTRY
+        .iter()
+        .filter(|m| m.kind == Kind::PerFrame)
+        .map(|m| m.id)
+        .collect()
+}
+
+/// The methods a comparison sheet can show as columns (not the truth it compares against,
+/// not direct light only), in registry order.
+pub fn sheet_columns() -> Vec<MethodId> {
+    REGISTRY
+        .iter()
+        .filter(|m| !m.truth_of_vpls && m.kind != Kind::DirectOnly)
+        .map(|m| m.id)
+        .collect()
+}
+
+/// The method the comparison views, `--compare-gt`, sheets and the harness measure against:
+/// the ground truth of the frame's own VPLs.
+pub fn comparison_truth() -> MethodId {
+    REGISTRY
+        .iter()
+        .find(|m| m.truth_of_vpls)
+        .map_or(ground_truth::ID, |m| m.id)
+}
+
+/// The method modules (methods that share a module share one GPU instance), each once.
+pub fn modules() -> Vec<&'static Module> {
+    let mut v: Vec<&'static Module> = Vec::new();
+    for m in REGISTRY {
+        if !v.iter().any(|x| x.name == m.module.name) {
+            v.push(m.module);
+        }
+    }
+    v
+}
+
+/// Checks every registered method's settings (each names the field it refuses).
+pub fn validate_all(s: &RenderSettings) -> Result<(), String> {
+    for m in REGISTRY {
+        (m.validate)(s)?;
+    }
+    Ok(())
+}
+
+/// A view a method draws beside final / direct / GI (the tree samplers' traversal steps, ...).
+pub struct ViewInfo {
+    /// Its name in every buffer menu, in `--views` and in saved layouts (unique over the
+    /// registry).
+    pub name: &'static str,
+    /// The file name (without extension) `render` writes it to.
+    pub file: &'static str,
+    /// What it shows (the buffer menu's hover text).
+    pub about: &'static str,
+    /// The GPU passes whose output it shows (hovering one in the timings window shows it).
+    pub passes: &'static [&'static str],
+}
+
+/// A method's view, by its [`ViewInfo::name`]: `ViewBuffer::Method(..)` in every view, A/B,
+/// export and layout.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct MethodView(&'static str);
+
+impl MethodView {
+    pub const fn new(name: &'static str) -> Self {
+        Self(name)
+    }
+    pub const fn name(self) -> &'static str {
+        self.0
+    }
+    /// Its declaration and the first registered method that offers it.
+    pub fn find(self) -> Option<(&'static ViewInfo, MethodId)> {
+        REGISTRY
+            .iter()
+            .find_map(|m| m.views.iter().find(|v| v.name == self.0).map(|v| (v, m.id)))
+    }
+    /// Every method view of the registry, each once, in registry order.
+    pub fn all() -> Vec<MethodView> {
+        let mut v: Vec<MethodView> = Vec::new();
+        for m in REGISTRY {
+            for info in m.views {
+                if !v.iter().any(|x| x.0 == info.name) {
+                    v.push(MethodView(info.name));
+                }
+            }
+        }
+        v
+    }
+}
+
+impl fmt::Debug for MethodView {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "MethodView({:?})", self.0)
+    }
+}
+
+impl Serialize for MethodView {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.0)
+    }
+}
+
+impl<'de> Deserialize<'de> for MethodView {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        MethodView::all()
+            .into_iter()
+            .find(|v| v.0 == s)
+            .ok_or_else(|| serde::de::Error::custom(format!("unknown method view '{s}'")))
+    }
+}
+
+/// A heat-map view's colour scale, as the GUI draws its legend.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Legend {
+    pub title: String,
+    pub lo: f32,
+    pub hi: f32,
+    /// log10 scale (else linear).
+    pub log: bool,
+}
+
+/// How a method produces its image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// No indirect light.
+    DirectOnly,
+    /// Accumulates towards a converged image over frames (progress bar, restarts on change).
+    Progressive,
+    /// One estimate per frame (averaged over frames only while `sampling.accumulate`).
+    PerFrame,
+}
+
+/// Frame resources a method may read (what its passes bind).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Resource {
+    Gbuffer,
+    /// The lights' shadow maps / reflective shadow maps (and their pyramids).
+    ShadowMaps,
+    /// The frame's VPLs.
+    Vpls,
+    /// The light tree (SST nodes, usable flags, VPLs in leaf order).
+    Tree,
+    /// The scene BVH (shadow rays).
+    Bvh,
+}
+
+/// What a module (one folder under `src/methods/`) brings: its GPU instance and shaders.
+pub struct Module {
+    /// The folder name.
+    pub name: &'static str,
+    /// Builds its pipelines (again on shader reload).
+    pub create: fn(&wgpu::Device) -> Result<Box<dyn Method>, ShaderError>,
+    /// Its WGSL files, by path under `shaders/` (`methods/<module>/...`), embedded.
+    pub shaders: &'static [(&'static str, &'static str)],
+    /// Those of its files that are entry points.
+    pub entry_shaders: &'static [&'static str],
+}
+
+/// One row of the registry: everything the workbench needs to know of a method.
+pub struct MethodInfo {
+    pub id: MethodId,
+    /// Other spellings accepted by [`MethodId::parse`] (older settings files).
+    pub aliases: &'static [&'static str],
+    /// The label in the GUI and on sheets.
+    pub label: &'static str,
+    /// Short label for tables and plots.
+    pub short: &'static str,
+    /// One sentence: the paper and what the method does.
+    pub about: &'static str,
+    pub kind: Kind,
+    /// What a progressive method's progress counts ("VPLs", "samples per pixel").
+    pub progress_unit: &'static str,
+    pub module: &'static Module,
+    pub reads: &'static [Resource],
+    /// The named views it draws beside final / direct / GI (every buffer menu lists them as
+    /// `ViewBuffer::Method`; A/B, pixel values and export work on them as on every view).
+    pub views: &'static [ViewInfo],
+    /// Its GPU passes (timer names) that form its GI cost: the harness's equal-time cost and
+    /// the `gi_gpu_ms` column.
+    pub timed_passes: &'static [&'static str],
+    /// True when the pixel story can trace it.
+    pub story: bool,
+    /// True when it honours `gi.shadow_rays` (the GUI shows the switch).
+    pub shadow_ray_switch: bool,
+    /// True for the ground truth of the frame's own VPLs (the comparison's truth).
+    pub truth_of_vpls: bool,
+    /// Checks its settings; the message names the field.
+    pub validate: fn(&RenderSettings) -> Result<(), String>,
+    /// Sets one of its settings out of range and returns that field's name (the registry test
+    /// checks that `validate` refuses it by name); None for a method without settings.
+    pub invalid_example: Option<fn(&mut RenderSettings) -> &'static str>,
+    /// Its settings in the GUI's Global illumination section.
+    pub ui: fn(&mut egui::Ui, MethodId, &mut RenderSettings),
+    /// The tests (by name, `file::test`) that check it against a CPU reference or for
+    /// convergence; the registry test checks that each exists.
+    pub tests: &'static [&'static str],
+}
+
+/// What a method's `record` may use: the frame's resources and where to write.
+pub struct FrameCx<'a> {
+    /// Which method of the module runs (the tree samplers share one instance).
+    pub method: MethodId,
+    pub device: &'a wgpu::Device,
+    pub queue: &'a wgpu::Queue,
+    pub errors: &'a ErrorSink,
+    pub timer: &'a mut GpuTimer,
+    pub settings: &'a RenderSettings,
+    pub scene: &'a SceneGpu,
+    /// Scene bounding radius (metres, > 0).
+    pub scene_radius: f32,
+    pub targets: &'a FrameTargets,
+    pub vpl_buffers: &'a VplBuffers,
+    pub vpl_frame: &'a VplFrame,
+    /// The VPL generation's parameter buffer (the reference reads the RSM pyramids with it).
+    pub vpl_params: &'a wgpu::Buffer,
+    pub tree: &'a TreeBuffers,
+    /// The GI accumulation buffer to write (rgb sum per frame pixel, `vec4<f32>`).
+    pub gi_accum: &'a wgpu::Buffer,
+    pub size: (u32, u32),
+    /// Fingerprint of everything its image depends on: a progressive or accumulating method
+    /// restarts when it changes.
+    pub key: u64,
+    /// Frames rendered so far (the samplers' seeds).
+    pub frame_index: u64,
+    /// The pinned pixel whose story the method records (if it tells one).
+    pub trace_pixel: Option<(u32, u32)>,
+}
+
+/// What a method's view drawing may use.
+pub struct ViewCx<'a> {
+    pub device: &'a wgpu::Device,
+    pub queue: &'a wgpu::Queue,
+    pub timer: &'a mut GpuTimer,
+    pub look: &'a ViewLook,
+    pub targets: &'a FrameTargets,
+    pub tree: &'a TreeBuffers,
+    /// Destination (`Rgba8Unorm` storage view) of the size [`Method::view_size`] gave.
+    pub dst: &'a wgpu::TextureView,
+    /// Block outlined in the cut views (set by the UI).
+    pub selected_block: Option<u32>,
+}
+
+/// A method's GPU instance: pipelines and the state it keeps between frames.
+pub trait Method: Any {
+    /// Records this frame's passes writing `cx.gi_accum`; returns the composite's scale of
+    /// the accumulation (1 / frames summed; 0 = no GI yet).
+    fn record(&mut self, cx: &mut FrameCx<'_>, enc: &mut wgpu::CommandEncoder) -> f32;
+    /// Progress towards convergence (progressive methods).
+    fn progress(&self) -> Option<GiProgress> {
+        None
+    }
+    /// Forget the state of earlier frames (the VPL buffers were recreated).
+    fn reset(&mut self) {}
+    /// After the frame's submission (starts non-blocking readbacks).
+    fn after_submit(&mut self) {}
+    /// The size of one of its views (`MethodInfo::views`), None when it has nothing to show.
+    fn view_size(&self, _view: MethodView, _frame: (u32, u32)) -> Option<(u32, u32)> {
+        None
+    }
+    /// Draws one of its views into `cx.dst`.
+    fn record_view(&mut self, _view: MethodView, _cx: &mut ViewCx<'_>, _enc: &mut wgpu::CommandEncoder) {}
+    /// The linear data behind one of its views (EXR export): None when it has none yet.
+    fn read_view(&self, _ctx: &GpuContext, _view: MethodView) -> Result<Option<ImageF32>, GpuError> {
+        Ok(None)
+    }
+    /// The colour scale of one of its views (None: no legend).
+    fn legend(&self, _view: MethodView, _tree_levels: u32) -> Option<Legend> {
+        None
+    }
+    /// The pinned pixel's story in the last frame (methods whose `MethodInfo::story` is set;
+    /// the story panel draws `PixelTrace`: blocks, blend weights, each sample's path, stop,
+    /// point, shadow ray and contribution).
+    fn read_story(&self, _ctx: &GpuContext) -> Result<Option<tree_samplers::pass::PixelTrace>, GpuError> {
+        Ok(None)
+    }
+    /// Its rows in the pixel-values window at frame pixel (x, y) of a `frame`-sized image.
+    fn pixel_rows(
+        &self,
+        _ctx: &GpuContext,
+        _x: u32,
+        _y: u32,
+        _frame: (u32, u32),
+    ) -> Result<Vec<(&'static str, [f32; 4])>, GpuError> {
+        Ok(Vec::new())
+    }
+    /// One line of its statistics for the GUI (non-blocking; None before there are any).
+    fn status(&mut self) -> Option<String> {
+        None
+    }
+}

@@ -1,0 +1,554 @@
+//! The tree samplers (thesis chapter 5 and its baselines), one module with a mode:
+//! - **SLC** (the thesis): shallow per-block light cuts, stochastic cut blending with mock
+//!   cuts, traversal from each cut node that stops at usable substitute nodes;
+//! - **SST** (Tatzgern et al. 2020): `cut_size` traversals per pixel from the root, each
+//!   stopping at a usable node;
+//! - **RTSLC** (Lin & Yuksel 2020): the same cuts and blending as SLC, traversal always down
+//!   to a leaf VPL.
+//!
+//! Passes: optional `gi_downsample` (half-resolution G-buffer), `slc_cuts` (not for SST),
+//! `slc_sample` / `sst_sample` / `rtslc_sample`, optional `gi_upsample`. CPU twins in
+//! `crate::reference::slc`; docs/sampling.md.
+
+pub mod half;
+pub mod pass;
+pub mod settings;
+mod ui;
+
+use super::{
+    FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
+};
+use crate::renderer::{
+    context::{GpuContext, GpuError},
+    gpu_data::GpuSlcParams,
+    readback::{self, ImageF32},
+    settings::RenderSettings,
+    shaders::ShaderError,
+};
+use half::{HalfPass, HalfTargets};
+use pass::{GpuSlcViewParams, PixelTrace, SamplingStats, SlcBuffers, SlcPass};
+use settings::{ChildProbability, CutBlending, CutFallback};
+
+pub const SLC: MethodId = MethodId::new("slc");
+pub const SST: MethodId = MethodId::new("sst");
+pub const RTSLC: MethodId = MethodId::new("rtslc");
+
+macro_rules! shader {
+    ($name:literal) => {
+        (
+            concat!("methods/tree_samplers/", $name),
+            include_str!(concat!("../../../shaders/methods/tree_samplers/", $name)),
+        )
+    };
+}
+
+pub static MODULE: Module = Module {
+    name: "tree_samplers",
+    create,
+    shaders: &[
+        shader!("slc_cuts.wgsl"),
+        shader!("slc_sample.wgsl"),
+        shader!("slc_views.wgsl"),
+        shader!("slc_half.wgsl"),
+        shader!("slc_upsample.wgsl"),
+    ],
+    entry_shaders: &[
+        "methods/tree_samplers/slc_cuts.wgsl",
+        "methods/tree_samplers/slc_sample.wgsl",
+        "methods/tree_samplers/slc_views.wgsl",
+        "methods/tree_samplers/slc_half.wgsl",
+        "methods/tree_samplers/slc_upsample.wgsl",
+    ],
+};
+
+/// Traversal steps per traversal, per pixel (heat map, thesis fig. 7.2).
+pub const STEPS: MethodView = MethodView::new("traversal steps");
+/// Pixels without a similar surrounding cut (red over the grey final; fig. 7.6).
+pub const FALLBACK: MethodView = MethodView::new("pixels without a similar cut");
+/// The per-block cuts, a colour per cut, over the grey final (fig. 7.4).
+pub const CUT_BLOCKS: MethodView = MethodView::new("cuts per block");
+/// The per-block cuts coloured by their mean node depth.
+pub const CUT_DEPTH: MethodView = MethodView::new("cut depth per block");
+
+/// The diagnostic views every tree sampler draws (one `slc_views` pass, a mode each).
+const VIEWS: &[ViewInfo] = &[
+    ViewInfo {
+        name: STEPS.name(),
+        file: "traversal_steps",
+        about: "traversal steps per traversal, per pixel (thesis fig. 7.2)",
+        passes: &["slc_sample", "sst_sample", "rtslc_sample"],
+    },
+    ViewInfo {
+        name: FALLBACK.name(),
+        file: "cut_fallback",
+        about: "pixels without a similar surrounding cut, red over the grey final (fig. 7.6)",
+        passes: &[],
+    },
+    ViewInfo {
+        name: CUT_BLOCKS.name(),
+        file: "cut_blocks",
+        about: "the per-block cuts, a colour per cut; click a block to list its cut (fig. 7.4)",
+        passes: &["slc_cuts"],
+    },
+    ViewInfo {
+        name: CUT_DEPTH.name(),
+        file: "cut_depth",
+        about: "the per-block cuts coloured by their mean node depth",
+        passes: &[],
+    },
+];
+const READS: &[Resource] = &[Resource::Gbuffer, Resource::Tree, Resource::Bvh];
+const TESTS: &[&str] = &[
+    "slc::gpu_cuts_equal_the_cpu_cuts_and_are_valid",
+    "slc::blending_picks_cuts_by_their_weights_and_falls_back_to_the_mock_cut",
+    "slc::rtslc_averaged_over_frames_converges_to_the_ground_truth",
+    "slc::slc_without_usable_inner_nodes_equals_rtslc_and_steps_order_as_the_thesis_says",
+    "slc::half_resolution_upsampling_equals_the_cpu_reference",
+    "slc::the_pixel_story_matches_the_frame_and_the_tree",
+];
+
+fn invalid_cut_size(s: &mut RenderSettings) -> &'static str {
+    s.sampling.cut_size = 0;
+    "sampling.cut_size"
+}
+
+pub static SLC_INFO: MethodInfo = MethodInfo {
+    id: SLC,
+    aliases: &["stochastic-light-cuts"],
+    label: "SLC (thesis)",
+    short: "SLC",
+    about: "Stochastic Light Cut Exploration (the thesis): per-block cuts, cut blending, \
+            traversal to usable substitute nodes.",
+    progress_unit: "",
+    kind: Kind::PerFrame,
+    module: &MODULE,
+    reads: READS,
+    views: VIEWS,
+    timed_passes: &["slc_cuts", "slc_sample", "gi_downsample", "gi_upsample"],
+    story: true,
+    shadow_ray_switch: true,
+    truth_of_vpls: false,
+    validate,
+    invalid_example: Some(invalid_cut_size),
+    ui: ui::settings_ui,
+    tests: TESTS,
+};
+
+pub static SST_INFO: MethodInfo = MethodInfo {
+    id: SST,
+    aliases: &["stochastic-substitute-trees"],
+    label: "SST (baseline)",
+    short: "SST",
+    about: "Stochastic Substitute Trees (Tatzgern et al. 2020): traversals from the root to \
+            usable substitute nodes.",
+    progress_unit: "",
+    kind: Kind::PerFrame,
+    module: &MODULE,
+    reads: READS,
+    views: VIEWS,
+    timed_passes: &["sst_sample", "gi_downsample", "gi_upsample"],
+    story: true,
+    shadow_ray_switch: true,
+    truth_of_vpls: false,
+    validate,
+    invalid_example: Some(invalid_cut_size),
+    ui: ui::settings_ui,
+    tests: TESTS,
+};
+
+pub static RTSLC_INFO: MethodInfo = MethodInfo {
+    id: RTSLC,
+    aliases: &["real-time-stochastic-lightcuts"],
+    label: "RTSLC (baseline)",
+    short: "RTSLC",
+    about: "Real-time stochastic lightcuts (Lin & Yuksel 2020): the same cuts, traversal to a \
+            leaf VPL.",
+    progress_unit: "",
+    kind: Kind::PerFrame,
+    module: &MODULE,
+    reads: READS,
+    views: VIEWS,
+    timed_passes: &["slc_cuts", "rtslc_sample", "gi_downsample", "gi_upsample"],
+    story: true,
+    shadow_ray_switch: true,
+    truth_of_vpls: false,
+    validate,
+    invalid_example: Some(invalid_cut_size),
+    ui: ui::settings_ui,
+    tests: TESTS,
+};
+
+/// `[sampling]`: every field in range, or a message naming it.
+fn validate(s: &RenderSettings) -> Result<(), String> {
+    let sm = &s.sampling;
+    if !(1..=64).contains(&sm.block_size) {
+        return Err(format!(
+            "sampling.block_size {} is out of range (1..=64)",
+            sm.block_size
+        ));
+    }
+    if !(1..=64).contains(&sm.cut_size) {
+        return Err(format!(
+            "sampling.cut_size {} is out of range (1..=64)",
+            sm.cut_size
+        ));
+    }
+    if !(0.0..=100.0).contains(&sm.near_field) {
+        return Err(format!(
+            "sampling.near_field {} is out of range (0..=100; 0 = off)",
+            sm.near_field
+        ));
+    }
+    if !(0.0..=1.0).contains(&sm.substitute_offset) {
+        return Err(format!(
+            "sampling.substitute_offset {} is out of range (0..=1 m; 0 = off)",
+            sm.substitute_offset
+        ));
+    }
+    Ok(())
+}
+
+/// The samplers' GPU state: pipelines, per-frame buffers, accumulation and half-resolution
+/// targets.
+pub struct TreeSamplers {
+    pass: SlcPass,
+    buffers: SlcBuffers,
+    half_pass: HalfPass,
+    half: Option<HalfTargets>,
+    /// Accumulation: (key, frames summed).
+    state: Option<(u64, u32)>,
+    /// Whether the last recorded frame traced a pixel's story.
+    traced: bool,
+}
+
+fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
+    Ok(Box::new(TreeSamplers {
+        pass: SlcPass::new(device)?,
+        // Sized at the first frame (after the device-limit check).
+        buffers: SlcBuffers::new(device, (1, 1), 1, 1),
+        half_pass: HalfPass::new(device)?,
+        half: None,
+        state: None,
+        traced: false,
+    }))
+}
+
+impl TreeSamplers {
+    /// Cuts, per-pixel diagnostics, counters and the story of the last frame.
+    pub fn buffers(&self) -> &SlcBuffers {
+        &self.buffers
+    }
+    /// Frames summed in the accumulation (0 before the first).
+    pub fn frames(&self) -> u32 {
+        self.state.map_or(0, |(_, n)| n)
+    }
+    /// Counters of a recent frame (non-blocking).
+    pub fn poll_stats(&mut self) -> Option<SamplingStats> {
+        self.pass.poll_stats()
+    }
+    /// The half-resolution targets of the last frame (None when half resolution is off).
+    pub fn half_targets(&self) -> Option<&HalfTargets> {
+        self.half.as_ref()
+    }
+    /// The cut of block `b` (node ids in slot order, without empty slots).
+    pub fn read_cut(&self, ctx: &GpuContext, b: u32) -> Result<Vec<u32>, GpuError> {
+        let s = &self.buffers;
+        if b >= s.grid.0 * s.grid.1 {
+            return Ok(Vec::new());
+        }
+        let off = b as u64 * s.cut_size as u64 * 4;
+        let bytes = readback::read_buffer_range(ctx, &s.cuts, off, s.cut_size as u64 * 4)?;
+        Ok(bytemuck::cast_slice::<u8, u32>(&bytes)
+            .iter()
+            .copied()
+            .take_while(|&n| n != 0)
+            .collect())
+    }
+}
+
+impl Method for TreeSamplers {
+    /// One frame; returns 1 / the frames summed in the accumulation (1 unless
+    /// `sampling.accumulate` and nothing changed).
+    fn record(&mut self, cx: &mut FrameCx<'_>, enc: &mut wgpu::CommandEncoder) -> f32 {
+        let s = cx.settings;
+        let sm = &s.sampling;
+        let device = cx.device;
+        let size = cx.size;
+        // Half-resolution GI: the sampler runs on every other G-buffer sample (demodulated)
+        // and is upsampled into the full-resolution accumulation afterwards.
+        let half = sm.half_resolution;
+        let gi_size = if half { HalfTargets::half_size(size) } else { size };
+        if !self.buffers.matches(gi_size, sm.block_size, sm.cut_size) {
+            let need = SlcBuffers::largest_binding(gi_size, sm.block_size, sm.cut_size);
+            let limit = device.limits().max_storage_buffer_binding_size;
+            if need > limit {
+                // Refuse (once per change) rather than fail validation; GI stays black.
+                cx.errors.report(format!(
+                    "sampling: {}x{} pixels with {}x{} blocks and cuts of {} need a {} MiB buffer; \
+                     this device binds at most {} MiB (raise sampling.block_size or lower cut_size)",
+                    gi_size.0,
+                    gi_size.1,
+                    sm.block_size,
+                    sm.block_size,
+                    sm.cut_size,
+                    need >> 20,
+                    limit >> 20
+                ));
+                enc.clear_buffer(cx.gi_accum, 0, None);
+                self.state = None;
+                return 1.0;
+            }
+            self.buffers = SlcBuffers::new(device, gi_size, sm.block_size, sm.cut_size);
+        }
+        let d_max = s.vpl.d_max * cx.scene_radius;
+        let half_targets = if half {
+            let h = match self.half.take() {
+                Some(h) if h.size == gi_size => h,
+                _ => HalfTargets::new(device, size),
+            };
+            self.half_pass.record_downsample(
+                device,
+                cx.queue,
+                enc,
+                cx.timer,
+                &cx.targets.gbuffer,
+                size,
+                &h,
+                s.vpl.n_min,
+                d_max,
+            );
+            Some(h)
+        } else {
+            self.half = None;
+            None
+        };
+        // Accumulate while nothing changes (the key also covers the method and its settings);
+        // a frozen tree keeps its VPLs, otherwise new VPLs average in too.
+        let key = cx.key;
+        if half && self.state.is_none_or(|(k, _)| k != key || !sm.accumulate) {
+            // The half-resolution sum restarts with the accumulation.
+            if let Some(h) = &half_targets {
+                enc.clear_buffer(&h.accum, 0, None);
+            }
+        }
+        let frames = match self.state {
+            Some((k, n)) if sm.accumulate && k == key => n + 1,
+            _ => 1,
+        };
+        self.state = Some((key, frames));
+        let grid = self.buffers.grid;
+        let p = GpuSlcParams {
+            width: gi_size.0,
+            height: gi_size.1,
+            block: sm.block_size,
+            grid_x: grid.0,
+            grid_y: grid.1,
+            cut_size: sm.cut_size,
+            leaves: cx.tree.leaves,
+            levels: cx.tree.levels(),
+            method: if cx.method == SST {
+                1
+            } else if cx.method == RTSLC {
+                2
+            } else {
+                0
+            },
+            blending: match sm.blending {
+                CutBlending::Stochastic => 0,
+                CutBlending::Off => 1,
+            },
+            fallback: match sm.fallback {
+                CutFallback::MockCut => 0,
+                CutFallback::Average => 1,
+                CutFallback::Root => 2,
+                CutFallback::Recompute => 3,
+            },
+            cull: sm.cull_behind as u32,
+            seed: if sm.fixed_seed {
+                s.vpl.seed
+            } else {
+                s.vpl.seed ^ (cx.frame_index as u32).wrapping_mul(0x9e37_79b9)
+            },
+            accumulate: (frames > 1) as u32,
+            epsilon: s.gi.distance_epsilon,
+            ray_offset: s.gi.ray_offset,
+            n_min: s.vpl.n_min,
+            d_max,
+            demodulate: half as u32,
+            trace_pixel: match cx.trace_pixel {
+                // In GI pixels (half resolution: the GI pixel covering it).
+                Some((x, y)) if half => (x / 2) | (y / 2) << 16,
+                Some((x, y)) => x | y << 16,
+                None => u32::MAX,
+            },
+            near_field: sm.near_field,
+            shadow_rays: s.gi.shadow_rays as u32,
+            substitute_offset: sm.substitute_offset,
+            child_probability: match sm.child_probability {
+                ChildProbability::Mean => 0,
+                ChildProbability::MinMax => 1,
+                ChildProbability::Defensive => 2,
+            },
+        };
+        self.traced = cx.trace_pixel.is_some();
+        let (gbuffer, accum) = match &half_targets {
+            Some(h) => (&h.gbuffer, &h.accum),
+            None => (&cx.targets.gbuffer, cx.gi_accum),
+        };
+        self.pass.record(
+            device,
+            cx.queue,
+            enc,
+            cx.timer,
+            p,
+            cx.tree,
+            cx.scene,
+            gbuffer,
+            accum,
+            &self.buffers,
+        );
+        if let Some(h) = half_targets {
+            self.half_pass
+                .record_upsample(device, enc, cx.timer, &cx.targets.gbuffer, size, &h, cx.gi_accum);
+            self.half = Some(h);
+        }
+        1.0 / frames.max(1) as f32
+    }
+
+    fn after_submit(&mut self) {
+        self.pass.after_submit();
+    }
+
+    /// The diagnostics are drawn at the GI resolution (full or half).
+    fn view_size(&self, _view: MethodView, frame: (u32, u32)) -> Option<(u32, u32)> {
+        let b = &self.buffers;
+        let scale = frame.0.div_ceil(b.size.0.max(1));
+        // No tree-sampling frame at this size yet: nothing to show.
+        (scale != 0 && b.size.0 * scale >= frame.0 && scale <= 2).then_some(b.size)
+    }
+
+    fn record_view(&mut self, view: MethodView, cx: &mut ViewCx<'_>, enc: &mut wgpu::CommandEncoder) {
+        let b = &self.buffers;
+        let scale = cx.targets.size.0.div_ceil(b.size.0.max(1));
+        let p = GpuSlcViewParams {
+            mode: if view == STEPS {
+                0
+            } else if view == FALLBACK {
+                1
+            } else if view == CUT_BLOCKS {
+                2
+            } else {
+                3
+            },
+            grid_x: b.grid.0,
+            block: b.block,
+            cut_size: b.cut_size,
+            exposure: cx.look.exposure_ev.exp2(),
+            tonemap: cx.look.tonemap.gpu_id(),
+            max_steps: steps_scale(cx.tree.levels()),
+            levels: cx.tree.levels(),
+            selected: cx.selected_block.map_or(0, |b| b + 1),
+            final_scale: scale,
+            _pad: [0; 2],
+        };
+        self.pass.record_view(
+            cx.device,
+            cx.queue,
+            enc,
+            cx.timer,
+            p,
+            &cx.targets.lighting.final_view,
+            &cx.targets.gbuffer.position_view,
+            b,
+            cx.dst,
+        );
+    }
+
+    /// The per-pixel diagnostics (steps per traversal, fell back, samples, 1 + block) at the
+    /// GI resolution, whichever of the views asks.
+    fn read_view(&self, ctx: &GpuContext, _view: MethodView) -> Result<Option<ImageF32>, GpuError> {
+        let b = &self.buffers;
+        let n = b.size.0 as u64 * b.size.1 as u64;
+        if n <= 1 {
+            return Ok(None);
+        }
+        let bytes = readback::read_buffer_range(ctx, &b.diag, 0, 16 * n)?;
+        Ok(Some(ImageF32 {
+            width: b.size.0,
+            height: b.size.1,
+            pixels: bytemuck::pod_collect_to_vec(&bytes),
+        }))
+    }
+
+    fn read_story(&self, ctx: &GpuContext) -> Result<Option<PixelTrace>, GpuError> {
+        if !self.traced {
+            return Ok(None);
+        }
+        let bytes = readback::read_storage_buffer(ctx, &self.buffers.trace)?;
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        Ok(PixelTrace::parse(&words))
+    }
+
+    fn pixel_rows(
+        &self,
+        ctx: &GpuContext,
+        x: u32,
+        y: u32,
+        frame: (u32, u32),
+    ) -> Result<Vec<(&'static str, [f32; 4])>, GpuError> {
+        let b = &self.buffers;
+        let scale = frame.0.div_ceil(b.size.0.max(1)).max(1);
+        let (dx, dy) = (x / scale, y / scale);
+        if dx >= b.size.0 || dy >= b.size.1 {
+            return Ok(Vec::new());
+        }
+        let off = (dy as u64 * b.size.0 as u64 + dx as u64) * 16;
+        let bytes = readback::read_buffer_range(ctx, &b.diag, off, 16)?;
+        let d: [f32; 4] = bytemuck::pod_read_unaligned(&bytes[..16]);
+        Ok(vec![("sampling (steps, fallback, samples, 1 + block)", d)])
+    }
+
+    fn legend(&self, view: MethodView, tree_levels: u32) -> Option<Legend> {
+        let hi = steps_scale(tree_levels);
+        if view == STEPS {
+            let title = match self.pass.last_stats() {
+                Some(st) => format!(
+                    "traversal steps per traversal (image mean {:.2})",
+                    st.steps_per_traversal()
+                ),
+                None => "traversal steps per traversal".to_string(),
+            };
+            Some(Legend {
+                title,
+                lo: 0.0,
+                hi,
+                log: false,
+            })
+        } else if view == CUT_DEPTH {
+            Some(Legend {
+                title: "mean cut node depth (root = 0)".into(),
+                lo: 0.0,
+                hi,
+                log: false,
+            })
+        } else {
+            None
+        }
+    }
+
+    fn status(&mut self) -> Option<String> {
+        let st = self.pass.poll_stats()?;
+        Some(format!(
+            "{:.2} steps per traversal · {:.1} per pixel · {:.2}% pixels without a similar cut · {} dead branches",
+            st.steps_per_traversal(),
+            st.steps_per_pixel(),
+            100.0 * st.fallback_fraction(),
+            st.dead
+        ))
+    }
+}
+
+/// The top of the traversal-steps heat map: the depth of a tree of `levels` levels.
+pub fn steps_scale(levels: u32) -> f32 {
+    (levels.max(2) - 1) as f32
+}

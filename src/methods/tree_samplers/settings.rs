@@ -1,0 +1,126 @@
+//! The tree samplers' settings (`[sampling]` in a settings file): thesis chapter 5 and the
+//! options this workbench adds, each documented with what it trades.
+
+use serde::{Deserialize, Serialize};
+
+/// How a pixel picks a cut per slot (thesis 5.1.3, fig. 7.4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CutBlending {
+    /// Algorithm 1: per slot, one of the 4 surrounding blocks' cuts by bilinear weight x S.
+    #[default]
+    Stochastic,
+    /// No blending: the cut of the pixel's own block (if similar, else the fallback).
+    Off,
+}
+
+impl CutBlending {
+    pub const ALL: [CutBlending; 2] = [CutBlending::Stochastic, CutBlending::Off];
+    pub fn name(self) -> &'static str {
+        match self {
+            CutBlending::Stochastic => "stochastic (Algorithm 1)",
+            CutBlending::Off => "off (own block)",
+        }
+    }
+}
+
+/// What a pixel does when no surrounding cut is similar (thesis 5.1.4, fig. 7.6).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CutFallback {
+    /// All nodes of tree level floor(log2(cut_size)).
+    #[default]
+    MockCut,
+    /// Blend the dissimilar cuts anyway, by bilinear weight alone.
+    Average,
+    /// `cut_size` traversals from the root (as SST).
+    Root,
+    /// Build a cut at the pixel itself (costly).
+    Recompute,
+}
+
+impl CutFallback {
+    pub const ALL: [CutFallback; 4] = [
+        CutFallback::MockCut,
+        CutFallback::Average,
+        CutFallback::Root,
+        CutFallback::Recompute,
+    ];
+    pub fn name(self) -> &'static str {
+        match self {
+            CutFallback::MockCut => "mock cut",
+            CutFallback::Average => "average the cuts",
+            CutFallback::Root => "traverse from the root",
+            CutFallback::Recompute => "recompute a cut",
+        }
+    }
+}
+
+pub use crate::base::sampling::ChildProbability;
+
+/// Sampling the tree (stages 11-16, thesis chapter 5): used by the SLC, SST and RTSLC methods.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SamplingSettings {
+    /// k: one shallow light cut per k x k block of GI pixels (1 = a cut per pixel). Larger
+    /// blocks cost less and blur the cut choice across edges (blending hides the seams).
+    pub block_size: u32,
+    /// Nodes per cut = cluster evaluations (shadow rays) per pixel; SST takes this many
+    /// traversals from the root.
+    pub cut_size: u32,
+    /// Leave out of the cuts children whose box lies wholly behind the block centre's
+    /// surface (thesis 5.1). Pixels of a block that face differently can then miss light
+    /// from those nodes (bias, bounded by the similarity test); off keeps the cuts complete.
+    pub cull_behind: bool,
+    /// Near-field refinement (ours, not in the thesis; 0 = the thesis's rule): SLC and SST
+    /// stop at a usable node only when the shaded point lies at least max(distance epsilon,
+    /// `near_field` x the node's box diagonal) from the node's box, and descend otherwise (to
+    /// a leaf at most). A substitute distribution stands for its VPLs only seen from afar:
+    /// next to it, its samples land off the real surfaces (through thin walls, in front of
+    /// the shaded surface) and the 1/d^2 term turns them into fireflies. Higher refines more
+    /// (fewer fireflies, more steps). See docs/results.md.
+    pub near_field: f32,
+    /// Shadow rays of substitute samples (SLC/SST inner nodes, never leaf VPLs) end this far
+    /// (m) short of the drawn point, towards the shaded point and at most half way: the SST
+    /// paper's "scene size dependent epsilon" (Tatzgern et al. 2020, section 5, Sampling: drawn points
+    /// "may be slightly inside geometry"). A Gaussian draw clamped to the box lands behind
+    /// walls and under neighbouring surfaces, where the node's real VPLs are not; 0 (only
+    /// `gi.ray_offset`, the thesis) left SLC 8.6% dark in the Breakfast Room. Too large leaks
+    /// light through walls thinner than it. See docs/results.md.
+    pub substitute_offset: f32,
+    /// How a traversal step splits its probability between the children (all three
+    /// samplers; the cuts are built the same either way).
+    pub child_probability: ChildProbability,
+    pub blending: CutBlending,
+    pub fallback: CutFallback,
+    /// Average successive frames while the view, lights and settings stay (progressive);
+    /// off shows each frame's estimate alone, as a real-time renderer would.
+    pub accumulate: bool,
+    /// Render GI at half resolution and upsample it with a joint bilateral filter using S.
+    pub half_resolution: bool,
+    /// The samplers' random numbers are the same every frame (debugging: a pixel's story
+    /// repeats); off, the seed changes per frame (needed to accumulate).
+    pub fixed_seed: bool,
+}
+
+impl Default for SamplingSettings {
+    fn default() -> Self {
+        // The thesis's defaults: 8 x 8 blocks, 32 samples per pixel.
+        Self {
+            block_size: 8,
+            cut_size: 32,
+            cull_behind: true,
+            // Measured on Sponza and Breakfast Room (docs/results.md): 1 removes the
+            // substitute fireflies for 3-11% more steps; 0.5 and 2 are within noise of it in
+            // error, for fewer / more steps.
+            near_field: 1.0,
+            // Measured (16-frame means vs the ground truth, docs/results.md): 0.05 m brings
+            // SLC from 0.915x to 0.98x in the Breakfast Room; 0.1 m overshoots (light leaks).
+            substitute_offset: 0.05,
+            child_probability: ChildProbability::Defensive,
+            blending: CutBlending::Stochastic,
+            fallback: CutFallback::MockCut,
+            accumulate: false,
+            half_resolution: false,
+            fixed_seed: false,
+        }
+    }
+}

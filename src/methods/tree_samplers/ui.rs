@@ -1,0 +1,75 @@
+//! The tree samplers' settings in the GUI (SST hides the cut and blending controls it does
+//! not use; RTSLC hides the substitute controls).
+
+use super::settings::{ChildProbability, CutBlending, CutFallback};
+use super::{RTSLC, SST};
+use crate::methods::MethodId;
+use crate::renderer::settings::RenderSettings;
+
+pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) {
+    let sm = &mut s.sampling;
+    let cut_label = if method == SST {
+        "samples per pixel"
+    } else {
+        "cut size (samples per pixel)"
+    };
+    ui.add(egui::Slider::new(&mut sm.cut_size, 1..=64).text(cut_label));
+    if method != SST {
+        ui.add(egui::Slider::new(&mut sm.block_size, 1..=64).text("cut block k (pixels)"))
+            .on_hover_text("one shallow light cut per k x k block (1 = per pixel)");
+        egui::ComboBox::from_label("cut blending")
+            .selected_text(sm.blending.name())
+            .show_ui(ui, |ui| {
+                for b in CutBlending::ALL {
+                    ui.selectable_value(&mut sm.blending, b, b.name());
+                }
+            });
+        egui::ComboBox::from_label("no similar cut")
+            .selected_text(sm.fallback.name())
+            .show_ui(ui, |ui| {
+                for f in CutFallback::ALL {
+                    ui.selectable_value(&mut sm.fallback, f, f.name());
+                }
+            });
+        ui.checkbox(&mut sm.cull_behind, "cull nodes behind the block centre")
+            .on_hover_text("thesis 5.1; off keeps every cut complete (unbiased)");
+    }
+    if method != RTSLC {
+        ui.add(egui::Slider::new(&mut sm.near_field, 0.0..=4.0).text("near-field refinement"))
+            .on_hover_text(
+                "stop at a usable node only when the point is at least this many box \
+                 diagonals from its box (0 = the thesis's rule): substitute samples \
+                 next to the point turn into fireflies",
+            );
+        ui.add(
+            egui::Slider::new(&mut sm.substitute_offset, 0.0..=0.3)
+                .suffix(" m")
+                .text("substitute ray offset"),
+        )
+        .on_hover_text(
+            "substitute samples' shadow rays end this far short of the drawn point \
+             (the SST paper's scene-size epsilon; 0 = the thesis): drawn points land \
+             slightly inside geometry; too large leaks light through thin walls",
+        );
+    }
+    egui::ComboBox::from_label("child probability")
+        .selected_text(sm.child_probability.name())
+        .show_ui(ui, |ui| {
+            for c in ChildProbability::ALL {
+                ui.selectable_value(&mut sm.child_probability, c, c.name());
+            }
+        })
+        .response
+        .on_hover_text(
+            "how a traversal step picks a child: eq. 5.5's weights with the distance to \
+             each child's mean (thesis); RTSLC's average of the closest- and \
+             farthest-point box distances; or (default) the thesis's mixed with 20% \
+             of the closest-point one, which keeps VPLs next to the point from being \
+             drawn rarely (fireflies)",
+        );
+    ui.checkbox(
+        &mut sm.half_resolution,
+        "half-resolution GI (bilateral upsampling)",
+    );
+    ui.checkbox(&mut sm.accumulate, "accumulate frames while static");
+}

@@ -1,0 +1,459 @@
+//! The frame graph: what one frame records and submits, in pass order (ARCHITECTURE.md,
+//! *Frame pass order*): shadow maps / RSMs, G-buffer, direct light, VPLs, light tree, the GI
+//! method (through `crate::methods`) and the comparison's truth beside it, composite, and
+//! each docked view with its overlays.
+
+use super::*;
+
+impl Renderer {
+    /// Records and submits one frame, ending with the selected view (with the global display
+    /// look) in the view texture.
+    pub fn render(&mut self, input: &FrameInput<'_>) {
+        let spec = ViewSpec::new(input.view, &self.settings.display);
+        self.render_views(input, &[spec]);
+    }
+
+    /// Records and submits one frame and draws every view of `views` (at least one; the
+    /// first into [`Renderer::view_texture`], the others into [`Renderer::view_texture_at`]).
+    /// `input.view` is ignored. Each extra view is its own submission (the view passes share
+    /// their parameter buffers).
+    pub fn render_views(&mut self, input: &FrameInput<'_>, views: &[ViewSpec]) {
+        let first = views.first().copied().unwrap_or_default();
+        let device = self.ctx.device.clone();
+        let queue = self.ctx.queue.clone();
+        let size = self.targets.size;
+        let s = self.settings.clone();
+
+        let lights = &input.lights[..input.lights.len().min(MAX_LIGHTS)];
+        let layers = lights.len().max(1) as u32;
+        if layers != self.targets.shadow.layers() {
+            self.targets.shadow = ShadowTargets::new(&device, s.shadow.resolution, layers);
+        }
+        let gpu_lights = GpuLights::new(
+            lights,
+            &self.scene.bounds,
+            s.shadow.resolution,
+            s.shadow.depth_bias,
+            s.shadow.normal_offset,
+            s.shadow.slope_bias,
+            s.shadow.pcf_radius,
+        );
+        queue.write_buffer(
+            &self.camera_buf,
+            0,
+            bytemuck::bytes_of(&GpuCamera::new(input.camera, size.0, size.1)),
+        );
+        queue.write_buffer(&self.lights_buf, 0, bytemuck::bytes_of(&gpu_lights));
+        self.light0_lum = lights
+            .first()
+            .map(|l| l.irradiance.dot(Vec3::new(0.2126, 0.7152, 0.0722)))
+            .unwrap_or(1.0);
+        self.lights_texel = gpu_lights.lights[0].shadow[0];
+
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("frame::encoder"),
+        });
+        self.timer.begin_frame();
+        let t = &self.targets;
+        self.rsm.record(
+            &device,
+            &queue,
+            &mut enc,
+            &mut self.timer,
+            &gpu_lights,
+            &self.scene,
+            &t.shadow,
+        );
+        self.gbuffer.record(
+            &device,
+            &mut enc,
+            &mut self.timer,
+            &self.camera_buf,
+            &self.scene,
+            &t.gbuffer,
+        );
+        self.direct.record(
+            &device,
+            &mut enc,
+            &mut self.timer,
+            &self.camera_buf,
+            &self.lights_buf,
+            &t.shadow,
+            &t.gbuffer,
+            &t.lighting.direct_view,
+            size,
+        );
+        // VPLs (thesis 4.1): resources follow the RSM resolution, light count and VPL budget.
+        let vb = &self.vpl_buffers;
+        let mut vpl_ok = true;
+        if vb.res != s.shadow.resolution || vb.layers != layers || vb.capacity != s.vpl.count {
+            match check_device_limits(&device, &s, layers) {
+                // More lights than the buffers fit: say so and keep the frame direct-only.
+                Err(e) => {
+                    self.ctx.errors.report(e.to_string());
+                    vpl_ok = false;
+                }
+                Ok(()) => {
+                    self.vpl_buffers = VplBuffers::new(&device, s.shadow.resolution, layers, s.vpl.count);
+                    for (_, m) in &mut self.methods {
+                        m.reset();
+                    }
+                    self.compare = None;
+                }
+            }
+        }
+        let seed = s
+            .vpl
+            .seed
+            .wrapping_add(if s.vpl.animate { self.frames as u32 } else { 0 });
+        let frozen = self.freeze.is_some() && vpl_ok && self.tree.count == self.vpl_frame.count;
+        if frozen {
+            // Frozen VPLs and tree (debugging): only the flags follow new thresholds.
+            let th = (s.tree.v_min, s.tree.sigma_max);
+            if self.freeze != Some(th) {
+                self.sst_build.record_classify(
+                    &device,
+                    &queue,
+                    &mut enc,
+                    &mut self.timer,
+                    &self.tree,
+                    th.0,
+                    th.1,
+                );
+                self.freeze = Some(th);
+            }
+        } else if vpl_ok {
+            if self.freeze.is_some() {
+                self.freeze = Some((s.tree.v_min, s.tree.sigma_max));
+            }
+            let t = &self.targets;
+            self.vpl_frame = self.vpl_gen.record(
+                &device,
+                &queue,
+                &mut enc,
+                &mut self.timer,
+                &s.vpl,
+                &s.gi,
+                seed,
+                self.scene.bounds.radius().max(1e-3),
+                lights,
+                &self.camera_buf,
+                &t.shadow,
+                &t.gbuffer,
+                &self.vpl_buffers,
+            );
+            // SST stages 8-9: sort keys and the bitonic sort of (key, index) pairs.
+            if self.sort_buffers.count != self.vpl_frame.count {
+                self.sort_buffers = SortBuffers::new(&device, self.vpl_frame.count);
+            }
+            self.sst_sort.record(
+                &device,
+                &queue,
+                &mut enc,
+                &mut self.timer,
+                &self.vpl_buffers.vpls,
+                &self.sort_buffers,
+            );
+            // SST stage 10: the tree over the sorted VPLs, then its usable flags.
+            if self.tree.count != self.vpl_frame.count {
+                self.tree = TreeBuffers::new(&device, self.vpl_frame.count);
+            }
+            self.sst_build.record(
+                &device,
+                &queue,
+                &mut enc,
+                &mut self.timer,
+                &self.vpl_buffers.vpls,
+                &self.sort_buffers,
+                &self.tree,
+                s.tree.v_min,
+                s.tree.sigma_max,
+            );
+            // The flux-pyramid tops (one float per light), read back on a later frame.
+            let (per_layer, offsets) = passes::vpl_gen::pyramid_layout(self.vpl_buffers.res);
+            let top = *offsets.last().unwrap_or(&0) as u64;
+            let fp = &self.vpl_buffers.flux_pyramid;
+            let copies: Vec<(&wgpu::Buffer, u64, u64, u64)> = (0..self.vpl_frame.ranges.len() as u64)
+                .map(|l| (fp, 4 * (l * per_layer as u64 + top), 4 * l, 4))
+                .collect();
+            self.flux_readback.record(&mut enc, &copies);
+        }
+        let indirect_scale = if vpl_ok {
+            let key = self.gt_key(input, lights, size);
+            let scale = self.record_method(&mut enc, s.gi.method, key, size);
+            if self.compare_on && s.gi.method.per_frame() {
+                self.step_compare(&mut enc, input, lights, size);
+            }
+            scale
+        } else {
+            0.0
+        };
+        let t = &self.targets;
+        self.composite.record(
+            &device,
+            &queue,
+            &mut enc,
+            &mut self.timer,
+            size,
+            indirect_scale,
+            &t.lighting.direct_view,
+            &t.lighting.gi_accum,
+            &t.lighting.indirect_view,
+            &t.lighting.final_view,
+        );
+        self.record_view_with_overlays(&mut enc, &first, input.camera, vpl_ok);
+        queue.submit([enc.finish()]);
+        // The other views, each into its own texture.
+        self.extra_views.truncate(views.len().saturating_sub(1));
+        for (i, spec) in views.iter().enumerate().skip(1) {
+            if self.extra_views.len() < i {
+                self.view_generation += 1;
+                self.extra_views
+                    .push(ViewTarget::new(&device, (1, 1), self.view_generation));
+            }
+            let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frame::view_encoder"),
+            });
+            std::mem::swap(&mut self.targets.view, &mut self.extra_views[i - 1]);
+            self.record_view_with_overlays(&mut enc, spec, input.camera, vpl_ok);
+            std::mem::swap(&mut self.targets.view, &mut self.extra_views[i - 1]);
+            queue.submit([enc.finish()]);
+        }
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("frame::resolve_encoder"),
+        });
+        self.timer.resolve(&mut enc);
+        queue.submit([enc.finish()]);
+        self.timer.after_submit();
+        self.flux_readback.after_submit();
+        for (_, m) in &mut self.methods {
+            m.after_submit();
+        }
+        self.frames += 1;
+    }
+
+    /// One view into `targets.view`, then the overlays that apply to it.
+    pub(super) fn record_view_with_overlays(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        spec: &ViewSpec,
+        camera: &Camera,
+        vpl_ok: bool,
+    ) {
+        let device = self.ctx.device.clone();
+        let queue = self.ctx.queue.clone();
+        self.record_view(enc, spec, camera);
+        if self.settings.display.vpl_overlay && vpl_ok {
+            self.record_vpl_overlay(enc, spec.buffer);
+        }
+        let d = &self.settings.display;
+        if d.tree_overlay != TreeOverlay::Off
+            && vpl_ok
+            && !spec.buffer.is_rsm_space()
+            && spec.effective_ab().is_none()
+        {
+            self.sst_overlay.record(
+                &device,
+                &queue,
+                enc,
+                &mut self.timer,
+                d.tree_overlay,
+                d.tree_color,
+                d.tree_level,
+                0.003 * self.scene.bounds.radius().max(1e-3),
+                &self.camera_buf,
+                &self.tree,
+                &self.targets.gbuffer.position_view,
+                &self.targets.view.view,
+            );
+        }
+    }
+
+    /// Fingerprint of everything the ground truth depends on (not the animated seed).
+    pub(super) fn gt_key(
+        &self,
+        input: &FrameInput<'_>,
+        lights: &[DirectionalLight],
+        size: (u32, u32),
+    ) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        hash_view(&mut h, input, lights, size);
+        let mut s = self.settings.clone();
+        s.display = Default::default();
+        s.gi.rays_per_frame = 0;
+        s.gi.reference_samples = 0;
+        s.gi.reference_spp_per_frame = 0;
+        s.vpl.animate = false;
+        format!("{s:?}").hash(&mut h);
+        h.finish()
+    }
+
+    /// Records the passes of `method` (its module's instance) for this frame into the GI
+    /// accumulation; returns the composite's scale.
+    pub(super) fn record_method(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        method: MethodId,
+        key: u64,
+        size: (u32, u32),
+    ) -> f32 {
+        let module = method.info().module.name;
+        let Some((_, m)) = self.methods.iter_mut().find(|(n, _)| *n == module) else {
+            return 0.0;
+        };
+        let mut cx = FrameCx {
+            method,
+            device: &self.ctx.device,
+            queue: &self.ctx.queue,
+            errors: &self.ctx.errors,
+            timer: &mut self.timer,
+            settings: &self.settings,
+            scene: &self.scene,
+            scene_radius: self.scene.bounds.radius().max(1e-3),
+            targets: &self.targets,
+            vpl_buffers: &self.vpl_buffers,
+            vpl_frame: &self.vpl_frame,
+            vpl_params: self.vpl_gen.params_buffer(),
+            tree: &self.tree,
+            gi_accum: &self.targets.lighting.gi_accum,
+            size,
+            key,
+            frame_index: self.frames,
+            trace_pixel: self.trace_pixel,
+        };
+        m.record(&mut cx, enc)
+    }
+
+    /// Key of the comparison ground truth: what its image depends on (view, lights, size,
+    /// VPL and shading settings), not the sampler's settings.
+    pub(super) fn compare_key(
+        &self,
+        input: &FrameInput<'_>,
+        lights: &[DirectionalLight],
+        size: (u32, u32),
+    ) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        hash_view(&mut h, input, lights, size);
+        let s = &self.settings;
+        let mut v = s.vpl.clone();
+        v.animate = false;
+        format!(
+            "{:?}{:?}{}{}",
+            s.shadow, v, s.gi.distance_epsilon, s.gi.ray_offset
+        )
+        .hash(&mut h);
+        // Animated or unfrozen-but-changing VPLs: a new set each frame never converges.
+        if s.vpl.animate && self.freeze.is_none() {
+            self.frames.hash(&mut h);
+        }
+        h.finish()
+    }
+
+    /// The ground truth of the same VPLs beside a tree sampler (progressive, into its own
+    /// buffers), then its composite.
+    pub(super) fn step_compare(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        input: &FrameInput<'_>,
+        lights: &[DirectionalLight],
+        size: (u32, u32),
+    ) {
+        let device = self.ctx.device.clone();
+        let queue = self.ctx.queue.clone();
+        let key = self.compare_key(input, lights, size);
+        let truth = methods::comparison_truth();
+        let mut cmp = match self.compare.take() {
+            Some(c) if c.targets_size == size => c,
+            _ => match (truth.info().module.create)(&device) {
+                Ok(m) => CompareState {
+                    truth: m,
+                    targets: frame::LightingTargets::new(&device, size),
+                    targets_size: size,
+                },
+                Err(e) => {
+                    self.ctx.errors.report(format!("comparison ground truth: {e}"));
+                    return;
+                }
+            },
+        };
+        let mut cx = FrameCx {
+            method: truth,
+            device: &device,
+            queue: &queue,
+            errors: &self.ctx.errors,
+            timer: &mut self.timer,
+            settings: &self.settings,
+            scene: &self.scene,
+            scene_radius: self.scene.bounds.radius().max(1e-3),
+            targets: &self.targets,
+            vpl_buffers: &self.vpl_buffers,
+            vpl_frame: &self.vpl_frame,
+            vpl_params: self.vpl_gen.params_buffer(),
+            tree: &self.tree,
+            gi_accum: &cmp.targets.gi_accum,
+            size,
+            key,
+            frame_index: self.frames,
+            trace_pixel: None,
+        };
+        cmp.truth.record(&mut cx, enc);
+        self.compare_composite.record(
+            &device,
+            &queue,
+            enc,
+            &mut self.timer,
+            size,
+            1.0,
+            &self.targets.lighting.direct_view,
+            &cmp.targets.gi_accum,
+            &cmp.targets.indirect_view,
+            &cmp.targets.final_view,
+        );
+        self.compare = Some(cmp);
+    }
+
+    /// Runs the ground truth of the same VPLs beside a tree sampler (SLC, SST, RTSLC), for the
+    /// comparison views and metrics; off frees its buffers.
+    pub fn set_compare_ground_truth(&mut self, on: bool) {
+        self.compare_on = on;
+        if !on {
+            self.compare = None;
+        }
+    }
+
+    /// Progress of the comparison ground truth (None when off or not started).
+    pub fn compare_progress(&self) -> Option<GiProgress> {
+        self.compare.as_ref().and_then(|c| c.truth.progress())
+    }
+}
+
+/// Clears a view texture to black (a render pass: `clear_texture` needs a device feature).
+/// One GPU instance per method module.
+pub(super) fn create_methods(device: &wgpu::Device) -> Result<Vec<MethodInstance>, RenderError> {
+    methods::modules()
+        .into_iter()
+        .map(|m| Ok((m.name, (m.create)(device)?)))
+        .collect()
+}
+
+/// Hashes what a frame's image depends on besides the settings: camera, lights, size.
+pub(super) fn hash_view(
+    h: &mut impl std::hash::Hasher,
+    input: &FrameInput<'_>,
+    lights: &[DirectionalLight],
+    size: (u32, u32),
+) {
+    use std::hash::Hash;
+    let c = input.camera;
+    for v in [c.position, c.forward, c.up] {
+        v.to_array().map(f32::to_bits).hash(h);
+    }
+    c.yfov.to_bits().hash(h);
+    for l in lights {
+        l.direction.to_array().map(f32::to_bits).hash(h);
+        l.irradiance.to_array().map(f32::to_bits).hash(h);
+    }
+    size.hash(h);
+}

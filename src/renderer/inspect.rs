@@ -1,0 +1,321 @@
+//! What the workbench reads back from the renderer between frames: pixel values, the pixel
+//! story, cuts, the tree, the VPLs, progress, timings and whole buffers (blocking readbacks;
+//! none of them is recorded into a frame).
+
+use super::*;
+
+impl Renderer {
+    /// Every buffer's value at frame pixel (x, y) (final, direct, GI, G-buffer; the tree
+    /// samplers' diagnostics and the comparison ground truth when present), as
+    /// (name, RGBA) rows, read with one submission.
+    pub fn read_pixel(&self, x: u32, y: u32) -> Result<Vec<(&'static str, [f32; 4])>, GpuError> {
+        let t = &self.targets;
+        let (x, y) = (x.min(t.size.0 - 1), y.min(t.size.1 - 1));
+        let mut names = vec![
+            "final",
+            "direct",
+            "GI",
+            "position (w: material + 1)",
+            "normal",
+            "albedo",
+        ];
+        let mut texels = vec![
+            (&t.lighting.final_, x, y),
+            (&t.lighting.direct, x, y),
+            (&t.lighting.indirect, x, y),
+            (&t.gbuffer.position, x, y),
+            (&t.gbuffer.normal, x, y),
+            (&t.gbuffer.albedo, x, y),
+        ];
+        if let Some(c) = self.compare.as_ref().filter(|c| c.targets_size == t.size) {
+            names.push("ground truth GI");
+            texels.push((&c.targets.indirect, x, y));
+        }
+        let values = readback::read_texels(&self.ctx, &texels)?;
+        let mut rows: Vec<(&'static str, [f32; 4])> = names.into_iter().zip(values).collect();
+        if let Some(m) = self.method_instance(self.settings.gi.method) {
+            rows.extend(m.pixel_rows(&self.ctx, x, y, t.size)?);
+        }
+        Ok(rows)
+    }
+
+    /// Records the tree samples of frame pixel (x, y) from the next frame on (None: stop).
+    pub fn set_trace_pixel(&mut self, pixel: Option<(u32, u32)>) {
+        self.trace_pixel = pixel.filter(|&(x, y)| x < 8192 && y < 8192);
+    }
+
+    /// What the traced pixel's samples did in the last tree-sampling frame (None: no trace,
+    /// or the pixel saw no geometry).
+    pub fn read_pixel_trace(&self) -> Result<Option<PixelTrace>, GpuError> {
+        if self.trace_pixel.is_none() || !self.settings.gi.method.info().story {
+            return Ok(None);
+        }
+        match self.method_instance(self.settings.gi.method) {
+            Some(m) => m.read_story(&self.ctx),
+            None => Ok(None),
+        }
+    }
+
+    /// The top of the traversal-steps heat map: the depth of the tree (root to leaves).
+    pub fn sampling_steps_scale(&self) -> f32 {
+        methods::tree_samplers::steps_scale(self.tree.levels())
+    }
+
+    /// Outlines a block in the cut views (None: no outline).
+    pub fn select_block(&mut self, block: Option<u32>) {
+        self.selected_block = block;
+    }
+
+    /// Reads the cut of block `b` (node ids in slot order, without empty slots).
+    pub fn read_cut(&self, b: u32) -> Result<Vec<u32>, GpuError> {
+        match self.tree_samplers() {
+            Some(t) => t.read_cut(&self.ctx, b),
+            None => Ok(Vec::new()),
+        }
+    }
+
+    /// Half-resolution GI of the last frame: its G-buffer position, normal and the sampler's
+    /// demodulated sums (None when half resolution is off).
+    pub fn read_half_resolution(&self) -> Result<Option<HalfReadback>, GpuError> {
+        let Some(h) = self.tree_samplers().and_then(|t| t.half_targets()) else {
+            return Ok(None);
+        };
+        let pos = readback::read_texture_f32(&self.ctx, &h.gbuffer.position, 0)?;
+        let nrm = readback::read_texture_f32(&self.ctx, &h.gbuffer.normal, 0)?;
+        let acc = readback::read_storage_buffer(&self.ctx, &h.accum)?;
+        Ok(Some((pos, nrm, bytemuck::cast_slice(&acc).to_vec())))
+    }
+
+    /// Frames summed in the tree samplers' accumulation (0 before the first).
+    pub fn sampling_frames(&self) -> u32 {
+        self.tree_samplers().map_or(0, |t| t.frames())
+    }
+
+    /// The last frame's sampling counters, waiting for them.
+    pub fn sampling_stats_blocking(&mut self) -> Option<SamplingStats> {
+        let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+        self.tree_samplers_mut()?.poll_stats()
+    }
+
+    /// Counters of a recent frame of the tree samplers (non-blocking; None before the first).
+    pub fn sampling_stats(&mut self) -> Option<SamplingStats> {
+        self.tree_samplers_mut()?.poll_stats()
+    }
+
+    /// The tree samplers' buffers (cuts, per-pixel diagnostics, counters) of the last frame.
+    pub fn slc_buffers(&self) -> &SlcBuffers {
+        match self.tree_samplers() {
+            Some(t) => t.buffers(),
+            None => unreachable!("the tree samplers are registered"),
+        }
+    }
+
+    /// One line of the current method's statistics (non-blocking; None before any).
+    pub fn method_status(&mut self) -> Option<String> {
+        let module = self.settings.gi.method.info().module.name;
+        self.methods
+            .iter_mut()
+            .find(|(n, _)| *n == module)
+            .and_then(|(_, m)| m.status())
+    }
+
+    /// The GPU instance of `method`'s module.
+    pub(super) fn method_instance(&self, method: MethodId) -> Option<&dyn Method> {
+        let module = method.info().module.name;
+        self.methods
+            .iter()
+            .find(|(n, _)| *n == module)
+            .map(|(_, m)| m.as_ref())
+    }
+
+    /// The linear data behind a method's view (None: nothing rendered yet, or the current
+    /// method does not draw it).
+    pub(crate) fn read_method_view(&self, view: MethodView) -> Result<Option<ImageF32>, GpuError> {
+        let current = self.settings.gi.method;
+        if !current.info().views.iter().any(|v| v.name == view.name()) {
+            return Ok(None);
+        }
+        match self.method_instance(current) {
+            Some(m) => m.read_view(&self.ctx, view),
+            None => Ok(None),
+        }
+    }
+
+    /// The colour scale of a method's view (None: no legend).
+    pub fn method_legend(&self, view: MethodView) -> Option<methods::Legend> {
+        let (_, owner) = view.find()?;
+        self.method_instance(owner)?.legend(view, self.tree.levels())
+    }
+
+    pub(super) fn tree_samplers(&self) -> Option<&TreeSamplers> {
+        let m = self.method_instance(methods::tree_samplers::SLC)?;
+        (m as &dyn std::any::Any).downcast_ref::<TreeSamplers>()
+    }
+
+    pub(super) fn tree_samplers_mut(&mut self) -> Option<&mut TreeSamplers> {
+        let module = methods::tree_samplers::MODULE.name;
+        let (_, m) = self.methods.iter_mut().find(|(n, _)| *n == module)?;
+        (m.as_mut() as &mut dyn std::any::Any).downcast_mut::<TreeSamplers>()
+    }
+
+    /// Progress of the progressive GI method: VPLs done (ground truth) or samples per pixel
+    /// (reference); None when GI is off.
+    pub fn gi_progress(&self) -> Option<GiProgress> {
+        self.method_instance(self.settings.gi.method)?.progress()
+    }
+
+    /// The VPLs of the last frame (count and per-light ranges).
+    pub fn vpl_frame(&self) -> &VplFrame {
+        &self.vpl_frame
+    }
+
+    pub fn vpl_buffers(&self) -> &VplBuffers {
+        &self.vpl_buffers
+    }
+
+    /// Reads a storage buffer of f32 back (pyramids, importance).
+    /// The last frame's sorted (key, index) pairs and tree.
+    pub fn tree_buffers(&self) -> (&SortBuffers, &TreeBuffers) {
+        (&self.sort_buffers, &self.tree)
+    }
+
+    /// Reads the last frame's tree back: nodes decoded (2 x leaves, node 0 unused) and the
+    /// usable bits.
+    pub fn read_tree(&self) -> Result<(Vec<SstNode>, Vec<u32>), GpuError> {
+        let nodes = passes::sst_build::read_nodes(&self.ctx, &self.tree)?;
+        let flags = passes::sst_build::read_flags(&self.ctx, &self.tree)?;
+        Ok((nodes.iter().map(SstNode::decode).collect(), flags))
+    }
+
+    /// Nodes `ids` of the frame's tree (one submission; ids past the tree read as empty)
+    /// and the usable flags, without reading the whole tree back.
+    pub fn read_tree_nodes(&self, ids: &[u32]) -> Result<(Vec<SstNode>, Vec<u32>), GpuError> {
+        const NODE: u64 = std::mem::size_of::<gpu_data::GpuSstNode>() as u64;
+        let count = self.tree.nodes.size() / NODE;
+        let inside: Vec<u32> = ids.iter().copied().filter(|&i| (i as u64) < count).collect();
+        let ranges: Vec<(u64, u64)> = inside.iter().map(|&i| (i as u64 * NODE, NODE)).collect();
+        let bytes = readback::read_buffer_ranges(&self.ctx, &self.tree.nodes, &ranges)?;
+        let mut decoded = bytes
+            .iter()
+            .map(|b| SstNode::decode(&bytemuck::pod_read_unaligned(b)));
+        let nodes = ids
+            .iter()
+            .map(|&i| match (i as u64) < count {
+                true => decoded.next().unwrap_or(SstNode::EMPTY),
+                false => SstNode::EMPTY,
+            })
+            .collect();
+        let flags = passes::sst_build::read_flags(&self.ctx, &self.tree)?;
+        Ok((nodes, flags))
+    }
+
+    /// Freezes (or thaws) the VPLs and the light tree: while frozen, frames reuse the last
+    /// VPLs, sort and tree (the camera can move around them), and a change of v_min /
+    /// sigma_max re-runs only the classify pass.
+    pub fn set_freeze_tree(&mut self, freeze: bool) {
+        if freeze && self.freeze.is_none() {
+            self.freeze = Some((self.settings.tree.v_min, self.settings.tree.sigma_max));
+        } else if !freeze {
+            self.freeze = None;
+        }
+    }
+
+    pub fn tree_frozen(&self) -> bool {
+        self.freeze.is_some()
+    }
+
+    /// Re-runs only the classify pass of the last frame's tree with new thresholds (the
+    /// settings are not changed).
+    pub fn reclassify(&mut self, v_min: f32, sigma_max: f32) {
+        let device = self.ctx.device.clone();
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("sst_classify::encoder"),
+        });
+        let mut timer = GpuTimer::new(&device, &self.ctx.queue);
+        self.sst_build.record_classify(
+            &device,
+            &self.ctx.queue,
+            &mut enc,
+            &mut timer,
+            &self.tree,
+            v_min,
+            sigma_max,
+        );
+        self.ctx.queue.submit([enc.finish()]);
+    }
+
+    pub fn read_f32_buffer(&self, buffer: &wgpu::Buffer) -> Result<Vec<f32>, GpuError> {
+        let bytes = readback::read_storage_buffer(&self.ctx, buffer)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+
+    /// Reads the last frame's VPLs back.
+    pub fn read_vpls(&self) -> Result<Vec<GpuVpl>, GpuError> {
+        let bytes = readback::read_storage_buffer(&self.ctx, &self.vpl_buffers.vpls)?;
+        let all: &[GpuVpl] = bytemuck::cast_slice(&bytes);
+        Ok(all[..(self.vpl_frame.count as usize).min(all.len())].to_vec())
+    }
+
+    /// Picks up finished readbacks (timings, flux total) without blocking; returns the latest
+    /// per-pass GPU timings, or None if not (yet) available.
+    /// Blocks until the GPU has finished all submitted work (wall-clock timing of frames).
+    pub fn wait_idle(&self) {
+        let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+    }
+
+    pub fn poll_timings(&mut self) -> Option<PassTimings> {
+        let t = self.timer.collect(&self.ctx.device).cloned();
+        self.take_flux_total();
+        t
+    }
+
+    /// Waits for the GPU and returns the last frame's per-pass timings.
+    pub fn wait_timings(&mut self) -> Option<PassTimings> {
+        let t = self.timer.collect_blocking(&self.ctx.device).cloned();
+        self.take_flux_total();
+        t
+    }
+
+    pub(super) fn take_flux_total(&mut self) {
+        if let Some(bytes) = self.flux_readback.try_take() {
+            let tops: &[f32] = bytemuck::cast_slice(&bytes);
+            self.flux_total = Some(tops.iter().sum());
+        }
+    }
+
+    /// Total reflected flux of the RSMs (luminance, W) = the expected total VPL flux, from the
+    /// flux pyramids' tops of a recent frame (read back without blocking).
+    pub fn flux_total(&self) -> Option<f32> {
+        self.flux_total
+    }
+
+    pub fn timestamps_supported(&self) -> bool {
+        self.timer.supported()
+    }
+
+    /// Reads a buffer of the last frame back as linear floats.
+    pub fn read(&self, buffer: Buffer) -> Result<ImageF32, GpuError> {
+        let t = &self.targets;
+        match buffer {
+            Buffer::Final => readback::read_texture_f32(&self.ctx, &t.lighting.final_, 0),
+            Buffer::Direct => readback::read_texture_f32(&self.ctx, &t.lighting.direct, 0),
+            Buffer::Indirect => readback::read_texture_f32(&self.ctx, &t.lighting.indirect, 0),
+            Buffer::GroundTruthIndirect => match &self.compare {
+                Some(c) => readback::read_texture_f32(&self.ctx, &c.targets.indirect, 0),
+                None => Ok(ImageF32 {
+                    width: 0,
+                    height: 0,
+                    pixels: Vec::new(),
+                }),
+            },
+            Buffer::Position => readback::read_texture_f32(&self.ctx, &t.gbuffer.position, 0),
+            Buffer::Normal => readback::read_texture_f32(&self.ctx, &t.gbuffer.normal, 0),
+            Buffer::Albedo => readback::read_texture_f32(&self.ctx, &t.gbuffer.albedo, 0),
+            Buffer::Depth => readback::read_texture_f32(&self.ctx, &t.gbuffer.depth, 0),
+            Buffer::ShadowMap(layer) => readback::read_texture_f32(&self.ctx, &t.shadow.texture, layer),
+            Buffer::RsmPosition(layer) => readback::read_texture_f32(&self.ctx, &t.shadow.position, layer),
+            Buffer::RsmNormal(layer) => readback::read_texture_f32(&self.ctx, &t.shadow.normal, layer),
+            Buffer::RsmFlux(layer) => readback::read_texture_f32(&self.ctx, &t.shadow.flux, layer),
+        }
+    }
+}

@@ -1,0 +1,460 @@
+//! The bounds-checked reading of a glTF file's data: URIs and data URIs, buffers, base-colour
+//! images, accessors (with sparse substitution) and primitives. Nothing here trusts the
+//! file: every range is checked, every failure is a one-line message.
+
+use super::*;
+
+/// Geometry of one primitive in its local space.
+pub(super) struct PrimData {
+    pub(super) positions: Vec<Vec3>,
+    pub(super) normals: Option<Vec<Vec3>>,
+    pub(super) uvs: Option<Vec<Vec2>>,
+    pub(super) indices: Vec<u32>,
+}
+
+/// Upper bound on elements of an accessor that has no buffer view (all zeros).
+const MAX_VIEWLESS_COUNT: usize = 1 << 26;
+
+/// Decodes `%XX` escapes of a relative URI (invalid escapes are kept as they are).
+pub(super) fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' && i + 2 < b.len() {
+            let hex = |c: u8| (c as char).to_digit(16);
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Resolves a non-`data:` URI against the glTF file's folder.
+pub(super) fn resolve_uri(base_dir: &Path, uri: &str) -> Result<PathBuf, String> {
+    if let Some(rest) = uri.strip_prefix("file://").or_else(|| uri.strip_prefix("file:")) {
+        return Ok(PathBuf::from(percent_decode(rest)));
+    }
+    if let Some(colon) = uri.find(':') {
+        // A scheme is letters before ':' (Windows drive letters are one letter long).
+        let scheme = &uri[..colon];
+        if scheme.len() > 1
+            && scheme
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c))
+        {
+            return Err(format!("unsupported URI scheme '{scheme}:'"));
+        }
+    }
+    Ok(base_dir.join(percent_decode(uri)))
+}
+
+pub(super) fn decode_data_uri(uri: &str) -> Result<Vec<u8>, String> {
+    gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(uri), None)
+        .map(|d| d.0)
+        .map_err(|e| format!("bad data URI: {}", one_line(&e.to_string())))
+}
+
+pub(super) fn load_buffers(
+    doc: &gltf::Document,
+    path: &Path,
+    base_dir: &Path,
+    mut blob: Option<Vec<u8>>,
+) -> Result<Vec<Vec<u8>>, SceneError> {
+    let mut out = Vec::new();
+    for buffer in doc.buffers() {
+        let index = buffer.index();
+        let bad = |message: String| SceneError::BadBuffer {
+            path: path.to_path_buf(),
+            index,
+            message,
+        };
+        let (data, name) = match buffer.source() {
+            gltf::buffer::Source::Bin => match blob.take() {
+                Some(b) => (b, "GLB BIN chunk".to_string()),
+                None => return Err(bad("the GLB file has no BIN chunk".into())),
+            },
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                (decode_data_uri(uri).map_err(bad)?, "data URI".to_string())
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                let file = resolve_uri(base_dir, uri).map_err(bad)?;
+                match std::fs::read(&file) {
+                    Ok(d) => (d, file.display().to_string()),
+                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                        return Err(SceneError::MissingBuffer {
+                            gltf: path.to_path_buf(),
+                            index,
+                            buffer: file,
+                        });
+                    }
+                    Err(source) => return Err(SceneError::Io { path: file, source }),
+                }
+            }
+        };
+        if data.len() < buffer.length() {
+            return Err(SceneError::TruncatedBuffer {
+                path: path.to_path_buf(),
+                index,
+                name,
+                declared: buffer.length(),
+                actual: data.len(),
+            });
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// Decodes every image used as a base colour texture (each once, in parallel). Returns the
+/// decoded textures and a map image index -> texture index (`None` when it failed).
+pub(super) fn load_base_color_images(
+    doc: &gltf::Document,
+    buffers: &[Vec<u8>],
+    base_dir: &Path,
+    sourceless: &HashSet<usize>,
+    warnings: &mut Warnings,
+) -> (Vec<TextureImage>, HashMap<usize, Option<usize>>) {
+    // image index -> names of materials using it
+    let mut users: BTreeMap<usize, Vec<String>> = BTreeMap::new();
+    for (i, m) in doc.materials().enumerate() {
+        if let Some(info) = m.pbr_metallic_roughness().base_color_texture() {
+            if sourceless.contains(&info.texture().index()) {
+                continue;
+            }
+            let img = info.texture().source().index();
+            users.entry(img).or_default().push(
+                m.name()
+                    .map(str::to_string)
+                    .unwrap_or_else(|| format!("material{i}")),
+            );
+        }
+    }
+    let images: Vec<gltf::Image> = doc.images().collect();
+    let jobs: Vec<usize> = users.keys().copied().collect();
+    let results: Mutex<Vec<Option<DecodeResult>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
+    let next = AtomicUsize::new(0);
+    let threads = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(2)
+        .clamp(1, 8)
+        .min(jobs.len().max(1));
+
+    let work = || {
+        loop {
+            let j = next.fetch_add(1, Ordering::Relaxed);
+            let Some(&img_index) = jobs.get(j) else { break };
+            let Some(img) = images.get(img_index) else {
+                continue;
+            };
+            let (label, res) = decode_image(img, buffers, base_dir);
+            if let Ok(mut r) = results.lock() {
+                r[j] = Some((label, res));
+            }
+        }
+    };
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads).map(|_| s.spawn(work)).collect();
+        for h in handles {
+            // A decoder panic only loses that image (it is reported as a failure below).
+            let _ = h.join();
+        }
+    });
+    let results = results.into_inner().unwrap_or_else(|p| p.into_inner());
+
+    let mut textures = Vec::new();
+    let mut map = HashMap::new();
+    for (j, &img_index) in jobs.iter().enumerate() {
+        let user_list = users.get(&img_index).map(|u| u.join("', '")).unwrap_or_default();
+        match results.get(j).cloned().flatten() {
+            Some((_, Ok(t))) => {
+                map.insert(img_index, Some(textures.len()));
+                textures.push(t);
+            }
+            Some((label, Err(e))) => {
+                warnings.push(format!(
+                    "base colour image {label} not loaded ({e}); material(s) '{user_list}' use their colour factor only"
+                ));
+                map.insert(img_index, None);
+            }
+            None => {
+                warnings.push(format!(
+                    "base colour image {img_index} not loaded (decoder failure); material(s) '{user_list}' use their colour factor only"
+                ));
+                map.insert(img_index, None);
+            }
+        }
+    }
+    (textures, map)
+}
+
+pub(super) fn decode_image(
+    img: &gltf::Image,
+    buffers: &[Vec<u8>],
+    base_dir: &Path,
+) -> (String, Result<TextureImage, String>) {
+    let (label, bytes): (String, Result<Vec<u8>, String>) = match img.source() {
+        gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => (
+            format!("{} (data URI)", img.name().unwrap_or("image")),
+            decode_data_uri(uri),
+        ),
+        gltf::image::Source::Uri { uri, .. } => match resolve_uri(base_dir, uri) {
+            Ok(p) => (
+                format!("'{}'", p.display()),
+                std::fs::read(&p).map_err(|e| e.to_string()),
+            ),
+            Err(e) => (format!("'{uri}'"), Err(e)),
+        },
+        gltf::image::Source::View { view, .. } => (
+            format!("{} (buffer view {})", img.name().unwrap_or("image"), view.index()),
+            view_slice(&view, buffers).map(<[u8]>::to_vec),
+        ),
+    };
+    let name = img
+        .name()
+        .map(str::to_string)
+        .unwrap_or_else(|| format!("image{}", img.index()));
+    let res = bytes.and_then(|b| {
+        let decoded = image::load_from_memory(&b).map_err(|e| one_line(&e.to_string()))?;
+        let rgba = decoded.into_rgba8();
+        Ok(TextureImage {
+            name,
+            width: rgba.width(),
+            height: rgba.height(),
+            rgba8: rgba.into_raw(),
+        })
+    });
+    (label, res)
+}
+
+pub(super) fn view_slice<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) -> Result<&'b [u8], String> {
+    let buf = buffers
+        .get(view.buffer().index())
+        .ok_or_else(|| format!("buffer view {} names a missing buffer", view.index()))?;
+    let end = view
+        .offset()
+        .checked_add(view.length())
+        .ok_or("buffer view range overflows")?;
+    buf.get(view.offset()..end).ok_or_else(|| {
+        format!(
+            "buffer view {} (bytes {}..{end}) lies outside its buffer ({} bytes)",
+            view.index(),
+            view.offset(),
+            buf.len()
+        )
+    })
+}
+
+pub(super) fn read_primitive(
+    prim: &gltf::Primitive,
+    buffers: &[Vec<u8>],
+    uv_set: u32,
+) -> Result<(PrimData, bool), String> {
+    let pos_acc = prim
+        .get(&gltf::Semantic::Positions)
+        .ok_or("no POSITION attribute")?;
+    if pos_acc.dimensions() != Dimensions::Vec3 {
+        return Err("POSITION is not a VEC3 accessor".into());
+    }
+    let positions: Vec<Vec3> = read_floats(&pos_acc, buffers)
+        .map_err(|e| format!("POSITION: {e}"))?
+        .chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect();
+    let n = positions.len();
+
+    let normals = match prim.get(&gltf::Semantic::Normals) {
+        Some(acc) if acc.dimensions() == Dimensions::Vec3 && acc.count() == n => {
+            let v = read_floats(&acc, buffers).map_err(|e| format!("NORMAL: {e}"))?;
+            Some(v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect())
+        }
+        _ => None,
+    };
+    let (uvs, uv_missing) = match prim.get(&gltf::Semantic::TexCoords(uv_set)) {
+        Some(acc) if acc.dimensions() == Dimensions::Vec2 && acc.count() == n => {
+            let v = read_floats(&acc, buffers).map_err(|e| format!("TEXCOORD_{uv_set}: {e}"))?;
+            let uvs: Vec<Vec2> = v
+                .chunks_exact(2)
+                .map(|c| {
+                    let uv = Vec2::new(c[0], c[1]);
+                    if uv.is_finite() { uv } else { Vec2::ZERO }
+                })
+                .collect();
+            (Some(uvs), false)
+        }
+        _ => (
+            None,
+            prim.material()
+                .pbr_metallic_roughness()
+                .base_color_texture()
+                .is_some(),
+        ),
+    };
+    let indices = match prim.indices() {
+        Some(acc) => read_indices(&acc, buffers).map_err(|e| format!("indices: {e}"))?,
+        None => (0..n as u32).collect(),
+    };
+    Ok((
+        PrimData {
+            positions,
+            normals,
+            uvs,
+            indices,
+        },
+        uv_missing,
+    ))
+}
+
+pub(super) fn component_size(t: DataType) -> usize {
+    match t {
+        DataType::I8 | DataType::U8 => 1,
+        DataType::I16 | DataType::U16 => 2,
+        DataType::U32 | DataType::F32 => 4,
+    }
+}
+
+/// Reads all components of an accessor (including sparse substitution) through `conv`,
+/// which turns the bytes of one component into a value. Every range is checked.
+pub(super) fn read_accessor<T: Copy + Default>(
+    acc: &gltf::Accessor,
+    buffers: &[Vec<u8>],
+    conv: &dyn Fn(&[u8], DataType) -> T,
+) -> Result<Vec<T>, String> {
+    let comps = match acc.dimensions() {
+        Dimensions::Scalar => 1,
+        Dimensions::Vec2 => 2,
+        Dimensions::Vec3 => 3,
+        Dimensions::Vec4 => 4,
+        d => return Err(format!("unsupported accessor type {d:?}")),
+    };
+    let ct = acc.data_type();
+    let csize = component_size(ct);
+    let elem = comps * csize;
+    let count = acc.count();
+    let total = count.checked_mul(comps).ok_or("accessor count overflows")?;
+    let mut out: Vec<T>;
+    match acc.view() {
+        Some(view) => {
+            let data = view_slice(&view, buffers)?;
+            let stride = view.stride().unwrap_or(elem);
+            if stride < elem {
+                return Err(format!(
+                    "byteStride {stride} is smaller than the element size {elem}"
+                ));
+            }
+            if count > 0 {
+                let end = (count - 1)
+                    .checked_mul(stride)
+                    .and_then(|x| x.checked_add(acc.offset()))
+                    .and_then(|x| x.checked_add(elem))
+                    .ok_or("accessor range overflows")?;
+                if end > data.len() {
+                    return Err(format!(
+                        "accessor {} needs {end} bytes but its buffer view has {}",
+                        acc.index(),
+                        data.len()
+                    ));
+                }
+            }
+            out = Vec::with_capacity(total);
+            for i in 0..count {
+                let start = acc.offset() + i * stride;
+                for c in 0..comps {
+                    let s = start + c * csize;
+                    out.push(conv(&data[s..s + csize], ct));
+                }
+            }
+        }
+        None => {
+            if count > MAX_VIEWLESS_COUNT {
+                return Err(format!(
+                    "accessor {} without buffer view has count {count}",
+                    acc.index()
+                ));
+            }
+            out = vec![T::default(); total];
+        }
+    }
+
+    if let Some(sparse) = acc.sparse() {
+        let sc = sparse.count();
+        let idx = sparse.indices();
+        let idx_data = view_slice(&idx.view(), buffers)?;
+        let isize_ = idx.index_type().size();
+        let idx_end = sc
+            .checked_mul(isize_)
+            .and_then(|x| x.checked_add(idx.offset()))
+            .ok_or("sparse index range overflows")?;
+        let vals = sparse.values();
+        let val_data = view_slice(&vals.view(), buffers)?;
+        let val_end = sc
+            .checked_mul(elem)
+            .and_then(|x| x.checked_add(vals.offset()))
+            .ok_or("sparse value range overflows")?;
+        if idx_end > idx_data.len() || val_end > val_data.len() {
+            return Err("sparse accessor data lies outside its buffer views".into());
+        }
+        for k in 0..sc {
+            let s = idx.offset() + k * isize_;
+            let b = &idx_data[s..s + isize_];
+            let target = match isize_ {
+                1 => b[0] as usize,
+                2 => u16::from_le_bytes([b[0], b[1]]) as usize,
+                _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
+            };
+            if target >= count {
+                return Err(format!("sparse index {target} out of range (count {count})"));
+            }
+            let vs = vals.offset() + k * elem;
+            for c in 0..comps {
+                let s = vs + c * csize;
+                out[target * comps + c] = conv(&val_data[s..s + csize], ct);
+            }
+        }
+    }
+    Ok(out)
+}
+
+pub(super) fn read_floats(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<f32>, String> {
+    let norm = acc.normalized();
+    read_accessor(acc, buffers, &|b: &[u8], t: DataType| match t {
+        DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+        DataType::U8 => {
+            let v = b[0] as f32;
+            if norm { v / 255.0 } else { v }
+        }
+        DataType::I8 => {
+            let v = b[0] as i8 as f32;
+            if norm { (v / 127.0).max(-1.0) } else { v }
+        }
+        DataType::U16 => {
+            let v = u16::from_le_bytes([b[0], b[1]]) as f32;
+            if norm { v / 65535.0 } else { v }
+        }
+        DataType::I16 => {
+            let v = i16::from_le_bytes([b[0], b[1]]) as f32;
+            if norm { (v / 32767.0).max(-1.0) } else { v }
+        }
+        DataType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+    })
+}
+
+pub(super) fn read_indices(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>, String> {
+    if acc.dimensions() != Dimensions::Scalar {
+        return Err("index accessor is not SCALAR".into());
+    }
+    match acc.data_type() {
+        DataType::U8 | DataType::U16 | DataType::U32 => {}
+        t => return Err(format!("index component type {t:?} is not unsigned")),
+    }
+    read_accessor(acc, buffers, &|b: &[u8], t: DataType| match t {
+        DataType::U8 => b[0] as u32,
+        DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as u32,
+        _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+    })
+}

@@ -1,0 +1,153 @@
+//! The GI-method registry, walked: every registered method renders the default scene
+//! headlessly with finite output, draws its views, refuses an out-of-range setting by the
+//! field's name, and names the tests that check it against a CPU reference or for
+//! convergence (which must exist). A new method is held to all of it by its registry line.
+
+mod common;
+
+use lightcut::methods::{self, Kind, MethodId, REGISTRY};
+use lightcut::renderer::{
+    Buffer, FrameInput, Renderer,
+    settings::{RenderSettings, ViewBuffer},
+};
+use lightcut::scene::default_scene;
+
+/// Tiny: 48 x 32 pixels, 256 VPLs, small budgets.
+fn tiny(method: MethodId) -> RenderSettings {
+    let mut s = RenderSettings::default();
+    s.gi.method = method;
+    s.vpl.count = 256;
+    s.shadow.resolution = 256;
+    s.gi.rays_per_frame = 1 << 22;
+    s.gi.reference_samples = 8;
+    s.gi.reference_spp_per_frame = 8;
+    s.sampling.cut_size = 8;
+    s
+}
+
+#[test]
+fn every_method_renders_the_default_scene_with_finite_output_and_draws_its_views() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = default_scene::build();
+    let cam = scene.camera_or_default(None).unwrap();
+    let mut r = Renderer::new(ctx, &scene, (48, 32), tiny(REGISTRY[0].id)).unwrap();
+    for m in REGISTRY {
+        r.set_settings(tiny(m.id)).unwrap();
+        let frame = |r: &mut Renderer, view: ViewBuffer| {
+            r.render(&FrameInput {
+                camera: &cam,
+                lights: &scene.lights,
+                view,
+            })
+        };
+        // Progressive methods until they converge (bounded), per-frame ones a few frames.
+        for _ in 0..200 {
+            frame(&mut r, ViewBuffer::Final);
+            r.wait_idle();
+            if m.kind != Kind::Progressive || r.gi_progress().is_some_and(|p| p.finished()) {
+                break;
+            }
+        }
+        assert_eq!(
+            m.kind == Kind::Progressive,
+            r.gi_progress().is_some(),
+            "{}: progress is reported by progressive methods only",
+            m.id
+        );
+        let gi = r.read(Buffer::Indirect).unwrap();
+        assert!(
+            gi.pixels.iter().all(|p| p.iter().all(|v| v.is_finite())),
+            "{}: non-finite GI",
+            m.id
+        );
+        let mean = gi.mean_rgb();
+        if m.kind == Kind::DirectOnly {
+            assert_eq!(mean, [0.0; 3], "{}: GI must be black", m.id);
+        } else {
+            assert!(mean[0] > 0.0 && mean[1] > 0.0, "{}: no GI ({mean:?})", m.id);
+        }
+        // Its views draw something (not the cleared view) once it has rendered a frame.
+        for info in m.views {
+            let v = ViewBuffer::Method(methods::MethodView::new(info.name));
+            frame(&mut r, v);
+            let (w, h, rgba) = r.read_view_rgba8().unwrap();
+            assert!(w > 0 && h > 0, "{}: view '{}' is empty", m.id, v.name());
+            assert!(
+                rgba.chunks(4).any(|p| p[..3] != [0, 0, 0]),
+                "{}: view '{}' is black",
+                m.id,
+                v.name()
+            );
+        }
+        assert!(r.ctx.errors.take().is_empty(), "{}: GPU errors", m.id);
+    }
+}
+
+#[test]
+fn every_method_refuses_an_out_of_range_setting_by_name() {
+    for m in REGISTRY {
+        let Some(spoil) = m.invalid_example else {
+            continue;
+        };
+        let mut s = tiny(m.id);
+        assert_eq!((m.validate)(&s), Ok(()), "{}: defaults are valid", m.id);
+        let field = spoil(&mut s);
+        let e = (m.validate)(&s).expect_err(field);
+        assert!(e.contains(field), "{}: '{e}' does not name {field}", m.id);
+        // The settings as a whole are refused with the same message.
+        assert!(s.validate().unwrap_err().contains(field));
+    }
+}
+
+#[test]
+fn every_method_is_named_consistently_and_has_its_tests() {
+    let mut seen = Vec::new();
+    for m in REGISTRY {
+        // One id per row, parsed back from its CLI name and every alias.
+        assert!(!seen.contains(&m.id), "{} registered twice", m.id);
+        seen.push(m.id);
+        assert_eq!(MethodId::parse(m.id.cli()), Ok(m.id));
+        for a in m.aliases {
+            assert_eq!(MethodId::parse(a), Ok(m.id), "alias {a}");
+        }
+        assert!(!m.label.is_empty() && !m.short.is_empty() && !m.about.is_empty());
+        if m.kind == Kind::Progressive {
+            assert!(!m.progress_unit.is_empty(), "{}: progress unit", m.id);
+        }
+        if m.kind != Kind::DirectOnly {
+            assert!(!m.timed_passes.is_empty(), "{}: no timed passes", m.id);
+        }
+        // Its CPU-reference / convergence tests exist (file::name, a #[test] fn).
+        if m.kind != Kind::DirectOnly {
+            assert!(!m.tests.is_empty(), "{}: no reference or convergence test", m.id);
+        }
+        for t in m.tests {
+            let (file, name) = t.split_once("::").expect("file::test");
+            let path = format!("{}/tests/{file}.rs", env!("CARGO_MANIFEST_DIR"));
+            let text = std::fs::read_to_string(&path).unwrap_or_default();
+            let at = text.find(&format!("fn {name}("));
+            assert!(
+                at.is_some_and(|i| text[..i].trim_end().ends_with("#[test]")),
+                "{}: test {t} not found",
+                m.id
+            );
+        }
+        // Its shaders are embedded and validate.
+        for f in m.module.entry_shaders {
+            assert!(
+                m.module.shaders.iter().any(|(n, _)| n == f),
+                "{}: entry shader {f} not embedded",
+                m.id
+            );
+        }
+    }
+    assert!(MethodId::parse("nope").unwrap_err().contains("slc"));
+    // Older settings files spell the methods as enum variants.
+    assert_eq!(MethodId::parse("GroundTruth"), Ok(methods::ground_truth::ID));
+    assert_eq!(MethodId::parse("Off"), Ok(methods::direct_only::ID));
+    let s: RenderSettings = toml::from_str("[gi]\nmethod = \"Rtslc\"").unwrap();
+    assert_eq!(s.gi.method, methods::tree_samplers::RTSLC);
+    // The workbench and `render` open on the thesis's method.
+    assert_eq!(RenderSettings::default().gi.method, methods::tree_samplers::SLC);
+    assert_eq!(methods::comparison_truth(), methods::ground_truth::ID);
+}

@@ -1,0 +1,433 @@
+//! Every command example in README.md, run at a tiny size and checked to do what its comment
+//! promises. The README's `cargo run --release` lines and the table below must match exactly
+//! (a new example without a check, or a check of a removed example, fails the test). CLI
+//! examples run the built binary (sizes, frame counts and output folders shrunk or moved to a
+//! temporary folder); GUI examples build the app through `egui_kittest` from the same command
+//! line (`cli::gui_options`), as `main` does.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use clap::Parser;
+use egui_kittest::Harness;
+use lightcut::app::WorkbenchApp;
+use lightcut::cli::{Cli, gui_options};
+use lightcut::methods::{Kind, REGISTRY, tree_samplers};
+use lightcut::renderer::{Buffer, settings::ViewBuffer};
+
+/// The README's command lines (after `cargo run --release`), exactly as written there.
+const EXAMPLES: &[&str] = &[
+    "",
+    "-- methods",
+    "-- --scene scenes/sponza.toml",
+    "-- --scene ../shared/scenes/breakfast_room/BreakfastRoom.gltf --camera CameraMain",
+    "-- render --scene scenes/breakfast_room.toml --width 1280 --height 720 --out out/",
+    "-- render --scene default --width 320 --height 240 --method ground-truth --out out/gt",
+    "-- render --scene default --width 320 --height 240 --method reference --samples 1024 --out out/ref",
+    "-- export-scene --scene default --out out/scene",
+    "-- bench rays --scene scenes/sponza.toml",
+    "-- render --scene default --width 320 --height 240 --method slc --frames 16 --compare-gt --out out/slc",
+    "-- compare out/slc/indirect.exr out/slc/ground_truth_indirect.exr --exposure 3",
+    "-- bench tree",
+    "-- --view albedo --settings docs/settings-example.toml --tree-stats",
+    "-- --compare-gt --views \"final;GI only;traversal steps;A/B comparison\" --pin 150,70",
+    "-- sheet --methods slc,rtslc,sst --frames 16 --out screenshots/comparison_sheet.png",
+    "-- results --out docs/results",
+];
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Words of a command line (double quotes group, as the shell does for these examples).
+fn words(line: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    let mut quoted = false;
+    let mut any = false;
+    for c in line.chars() {
+        match c {
+            '"' => {
+                quoted = !quoted;
+                any = true;
+            }
+            c if c.is_whitespace() && !quoted => {
+                if any {
+                    out.push(std::mem::take(&mut cur));
+                    any = false;
+                }
+            }
+            c => {
+                cur.push(c);
+                any = true;
+            }
+        }
+    }
+    if any {
+        out.push(cur);
+    }
+    out
+}
+
+/// The `cargo run --release ...` lines of the README's shell blocks (the part after it).
+fn readme_examples() -> Vec<String> {
+    let text = std::fs::read_to_string(repo().join("README.md")).expect("README.md");
+    let mut in_sh = false;
+    let mut v = Vec::new();
+    for line in text.lines() {
+        if line.starts_with("```") {
+            in_sh = line.trim() == "```sh";
+            continue;
+        }
+        if !in_sh {
+            continue;
+        }
+        if let Some(i) = line.find("cargo run --release") {
+            v.push(line[i + "cargo run --release".len()..].trim().to_string());
+        }
+    }
+    v
+}
+
+#[test]
+fn the_readme_examples_are_the_checked_ones() {
+    let mut found = readme_examples();
+    found.sort();
+    found.dedup();
+    let mut want: Vec<String> = EXAMPLES.iter().map(|s| s.to_string()).collect();
+    want.sort();
+    assert_eq!(found, want, "README examples and the checked examples differ");
+}
+
+/// The example's arguments after `--`, with `(flag, value)` replaced and `extra` appended.
+fn args(example: &str, replace: &[(&str, &str)], extra: &[&str]) -> Vec<String> {
+    let mut w = words(example);
+    if !w.is_empty() {
+        assert_eq!(w[0], "--", "{example}");
+        w.remove(0);
+    }
+    for (flag, value) in replace {
+        let i = w
+            .iter()
+            .position(|x| x == flag)
+            .unwrap_or_else(|| panic!("{flag} in {example}"));
+        w[i + 1] = value.to_string();
+    }
+    w.extend(extra.iter().map(|s| s.to_string()));
+    w
+}
+
+fn run_cli(a: &[String]) -> String {
+    let o = Command::new(env!("CARGO_BIN_EXE_lightcut-workbench"))
+        .args(a)
+        .current_dir(repo())
+        .output()
+        .expect("run the binary");
+    let stdout = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        o.status.success(),
+        "{a:?} failed\nstdout: {stdout}\nstderr: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    stdout
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("lightcut-readme-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn mean(path: &Path) -> [f64; 3] {
+    lightcut::export::read_exr(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .mean_rgb()
+}
+
+fn shared_present() -> bool {
+    repo().join("../shared/scenes/sponza/Sponza.gltf").is_file()
+}
+
+fn setup() -> egui_wgpu::WgpuSetup {
+    let mut s = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
+    s.instance_descriptor.backends = lightcut::renderer::context::BACKENDS;
+    s.device_descriptor = std::sync::Arc::new(lightcut::renderer::context::device_descriptor);
+    egui_wgpu::WgpuSetup::CreateNew(s)
+}
+
+/// The GUI of `example` (no subcommand) in a small window, after `steps` frames.
+fn gui(example: &str, size: egui::Vec2, steps: usize) -> Harness<'static, WorkbenchApp> {
+    let mut argv = vec!["lightcut-workbench".to_string()];
+    argv.extend(args(example, &[], &[]));
+    let cli = Cli::try_parse_from(&argv).unwrap_or_else(|e| panic!("{example}: {e}"));
+    // A fresh app state (no saved layout), as on a clean checkout.
+    let options = gui_options(&cli).expect("options");
+    let mut h = Harness::builder()
+        .with_size(size)
+        .wgpu_setup(setup())
+        .build_eframe(move |cc| WorkbenchApp::new(cc, options.clone()));
+    h.run_steps(steps);
+    assert!(
+        h.state().errors().is_empty(),
+        "{example}: {:?}",
+        h.state().errors()
+    );
+    h
+}
+
+fn gi_mean(h: &Harness<'_, WorkbenchApp>) -> [f64; 3] {
+    h.state()
+        .renderer()
+        .expect("renderer")
+        .read(Buffer::Indirect)
+        .expect("GI")
+        .mean_rgb()
+}
+
+#[test]
+fn gui_examples_open_what_they_promise() {
+    if common::gpu().is_none() {
+        return;
+    }
+    // `cargo run --release`: SLC, GI visible, the four first-screen views, the comparison's
+    // ground truth running.
+    let h = gui("", egui::vec2(900.0, 600.0), 4);
+    let r = h.state().renderer().expect("renderer");
+    assert_eq!(r.settings().gi.method, tree_samplers::SLC);
+    let views: Vec<ViewBuffer> = h.state().layout().panes().iter().map(|p| p.spec.buffer).collect();
+    assert_eq!(views, lightcut::app::FIRST_SCREEN.to_vec());
+    assert!(gi_mean(&h)[1] > 0.0, "GI is black");
+    assert!(r.compare_progress().is_some(), "no ground truth beside SLC");
+    drop(h);
+
+    // The views, the ground truth and a pinned pixel's story with samples.
+    let ex = "-- --compare-gt --views \"final;GI only;traversal steps;A/B comparison\" --pin 150,70";
+    let h = gui(ex, egui::vec2(1440.0, 900.0), 5);
+    assert_eq!(h.state().layout().view_count(), 4);
+    assert!(gi_mean(&h)[1] > 0.0, "GI is black");
+    let r = h.state().renderer().expect("renderer");
+    assert!(
+        r.compare_progress().is_some_and(|p| p.done > 0),
+        "no ground truth"
+    );
+    let story = h.state().story();
+    assert!(story.show, "the story is not open");
+    let t = story.trace.as_ref().unwrap_or_else(|| {
+        panic!(
+            "no story at the pinned pixel (frame {:?}): {}",
+            r.size(),
+            story.note
+        )
+    });
+    assert!(!t.samples.is_empty(), "a story without samples");
+    drop(h);
+
+    // A view and a settings file by name, the statistics window open.
+    let h = gui(
+        "-- --view albedo --settings docs/settings-example.toml --tree-stats",
+        egui::vec2(700.0, 500.0),
+        3,
+    );
+    assert_eq!(h.state().view(), ViewBuffer::Albedo);
+    assert!(h.state().tree_stats_shown());
+    let s = h.state().renderer().expect("renderer").settings();
+    assert_eq!(
+        (s.shadow.resolution, s.vpl.count, s.sampling.cut_size),
+        (1024, 2048, 16)
+    );
+    drop(h);
+
+    if !shared_present() {
+        eprintln!("SKIPPED the shared-scene GUI examples: ../shared/scenes not found");
+        return;
+    }
+    let h = gui("-- --scene scenes/sponza.toml", egui::vec2(700.0, 500.0), 2);
+    assert_eq!(h.state().open().expect("a scene").scene.name, "Sponza");
+    drop(h);
+    let h = gui(
+        "-- --scene ../shared/scenes/breakfast_room/BreakfastRoom.gltf --camera CameraMain",
+        egui::vec2(700.0, 500.0),
+        2,
+    );
+    assert_eq!(h.state().open().expect("a scene").camera.name, "CameraMain");
+}
+
+#[test]
+fn cli_examples_write_what_they_promise() {
+    if common::gpu().is_none() {
+        return;
+    }
+    // The method table lists every registered method.
+    let out = run_cli(&args("-- methods", &[], &[]));
+    for m in REGISTRY {
+        assert!(out.contains(m.id.cli()), "{} missing from `methods`", m.id);
+    }
+
+    // Ground truth and reference: GI written, the promised summary printed.
+    let gt = tmp("gt");
+    let out = run_cli(&args(
+        "-- render --scene default --width 320 --height 240 --method ground-truth --out out/gt",
+        &[
+            ("--width", "40"),
+            ("--height", "30"),
+            ("--out", gt.to_str().unwrap()),
+        ],
+        &["--vpls", "256"],
+    ));
+    assert!(out.contains("ground truth: 256 VPLs"), "{out}");
+    assert!(mean(&gt.join("indirect.exr"))[1] > 0.0);
+    let rf = tmp("ref");
+    let out = run_cli(&args(
+        "-- render --scene default --width 320 --height 240 --method reference --samples 1024 --out out/ref",
+        &[
+            ("--width", "40"),
+            ("--height", "30"),
+            ("--samples", "8"),
+            ("--out", rf.to_str().unwrap()),
+        ],
+        &[],
+    ));
+    assert!(out.contains("reference: 8 samples per pixel"), "{out}");
+    assert!(mean(&rf.join("indirect.exr"))[1] > 0.0);
+
+    // The scene for an independent renderer.
+    let sc = tmp("scene");
+    run_cli(&args(
+        "-- export-scene --scene default --out out/scene",
+        &[("--out", sc.to_str().unwrap())],
+        &[],
+    ));
+    assert!(sc.join("scene.json").is_file() && sc.join("mesh_0.ply").is_file());
+
+    // SLC with the ground truth of the same VPLs; then `compare` on its two EXRs.
+    let slc = tmp("slc");
+    let out = run_cli(&args(
+        "-- render --scene default --width 320 --height 240 --method slc --frames 16 --compare-gt --out out/slc",
+        &[
+            ("--width", "40"),
+            ("--height", "30"),
+            ("--frames", "2"),
+            ("--out", slc.to_str().unwrap()),
+        ],
+        &["--vpls", "256"],
+    ));
+    assert!(out.contains("vs ground truth"), "{out}");
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(slc.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(m["method"], "slc");
+    assert!(
+        m["vs_ground_truth"]["rmse"]
+            .as_f64()
+            .is_some_and(|v| v.is_finite())
+    );
+    assert!(slc.join("traversal_steps.png").is_file());
+    let a = slc.join("indirect.exr");
+    let b = slc.join("ground_truth_indirect.exr");
+    let ex = format!("-- compare {} {} --exposure 3", a.display(), b.display());
+    let out = run_cli(&args(&ex, &[], &[]));
+    assert!(out.contains("RMSE") && out.contains("SSIM"), "{out}");
+
+    // The light-tree benchmark (two sizes here) prints a row per size and the slopes.
+    let out = run_cli(&args("-- bench tree", &[], &["--max-log2", "13"]));
+    assert!(
+        out.contains("4096") && out.contains("8192") && out.contains("slope"),
+        "{out}"
+    );
+
+    // A comparison sheet of three methods.
+    let sh = tmp("sheet");
+    let png = sh.join("sheet.png");
+    run_cli(&args(
+        "-- sheet --methods slc,rtslc,sst --frames 16 --out screenshots/comparison_sheet.png",
+        &[("--frames", "1"), ("--out", png.to_str().unwrap())],
+        &["--width", "40", "--height", "30", "--vpls", "256"],
+    ));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(sh.join("sheet.json")).unwrap()).unwrap();
+    assert_eq!(json["columns"].as_array().map(Vec::len), Some(3));
+    assert!(image::open(&png).is_ok());
+
+    // `results`: one figure at a tiny size (tests/harness.rs runs every figure).
+    let rs = tmp("results");
+    run_cli(&args(
+        "-- results --out docs/results",
+        &[("--out", rs.to_str().unwrap())],
+        &[
+            "timings",
+            "--scenes",
+            "default",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--frames",
+            "1",
+            "--timing-frames",
+            "2",
+        ],
+    ));
+    let csv = std::fs::read_dir(&rs)
+        .expect("results folder")
+        .filter_map(|e| e.ok())
+        .map(|e| e.path().join("timings.csv"))
+        .find(|p| p.is_file());
+    assert!(csv.is_some(), "no timings.csv under {}", rs.display());
+
+    // Per-frame methods all render headlessly too (the registry, not only SLC).
+    for m in REGISTRY.iter().filter(|m| m.kind == Kind::PerFrame) {
+        let d = tmp(m.id.cli());
+        run_cli(
+            &[
+                "render",
+                "--scene",
+                "default",
+                "--width",
+                "32",
+                "--height",
+                "24",
+                "--vpls",
+                "256",
+                "--output",
+                "indirect",
+                "--method",
+                m.id.cli(),
+                "--out",
+                d.to_str().unwrap(),
+            ]
+            .map(String::from),
+        );
+        assert!(mean(&d.join("indirect.exr"))[1] > 0.0, "{}: black GI", m.id);
+    }
+
+    for d in [gt, rf, sc, slc, sh, rs] {
+        let _ = std::fs::remove_dir_all(d);
+    }
+
+    if !shared_present() {
+        eprintln!("SKIPPED the shared-scene CLI examples: ../shared/scenes not found");
+        return;
+    }
+    // Breakfast Room headless, SLC by default: GI, SLC's views and its metrics.
+    let br = tmp("breakfast");
+    run_cli(&args(
+        "-- render --scene scenes/breakfast_room.toml --width 1280 --height 720 --out out/",
+        &[
+            ("--width", "48"),
+            ("--height", "27"),
+            ("--out", br.to_str().unwrap()),
+        ],
+        &["--vpls", "256", "--max-texture", "64"],
+    ));
+    assert!(mean(&br.join("indirect.exr"))[1] > 0.0, "no GI");
+    assert!(br.join("metrics.json").is_file() && br.join("cut_blocks.png").is_file());
+    let _ = std::fs::remove_dir_all(br);
+    // Shadow rays per second through Sponza's BVH.
+    let out = run_cli(&args(
+        "-- bench rays --scene scenes/sponza.toml",
+        &[],
+        &["--rays", "4096", "--repeat", "1"],
+    ));
+    assert!(out.contains("rays") && out.contains("Sponza"), "{out}");
+}
