@@ -66,7 +66,11 @@ fn every_method_renders_the_default_scene_with_finite_output_and_draws_its_views
         } else {
             assert!(mean[0] > 0.0 && mean[1] > 0.0, "{}: no GI ({mean:?})", m.id);
         }
-        // Its views draw something (not the cleared view) once it has rendered a frame.
+        // Its views draw their own image: not the cleared view, not the final image, and not
+        // each other; export finds the data behind each.
+        frame(&mut r, ViewBuffer::Final);
+        let fin = r.read_view_rgba8().unwrap();
+        let mut seen: Vec<Vec<u8>> = Vec::new();
         for info in m.views {
             let v = ViewBuffer::Method(methods::MethodView::new(info.name));
             frame(&mut r, v);
@@ -75,6 +79,26 @@ fn every_method_renders_the_default_scene_with_finite_output_and_draws_its_views
             assert!(
                 rgba.chunks(4).any(|p| p[..3] != [0, 0, 0]),
                 "{}: view '{}' is black",
+                m.id,
+                v.name()
+            );
+            assert!(
+                (w, h, &rgba) != (fin.0, fin.1, &fin.2),
+                "{}: view '{}' is the final image",
+                m.id,
+                v.name()
+            );
+            assert!(
+                !seen.contains(&rgba),
+                "{}: view '{}' repeats another view",
+                m.id,
+                v.name()
+            );
+            seen.push(rgba);
+            let data = r.read_view_buffer(v).unwrap();
+            assert!(
+                data.is_some_and(|d| d.width > 0 && d.height > 0),
+                "{}: view '{}' has no data to export",
                 m.id,
                 v.name()
             );
@@ -132,7 +156,7 @@ fn every_method_is_named_consistently_and_has_its_tests() {
                 m.id
             );
         }
-        // Its shaders are embedded and validate.
+        // Its entry shaders are embedded (`renderer::shaders` validates every one with naga).
         for f in m.module.entry_shaders {
             assert!(
                 m.module.shaders.iter().any(|(n, _)| n == f),

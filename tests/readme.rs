@@ -35,6 +35,8 @@ const EXAMPLES: &[&str] = &[
     "-- --compare-gt --views \"final;GI only;traversal steps;A/B comparison\" --pin 150,70",
     "-- sheet --methods slc,rtslc,sst --frames 16 --out screenshots/comparison_sheet.png",
     "-- results --out docs/results",
+    // Not `cargo run`: the independent check, run when Mitsuba 3 is importable.
+    "python3 scripts/mitsuba_check.py --scene-dir out/scene --ours out/ref --width 320 --height 240 --indirect --out out/check",
 ];
 
 fn repo() -> PathBuf {
@@ -86,6 +88,8 @@ fn readme_examples() -> Vec<String> {
         }
         if let Some(i) = line.find("cargo run --release") {
             v.push(line[i + "cargo run --release".len()..].trim().to_string());
+        } else if line.starts_with("python3 ") {
+            v.push(line.trim().to_string());
         }
     }
     v
@@ -214,6 +218,10 @@ fn gui_examples_open_what_they_promise() {
     );
     let story = h.state().story();
     assert!(story.show, "the story is not open");
+    assert!(
+        h.state().docked_tools().contains(&lightcut::app::Tool::Story),
+        "the story floats over the views instead of docking beside them"
+    );
     let t = story.trace.as_ref().unwrap_or_else(|| {
         panic!(
             "no story at the pinned pixel (frame {:?}): {}",
@@ -262,7 +270,12 @@ fn cli_examples_write_what_they_promise() {
     // The method table lists every registered method.
     let out = run_cli(&args("-- methods", &[], &[]));
     for m in REGISTRY {
-        assert!(out.contains(m.id.cli()), "{} missing from `methods`", m.id);
+        let row = format!("{:<14} ", m.id.cli());
+        assert!(
+            out.lines().any(|l| l.starts_with(&row)),
+            "{} missing from `methods`",
+            m.id
+        );
     }
 
     // Ground truth and reference: GI written, the promised summary printed.
@@ -300,6 +313,43 @@ fn cli_examples_write_what_they_promise() {
         &[],
     ));
     assert!(sc.join("scene.json").is_file() && sc.join("mesh_0.ply").is_file());
+
+    // The Mitsuba 3 check of the reference against the exported scene (docs/mitsuba_check.md),
+    // where the `mitsuba` Python package is installed.
+    let has_mitsuba = Command::new("python3")
+        .args(["-c", "import mitsuba, numpy"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if has_mitsuba {
+        let ck = tmp("check");
+        let ex = "python3 scripts/mitsuba_check.py --scene-dir out/scene --ours out/ref --width 320 --height 240 --indirect --out out/check";
+        let mut w = words(ex);
+        for (flag, value) in [
+            ("--scene-dir", sc.to_str().unwrap()),
+            ("--ours", rf.to_str().unwrap()),
+            ("--width", "40"),
+            ("--height", "30"),
+            ("--out", ck.to_str().unwrap()),
+        ] {
+            let i = w.iter().position(|x| x == flag).expect(flag);
+            w[i + 1] = value.to_string();
+        }
+        let o = Command::new(&w[0])
+            .args(&w[1..])
+            .args(["--spp", "16", "--splits", "2"])
+            .current_dir(repo())
+            .output()
+            .expect("python3");
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            o.status.success() && out.contains("Mitsuba"),
+            "{out}\n{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let _ = std::fs::remove_dir_all(ck);
+    } else {
+        eprintln!("SKIPPED scripts/mitsuba_check.py: the mitsuba Python package is not installed");
+    }
 
     // SLC with the ground truth of the same VPLs; then `compare` on its two EXRs.
     let slc = tmp("slc");

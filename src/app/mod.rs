@@ -12,6 +12,8 @@ mod exports;
 mod frame;
 mod side_panel;
 mod tool_dock;
+
+pub use tool_dock::Tool;
 mod windows;
 
 pub use exports::{export_view_files, preset_files, write_sheet};
@@ -454,6 +456,10 @@ impl WorkbenchApp {
     }
     pub fn errors(&self) -> &[String] {
         &self.errors
+    }
+    /// The tools docked beside the views (the others float or are closed).
+    pub fn docked_tools(&self) -> Vec<Tool> {
+        self.tools.docked()
     }
     /// Whether the light-tree statistics window is open.
     pub fn tree_stats_shown(&self) -> bool {

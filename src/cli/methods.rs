@@ -12,6 +12,10 @@ pub fn run() -> anyhow::Result<()> {
             Kind::PerFrame => "per frame",
         };
         println!("{:<14} {:<12} {:<34} {}", m.id.cli(), kind, m.label, m.about);
+        if !m.reads.is_empty() {
+            let r: Vec<String> = m.reads.iter().map(|r| format!("{r:?}")).collect();
+            println!("{:<14} reads: {}", "", r.join(", "));
+        }
         if !m.views.is_empty() {
             let v: Vec<&str> = m.views.iter().map(|v| v.name).collect();
             println!("{:<14} views: {}", "", v.join("; "));

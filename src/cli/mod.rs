@@ -49,7 +49,8 @@ pub struct Cli {
     /// (e.g. "final;GI only;traversal steps"); the saved layout is not used then.
     #[arg(long)]
     pub views: Option<String>,
-    /// Ignore the saved view layout (one view of the final image).
+    /// Ignore the saved view layout (the first screen: final, GI, ground truth, traversal
+    /// steps; or the views of --view / --views).
     #[arg(long)]
     pub reset_layout: bool,
     /// Pin a frame pixel "X,Y" and open its pixel story (tree samplers).

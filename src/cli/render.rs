@@ -227,7 +227,8 @@ pub struct RenderArgs {
     pub sampling: SamplingArgs,
 }
 
-/// metrics.json of a tree sampler: traversal statistics, per-pass times and (with
+/// metrics.json of a per-frame method: frames, per-pass times, the tree samplers' traversal
+/// statistics, and (with
 /// --compare-gt) RMSE / SSIM against the ground truth of the same VPLs.
 fn write_metrics(
     r: &mut Renderer,
@@ -237,26 +238,30 @@ fn write_metrics(
     frame: &dyn Fn(&mut Renderer, ViewBuffer),
 ) -> anyhow::Result<()> {
     let s = r.settings().clone();
-    let st = r.sampling_stats_blocking().unwrap_or_default();
+    let tree = s.gi.method.samples_tree();
+    let st = if tree { r.sampling_stats_blocking() } else { None };
     let mut json = serde_json::json!({
         "method": s.gi.method.cli(),
         "width": args.width,
         "height": args.height,
         "vpls": r.vpl_frame().count,
         "frames_averaged": r.sampling_frames(),
-        "sampling": &s.sampling,
         "tree": &s.tree,
         "n_min": s.vpl.n_min,
         "d_max_fraction_of_scene_radius": s.vpl.d_max,
         "distance_epsilon": s.gi.distance_epsilon,
-        "steps_per_traversal": st.steps_per_traversal(),
-        "steps_per_pixel": st.steps_per_pixel(),
-        "fallback_pixel_fraction": st.fallback_fraction(),
-        "dead_branches": st.dead,
-        "traversals": st.traversals,
         "gpu_ms": timings.map(|t| t.passes.iter().map(|(n, ms)| (n.clone(), *ms)).collect::<std::collections::BTreeMap<_, _>>()),
         "indirect_mean_rgb": indirect.mean_rgb(),
     });
+    // The tree samplers' settings and traversal statistics.
+    if let Some(st) = st {
+        json["sampling"] = serde_json::to_value(&s.sampling)?;
+        json["steps_per_traversal"] = st.steps_per_traversal().into();
+        json["steps_per_pixel"] = st.steps_per_pixel().into();
+        json["fallback_pixel_fraction"] = st.fallback_fraction().into();
+        json["dead_branches"] = st.dead.into();
+        json["traversals"] = st.traversals.into();
+    }
     if args.sampling.compare_gt {
         let mut g = s.clone();
         g.gi.method = crate::methods::comparison_truth();
@@ -288,10 +293,6 @@ fn write_metrics(
     std::fs::write(&path, serde_json::to_string_pretty(&json)?)
         .with_context(|| format!("cannot write {}", path.display()))?;
     Ok(())
-}
-
-fn settings_method(r: &Renderer) -> MethodId {
-    r.settings().gi.method
 }
 
 /// GPU time of `method`'s own passes in one frame's timings.
@@ -370,16 +371,16 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         r.ctx.wait_idle()?;
     }
     let timings = r.wait_timings();
-    // Tree samplers: average --frames independent frames (the timing frames count).
-    if settings_method(&r).samples_tree() {
-        while r.sampling_frames() < args.sampling.frames {
+    // Per-frame methods that average: --frames independent frames (the timing frames count).
+    if method.per_frame() {
+        while r.frames_averaged().is_some_and(|n| n < args.sampling.frames) {
             if let Some(e) = r.ctx.errors.take().into_iter().next() {
                 return Err(anyhow!("GPU error: {e}"));
             }
             frame(&mut r, ViewBuffer::Final);
             r.ctx.wait_idle()?;
         }
-        if let Some(st) = r.sampling_stats_blocking() {
+        if let Some(st) = r.sampling_stats_blocking().filter(|_| method.samples_tree()) {
             println!(
                 "tree sampling: {} frame(s) averaged; {:.3} traversal steps per traversal, {:.2} per pixel; {:.3}% of pixels without a similar cut; {} dead branches in the last frame",
                 r.sampling_frames(),
@@ -522,7 +523,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             write_png(&out.join(name), w, h, &bytes)?;
         }
     }
-    if settings_method(&r).samples_tree() {
+    if method.per_frame() {
         write_metrics(&mut r, args, &indirect, timings.as_ref(), &frame)?;
     }
     if let Some(e) = r.ctx.errors.take().into_iter().next() {

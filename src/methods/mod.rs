@@ -24,7 +24,6 @@ use std::fmt;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::renderer::{
-    GiProgress,
     context::{ErrorSink, GpuContext, GpuError},
     frame::FrameTargets,
     passes::{
@@ -196,6 +195,27 @@ pub fn validate_all(s: &RenderSettings) -> Result<(), String> {
     Ok(())
 }
 
+/// Progress of a progressive method: VPLs (ground truth) or samples per pixel (reference).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GiProgress {
+    /// Units done so far (`MethodInfo::progress_unit`).
+    pub done: u32,
+    pub total: u32,
+}
+
+impl GiProgress {
+    pub fn fraction(&self) -> f32 {
+        if self.total == 0 {
+            1.0
+        } else {
+            self.done as f32 / self.total as f32
+        }
+    }
+    pub fn finished(&self) -> bool {
+        self.done >= self.total
+    }
+}
+
 /// A view a method draws beside final / direct / GI (the tree samplers' traversal steps, ...).
 pub struct ViewInfo {
     /// Its name in every buffer menu, in `--views` and in saved layouts (unique over the
@@ -326,8 +346,9 @@ pub struct MethodInfo {
     pub progress_unit: &'static str,
     pub module: &'static Module,
     pub reads: &'static [Resource],
-    /// The named views it draws beside final / direct / GI (every buffer menu lists them as
-    /// `ViewBuffer::Method`; A/B, pixel values and export work on them as on every view).
+    /// The named views it draws beside final / direct / GI (every buffer menu, `--views` and
+    /// `render`'s PNGs list them as `ViewBuffer::Method`; export writes the PNG as shown and
+    /// the EXR of `Method::read_view`; A/B compares radiance buffers and snapshots, not these).
     pub views: &'static [ViewInfo],
     /// Its GPU passes (timer names) that form its GI cost: the harness's equal-time cost and
     /// the `gi_gpu_ms` column.
@@ -399,6 +420,10 @@ pub trait Method: Any {
     /// Records this frame's passes writing `cx.gi_accum`; returns the composite's scale of
     /// the accumulation (1 / frames summed; 0 = no GI yet).
     fn record(&mut self, cx: &mut FrameCx<'_>, enc: &mut wgpu::CommandEncoder) -> f32;
+    /// Frames averaged in its current image (per-frame methods; None: it does not average).
+    fn frames_averaged(&self) -> Option<u32> {
+        None
+    }
     /// Progress towards convergence (progressive methods).
     fn progress(&self) -> Option<GiProgress> {
         None

@@ -365,8 +365,16 @@ impl Renderer {
         let key = self.compare_key(input, lights, size);
         let truth = methods::comparison_truth();
         let mut cmp = match self.compare.take() {
-            Some(c) if c.targets_size == size => c,
-            _ => match (truth.info().module.create)(&device) {
+            // A new size: new targets, the same pipelines, the sum restarts.
+            Some(mut c) => {
+                if c.targets_size != size {
+                    c.targets = frame::LightingTargets::new(&device, size);
+                    c.targets_size = size;
+                    c.truth.reset();
+                }
+                c
+            }
+            None => match (truth.info().module.create)(&device) {
                 Ok(m) => CompareState {
                     truth: m,
                     targets: frame::LightingTargets::new(&device, size),

@@ -86,9 +86,17 @@ impl Renderer {
         Ok(Some((pos, nrm, bytemuck::cast_slice(&acc).to_vec())))
     }
 
-    /// Frames summed in the tree samplers' accumulation (0 before the first).
+    /// Frames the current method averaged in its image (None: it does not average).
+    pub fn frames_averaged(&self) -> Option<u32> {
+        self.method_instance(self.settings.gi.method)?.frames_averaged()
+    }
+
+    /// Frames summed in the current method's accumulation (0 before the first, or when it
+    /// does not average).
     pub fn sampling_frames(&self) -> u32 {
-        self.tree_samplers().map_or(0, |t| t.frames())
+        self.method_instance(self.settings.gi.method)
+            .and_then(|m| m.frames_averaged())
+            .unwrap_or(0)
     }
 
     /// The last frame's sampling counters, waiting for them.

@@ -95,26 +95,7 @@ pub enum Buffer {
     GroundTruthIndirect,
 }
 
-/// Progress of the progressive GI method (ground truth).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct GiProgress {
-    /// VPLs evaluated at every pixel so far.
-    pub done: u32,
-    pub total: u32,
-}
-
-impl GiProgress {
-    pub fn fraction(&self) -> f32 {
-        if self.total == 0 {
-            1.0
-        } else {
-            self.done as f32 / self.total as f32
-        }
-    }
-    pub fn finished(&self) -> bool {
-        self.done >= self.total
-    }
-}
+pub use crate::methods::GiProgress;
 
 /// Half-resolution G-buffer position and normal, and the sampler's demodulated sums there.
 pub type HalfReadback = (ImageF32, ImageF32, Vec<[f32; 4]>);

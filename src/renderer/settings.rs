@@ -472,10 +472,13 @@ impl RenderSettings {
             .keys()
             .find(|k| MethodId::parse(k).map(|m| m.cli()) != Ok(k.as_str()))
         {
-            return Err(format!(
-                "methods.{k}: no such method (the methods: {})",
-                crate::methods::cli_names().join(", ")
-            ));
+            return Err(match MethodId::parse(k) {
+                Ok(m) => format!("methods.{k}: write the method's name as [methods.{}]", m.cli()),
+                Err(_) => format!(
+                    "methods.{k}: no such method (the methods: {})",
+                    crate::methods::cli_names().join(", ")
+                ),
+            });
         }
         crate::methods::validate_all(self)
     }

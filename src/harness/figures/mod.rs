@@ -13,7 +13,10 @@ use std::path::Path;
 use anyhow::Context;
 
 use super::{Bench, Csv, Measured, PASS_GROUPS, SAMPLE_PASSES, gi_passes, mean_std, num, plot};
-use crate::methods::{self as gi_methods, MethodId, direct_only, tree_samplers::SLC};
+use crate::methods::{
+    self as gi_methods, MethodId, direct_only,
+    tree_samplers::{RTSLC, SLC, SST},
+};
 use crate::renderer::settings::{CutBlending, CutFallback, RenderSettings};
 
 /// What every figure needs besides the bench.
@@ -77,12 +80,18 @@ pub struct Report {
     pub checks: Vec<Check>,
 }
 
-/// The three samplers, in the order (and colours) of every plot.
+/// The methods of every sweep, in the order (and colours) of every plot: the thesis's
+/// comparison first, SLC, RTSLC, SST (the checks index them so), then any other per-frame
+/// method of the registry.
 pub fn methods() -> Vec<(MethodId, &'static str)> {
-    gi_methods::per_frame()
-        .into_iter()
-        .map(|m| (m, m.info().short))
-        .collect()
+    let thesis = [SLC, RTSLC, SST];
+    let mut v = thesis.to_vec();
+    v.extend(
+        gi_methods::per_frame()
+            .into_iter()
+            .filter(|m| !thesis.contains(m)),
+    );
+    v.into_iter().map(|m| (m, m.info().short)).collect()
 }
 
 fn with(b: &Bench, f: impl FnOnce(&mut RenderSettings)) -> RenderSettings {

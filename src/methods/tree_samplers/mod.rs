@@ -419,6 +419,10 @@ impl Method for TreeSamplers {
         self.pass.after_submit();
     }
 
+    fn frames_averaged(&self) -> Option<u32> {
+        Some(self.frames())
+    }
+
     /// The diagnostics are drawn at the GI resolution (full or half).
     fn view_size(&self, _view: MethodView, frame: (u32, u32)) -> Option<(u32, u32)> {
         let b = &self.buffers;
