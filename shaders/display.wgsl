@@ -1,7 +1,7 @@
 // Display: exposure, tonemap and sRGB encoding of a linear-radiance buffer into the Rgba8Unorm
 // texture the UI shows (and the PNG exports use), with the view's look: channel isolation,
 // log10 false colour of the (isolated) value, NaN/Inf highlight. CPU twin:
-// `reference::display::encode_look`.
+// `base::display::encode_look`.
 #include "common/color.wgsl"
 
 struct DisplayParams {

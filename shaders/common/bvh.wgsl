@@ -8,7 +8,7 @@
 //     @group(G) @binding(B0) var<storage, read> bvh_nodes: array<BvhNode>;
 //     @group(G) @binding(B1) var<storage, read> bvh_triangles: array<BvhTriangle>;
 //
-// filled with the bytes of `Bvh::nodes` / `Bvh::triangles` (src/scene/bvh.rs, `bytemuck::cast_slice`).
+// filled with the bytes of `Bvh::nodes` / `Bvh::triangles` (src/scene/bvh/mod.rs, `bytemuck::cast_slice`).
 // WGSL allows module-scope declarations to be used before they appear, so the declarations may
 // come before or after this file's text. Every name declared here starts with `bvh_`, `Bvh` or
 // `BVH_`.

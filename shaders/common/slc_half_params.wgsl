@@ -1,5 +1,5 @@
-// Parameters of half-resolution GI (shaders/slc_half.wgsl, shaders/slc_upsample.wgsl).
-// Twin of `GpuHalfParams` in src/renderer/passes/slc_half.rs.
+// Parameters of half-resolution GI (shaders/methods/tree_samplers/slc_half.wgsl, slc_upsample.wgsl).
+// Twin of `GpuHalfParams` in src/methods/tree_samplers/half.rs.
 struct HalfParams {
     full_w: u32,
     full_h: u32,

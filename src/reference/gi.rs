@@ -1,5 +1,5 @@
 //! References of the one-bounce GI kernels: the exact sum over every RSM texel (what the
-//! converged reference `shaders/reference.wgsl` estimates) at one surface point.
+//! converged reference `shaders/methods/reference/reference.wgsl` estimates) at one surface point.
 
 use glam::Vec3;
 

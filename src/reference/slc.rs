@@ -1,6 +1,6 @@
 //! Reference of the tree sampling (stages 11-15; thesis chapter 5): node weights, shallow
 //! light cuts, cut blending weights, mock cuts, traversal and cluster evaluation. The GPU twins
-//! are `shaders/common/slc.wgsl`, `shaders/slc_cuts.wgsl` and `shaders/slc_sample.wgsl`.
+//! are `shaders/common/slc.wgsl`, `shaders/methods/tree_samplers/slc_cuts.wgsl` and `slc_sample.wgsl`.
 //!
 //! Weight of node C at shading point x with normal n (thesis eq. 5.5 with M = 1 for diffuse
 //! surfaces, V = 1, and the geometric term of eq. 5.2):
@@ -299,7 +299,7 @@ pub fn subtree_sum(nodes: &[SstNode], node: u32, g: &dyn Fn(&SstNode) -> f32) ->
         .sum()
 }
 
-/// Reference of `shaders/slc_upsample.wgsl`: full-resolution pixel (x, y) from the 4
+/// Reference of `shaders/methods/tree_samplers/slc_upsample.wgsl`: full-resolution pixel (x, y) from the 4
 /// half-resolution samples around (x/2, y/2) (half pixel h holds full pixel 2h), with
 /// bilinear weights x S (eq. 5.3); if none is similar, the neighbour with the most similar
 /// normal. Returns the demodulated value (multiply by the albedo for radiance); None without

@@ -294,7 +294,7 @@ pub struct GpuSlcParams {
     pub child_probability: u32,
 }
 
-/// Twin: `GtParams` in `shaders/ground_truth.wgsl`.
+/// Twin: `GtParams` in `shaders/methods/ground_truth/ground_truth.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuGtParams {

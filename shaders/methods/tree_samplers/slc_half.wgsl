@@ -1,6 +1,6 @@
 // Half-resolution GI (thesis chapter 6, "Upsampling"), first half: the G-buffer sample at
 // pixel (2x, 2y) becomes half-resolution pixel (x, y). The sampler then runs there
-// (demodulated: without the albedo) and shaders/slc_upsample.wgsl fills each full-resolution
+// (demodulated: without the albedo) and slc_upsample.wgsl fills each full-resolution
 // pixel from the 4 nearest half-resolution samples with bilinear weights x S(x, sample)
 // (eq. 5.3: a joint bilateral filter), re-modulated with the full-resolution albedo; where no
 // neighbour is similar, the neighbour with the most similar normal is used.

@@ -40,7 +40,7 @@
 @group(0) @binding(12) var<storage, read_write> stats: array<atomic<u32>>;
 
 // The pixel story (`trace_pixel`): what its samples did this frame. Layout (u32 words, f32
-// bitcast) in `passes::slc::PixelTrace`: a 32-word header, then per sample (the first
+// bitcast) in `methods::tree_samplers::pass::PixelTrace`: a 32-word header, then per sample (the first
 // TRACE_SAMPLES) a 64-word record: slot, start node, end node, steps, stop reason, path
 // probability, sampled point xyz, visible, contribution rgb (flux/pi x G x V / prob), then
 // the path as (child taken, its probability) pairs.

@@ -1,4 +1,4 @@
-// The upsampling half of shaders/slc_half.wgsl (separate module: it reads the half-resolution
+// The upsampling half of slc_half.wgsl (separate module: it reads the half-resolution
 // G-buffer as textures and writes the full-resolution accumulation).
 
 #include "common/slc_half_params.wgsl"

@@ -15,7 +15,7 @@ use crate::renderer::passes::{
     storage_texture_entry, uniform_buffer, uniform_entry,
 };
 
-/// Twin: `HalfParams` in `shaders/slc_half.wgsl` and `shaders/slc_upsample.wgsl`.
+/// Twin: `HalfParams` in `shaders/methods/tree_samplers/slc_half.wgsl` and `slc_upsample.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuHalfParams {

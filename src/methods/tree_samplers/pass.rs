@@ -260,7 +260,7 @@ impl SlcBuffers {
     }
 }
 
-/// Twin: `ViewParams` in `shaders/slc_views.wgsl`.
+/// Twin: `ViewParams` in `shaders/methods/tree_samplers/slc_views.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuSlcViewParams {
