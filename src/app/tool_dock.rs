@@ -4,13 +4,12 @@
 //! `PixelInspect::show`, the cut inspector, `TimingsPanel::show`); the dock follows them.
 
 use egui_tiles::{Behavior, TileId, UiResponse};
-use serde::{Deserialize, Serialize};
 
 use super::WorkbenchApp;
 use crate::renderer::settings::ViewBuffer;
 
 /// A tool pane.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Tool {
     Story,
     PixelValues,

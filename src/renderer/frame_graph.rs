@@ -5,6 +5,34 @@
 
 use super::*;
 
+/// What a method's `record` sees of the renderer: the frame's shared resources by disjoint
+/// field borrows of `$r` (a macro, so that the method instance, another field, stays
+/// borrowable), writing into `$accum`.
+macro_rules! frame_cx {
+    ($r:ident, $method:expr, $accum:expr, $size:expr, $key:expr, $trace:expr) => {
+        FrameCx {
+            method: $method,
+            device: &$r.ctx.device,
+            queue: &$r.ctx.queue,
+            errors: &$r.ctx.errors,
+            timer: &mut $r.timer,
+            settings: &$r.settings,
+            scene: &$r.scene,
+            scene_radius: $r.scene.bounds.radius().max(1e-3),
+            targets: &$r.targets,
+            vpl_buffers: &$r.vpl_buffers,
+            vpl_frame: &$r.vpl_frame,
+            vpl_params: $r.vpl_gen.params_buffer(),
+            tree: &$r.tree,
+            gi_accum: $accum,
+            size: $size,
+            key: $key,
+            frame_index: $r.frames,
+            trace_pixel: $trace,
+        }
+    };
+}
+
 impl Renderer {
     /// Records and submits one frame, ending with the selected view (with the global display
     /// look) in the view texture.
@@ -302,26 +330,14 @@ impl Renderer {
         let Some((_, m)) = self.methods.iter_mut().find(|(n, _)| *n == module) else {
             return 0.0;
         };
-        let mut cx = FrameCx {
+        let mut cx = frame_cx!(
+            self,
             method,
-            device: &self.ctx.device,
-            queue: &self.ctx.queue,
-            errors: &self.ctx.errors,
-            timer: &mut self.timer,
-            settings: &self.settings,
-            scene: &self.scene,
-            scene_radius: self.scene.bounds.radius().max(1e-3),
-            targets: &self.targets,
-            vpl_buffers: &self.vpl_buffers,
-            vpl_frame: &self.vpl_frame,
-            vpl_params: self.vpl_gen.params_buffer(),
-            tree: &self.tree,
-            gi_accum: &self.targets.lighting.gi_accum,
+            &self.targets.lighting.gi_accum,
             size,
             key,
-            frame_index: self.frames,
-            trace_pixel: self.trace_pixel,
-        };
+            self.trace_pixel
+        );
         m.record(&mut cx, enc)
     }
 
@@ -386,26 +402,7 @@ impl Renderer {
                 }
             },
         };
-        let mut cx = FrameCx {
-            method: truth,
-            device: &device,
-            queue: &queue,
-            errors: &self.ctx.errors,
-            timer: &mut self.timer,
-            settings: &self.settings,
-            scene: &self.scene,
-            scene_radius: self.scene.bounds.radius().max(1e-3),
-            targets: &self.targets,
-            vpl_buffers: &self.vpl_buffers,
-            vpl_frame: &self.vpl_frame,
-            vpl_params: self.vpl_gen.params_buffer(),
-            tree: &self.tree,
-            gi_accum: &cmp.targets.gi_accum,
-            size,
-            key,
-            frame_index: self.frames,
-            trace_pixel: None,
-        };
+        let mut cx = frame_cx!(self, truth, &cmp.targets.gi_accum, size, key, None);
         cmp.truth.record(&mut cx, enc);
         self.compare_composite.record(
             &device,
