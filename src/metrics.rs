@@ -107,68 +107,88 @@ fn mean_rgb(a: &ImageF32, mask: Option<&[bool]>) -> f64 {
 
 /// Display luminance in [0, 1] of every pixel (exposure, tonemap, sRGB).
 pub fn display_luminance(a: &ImageF32, exposure_ev: f32, tonemap: Tonemap) -> Vec<f32> {
-    a.pixels
-        .iter()
-        .map(|p| {
-            let e = display::encode(*p, exposure_ev, tonemap);
-            display::luminance(Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32) / 255.0)
-        })
-        .collect()
+    par_map(a.pixels.len(), |i| {
+        let e = display::encode(a.pixels[i], exposure_ev, tonemap);
+        display::luminance(Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32) / 255.0)
+    })
+}
+
+/// Threads for the metrics (the machine's cores, at most 16).
+fn threads() -> usize {
+    std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(16)
+}
+
+/// `f(i)` for i in 0..n, computed on [`threads`] threads in contiguous chunks, in order.
+fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let t = threads();
+    if t <= 1 || n < 4096 {
+        return (0..n).map(f).collect();
+    }
+    let chunk = n.div_ceil(t);
+    let f = &f;
+    std::thread::scope(|s| {
+        let parts: Vec<_> = (0..n)
+            .step_by(chunk)
+            .map(|a| s.spawn(move || (a..(a + chunk).min(n)).map(f).collect::<Vec<T>>()))
+            .collect();
+        parts
+            .into_iter()
+            .flat_map(|p| p.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    })
 }
 
 /// Mean SSIM of two grey images in [0, 1] (Wang et al. 2004, Gaussian window 11, sigma 1.5);
-/// windows are clipped at the borders.
+/// windows are clipped at the borders. The five weighted moments (mu_a, mu_b, E[a^2],
+/// E[b^2], E[ab]) are blurred together, rows and then columns in parallel.
 pub fn ssim(a: &[f32], b: &[f32], w: usize, h: usize) -> f64 {
     const R: i32 = 5;
     let g: Vec<f64> = (-R..=R)
         .map(|i| (-(i * i) as f64 / (2.0 * 1.5 * 1.5)).exp())
         .collect();
     let (c1, c2) = ((0.01f64).powi(2), (0.03f64).powi(2));
-    // Separable weighted moments: mu_a, mu_b, E[a^2], E[b^2], E[ab].
-    let blur = |f: &dyn Fn(usize) -> f64| -> Vec<f64> {
-        let mut tmp = vec![0.0; w * h];
-        for y in 0..h {
-            for x in 0..w {
-                let (mut s, mut ws) = (0.0, 0.0);
-                for (k, gk) in g.iter().enumerate() {
-                    let xx = x as i32 + k as i32 - R;
-                    if xx >= 0 && (xx as usize) < w {
-                        s += gk * f(y * w + xx as usize);
-                        ws += gk;
-                    }
-                }
-                tmp[y * w + x] = s / ws;
-            }
-        }
-        let mut out = vec![0.0; w * h];
-        for y in 0..h {
-            for x in 0..w {
-                let (mut s, mut ws) = (0.0, 0.0);
-                for (k, gk) in g.iter().enumerate() {
-                    let yy = y as i32 + k as i32 - R;
-                    if yy >= 0 && (yy as usize) < h {
-                        s += gk * tmp[yy as usize * w + x];
-                        ws += gk;
-                    }
-                }
-                out[y * w + x] = s / ws;
-            }
-        }
-        out
+    let moments = |i: usize| {
+        let (x, y) = (a[i] as f64, b[i] as f64);
+        [x, y, x * x, y * y, x * y]
     };
-    let ma = blur(&|i| a[i] as f64);
-    let mb = blur(&|i| b[i] as f64);
-    let aa = blur(&|i| (a[i] as f64).powi(2));
-    let bb = blur(&|i| (b[i] as f64).powi(2));
-    let ab = blur(&|i| a[i] as f64 * b[i] as f64);
-    let mut total = 0.0;
-    for i in 0..w * h {
-        let (va, vb) = ((aa[i] - ma[i] * ma[i]).max(0.0), (bb[i] - mb[i] * mb[i]).max(0.0));
-        let cov = ab[i] - ma[i] * mb[i];
-        total += ((2.0 * ma[i] * mb[i] + c1) * (2.0 * cov + c2))
-            / ((ma[i] * ma[i] + mb[i] * mb[i] + c1) * (va + vb + c2));
-    }
-    total / (w * h).max(1) as f64
+    // Horizontal pass: per pixel, the five moments blurred along its row.
+    let tmp: Vec<[f64; 5]> = par_map(w * h, |i| {
+        let (x, y) = (i % w, i / w);
+        let (mut s, mut ws) = ([0.0f64; 5], 0.0);
+        for (k, gk) in g.iter().enumerate() {
+            let xx = x as i32 + k as i32 - R;
+            if xx >= 0 && (xx as usize) < w {
+                let m = moments(y * w + xx as usize);
+                for c in 0..5 {
+                    s[c] += gk * m[c];
+                }
+                ws += gk;
+            }
+        }
+        s.map(|v| v / ws)
+    });
+    // Vertical pass and the SSIM of each pixel.
+    let per_pixel: Vec<f64> = par_map(w * h, |i| {
+        let (x, y) = (i % w, i / w);
+        let (mut s, mut ws) = ([0.0f64; 5], 0.0);
+        for (k, gk) in g.iter().enumerate() {
+            let yy = y as i32 + k as i32 - R;
+            if yy >= 0 && (yy as usize) < h {
+                let m = tmp[yy as usize * w + x];
+                for c in 0..5 {
+                    s[c] += gk * m[c];
+                }
+                ws += gk;
+            }
+        }
+        let [ma, mb, aa, bb, ab] = s.map(|v| v / ws);
+        let (va, vb) = ((aa - ma * ma).max(0.0), (bb - mb * mb).max(0.0));
+        let cov = ab - ma * mb;
+        ((2.0 * ma * mb + c1) * (2.0 * cov + c2)) / ((ma * ma + mb * mb + c1) * (va + vb + c2))
+    });
+    per_pixel.iter().sum::<f64>() / (w * h).max(1) as f64
 }
 
 /// Splits the error of F independent frames against a reference into bias and noise:
@@ -188,6 +208,19 @@ pub fn bias_noise(frame_mse: &[f64], mean_mse: f64) -> (f64, f64) {
 
 /// Every metric of `image` against `reference` (same size), SSIM on the display transform.
 pub fn compare(image: &ImageF32, reference: &ImageF32, exposure_ev: f32, tonemap: Tonemap) -> Metrics {
+    Metrics {
+        flip: flip(image, reference, exposure_ev, tonemap),
+        ..compare_without_flip(image, reference, exposure_ev, tonemap)
+    }
+}
+
+/// [`compare`] without FLIP (NaN), the costly one: what the harness computes per frame.
+pub fn compare_without_flip(
+    image: &ImageF32,
+    reference: &ImageF32,
+    exposure_ev: f32,
+    tonemap: Tonemap,
+) -> Metrics {
     let rm = rmse(image, reference, None);
     let mean_ref = mean_rgb(reference, None);
     let mean_img = mean_rgb(image, None);
@@ -208,7 +241,7 @@ pub fn compare(image: &ImageF32, reference: &ImageF32, exposure_ev: f32, tonemap
             f64::NAN
         },
         reference_mean: mean_ref,
-        flip: flip(image, reference, exposure_ev, tonemap),
+        flip: f64::NAN,
     }
 }
 
@@ -332,5 +365,87 @@ mod tests {
         let shifted: Vec<f32> = a.iter().map(|v| v + 0.05).collect();
         let q2 = ssim(&a, &shifted, w, h);
         assert!(q2 > 0.95 && q2 < 1.0, "{q2}");
+    }
+
+    /// The single-threaded SSIM the workbench used before the parallel one (each moment
+    /// blurred on its own): the reference the parallel version must equal.
+    fn ssim_serial(a: &[f32], b: &[f32], w: usize, h: usize) -> f64 {
+        const R: i32 = 5;
+        let g: Vec<f64> = (-R..=R)
+            .map(|i| (-(i * i) as f64 / (2.0 * 1.5 * 1.5)).exp())
+            .collect();
+        let (c1, c2) = ((0.01f64).powi(2), (0.03f64).powi(2));
+        let blur = |f: &dyn Fn(usize) -> f64| -> Vec<f64> {
+            let mut tmp = vec![0.0; w * h];
+            for y in 0..h {
+                for x in 0..w {
+                    let (mut s, mut ws) = (0.0, 0.0);
+                    for (k, gk) in g.iter().enumerate() {
+                        let xx = x as i32 + k as i32 - R;
+                        if xx >= 0 && (xx as usize) < w {
+                            s += gk * f(y * w + xx as usize);
+                            ws += gk;
+                        }
+                    }
+                    tmp[y * w + x] = s / ws;
+                }
+            }
+            let mut out = vec![0.0; w * h];
+            for y in 0..h {
+                for x in 0..w {
+                    let (mut s, mut ws) = (0.0, 0.0);
+                    for (k, gk) in g.iter().enumerate() {
+                        let yy = y as i32 + k as i32 - R;
+                        if yy >= 0 && (yy as usize) < h {
+                            s += gk * tmp[yy as usize * w + x];
+                            ws += gk;
+                        }
+                    }
+                    out[y * w + x] = s / ws;
+                }
+            }
+            out
+        };
+        let ma = blur(&|i| a[i] as f64);
+        let mb = blur(&|i| b[i] as f64);
+        let aa = blur(&|i| (a[i] as f64).powi(2));
+        let bb = blur(&|i| (b[i] as f64).powi(2));
+        let ab = blur(&|i| a[i] as f64 * b[i] as f64);
+        let mut total = 0.0;
+        for i in 0..w * h {
+            let (va, vb) = ((aa[i] - ma[i] * ma[i]).max(0.0), (bb[i] - mb[i] * mb[i]).max(0.0));
+            let cov = ab[i] - ma[i] * mb[i];
+            total += ((2.0 * ma[i] * mb[i] + c1) * (2.0 * cov + c2))
+                / ((ma[i] * ma[i] + mb[i] * mb[i] + c1) * (va + vb + c2));
+        }
+        total / (w * h).max(1) as f64
+    }
+
+    #[test]
+    fn parallel_ssim_and_luminance_equal_the_serial_reference() {
+        // Large enough for the parallel path (>= 4096 pixels), odd sizes.
+        let (w, h) = (131usize, 77usize);
+        let mut state = 0x2545_f491u32;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as f32 / u32::MAX as f32
+        };
+        let a: Vec<f32> = (0..w * h).map(|_| next()).collect();
+        let b: Vec<f32> = a.iter().map(|v| (v + 0.2 * next()).min(1.0)).collect();
+        let p = ssim(&a, &b, w, h);
+        let s = ssim_serial(&a, &b, w, h);
+        assert!(
+            (p - s).abs() <= 1e-12 * s.abs().max(1.0),
+            "parallel {p} vs serial {s}"
+        );
+        let image = img(w as u32, h as u32, |x, y| (x * y) as f32 * 1e-3);
+        let lum = display_luminance(&image, 0.0, Tonemap::default());
+        for (i, px) in image.pixels.iter().enumerate() {
+            let e = display::encode(*px, 0.0, Tonemap::default());
+            let want = display::luminance(Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32) / 255.0);
+            assert_eq!(lum[i], want, "pixel {i}");
+        }
     }
 }

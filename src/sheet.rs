@@ -13,7 +13,7 @@ use crate::{
     base::{colormap::false_color, display},
     metrics::{self, Metrics},
     renderer::{
-        Buffer, FrameInput, Renderer,
+        Buffer, FrameInput, FrameMode, Renderer,
         readback::ImageF32,
         settings::{MethodId, RenderSettings, ViewBuffer},
     },
@@ -73,6 +73,8 @@ pub struct SheetJob {
     gt: Option<(ImageF32, ImageF32)>,
     columns: Vec<SheetColumn>,
     title: String,
+    /// The renderer's frame mode before the job (the methods' frames are timed; restored).
+    mode_before: Option<FrameMode>,
 }
 
 impl SheetJob {
@@ -109,6 +111,7 @@ impl SheetJob {
             gt: None,
             columns: Vec::new(),
             title,
+            mode_before: None,
         })
     }
 
@@ -171,12 +174,14 @@ impl SheetJob {
                     s.gi.method = method;
                     s.sampling.accumulate = true;
                     r.set_settings(s).map_err(|e| e.to_string())?;
-                    // Drain the timings of earlier frames, so that every frame of the method
-                    // is timed (the readback skips frames while one is pending).
-                    let _ = r.wait_timings();
+                    // Every frame of the method timed, without diagnostics; drain the timings
+                    // of earlier frames (the readback skips frames while one is pending).
+                    self.mode_before.get_or_insert(r.frame_mode());
+                    r.set_frame_mode(FrameMode::Timed);
+                    let _ = r.wait_new_timings();
                 }
                 frame(r);
-                if let Some(t) = r.wait_timings() {
+                if let Some(t) = r.wait_new_timings() {
                     *ms += t.total_ms();
                     *timed += 1;
                 }
@@ -230,6 +235,9 @@ impl SheetJob {
     /// Puts the renderer back as it was (the job's settings, tree unfrozen).
     pub fn restore(&self, r: &mut Renderer) {
         r.set_freeze_tree(false);
+        if let Some(m) = self.mode_before {
+            r.set_frame_mode(m);
+        }
         let _ = r.set_settings(self.base.clone());
     }
 

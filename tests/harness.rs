@@ -117,7 +117,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         &d,
         "timings.csv",
         &["scene", "group", "passes", "frames"],
-        &["mean_ms", "std_ms", "min_ms", "max_ms"],
+        &["median_ms", "mean_ms", "std_ms", "min_ms", "max_ms"],
         10,
     );
     let (_, rows) = read_csv(&d.join("timings.csv"));
@@ -140,10 +140,11 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         "equal_time.csv",
         &["method", "spp"],
         &[
-            "frame_ms",
+            "gi_gpu_ms",
+            "sample_gpu_ms",
+            "frame_wall_ms",
             "rmse",
             "ssim",
-            "flip",
             "mean_ratio",
             "bias_rmse",
             "noise_rmse",
@@ -157,10 +158,12 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         "equal_time_matched.csv",
         &["method", "extrapolated", "spp_at_matched_time"],
         &[
-            "matched_ms",
+            "matched_gi_gpu_ms",
             "rmse_interpolated",
-            "measured_frame_ms",
+            "measured_gi_gpu_ms",
+            "measured_frame_wall_ms",
             "measured_rmse",
+            "measured_flip",
             "measured_mean_ratio",
             "measured_bias_rmse",
         ],
@@ -185,28 +188,35 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         &d,
         "blocks.csv",
         &["block", "cuts"],
-        &["cuts_gpu_ms", "frame_ms", "rmse", "ssim"],
+        &[
+            "cuts_gpu_ms",
+            "sample_gpu_ms",
+            "gi_gpu_ms",
+            "frame_wall_ms",
+            "rmse",
+            "ssim",
+        ],
         2,
     );
     check_csv(
         &d,
         "blending.csv",
         &["config", "blending", "fallback"],
-        &["frame_ms", "gi_gpu_ms", "rmse", "ssim", "fallback_fraction"],
+        &["frame_wall_ms", "gi_gpu_ms", "rmse", "ssim", "fallback_fraction"],
         5,
     );
     check_csv(
         &d,
         "upsampling.csv",
         &["width", "height", "gi_resolution"],
-        &["rmse", "ssim", "frame_ms", "gi_ms"],
+        &["rmse", "ssim", "gi_gpu_ms", "frame_wall_ms"],
         2,
     );
     check_csv(
         &d,
         "scaling.csv",
         &["vpls"],
-        &["tree_gpu_ms", "gi_gpu_ms", "frame_ms", "rmse", "ssim"],
+        &["tree_gpu_ms", "gi_gpu_ms", "frame_wall_ms", "rmse", "ssim"],
         2,
     );
     check_csv(
@@ -244,6 +254,16 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     let run: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
     assert_eq!(run["width"], 64);
+    // Each figure's wall time and the share of it outside rendering / GPU waits.
+    let times = run["scenes"][0]["figure_times"].as_array().unwrap();
+    assert_eq!(times.len(), 7, "{times:?}");
+    for t in times {
+        let share = t["share_outside_gpu"].as_f64().unwrap();
+        assert!(
+            (0.0..=1.0).contains(&share) && t["wall_s"].as_f64().unwrap() > 0.0,
+            "{t}"
+        );
+    }
     assert!(
         run["scenes"][0]["adapter"]
             .as_str()

@@ -175,3 +175,148 @@ fn every_method_is_named_consistently_and_has_its_tests() {
     assert_eq!(RenderSettings::default().gi.method, methods::tree_samplers::SLC);
     assert_eq!(methods::comparison_truth(), methods::ground_truth::ID);
 }
+
+/// What a timed frame records (`FrameMode::Timed`, issue 18): the frame's own passes and
+/// nothing else. The tree samplers' per-pixel diagnostics, counters and story buffers are
+/// not touched, the finished comparison truth is not re-recorded, and the GI is bit-equal to
+/// that of a diagnostic frame with the same random numbers: the timed shader variant does
+/// the same work minus the diagnostics.
+#[test]
+fn timed_frames_record_no_diagnostics_and_compute_the_same_gi() {
+    use lightcut::methods::tree_samplers::{RTSLC, SLC, SST};
+    use lightcut::renderer::FrameMode;
+    let Some(ctx) = common::gpu() else { return };
+    let scene = default_scene::build();
+    let cam = scene.camera_or_default(None).unwrap();
+    let truth_passes = methods::comparison_truth().info().timed_passes;
+    for m in [SLC, SST, RTSLC] {
+        let mut s = tiny(m);
+        s.sampling.fixed_seed = true;
+        s.sampling.accumulate = false;
+        let mut r = Renderer::new(ctx.clone(), &scene, (48, 32), s).unwrap();
+        r.set_trace_pixel(Some((20, 10)));
+        r.set_compare_ground_truth(true);
+        let frame = |r: &mut Renderer| {
+            r.render(&FrameInput {
+                camera: &cam,
+                lights: &scene.lights,
+                view: ViewBuffer::Final,
+            });
+            r.wait_idle();
+        };
+        // Diagnostic frames until the comparison truth has finished.
+        for _ in 0..50 {
+            frame(&mut r);
+            if r.compare_progress().is_some_and(|p| p.finished()) {
+                break;
+            }
+        }
+        assert!(r.compare_progress().is_some_and(|p| p.finished()), "{m}");
+        let diagnostic_gi = r.read(Buffer::Indirect).unwrap();
+        let stats = r.sampling_stats_blocking().unwrap();
+        assert!(stats.pixels > 0 && stats.traversals > 0, "{m}: {stats:?}");
+        // Poison the diagnostics buffers; a timed frame must leave them as they are.
+        let b = r.slc_buffers();
+        let sentinel = |buf: &wgpu::Buffer| {
+            let words = vec![0x7f7f_7f7fu32; (buf.size() / 4) as usize];
+            ctx.queue.write_buffer(buf, 0, bytemuck::cast_slice(&words));
+        };
+        for buf in [&b.diag, &b.stats, &b.trace] {
+            sentinel(buf);
+        }
+        let _ = r.wait_new_timings();
+        r.set_frame_mode(FrameMode::Timed);
+        frame(&mut r);
+        assert!(!r.last_frame_diagnostic());
+        let b = r.slc_buffers();
+        for (name, buf) in [
+            ("diagnostics", &b.diag),
+            ("counters", &b.stats),
+            ("story", &b.trace),
+        ] {
+            let v = r.read_f32_buffer(buf).unwrap();
+            assert!(
+                v.iter().all(|x| x.to_bits() == 0x7f7f_7f7f),
+                "{m}: a timed frame wrote the {name} buffer"
+            );
+        }
+        let timed_gi = r.read(Buffer::Indirect).unwrap();
+        assert!(
+            timed_gi
+                .pixels
+                .iter()
+                .zip(&diagnostic_gi.pixels)
+                .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits)),
+            "{m}: the timed frame's GI differs from the diagnostic frame's"
+        );
+        if r.timestamps_supported() {
+            let t = r.wait_new_timings().expect("a timed frame has timestamps");
+            let names: Vec<&str> = t.passes.iter().map(|(n, _)| n.as_str()).collect();
+            let own = m.info().timed_passes;
+            assert!(names.iter().any(|n| own.contains(n)), "{m}: {names:?}");
+            for n in &names {
+                assert!(
+                    !truth_passes.contains(n) && *n != "slc_views",
+                    "{m}: the timed frame recorded {n}: {names:?}"
+                );
+            }
+            assert_eq!(
+                names.iter().filter(|n| **n == "composite").count(),
+                1,
+                "{m}: the comparison's composite ran in a timed frame: {names:?}"
+            );
+        }
+        // A diagnostic frame after it writes them again.
+        r.set_frame_mode(FrameMode::Diagnostic);
+        frame(&mut r);
+        let after = r.sampling_stats_blocking().unwrap();
+        assert_eq!(after, stats, "{m}: same seed, same counters");
+    }
+}
+
+/// Cut size 64 (the anomaly of the H100 sweeps, issue 18): the counters and the sampling
+/// agree with cut size 32. SST starts every sample at the root, so its steps per traversal
+/// do not depend on the sample count, and it traverses exactly cut_size times per pixel.
+#[test]
+fn cut_size_64_counts_like_cut_size_32() {
+    use lightcut::methods::tree_samplers::{RTSLC, SLC, SST};
+    let Some(ctx) = common::gpu() else { return };
+    let scene = default_scene::build();
+    let cam = scene.camera_or_default(None).unwrap();
+    let mut r = Renderer::new(ctx, &scene, (48, 32), tiny(SST)).unwrap();
+    let stats = |r: &mut Renderer, m: MethodId, cut: u32| {
+        let mut s = tiny(m);
+        s.sampling.cut_size = cut;
+        s.sampling.accumulate = false;
+        r.set_settings(s).unwrap();
+        r.render(&FrameInput {
+            camera: &cam,
+            lights: &scene.lights,
+            view: ViewBuffer::Final,
+        });
+        r.sampling_stats_blocking().unwrap()
+    };
+    for m in [SST, SLC, RTSLC] {
+        let a = stats(&mut r, m, 32);
+        let b = stats(&mut r, m, 64);
+        assert_eq!(a.pixels, b.pixels, "{m}");
+        assert!(b.traversals > a.traversals, "{m}: {a:?} {b:?}");
+        if m == SST {
+            assert_eq!(a.traversals, 32 * a.pixels);
+            assert_eq!(b.traversals, 64 * b.pixels);
+            let (sa, sb) = (a.steps_per_traversal(), b.steps_per_traversal());
+            assert!(
+                (sb / sa - 1.0).abs() < 0.05,
+                "SST steps per traversal {sa} at 32, {sb} at 64"
+            );
+        } else {
+            // A deeper cut: traversals start lower, so no more steps each.
+            assert!(
+                b.steps_per_traversal() <= a.steps_per_traversal() * 1.05,
+                "{m}: {a:?} {b:?}"
+            );
+        }
+        let gi = r.read(Buffer::Indirect).unwrap();
+        assert!(gi.pixels.iter().all(|p| p.iter().all(|v| v.is_finite())), "{m}");
+    }
+}

@@ -28,6 +28,7 @@ const EXAMPLES: &[&str] = &[
     "-- render --scene default --width 320 --height 240 --method reference --samples 1024 --out out/ref",
     "-- export-scene --scene default --out out/scene",
     "-- bench rays --scene scenes/sponza.toml",
+    "-- bench gbuffer --scene scenes/sponza.toml",
     "-- render --scene default --width 320 --height 240 --method slc --frames 16 --compare-gt --out out/slc",
     "-- compare out/slc/indirect.exr out/slc/ground_truth_indirect.exr --exposure 3",
     "-- bench tree",
@@ -367,6 +368,12 @@ fn cli_examples_write_what_they_promise() {
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(slc.join("metrics.json")).unwrap()).unwrap();
     assert_eq!(m["method"], "slc");
+    // Exactly the frames asked for, however many views were drawn afterwards; the GPU times
+    // are those of the timed frames (a warm-up frame not counted).
+    assert_eq!(m["frames_averaged"], 2, "{m}");
+    assert_eq!(m["timed_frames"], 2, "{m}");
+    assert!(m["gpu_ms"]["slc_sample"].as_f64().is_some_and(|v| v > 0.0), "{m}");
+    assert!(m["shadow_rays"].as_u64().is_some_and(|v| v > 0), "{m}");
     assert!(
         m["vs_ground_truth"]["rmse"]
             .as_f64()
@@ -383,6 +390,11 @@ fn cli_examples_write_what_they_promise() {
     let out = run_cli(&args("-- bench tree", &[], &["--max-log2", "13"]));
     assert!(
         out.contains("4096") && out.contains("8192") && out.contains("slope"),
+        "{out}"
+    );
+    // Both variants, each size, in one run (issue 18's before / after).
+    assert!(
+        out.contains("baseline") && out.contains("parallel") && out.contains("speed-up"),
         "{out}"
     );
 
@@ -477,7 +489,23 @@ fn cli_examples_write_what_they_promise() {
     let out = run_cli(&args(
         "-- bench rays --scene scenes/sponza.toml",
         &[],
-        &["--rays", "4096", "--repeat", "1"],
+        &[
+            "--rays", "4096", "--repeat", "1", "--width", "32", "--height", "24",
+        ],
     ));
     assert!(out.contains("rays") && out.contains("Sponza"), "{out}");
+    assert!(
+        out.contains("in-frame shadow rays") && out.contains("Mrays/s"),
+        "{out}"
+    );
+    // The G-buffer's fragments and bytes per pixel, without and with the depth pre-pass.
+    let out = run_cli(&args(
+        "-- bench gbuffer --scene scenes/sponza.toml",
+        &[],
+        &["--width", "64", "--height", "48", "--repeat", "1"],
+    ));
+    assert!(
+        out.contains("depth complexity") && out.contains("pre-pass") && out.contains("bytes"),
+        "{out}"
+    );
 }

@@ -8,7 +8,7 @@ use lightcut::{
     renderer::{
         FrameInput, Renderer,
         gpu_data::VPL_NONE,
-        passes::sst_sort::{SortBuffers, SortPass, read_pairs},
+        passes::sst_sort::{SortBuffers, SortPass, SortVariant, read_pairs},
         settings::{RenderSettings, ViewBuffer},
         timing::GpuTimer,
     },
@@ -42,17 +42,25 @@ fn check_sorted(gpu: &[(u64, u32)], input: &[u64]) {
 #[test]
 fn gpu_bitonic_sort_equals_sort_unstable() {
     let Some(ctx) = common::gpu() else { return };
-    let pass = SortPass::new(&ctx.device).unwrap();
-    let mut next = rng(42);
-    // Random keys (power of two and not), then already sorted and reverse sorted inputs.
-    for n in [1usize, 2, 3, 1000, 4096, 5000] {
-        let keys: Vec<u64> = (0..n).map(|_| next()).collect();
-        check_sorted(&pass.sort_keys(&ctx, &keys).unwrap(), &keys);
+    let mut pass = SortPass::new(&ctx.device).unwrap();
+    // Both variants: the parallel one (workgroup-memory tiles of 512, global steps above)
+    // and the baseline (one global dispatch per step).
+    for variant in [SortVariant::Parallel, SortVariant::Baseline] {
+        pass.variant = variant;
+        let mut next = rng(42);
+        // Random keys (power of two and not, below, at and above the tile size), then
+        // already sorted and reverse sorted inputs, and many duplicates.
+        for n in [1usize, 2, 3, 300, 512, 1000, 4096, 5000] {
+            let keys: Vec<u64> = (0..n).map(|_| next()).collect();
+            check_sorted(&pass.sort_keys(&ctx, &keys).unwrap(), &keys);
+        }
+        let sorted: Vec<u64> = (0..3000u64).map(|i| i * 7919 + (i << 40)).collect();
+        check_sorted(&pass.sort_keys(&ctx, &sorted).unwrap(), &sorted);
+        let reversed: Vec<u64> = sorted.iter().rev().copied().collect();
+        check_sorted(&pass.sort_keys(&ctx, &reversed).unwrap(), &reversed);
+        let dups: Vec<u64> = (0..2100).map(|_| next() % 7).collect();
+        check_sorted(&pass.sort_keys(&ctx, &dups).unwrap(), &dups);
     }
-    let sorted: Vec<u64> = (0..3000u64).map(|i| i * 7919 + (i << 40)).collect();
-    check_sorted(&pass.sort_keys(&ctx, &sorted).unwrap(), &sorted);
-    let reversed: Vec<u64> = sorted.iter().rev().copied().collect();
-    check_sorted(&pass.sort_keys(&ctx, &reversed).unwrap(), &reversed);
     assert!(ctx.errors.take().is_empty());
 }
 
@@ -68,20 +76,31 @@ fn gpu_keys_of_the_frame_vpls_equal_the_cpu_keys() {
         view: ViewBuffer::Final,
     });
     let vpls = r.read_vpls().unwrap();
-    let pass = SortPass::new(&ctx.device).unwrap();
+    let mut pass = SortPass::new(&ctx.device).unwrap();
     let out = SortBuffers::new(&ctx.device, vpls.len() as u32);
-    let mut enc = ctx.device.create_command_encoder(&Default::default());
-    let mut timer = GpuTimer::new(&ctx.device, &ctx.queue);
-    pass.record(
-        &ctx.device,
-        &ctx.queue,
-        &mut enc,
-        &mut timer,
-        &r.vpl_buffers().vpls,
-        &out,
+    let mut run = |variant| {
+        pass.variant = variant;
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        let mut timer = GpuTimer::new(&ctx.device, &ctx.queue);
+        pass.record(
+            &ctx.device,
+            &ctx.queue,
+            &mut enc,
+            &mut timer,
+            &r.vpl_buffers().vpls,
+            &out,
+        );
+        ctx.queue.submit([enc.finish()]);
+        read_pairs(&ctx, &out).unwrap()
+    };
+    // The baseline (serial bounds, global steps) and the parallel variant give the same
+    // bounds, so the same keys, and the same sorted pairs.
+    let baseline = run(SortVariant::Baseline);
+    let pairs = run(SortVariant::Parallel);
+    assert_eq!(
+        pairs, baseline,
+        "the parallel keys / sort differ from the baseline's"
     );
-    ctx.queue.submit([enc.finish()]);
-    let pairs = read_pairs(&ctx, &out).unwrap();
     let mut bounds = Aabb::EMPTY;
     for v in vpls.iter().filter(|v| v.id != VPL_NONE) {
         bounds.grow(Vec3::from_slice(&v.position[..3]));

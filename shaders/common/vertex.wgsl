@@ -9,7 +9,9 @@ struct VertexIn {
 };
 
 struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
+    // Invariant: the G-buffer's depth pre-pass and its shading pass (depth test Equal) must
+    // compute bit-identical depths from the same vertex.
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,

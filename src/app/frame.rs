@@ -326,7 +326,7 @@ impl WorkbenchApp {
                 None => ui.label(format!("VPLs {}", r.vpl_frame().count)),
             };
             ui.separator();
-            ui.label(format!("frame {:.1} ms", self.frame_ms_smoothed));
+            ui.label(format!("frame {:.1} ms (wall)", self.frame_ms_smoothed));
             ui.separator();
             if !r.timestamps_supported() {
                 ui.label("timestamps not supported");
@@ -339,7 +339,10 @@ impl WorkbenchApp {
                 ui.add(egui::Label::new(t.summary()).truncate())
                     .on_hover_ui(|ui| {
                         ui.label(egui::RichText::new(lines.join("\n")).monospace());
-                        ui.label(format!("total {:.3} ms", t.total_ms()));
+                        ui.label(format!(
+                            "total {:.3} ms (GPU timestamps of the last timed frame, no diagnostics)",
+                            t.total_ms()
+                        ));
                     });
             } else {
                 ui.label("GPU timings pending");

@@ -48,6 +48,9 @@ use image_views::{ExportKind, Layout, PaneContext, ViewEvents};
 use timings_panel::TimingsPanel;
 use tree_panel::TreePanel;
 
+/// In the GUI every n-th frame is a diagnostic (untimed) frame ([`crate::renderer::FrameMode`]).
+pub const GUI_DIAGNOSTICS_EVERY: u32 = 4;
+
 /// How the app was started.
 #[derive(Clone, Debug, Default)]
 pub struct AppOptions {
@@ -370,8 +373,11 @@ impl WorkbenchApp {
             }
             None => {
                 let ctx = GpuContext::from_parts(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info());
-                let r = Renderer::new(ctx, &open.scene, (64, 64), self.settings.clone())
+                let mut r = Renderer::new(ctx, &open.scene, (64, 64), self.settings.clone())
                     .map_err(|e| e.to_string())?;
+                // Every 4th frame records the diagnostics (statistics, method views, the
+                // pixel story) untimed; the GPU timings come from the other frames.
+                r.set_frame_mode(crate::renderer::FrameMode::Interleaved(GUI_DIAGNOSTICS_EVERY));
                 self.renderer = Some(r);
             }
         }

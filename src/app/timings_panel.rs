@@ -75,9 +75,10 @@ impl TimingsPanel {
             return None;
         };
         ui.label(format!(
-            "last frame: {:.3} ms GPU over {} passes; hover a blue pass to see its output",
+            "last timed frame: {:.3} ms GPU over {} passes (GPU timestamps of frames without diagnostics: every {}th frame records them untimed, as does a frame that advances the comparison's ground truth); hover a blue pass to see its output",
             last.total_ms(),
-            last.passes.len()
+            last.passes.len(),
+            super::GUI_DIAGNOSTICS_EVERY
         ));
         // One row per pass: name, a bar to scale, the time; hovering a row shows the pass's
         // output in the viewport.

@@ -10,14 +10,18 @@ use wgpu::util::DeviceExt;
 
 use crate::{
     renderer::{
+        FrameInput, FrameMode, Renderer,
         bvh_trace::{BvhTracer, TraceMode, to_gpu_ray},
         context::GpuContext,
-        gpu_data::{GpuRay, GpuVpl},
+        frame::GbufferTargets,
+        gpu_data::{GpuCamera, GpuRay, GpuVpl},
         passes::{
+            gbuffer::{COLOR_BYTES_PER_FRAGMENT, DEPTH_BYTES, GbufferPass, OverdrawCounter},
             sst_build::{BuildPass, TreeBuffers},
-            sst_sort::{SortBuffers, SortPass},
+            sst_sort::{SORT_TILE, SortBuffers, SortPass, SortVariant},
         },
-        scene_gpu::upload_bvh,
+        scene_gpu::{SceneGpu, upload_bvh},
+        settings::{RenderSettings, ViewBuffer},
         timing::GpuTimer,
     },
     scene::{
@@ -33,8 +37,13 @@ pub enum BenchKind {
     /// directions (closest hit) through the scene BVH.
     Rays,
     /// SST stages 8-10 (keys, bitonic sort, tree build, usable flags) for VPL counts
-    /// 2^min-log2 .. 2^max-log2: GPU time per stage and the log-log slope against N.
+    /// 2^min-log2 .. 2^max-log2: GPU time per stage and the log-log slope against N, for the
+    /// baseline and the parallel keys / sort.
     Tree,
+    /// The G-buffer raster: fragments per pixel (depth complexity, written without and with
+    /// the depth pre-pass; machine-independent), bytes written per pixel, and GPU time of the
+    /// single pass and of pre-pass + shading.
+    Gbuffer,
 }
 
 #[derive(Args, Debug)]
@@ -44,9 +53,15 @@ pub struct BenchArgs {
     /// `default`, a .gltf/.glb file, or a preset .toml (e.g. scenes/sponza.toml).
     #[arg(long, default_value = "default")]
     pub scene: String,
-    /// Rays per dispatch (at most 4194240).
-    #[arg(long, default_value_t = 1 << 18)]
+    /// Rays per dispatch (at most 4194240, the default: enough to fill a large GPU).
+    #[arg(long, default_value_t = MAX_RAYS)]
     pub rays: u32,
+    /// `bench gbuffer` / the in-frame ray rate of `bench rays`: frame width.
+    #[arg(long, default_value_t = 1280)]
+    pub width: u32,
+    /// `bench gbuffer` / the in-frame ray rate of `bench rays`: frame height.
+    #[arg(long, default_value_t = 720)]
+    pub height: u32,
     /// Timed repetitions (the median is reported).
     #[arg(long, default_value_t = 5)]
     pub repeat: u32,
@@ -141,11 +156,115 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
     Some(v[v.len() / 2])
 }
 
+/// The most rays of one `bench rays` dispatch (65535 workgroups of 64).
+pub const MAX_RAYS: u32 = 65535 * 64;
+
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    if !(1..=8192).contains(&args.width) || !(1..=8192).contains(&args.height) {
+        return Err(anyhow!(
+            "--width {} / --height {}: each must be 1..=8192",
+            args.width,
+            args.height
+        ));
+    }
     match args.kind {
         BenchKind::Rays => run_rays(args),
         BenchKind::Tree => run_tree(args),
+        BenchKind::Gbuffer => run_gbuffer(args),
     }
+}
+
+fn run_gbuffer(args: &BenchArgs) -> anyhow::Result<()> {
+    let opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
+    let scene = &opened.scene;
+    let camera = scene
+        .camera_or_default(opened.camera_name.as_deref())
+        .map_err(|e| anyhow!("{e}"))?;
+    let size = (args.width, args.height);
+    let ctx = GpuContext::new_headless()?;
+    println!("adapter: {}", ctx.describe());
+    let device = &ctx.device;
+    let tex = crate::renderer::settings::RenderSettings::default().textures;
+    let gpu_scene = SceneGpu::new(device, &ctx.queue, scene, tex.max_size, tex.anisotropy);
+    let camera_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("bench::camera"),
+        contents: bytemuck::bytes_of(&GpuCamera::new(&camera, size.0, size.1)),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    println!(
+        "scene: {} ({} triangles, one draw in file order), camera '{}', {}x{}",
+        scene.name,
+        scene.triangle_count(),
+        camera.name,
+        size.0,
+        size.1
+    );
+    let c = OverdrawCounter::new(device)?.count(&ctx, &camera_buf, &gpu_scene, size)?;
+    let per = |n: u64| n as f64 / c.covered.max(1) as f64;
+    println!(
+        "fragments (machine-independent: rasterisation rules and draw order), per covered pixel; {} of {} pixels covered",
+        c.covered, c.pixels
+    );
+    println!(
+        "  depth complexity (every rasterised fragment):        {:>10} ({:.2} per covered pixel)",
+        c.rasterised,
+        per(c.rasterised)
+    );
+    println!(
+        "  written without pre-pass (depth Less, draw order):   {:>10} ({:.2})",
+        c.written_single_pass,
+        per(c.written_single_pass)
+    );
+    println!(
+        "  written after the depth pre-pass (depth Equal):      {:>10} ({:.2})",
+        c.written_after_prepass,
+        per(c.written_after_prepass)
+    );
+    println!(
+        "G-buffer bytes written per frame pixel ({COLOR_BYTES_PER_FRAGMENT} B of colour targets per shaded fragment, {DEPTH_BYTES} B per depth write): \
+         without pre-pass {:.1}, with {:.1}",
+        c.bytes_per_pixel_single_pass(),
+        c.bytes_per_pixel_prepass()
+    );
+    let mut pass = GbufferPass::new(device)?;
+    let targets = GbufferTargets::new(device, size);
+    let mut timer = GpuTimer::new(device, &ctx.queue);
+    if !timer.supported() {
+        println!("GPU time: timestamps not supported on this adapter");
+        return Ok(());
+    }
+    let mut ms = [f64::NAN; 2];
+    for (i, prepass) in [false, true].into_iter().enumerate() {
+        pass.prepass = prepass;
+        let mut samples = Vec::new();
+        // Back to back; the first repetition (pipelines) is dropped.
+        for rep in 0..=args.repeat {
+            let mut enc = device.create_command_encoder(&Default::default());
+            timer.begin_frame(true);
+            pass.record(device, &mut enc, &mut timer, &camera_buf, &gpu_scene, &targets);
+            timer.resolve(&mut enc);
+            ctx.queue.submit([enc.finish()]);
+            timer.after_submit();
+            let t = timer
+                .collect_new_blocking(device)
+                .ok_or_else(|| anyhow!("no timestamps came back"))?;
+            if rep > 0 {
+                samples.push(t.get("gbuffer_depth").unwrap_or(0.0) + t.get("gbuffer").unwrap_or(0.0));
+            }
+        }
+        ms[i] = median(samples).unwrap_or(f64::NAN);
+    }
+    println!(
+        "GPU time (median of {}): single pass {:.3} ms, depth pre-pass + shading {:.3} ms ({:.2}x)",
+        args.repeat,
+        ms[0],
+        ms[1],
+        ms[0] / ms[1]
+    );
+    if let Some(e) = ctx.errors.take().into_iter().next() {
+        return Err(anyhow!("GPU error: {e}"));
+    }
+    Ok(())
 }
 
 /// Least-squares slope of ln(y) against ln(x).
@@ -205,7 +324,7 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
         scene.name, args.repeat
     );
     let device = &ctx.device;
-    let sort = SortPass::new(device)?;
+    let mut sort = SortPass::new(device)?;
     let build = BuildPass::new(device)?;
     let limit = device.limits().max_storage_buffer_binding_size;
     let mut timer = GpuTimer::new(device, &ctx.queue);
@@ -215,10 +334,18 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
         ));
     }
     println!(
-        "{:>9} {:>11} {:>11} {:>11} {:>11} {:>11} {:>12}",
-        "VPLs", "keys ms", "sort ms", "build ms", "classify ms", "total ms", "build Mnode/s"
+        "variants: baseline = bounds by one 64-thread workgroup + one global dispatch per bitonic step \
+         (before issue 18); parallel = bounds as a reduction + bitonic steps below {SORT_TILE} in workgroup memory (in use)"
     );
-    let mut rows: Vec<(f64, [f64; 4])> = Vec::new();
+    println!(
+        "{:>9} {:>9} {:>11} {:>11} {:>11} {:>11} {:>11} {:>12}",
+        "VPLs", "variant", "keys ms", "sort ms", "build ms", "classify ms", "total ms", "build Mnode/s"
+    );
+    let variants = [
+        (SortVariant::Baseline, "baseline"),
+        (SortVariant::Parallel, "parallel"),
+    ];
+    let mut rows: Vec<(f64, [[f64; 4]; 2])> = Vec::new();
     for log2 in args.min_log2..=args.max_log2 {
         let n = 1u32 << log2;
         let need = TreeBuffers::largest_binding(n);
@@ -238,64 +365,83 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
         });
         let sb = SortBuffers::new(device, n);
         let tb = TreeBuffers::new(device, n);
-        let mut samples: [Vec<f64>; 4] = Default::default();
-        // The first repetition includes pipeline warm-up: dropped.
-        for rep in 0..=args.repeat {
-            let mut enc = device.create_command_encoder(&Default::default());
-            timer.begin_frame();
-            sort.record(device, &ctx.queue, &mut enc, &mut timer, &buf, &sb);
-            let d = crate::renderer::settings::TreeSettings::default();
-            build.record(
-                device,
-                &ctx.queue,
-                &mut enc,
-                &mut timer,
-                &buf,
-                &sb,
-                &tb,
-                d.v_min,
-                d.sigma_max,
-            );
-            timer.resolve(&mut enc);
-            ctx.queue.submit([enc.finish()]);
-            timer.after_submit();
-            let t = timer
-                .collect_blocking(device)
-                .cloned()
-                .ok_or_else(|| anyhow!("no timestamps came back"))?;
-            if rep > 0 {
-                for (k, stage) in TREE_STAGES.iter().enumerate() {
-                    samples[k].push(t.get(stage).unwrap_or(f64::NAN));
+        let mut both = [[f64::NAN; 4]; 2];
+        for (vi, (variant, name)) in variants.iter().enumerate() {
+            sort.variant = *variant;
+            let mut samples: [Vec<f64>; 4] = Default::default();
+            // The first repetition includes pipeline warm-up: dropped. Repetitions run back
+            // to back (no CPU work between them but the timestamp readback).
+            for rep in 0..=args.repeat {
+                let mut enc = device.create_command_encoder(&Default::default());
+                timer.begin_frame(true);
+                sort.record(device, &ctx.queue, &mut enc, &mut timer, &buf, &sb);
+                let d = crate::renderer::settings::TreeSettings::default();
+                build.record(
+                    device,
+                    &ctx.queue,
+                    &mut enc,
+                    &mut timer,
+                    &buf,
+                    &sb,
+                    &tb,
+                    d.v_min,
+                    d.sigma_max,
+                );
+                timer.resolve(&mut enc);
+                ctx.queue.submit([enc.finish()]);
+                timer.after_submit();
+                let t = timer
+                    .collect_new_blocking(device)
+                    .ok_or_else(|| anyhow!("no timestamps came back"))?;
+                if rep > 0 {
+                    for (k, stage) in TREE_STAGES.iter().enumerate() {
+                        samples[k].push(t.get(stage).unwrap_or(f64::NAN));
+                    }
                 }
             }
+            let m = samples.map(|v| median(v).unwrap_or(f64::NAN));
+            println!(
+                "{n:>9} {name:>9} {:>11.3} {:>11.3} {:>11.3} {:>11.3} {:>11.3} {:>12.2}",
+                m[0],
+                m[1],
+                m[2],
+                m[3],
+                m.iter().sum::<f64>(),
+                (2 * tb.leaves - 1) as f64 / (m[2] * 1e-3) / 1e6
+            );
+            both[vi] = m;
         }
-        let m = samples.map(|v| median(v).unwrap_or(f64::NAN));
         println!(
-            "{n:>9} {:>11.3} {:>11.3} {:>11.3} {:>11.3} {:>11.3} {:>12.2}",
-            m[0],
-            m[1],
-            m[2],
-            m[3],
-            m.iter().sum::<f64>(),
-            (2 * tb.leaves - 1) as f64 / (m[2] * 1e-3) / 1e6
+            "{n:>9} {:>9} keys {:.2}x, sort {:.2}x, total {:.2}x faster than the baseline",
+            "speed-up",
+            both[0][0] / both[1][0],
+            both[0][1] / both[1][1],
+            both[0].iter().sum::<f64>() / both[1].iter().sum::<f64>()
         );
-        rows.push((n as f64, m));
+        rows.push((n as f64, both));
     }
-    let slope = |k: usize| {
-        log_log_slope(&rows.iter().map(|(n, m)| (*n, m[k])).collect::<Vec<_>>())
-            .map_or("n/a".to_string(), |s| format!("{s:.2}"))
-    };
-    let total = log_log_slope(&rows.iter().map(|(n, m)| (*n, m.iter().sum())).collect::<Vec<_>>())
+    for (vi, (_, name)) in variants.iter().enumerate() {
+        let slope = |k: usize| {
+            log_log_slope(&rows.iter().map(|(n, m)| (*n, m[vi][k])).collect::<Vec<_>>())
+                .map_or("n/a".to_string(), |s| format!("{s:.2}"))
+        };
+        let total = log_log_slope(
+            &rows
+                .iter()
+                .map(|(n, m)| (*n, m[vi].iter().sum()))
+                .collect::<Vec<_>>(),
+        )
         .map_or("n/a".to_string(), |s| format!("{s:.2}"));
-    println!(
-        "log-log slope of time vs N: keys {}, sort {}, build {}, classify {}, total {} \
-         (1 = linear; a bitonic sort is N log^2 N of work)",
-        slope(0),
-        slope(1),
-        slope(2),
-        slope(3),
-        total
-    );
+        println!(
+            "{name}: log-log slope of time vs N: keys {}, sort {}, build {}, classify {}, total {} \
+             (1 = linear; a bitonic sort is N log^2 N of work)",
+            slope(0),
+            slope(1),
+            slope(2),
+            slope(3),
+            total
+        );
+    }
     if let Some(e) = ctx.errors.take().into_iter().next() {
         return Err(anyhow!("GPU error: {e}"));
     }
@@ -355,6 +501,71 @@ fn run_rays(args: &BenchArgs) -> anyhow::Result<()> {
         }
     }
     if let Some(e) = ctx.errors.take().into_iter().next() {
+        return Err(anyhow!("GPU error: {e}"));
+    }
+    in_frame_rays(args, &opened, ctx)
+}
+
+/// The shadow-ray rate inside the frame: SLC's sampling pass at the scene's settings and
+/// camera, timed with and without shadow rays (timed frames, median of `--repeat`), and the
+/// rays it traces (a diagnostic frame's counter): rays / (time with - time without).
+fn in_frame_rays(
+    args: &BenchArgs,
+    opened: &crate::scene::preset::OpenedScene,
+    ctx: GpuContext,
+) -> anyhow::Result<()> {
+    let scene = &opened.scene;
+    let camera = scene
+        .camera_or_default(opened.camera_name.as_deref())
+        .map_err(|e| anyhow!("{e}"))?;
+    let mut s = RenderSettings::default();
+    s.display.exposure_ev = opened.exposure_ev;
+    s.gi.method = crate::methods::tree_samplers::SLC;
+    s.sampling.accumulate = false;
+    let size = (args.width, args.height);
+    let mut r = Renderer::new(ctx, scene, size, s.clone())?;
+    if !r.timestamps_supported() {
+        println!("in-frame shadow rays: timestamps not supported on this adapter");
+        return Ok(());
+    }
+    let lights = scene.lights.clone();
+    let input = FrameInput {
+        camera: &camera,
+        lights: &lights,
+        view: ViewBuffer::Final,
+    };
+    // Median GPU time of the sampling pass over back-to-back timed frames (2 warm-up).
+    let sample_ms = |r: &mut Renderer| -> anyhow::Result<f64> {
+        r.set_frame_mode(FrameMode::Timed);
+        let mut v = Vec::new();
+        for i in 0..args.repeat + 2 {
+            r.render(&input);
+            if let Some(t) = r.wait_new_timings()
+                && i >= 2
+            {
+                v.push(t.get("slc_sample").unwrap_or(f64::NAN));
+            }
+        }
+        median(v).ok_or_else(|| anyhow!("no timestamps came back"))
+    };
+    let with = sample_ms(&mut r)?;
+    r.set_frame_mode(FrameMode::Diagnostic);
+    r.render(&input);
+    let rays = r.sampling_stats_blocking().map_or(0, |st| st.rays);
+    let mut open = s.clone();
+    open.gi.shadow_rays = false;
+    r.set_settings(open)?;
+    let without = sample_ms(&mut r)?;
+    println!(
+        "in-frame shadow rays (SLC's sampling pass, {}x{}, {} spp, {} VPLs): {rays} rays per frame; \
+         pass {with:.3} ms with them, {without:.3} ms without: {:.2} Mrays/s",
+        size.0,
+        size.1,
+        s.sampling.cut_size,
+        s.vpl.count,
+        rays as f64 / ((with - without).max(1e-9) * 1e-3) / 1e6
+    );
+    if let Some(e) = r.ctx.errors.take().into_iter().next() {
         return Err(anyhow!("GPU error: {e}"));
     }
     Ok(())

@@ -11,10 +11,11 @@ use super::SettingsArgs;
 use crate::{
     export::{write_exr, write_png},
     renderer::{
-        Buffer, FrameInput, Renderer,
+        Buffer, FrameInput, FrameMode, Renderer,
         context::GpuContext,
         readback::ImageF32,
         settings::{MethodId, MethodView, TreeColor, TreeOverlay, ViewBuffer},
+        timing::PassTimings,
     },
     scene::preset::{SceneSource, open_scene},
 };
@@ -227,16 +228,40 @@ pub struct RenderArgs {
     pub sampling: SamplingArgs,
 }
 
-/// metrics.json of a per-frame method: frames, per-pass times, the tree samplers' traversal
-/// statistics, and (with
-/// --compare-gt) RMSE / SSIM against the ground truth of the same VPLs.
+/// What the timed frames of `render` measured, and the frames the image averaged.
+struct Timed<'a> {
+    /// Mean GPU time per pass over the timed frames.
+    timings: Option<&'a PassTimings>,
+    frames: usize,
+    wall_ms: f64,
+    frames_averaged: u32,
+}
+
+/// Mean time of each pass over timed frames (passes in the first frame's order).
+fn mean_timings(frames: &[PassTimings]) -> Option<PassTimings> {
+    let first = frames.first()?;
+    let passes = first
+        .passes
+        .iter()
+        .map(|(name, _)| {
+            let v: Vec<f64> = frames.iter().filter_map(|f| f.get(name)).collect();
+            (name.clone(), crate::harness::mean_std(&v).0)
+        })
+        .collect();
+    Some(PassTimings { passes })
+}
+
+/// metrics.json of a per-frame method: frames averaged, per-pass GPU times of the timed
+/// frames, the tree samplers' traversal statistics, and (with --compare-gt) RMSE / SSIM
+/// against the ground truth of the same VPLs.
 fn write_metrics(
     r: &mut Renderer,
     args: &RenderArgs,
     indirect: &ImageF32,
-    timings: Option<&crate::renderer::timing::PassTimings>,
+    timed: &Timed<'_>,
     frame: &dyn Fn(&mut Renderer, ViewBuffer),
 ) -> anyhow::Result<()> {
+    let timings = timed.timings;
     let s = r.settings().clone();
     let tree = s.gi.method.samples_tree();
     let st = if tree { r.sampling_stats_blocking() } else { None };
@@ -245,7 +270,9 @@ fn write_metrics(
         "width": args.width,
         "height": args.height,
         "vpls": r.vpl_frame().count,
-        "frames_averaged": r.sampling_frames(),
+        "frames_averaged": timed.frames_averaged,
+        "timed_frames": timed.frames,
+        "frame_wall_ms": timed.wall_ms,
         "tree": &s.tree,
         "n_min": s.vpl.n_min,
         "d_max_fraction_of_scene_radius": s.vpl.d_max,
@@ -261,6 +288,7 @@ fn write_metrics(
         json["fallback_pixel_fraction"] = st.fallback_fraction().into();
         json["dead_branches"] = st.dead.into();
         json["traversals"] = st.traversals.into();
+        json["shadow_rays"] = st.rays.into();
     }
     if args.sampling.compare_gt {
         let mut g = s.clone();
@@ -296,7 +324,7 @@ fn write_metrics(
 }
 
 /// GPU time of `method`'s own passes in one frame's timings.
-fn method_ms(t: &crate::renderer::timing::PassTimings, method: MethodId) -> f64 {
+fn method_ms(t: &PassTimings, method: MethodId) -> f64 {
     method.info().timed_passes.iter().filter_map(|p| t.get(p)).sum()
 }
 
@@ -365,42 +393,78 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             view,
         })
     };
+    let redraw = |r: &mut Renderer, view| {
+        r.redraw_view(&FrameInput {
+            camera: &camera,
+            lights: &lights,
+            view,
+        })
+    };
     let render_start = std::time::Instant::now();
-    for _ in 0..args.timing_frames.max(1) {
+    // Timed frames: nothing but the frame's passes (FrameMode::Timed: no diagnostics, no
+    // readbacks). A per-frame method times frames that do not accumulate; the first of two
+    // or more is a warm-up (pipelines, buffers) and is not counted.
+    r.set_frame_mode(FrameMode::Timed);
+    let image_settings = r.settings().clone();
+    if method.per_frame() {
+        let mut s = image_settings.clone();
+        s.sampling.accumulate = false;
+        r.set_settings(s)?;
+    }
+    let n_timing = args.timing_frames.max(1);
+    let mut timed: Vec<PassTimings> = Vec::new();
+    let mut wall_ms: Vec<f64> = Vec::new();
+    // Progressive methods: the GPU time of every frame's passes adds up.
+    let mut gi_ms = 0.0;
+    for i in 0..n_timing {
+        let t0 = std::time::Instant::now();
         frame(&mut r, ViewBuffer::Final);
         r.ctx.wait_idle()?;
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        let t = r.wait_new_timings();
+        gi_ms += t.as_ref().map_or(0.0, |t| method_ms(t, method));
+        if i > 0 || n_timing == 1 {
+            wall_ms.push(ms);
+            timed.extend(t);
+        }
     }
-    let timings = r.wait_timings();
-    // Per-frame methods that average: --frames independent frames (the timing frames count).
+    let timings = mean_timings(&timed);
+    // The image: a per-frame method averages exactly --frames new diagnostic frames
+    // (untimed; the accumulation restarts with the settings change). A progressive method
+    // goes on in timed frames (below), each adding its GPU time.
+    r.set_settings(image_settings)?;
+    let mut frames_averaged = None;
     if method.per_frame() {
-        while r.frames_averaged().is_some_and(|n| n < args.sampling.frames) {
+        r.set_frame_mode(FrameMode::Diagnostic);
+        for _ in 0..args.sampling.frames {
             if let Some(e) = r.ctx.errors.take().into_iter().next() {
                 return Err(anyhow!("GPU error: {e}"));
             }
             frame(&mut r, ViewBuffer::Final);
             r.ctx.wait_idle()?;
         }
+        frames_averaged = Some(r.sampling_frames());
         if let Some(st) = r.sampling_stats_blocking().filter(|_| method.samples_tree()) {
             println!(
-                "tree sampling: {} frame(s) averaged; {:.3} traversal steps per traversal, {:.2} per pixel; {:.3}% of pixels without a similar cut; {} dead branches in the last frame",
+                "tree sampling: {} frame(s) averaged; {:.3} traversal steps per traversal, {:.2} per pixel; {:.3}% of pixels without a similar cut; {} dead branches and {} shadow rays in the last frame",
                 r.sampling_frames(),
                 st.steps_per_traversal(),
                 st.steps_per_pixel(),
                 100.0 * st.fallback_fraction(),
-                st.dead
+                st.dead,
+                st.rays
             );
         }
     }
     // Progressive GI: keep rendering the same frame until it has seen every VPL / sample.
     let info = method.info();
-    let mut gi_ms = timings.as_ref().map_or(0.0, |t| method_ms(t, method));
     while let Some(p) = r.gi_progress() {
         if p.finished() {
             break;
         }
         frame(&mut r, ViewBuffer::Final);
         r.ctx.wait_idle()?;
-        if let Some(t) = r.wait_timings() {
+        if let Some(t) = r.wait_new_timings() {
             gi_ms += method_ms(&t, method);
         }
         if let Some(p) = r.gi_progress() {
@@ -463,9 +527,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             (ViewBuffer::ImportanceRaw, "brsm_importance_raw.png"),
             (ViewBuffer::ImportanceFiltered, "brsm_importance_filtered.png"),
         ];
-        // Views re-render the frame; the finished GI keeps its key, so nothing restarts.
+        // Views are drawn from the last frame's buffers (no new frame: the averaged GI and
+        // its frame count stay those of the EXRs).
         for (view, name) in pngs {
-            frame(&mut r, view);
+            redraw(&mut r, view);
             let (w, h, bytes) = r.read_view_rgba8()?;
             write_png(&out.join(name), w, h, &bytes)?;
         }
@@ -480,7 +545,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             (ViewBuffer::Final, "vpls_in_view.png"),
             (ViewBuffer::PdfPyramid, "pdf_pyramid_level4.png"),
         ] {
-            frame(&mut r, view);
+            redraw(&mut r, view);
             let (w, h, bytes) = r.read_view_rgba8()?;
             write_png(&out.join(name), w, h, &bytes)?;
         }
@@ -490,7 +555,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             s3.display.vpl_overlay = false;
             r.set_settings(s3)?;
             for v in info.views {
-                frame(&mut r, ViewBuffer::Method(MethodView::new(v.name)));
+                redraw(&mut r, ViewBuffer::Method(MethodView::new(v.name)));
                 let (w, h, bytes) = r.read_view_rgba8()?;
                 write_png(&out.join(format!("{}.png", v.file)), w, h, &bytes)?;
             }
@@ -518,13 +583,19 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             s3.display.tree_color = color;
             s3.display.tree_level = level;
             r.set_settings(s3)?;
-            frame(&mut r, ViewBuffer::Albedo);
+            redraw(&mut r, ViewBuffer::Albedo);
             let (w, h, bytes) = r.read_view_rgba8()?;
             write_png(&out.join(name), w, h, &bytes)?;
         }
     }
     if method.per_frame() {
-        write_metrics(&mut r, args, &indirect, timings.as_ref(), &frame)?;
+        let timed = Timed {
+            timings: timings.as_ref(),
+            frames: timed.len(),
+            wall_ms: crate::harness::mean_std(&wall_ms).0,
+            frames_averaged: frames_averaged.unwrap_or(1),
+        };
+        write_metrics(&mut r, args, &indirect, &timed, &frame)?;
     }
     if let Some(e) = r.ctx.errors.take().into_iter().next() {
         return Err(anyhow!("GPU error: {e}"));
@@ -547,13 +618,22 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     match timings {
         Some(t) => {
             println!(
-                "GPU time per pass (last of {} frames):",
-                args.timing_frames.max(1)
+                "GPU time per pass (GPU timestamps, mean of {} timed frame(s) without diagnostics{}):",
+                timed.len(),
+                if n_timing > 1 {
+                    ", after 1 warm-up frame"
+                } else {
+                    ""
+                }
             );
             for (name, ms) in &t.passes {
                 println!("  {name:<14} {ms:>9.3} ms");
             }
             println!("  {:<14} {:>9.3} ms", "total", t.total_ms());
+            println!(
+                "frame wall clock (render + submit + wait): {:.3} ms",
+                crate::harness::mean_std(&wall_ms).0
+            );
         }
         None => println!("GPU time per pass: timestamps not supported on this adapter"),
     }

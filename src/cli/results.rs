@@ -23,7 +23,7 @@ use crate::{
 pub enum Figure {
     /// Every figure below.
     All,
-    /// Table 7.1: GPU time per pass (mean and spread over many frames).
+    /// Table 7.1: GPU time per pass (median, mean and spread over many timed frames).
     Timings,
     /// Fig. 7.1 / 7.3: RMSE and SSIM over frame time for SLC, RTSLC, SST; equal-time table.
     EqualTime,
@@ -65,11 +65,12 @@ pub struct ResultsArgs {
     pub width: u32,
     #[arg(long, default_value_t = 108)]
     pub height: u32,
-    /// Independent frames per configuration (metrics are per-frame means; the first frame
-    /// of a configuration is not timed when there are two or more).
+    /// Diagnostic frames per configuration: per-frame errors against the ground truth and
+    /// sampler statistics (their means reported), after the timed frames. docs/measurement.md.
     #[arg(long, default_value_t = 4)]
     pub frames: u32,
-    /// Frames of the per-pass timing table.
+    /// Timed frames per configuration, back to back after a warm-up (GPU timestamps: the
+    /// median reported; also the per-pass timing table's frames).
     #[arg(long, default_value_t = 20)]
     pub timing_frames: u32,
     /// Samples per pixel of the equal-time sweep (the base cut size is always added).
@@ -204,8 +205,10 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
             label.clone(),
             adapter.clone(),
         );
+        let mut figure_times = Vec::new();
         for f in &figures {
             let t = std::time::Instant::now();
+            let gpu0 = b.gpu_wall;
             let rep = match f {
                 Figure::Timings => figures::timings(&mut b, &o, &dir)?,
                 Figure::EqualTime => figures::equal_time(&mut b, &o, &dir)?,
@@ -220,7 +223,25 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
             for c in &rep.checks {
                 println!("  check: {}", c.line());
             }
-            println!("  ({:?} took {:.0} s)", f, t.elapsed().as_secs_f64());
+            // Wall time of the figure and the share of it not spent rendering / waiting for
+            // the GPU (readbacks, metrics, plots, PNGs: the CPU side).
+            let wall = t.elapsed().as_secs_f64();
+            let gpu = (b.gpu_wall - gpu0).as_secs_f64();
+            let outside = if wall > 0.0 {
+                (1.0 - gpu / wall).max(0.0)
+            } else {
+                0.0
+            };
+            println!(
+                "  ({f:?} took {wall:.1} s wall, {:.0}% of it outside rendering and GPU waits)",
+                100.0 * outside
+            );
+            figure_times.push(serde_json::json!({
+                "figure": format!("{f:?}"),
+                "wall_s": wall,
+                "rendering_and_gpu_wait_s": gpu,
+                "share_outside_gpu": outside,
+            }));
             checks.extend(rep.checks);
         }
         run_info.push(serde_json::json!({
@@ -231,6 +252,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
             "adapter": adapter,
             "settings": b.base,
             "gi_exposure_ev": b.gi_exposure,
+            "figure_times": figure_times,
         }));
     }
     let mut csv = Csv::new(&["scene", "check", "value", "limit", "kind", "met", "detail"]);

@@ -13,7 +13,11 @@
 pub mod figures;
 pub mod plot;
 
-use std::{collections::HashMap, path::Path, time::Instant};
+use std::{
+    collections::HashMap,
+    path::Path,
+    time::{Duration, Instant},
+};
 
 use anyhow::{Context, anyhow, bail};
 
@@ -22,7 +26,7 @@ use crate::{
     methods::tree_samplers::pass::SamplingStats,
     metrics,
     renderer::{
-        Buffer, FrameInput, Renderer,
+        Buffer, FrameInput, FrameMode, Renderer,
         readback::ImageF32,
         settings::{RenderSettings, ViewBuffer},
     },
@@ -31,7 +35,7 @@ use crate::{
 
 /// GPU passes grouped as the columns of thesis table 7.1.
 pub const PASS_GROUPS: [(&str, &[&str]); 8] = [
-    ("G-buffer", &["gbuffer"]),
+    ("G-buffer", &["gbuffer_depth", "gbuffer"]),
     ("shadow map", &["rsm"]),
     (
         "VPL generation",
@@ -74,6 +78,17 @@ pub fn gi_passes() -> Vec<&'static str> {
 /// The tree samplers' sampling passes alone (traversal, evaluation, shadow rays).
 pub const SAMPLE_PASSES: [&str; 3] = ["slc_sample", "sst_sample", "rtslc_sample"];
 
+/// The median (NaN when empty; the mean of the middle two for an even count).
+pub fn median(v: &[f64]) -> f64 {
+    let mut s: Vec<f64> = v.to_vec();
+    s.sort_by(|a, b| a.total_cmp(b));
+    match s.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => s[n / 2],
+        n => 0.5 * (s[n / 2 - 1] + s[n / 2]),
+    }
+}
+
 /// Mean and sample standard deviation.
 pub fn mean_std(v: &[f64]) -> (f64, f64) {
     if v.is_empty() {
@@ -92,14 +107,13 @@ pub fn mean_std(v: &[f64]) -> (f64, f64) {
 /// What one configuration measured over its frames.
 #[derive(Clone, Debug, Default)]
 pub struct Measured {
-    /// Wall-clock ms per frame (render + submit + wait), timed frames only.
+    /// Wall-clock ms per timed frame (render + submit + wait).
     pub frame_ms: Vec<f64>,
     /// GPU timestamps per pass, one entry per timed frame.
     pub passes: Vec<Vec<(String, f64)>>,
-    /// Per frame: GI against the ground truth (tree samplers with a ground truth).
+    /// Per diagnostic frame: GI against the ground truth (tree samplers with a ground truth).
     pub rmse: Vec<f64>,
     pub ssim: Vec<f64>,
-    pub flip: Vec<f64>,
     pub mean_ratio: Vec<f64>,
     /// The frames' error split into bias and noise (`metrics::bias_noise`: RMSEs of the
     /// frames' mean and of a frame around it); NaN without a ground truth or with one frame.
@@ -107,19 +121,26 @@ pub struct Measured {
     pub noise_rmse: f64,
     /// Per frame: RMSE over the pixels without a similar cut only (NaN when there are none).
     pub rmse_fallback: Vec<f64>,
-    /// Sampler statistics summed over the frames.
+    /// Sampler statistics summed over the diagnostic frames.
     pub stats: Option<SamplingStats>,
-    /// The last frame's GI.
+    /// The last diagnostic frame's GI.
     pub indirect: Option<ImageF32>,
-    /// The last frame's traversal steps per traversal, per GI pixel (NaN without geometry).
+    /// A diagnostic frame's traversal steps per traversal, per GI pixel (NaN without
+    /// geometry).
     pub steps: Option<(u32, u32, Vec<f32>)>,
-    /// The last frame's pixels without a similar cut.
+    /// The pixels without a similar cut.
     pub fallback: Option<Vec<bool>>,
 }
 
 impl Measured {
     pub fn frame_ms(&self) -> (f64, f64) {
         mean_std(&self.frame_ms)
+    }
+    /// GPU time of the method's whole GI cost (cuts, sampling, half-resolution down- and
+    /// upsampling: [`gi_passes`]) over the timed frames (median, standard deviation): what
+    /// equal time is decided on.
+    pub fn gi_ms(&self) -> (f64, f64) {
+        self.pass_ms(&gi_passes())
     }
     /// GPU time of a group of passes in each timed frame (`None`: every pass).
     pub fn pass_ms_per_frame(&self, names: Option<&[&str]>) -> Vec<f64> {
@@ -133,9 +154,18 @@ impl Measured {
             })
             .collect()
     }
-    /// Mean GPU time of a group of passes over the timed frames.
+    /// The fastest timed frame's GPU time of a group of passes (stable on an adapter whose
+    /// speed switches between states, as a shared CPU's does).
+    pub fn pass_ms_min(&self, names: &[&str]) -> f64 {
+        self.pass_ms_per_frame(Some(names))
+            .into_iter()
+            .fold(f64::NAN, f64::min)
+    }
+    /// GPU time of a group of passes over the timed frames: the median (robust to the odd
+    /// interrupted frame) and the standard deviation.
     pub fn pass_ms(&self, names: &[&str]) -> (f64, f64) {
-        mean_std(&self.pass_ms_per_frame(Some(names)))
+        let v = self.pass_ms_per_frame(Some(names));
+        (median(&v), mean_std(&v).1)
     }
     pub fn rmse(&self) -> (f64, f64) {
         mean_std(&self.rmse)
@@ -170,7 +200,24 @@ pub struct Bench {
     gt: HashMap<(u32, u32, u32), (ImageF32, u64)>,
     /// Progress lines to stderr.
     pub verbose: bool,
+    /// Wall clock spent rendering and waiting for the GPU (the rest of a figure's wall time
+    /// is CPU work: readbacks, metrics, plots, PNGs).
+    pub gpu_wall: Duration,
 }
+
+/// Frames of one configuration's measurement ([`Bench::measure`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Frames {
+    /// Timed frames (GPU timestamps; at least 1).
+    pub timed: u32,
+    /// Diagnostic frames (errors against the ground truth, sampler statistics; 0: none).
+    pub diagnostic: u32,
+}
+
+/// Untimed frames before a configuration's timed frames (see `Bench::warm_up`).
+pub const WARMUP_FRAMES: u32 = 2;
+/// ... and at least this much wall clock of back-to-back frames.
+pub const WARMUP_MS: f64 = 150.0;
 
 impl Bench {
     pub fn new(
@@ -197,6 +244,7 @@ impl Bench {
             adapter,
             gt: HashMap::new(),
             verbose: true,
+            gpu_wall: Duration::ZERO,
         }
     }
 
@@ -263,7 +311,9 @@ impl Bench {
         let t = Instant::now();
         let mut frames = 0;
         loop {
+            let tf = Instant::now();
             self.frame();
+            self.gpu_wall += tf.elapsed();
             frames += 1;
             let p = self.r.gi_progress().unwrap_or_default();
             if p.finished() && frames > 1 {
@@ -273,6 +323,9 @@ impl Bench {
                 bail!("the ground truth did not finish");
             }
         }
+        let tw = Instant::now();
+        self.r.wait_idle();
+        self.gpu_wall += tw.elapsed();
         let img = self.r.read(Buffer::Indirect)?;
         let hash = self.vpl_hash()?;
         self.say(&format!(
@@ -283,14 +336,43 @@ impl Bench {
         Ok((img, hash))
     }
 
-    /// Renders `frames` independent frames with settings `s` at `size`. With `with_gt`, every
-    /// frame's GI is compared with the ground truth of the same VPLs. The first frame after
-    /// the settings change is not timed when there are two or more (pipelines, buffers).
+    /// Renders and submits one frame and waits for the GPU; the wait counts as GPU time.
+    fn frame_wait(&mut self) {
+        let t = Instant::now();
+        self.frame();
+        self.r.wait_idle();
+        self.gpu_wall += t.elapsed();
+    }
+
+    /// Back-to-back untimed frames before the timed ones: at least [`WARMUP_FRAMES`] (the
+    /// first after a settings change builds pipelines and buffers) and at least
+    /// [`WARMUP_MS`] of wall clock, so that a GPU that idled during the CPU work before
+    /// (ground truth readback, metrics, PNGs) is back at its working clocks.
+    fn warm_up(&mut self) {
+        let t = Instant::now();
+        let mut n = 0;
+        while n < WARMUP_FRAMES || (t.elapsed().as_secs_f64() * 1e3 < WARMUP_MS && n < 64) {
+            self.frame_wait();
+            n += 1;
+        }
+        let _ = self.r.wait_new_timings();
+    }
+
+    /// Measures settings `s` at `size` in two phases:
+    ///
+    /// 1. **Timed**: after a warm-up, `frames.timed` frames back to back in
+    ///    `FrameMode::Timed`: the method's passes without diagnostics, nothing read back but
+    ///    the timestamps, no CPU work between frames. Their GPU timestamps and wall clock are
+    ///    the measurement.
+    /// 2. **Diagnostic** (untimed): `frames.diagnostic` independent frames that record the
+    ///    samplers' counters and per-pixel diagnostics; each one's GI is read back and, with
+    ///    `with_gt`, compared with the ground truth of the same VPLs (RMSE, SSIM, mean ratio;
+    ///    FLIP only where a figure asks for it, [`Bench::flip`]).
     pub fn measure(
         &mut self,
         s: &RenderSettings,
         size: (u32, u32),
-        frames: u32,
+        frames: Frames,
         with_gt: bool,
     ) -> anyhow::Result<Measured> {
         let tree = s.gi.method.per_frame();
@@ -305,46 +387,44 @@ impl Bench {
             noise_rmse: f64::NAN,
             ..Default::default()
         };
+        // 1. Timed frames.
+        self.r.set_frame_mode(FrameMode::Timed);
+        self.warm_up();
+        for _ in 0..frames.timed.max(1) {
+            let t0 = Instant::now();
+            self.frame_wait();
+            m.frame_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+            if let Some(t) = self.r.wait_new_timings() {
+                m.passes.push(t.passes);
+            }
+        }
+        // 2. Diagnostic frames (untimed).
+        self.r.set_frame_mode(FrameMode::Diagnostic);
+        if !tree {
+            return Ok(m);
+        }
         // Sum of the frames' GI (for the bias / noise split).
         let mut sum: Option<ImageF32> = None;
-        for f in 0..frames.max(1) {
-            // Drain any pending timestamp readback so this frame is timed.
-            let _ = self.r.wait_timings();
-            let t0 = Instant::now();
-            self.frame();
-            self.r.wait_idle();
-            let ms = t0.elapsed().as_secs_f64() * 1e3;
-            let timings = self.r.wait_timings();
-            if f > 0 || frames == 1 {
-                m.frame_ms.push(ms);
-                if let Some(t) = timings {
-                    m.passes.push(t.passes.clone());
-                }
-            }
-            if !tree {
-                continue;
-            }
+        // Pixels without a similar cut: a property of the G-buffer and the cuts, the same
+        // in every frame (read from the first).
+        let mut fallback_mask: Option<Vec<bool>> = None;
+        for _ in 0..frames.diagnostic {
+            self.frame_wait();
             if let Some(st) = self.r.sampling_stats_blocking() {
-                m.stats = Some(m.stats.map_or(st, |a| SamplingStats {
-                    pixels: a.pixels + st.pixels,
-                    fallback_pixels: a.fallback_pixels + st.fallback_pixels,
-                    steps: a.steps + st.steps,
-                    traversals: a.traversals + st.traversals,
-                    dead: a.dead + st.dead,
-                }));
+                m.stats = Some(m.stats.map_or(st, |a| a.add(st)));
             }
             let ind = self.r.read(Buffer::Indirect)?;
             // Steps and fallback flags are per GI pixel: read at full GI resolution only.
-            let diag = if s.sampling.half_resolution {
-                None
-            } else {
-                Some(self.read_steps()?)
-            };
+            if m.steps.is_none() && !s.sampling.half_resolution {
+                let (w, h, steps, fb) = self.read_steps()?;
+                m.steps = Some((w, h, steps));
+                fallback_mask = Some(fb.clone());
+                m.fallback = Some(fb);
+            }
             if let Some((gt, _)) = &gt {
-                let c = metrics::compare(&ind, gt, self.gi_exposure, self.base.display.tonemap);
+                let c = metrics::compare_without_flip(&ind, gt, self.gi_exposure, self.base.display.tonemap);
                 m.rmse.push(c.rmse);
                 m.ssim.push(c.ssim);
-                m.flip.push(c.flip);
                 m.mean_ratio.push(c.mean_ratio);
                 let acc = sum.get_or_insert_with(|| ImageF32 {
                     pixels: vec![[0.0; 4]; ind.pixels.len()],
@@ -355,7 +435,7 @@ impl Bench {
                         a[c] += p[c];
                     }
                 }
-                if let Some((_, _, _, fb)) = &diag {
+                if let Some(fb) = &fallback_mask {
                     m.rmse_fallback.push(if fb.iter().any(|f| *f) {
                         metrics::rmse(&ind, gt, Some(fb))
                     } else {
@@ -364,10 +444,6 @@ impl Bench {
                 }
             }
             m.indirect = Some(ind);
-            if let Some((w, h, steps, fb)) = diag {
-                m.steps = Some((w, h, steps));
-                m.fallback = Some(fb);
-            }
         }
         if let (Some((gt, _)), Some(mut mean)) = (&gt, sum) {
             let k = m.rmse.len() as f32;
@@ -385,6 +461,12 @@ impl Bench {
             );
         }
         Ok(m)
+    }
+
+    /// Mean FLIP of `img` against `gt` as displayed at the GI exposure (costly: only for the
+    /// images a figure writes).
+    pub fn flip(&self, img: &ImageF32, gt: &ImageF32) -> f64 {
+        metrics::flip(img, gt, self.gi_exposure, self.base.display.tonemap)
     }
 
     /// Traversal steps per traversal of the last frame, per pixel (NaN where no geometry), and

@@ -397,8 +397,13 @@ pub struct FrameCx<'a> {
     pub key: u64,
     /// Frames rendered so far (the samplers' seeds).
     pub frame_index: u64,
-    /// The pinned pixel whose story the method records (if it tells one).
+    /// The pinned pixel whose story the method records (if it tells one; diagnostic frames
+    /// only).
     pub trace_pixel: Option<(u32, u32)>,
+    /// A diagnostic frame (untimed): record counters, per-pixel statistics and the story.
+    /// Otherwise a timed frame: record only the work the method's image needs, no
+    /// diagnostics and no readbacks (`renderer::FrameMode`).
+    pub diagnostics: bool,
 }
 
 /// What a method's view drawing may use.

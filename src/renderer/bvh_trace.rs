@@ -135,7 +135,7 @@ impl BvhTracer {
             let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("bvh_rays::encoder"),
             });
-            timer.begin_frame();
+            timer.begin_frame(true);
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("bvh_rays::pass"),

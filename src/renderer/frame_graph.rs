@@ -9,7 +9,7 @@ use super::*;
 /// field borrows of `$r` (a macro, so that the method instance, another field, stays
 /// borrowable), writing into `$accum`.
 macro_rules! frame_cx {
-    ($r:ident, $method:expr, $accum:expr, $size:expr, $key:expr, $trace:expr) => {
+    ($r:ident, $method:expr, $accum:expr, $size:expr, $key:expr, $trace:expr, $diag:expr) => {
         FrameCx {
             method: $method,
             device: &$r.ctx.device,
@@ -29,6 +29,7 @@ macro_rules! frame_cx {
             key: $key,
             frame_index: $r.frames,
             trace_pixel: $trace,
+            diagnostics: $diag,
         }
     };
 }
@@ -81,7 +82,13 @@ impl Renderer {
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("frame::encoder"),
         });
-        self.timer.begin_frame();
+        // A diagnostic frame or a timed one (FrameMode); a timed frame that must advance a
+        // converging comparison truth is untimed too.
+        let diagnostic = self.next_frame_diagnostic();
+        let compare_due = self.compare_on
+            && s.gi.method.per_frame()
+            && (diagnostic || !self.compare_settled(input, lights, size));
+        self.timer.begin_frame(!diagnostic && !compare_due);
         let t = &self.targets;
         self.rsm.record(
             &device,
@@ -197,19 +204,22 @@ impl Renderer {
                 s.tree.v_min,
                 s.tree.sigma_max,
             );
-            // The flux-pyramid tops (one float per light), read back on a later frame.
+            // The flux-pyramid tops (one float per light), read back on a later frame: a
+            // readback, so in diagnostic frames only.
             let (per_layer, offsets) = passes::vpl_gen::pyramid_layout(self.vpl_buffers.res);
             let top = *offsets.last().unwrap_or(&0) as u64;
             let fp = &self.vpl_buffers.flux_pyramid;
             let copies: Vec<(&wgpu::Buffer, u64, u64, u64)> = (0..self.vpl_frame.ranges.len() as u64)
                 .map(|l| (fp, 4 * (l * per_layer as u64 + top), 4 * l, 4))
                 .collect();
-            self.flux_readback.record(&mut enc, &copies);
+            if diagnostic {
+                self.flux_readback.record(&mut enc, &copies);
+            }
         }
         let indirect_scale = if vpl_ok {
             let key = self.gt_key(input, lights, size);
-            let scale = self.record_method(&mut enc, s.gi.method, key, size);
-            if self.compare_on && s.gi.method.per_frame() {
+            let scale = self.record_method(&mut enc, s.gi.method, key, size, diagnostic);
+            if compare_due {
                 self.step_compare(&mut enc, input, lights, size);
             }
             scale
@@ -258,6 +268,35 @@ impl Renderer {
             m.after_submit();
         }
         self.frames += 1;
+        self.last_diagnostic = diagnostic;
+        self.last_vpl_ok = vpl_ok;
+    }
+
+    /// Draws `input.view` (with its overlays) from the last frame's buffers without rendering
+    /// a new frame: an accumulating method keeps its frame count, a view shows exactly what
+    /// was read back. Untimed.
+    pub fn redraw_view(&mut self, input: &FrameInput<'_>) {
+        let spec = ViewSpec::new(input.view, &self.settings.display);
+        let mut enc = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frame::redraw_encoder"),
+            });
+        self.timer.begin_frame(false);
+        let vpl_ok = self.last_vpl_ok;
+        self.record_view_with_overlays(&mut enc, &spec, input.camera, vpl_ok);
+        self.ctx.queue.submit([enc.finish()]);
+    }
+
+    /// Whether the comparison's truth is finished for this frame's view and settings (a timed
+    /// frame then leaves it out).
+    fn compare_settled(&self, input: &FrameInput<'_>, lights: &[DirectionalLight], size: (u32, u32)) -> bool {
+        self.compare.as_ref().is_some_and(|c| {
+            c.targets_size == size
+                && c.key == self.compare_key(input, lights, size)
+                && c.truth.progress().is_some_and(|p| p.finished())
+        })
     }
 
     /// One view into `targets.view`, then the overlays that apply to it.
@@ -325,6 +364,7 @@ impl Renderer {
         method: MethodId,
         key: u64,
         size: (u32, u32),
+        diagnostic: bool,
     ) -> f32 {
         let module = method.info().module.name;
         let Some((_, m)) = self.methods.iter_mut().find(|(n, _)| *n == module) else {
@@ -336,7 +376,8 @@ impl Renderer {
             &self.targets.lighting.gi_accum,
             size,
             key,
-            self.trace_pixel
+            if diagnostic { self.trace_pixel } else { None },
+            diagnostic
         );
         m.record(&mut cx, enc)
     }
@@ -393,6 +434,7 @@ impl Renderer {
             None => match (truth.info().module.create)(&device) {
                 Ok(m) => CompareState {
                     truth: m,
+                    key,
                     targets: frame::LightingTargets::new(&device, size),
                     targets_size: size,
                 },
@@ -402,8 +444,9 @@ impl Renderer {
                 }
             },
         };
-        let mut cx = frame_cx!(self, truth, &cmp.targets.gi_accum, size, key, None);
+        let mut cx = frame_cx!(self, truth, &cmp.targets.gi_accum, size, key, None, true);
         cmp.truth.record(&mut cx, enc);
+        cmp.key = key;
         self.compare_composite.record(
             &device,
             &queue,

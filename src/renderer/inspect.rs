@@ -284,6 +284,14 @@ impl Renderer {
         t
     }
 
+    /// Waits for the GPU and returns the timings of the last timed frame if they came back
+    /// since the previous call (None: no timed frame, or no timestamps on this adapter).
+    pub fn wait_new_timings(&mut self) -> Option<PassTimings> {
+        let t = self.timer.collect_new_blocking(&self.ctx.device);
+        self.take_flux_total();
+        t
+    }
+
     pub(super) fn take_flux_total(&mut self) {
         if let Some(bytes) = self.flux_readback.try_take() {
             let tops: &[f32] = bytemuck::cast_slice(&bytes);

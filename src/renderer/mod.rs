@@ -97,6 +97,21 @@ pub enum Buffer {
 
 pub use crate::methods::GiProgress;
 
+/// Which frames record diagnostics and which are timed. A frame is one or the other, so the
+/// GPU timestamps of a timed frame never include diagnostics work: the samplers' counters,
+/// per-pixel statistics and pixel story, readbacks, or the comparison's ground truth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameMode {
+    /// Every frame records diagnostics, untimed (the default: every statistic, story and
+    /// method view read after a frame is that frame's).
+    Diagnostic,
+    /// Every frame timed, without diagnostics (the harness's and `render`'s timed frames).
+    /// The comparison's ground truth, while it still converges, makes a frame untimed.
+    Timed,
+    /// Every `n`-th frame diagnostic (untimed), the others timed (the GUI).
+    Interleaved(u32),
+}
+
 /// Half-resolution G-buffer position and normal, and the sampler's demodulated sums there.
 pub type HalfReadback = (ImageF32, ImageF32, Vec<[f32; 4]>);
 
@@ -104,6 +119,9 @@ pub type HalfReadback = (ImageF32, ImageF32, Vec<[f32; 4]>);
 /// [`methods::comparison_truth`]): its own accumulation and composite targets.
 struct CompareState {
     truth: Box<dyn Method>,
+    /// The key its image was last recorded for (a timed frame skips a finished truth whose
+    /// key did not change).
+    key: u64,
     targets: frame::LightingTargets,
     targets_size: (u32, u32),
 }
@@ -151,6 +169,11 @@ pub struct Renderer {
     lights_buf: wgpu::Buffer,
     timer: GpuTimer,
     frames: u64,
+    frame_mode: FrameMode,
+    /// Whether the last frame recorded diagnostics (else it was timed).
+    last_diagnostic: bool,
+    /// Whether the last frame had VPLs (redrawing its views without a new frame).
+    last_vpl_ok: bool,
     /// While frozen: the thresholds the flags were last classified with.
     freeze: Option<(f32, f32)>,
     /// View textures of the views after the first (`render_views`); the first is
@@ -256,6 +279,9 @@ impl Renderer {
             timer: GpuTimer::new(device, &ctx.queue),
             settings,
             frames: 0,
+            frame_mode: FrameMode::Diagnostic,
+            last_diagnostic: false,
+            last_vpl_ok: false,
             freeze: None,
             extra_views: Vec::new(),
             view_generation: 0,
@@ -355,6 +381,33 @@ impl Renderer {
 
     pub fn size(&self) -> (u32, u32) {
         self.targets.size
+    }
+
+    /// Which frames are timed and which record diagnostics ([`FrameMode`]).
+    pub fn set_frame_mode(&mut self, mode: FrameMode) {
+        self.frame_mode = match mode {
+            FrameMode::Interleaved(0) => FrameMode::Timed,
+            m => m,
+        };
+    }
+
+    pub fn frame_mode(&self) -> FrameMode {
+        self.frame_mode
+    }
+
+    /// Whether the next frame records diagnostics (and is untimed).
+    fn next_frame_diagnostic(&self) -> bool {
+        match self.frame_mode {
+            FrameMode::Diagnostic => true,
+            FrameMode::Timed => false,
+            FrameMode::Interleaved(n) => self.frames % n.max(1) as u64 == 0,
+        }
+    }
+
+    /// Whether the last frame recorded diagnostics (statistics, per-pixel diagnostics and the
+    /// story are that frame's; a timed frame leaves the previous diagnostic frame's).
+    pub fn last_frame_diagnostic(&self) -> bool {
+        self.last_diagnostic
     }
 
     pub fn resize(&mut self, w: u32, h: u32) -> Result<(), RenderError> {

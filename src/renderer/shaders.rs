@@ -67,6 +67,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ),
     ("vpl_gen.wgsl", include_str!("../../shaders/vpl_gen.wgsl")),
     ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),
+    (
+        "gbuffer_overdraw.wgsl",
+        include_str!("../../shaders/gbuffer_overdraw.wgsl"),
+    ),
     ("vpl_splat.wgsl", include_str!("../../shaders/vpl_splat.wgsl")),
     ("sst_sort.wgsl", include_str!("../../shaders/sst_sort.wgsl")),
     ("sst_build.wgsl", include_str!("../../shaders/sst_build.wgsl")),
@@ -91,6 +95,7 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
 /// the methods'.
 pub const ENTRY_SHADERS: &[&str] = &[
     "gbuffer.wgsl",
+    "gbuffer_overdraw.wgsl",
     "rsm.wgsl",
     "direct.wgsl",
     "display.wgsl",

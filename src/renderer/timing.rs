@@ -35,6 +35,8 @@ impl PassTimings {
 /// `collect_blocking`. A frame gets timestamps only while the previous readback is done.
 pub struct GpuTimer {
     inner: Option<TimerInner>,
+    /// Whether the current frame is timed (`begin_frame`).
+    timing: bool,
     names: Vec<String>,
     last: Option<PassTimings>,
 }
@@ -74,6 +76,7 @@ impl GpuTimer {
             });
         Self {
             inner,
+            timing: true,
             names: Vec::new(),
             last: None,
         }
@@ -83,12 +86,15 @@ impl GpuTimer {
         self.inner.is_some()
     }
 
-    /// True when this frame's passes get timestamps (the previous readback is finished).
+    /// True when this frame's passes get timestamps (a timed frame, and the previous
+    /// readback is finished).
     fn active(&self) -> bool {
-        self.inner.as_ref().is_some_and(|i| i.readback.is_idle())
+        self.timing && self.inner.as_ref().is_some_and(|i| i.readback.is_idle())
     }
 
-    pub fn begin_frame(&mut self) {
+    /// Starts a frame; `timed = false` records no timestamps (a diagnostic frame).
+    pub fn begin_frame(&mut self, timed: bool) {
+        self.timing = timed;
         self.names.clear();
     }
 
@@ -157,11 +163,20 @@ impl GpuTimer {
         self.last.as_ref()
     }
 
-    /// Reads finished timings (the caller polled the device).
-    pub fn read_if_ready(&mut self) {
-        let Some(inner) = self.inner.as_mut() else { return };
+    /// Waits for the GPU; returns the timings only if a frame's timings came back by this
+    /// call (never a stale earlier frame's).
+    pub fn collect_new_blocking(&mut self, device: &wgpu::Device) -> Option<PassTimings> {
+        let _ = device.poll(wgpu::PollType::wait_indefinitely());
+        self.read_if_ready().then(|| self.last.clone()).flatten()
+    }
+
+    /// Reads finished timings (the caller polled the device); true if new ones came.
+    pub fn read_if_ready(&mut self) -> bool {
+        let Some(inner) = self.inner.as_mut() else {
+            return false;
+        };
         let Some(bytes) = inner.readback.try_take() else {
-            return;
+            return false;
         };
         let ticks: &[u64] = bytemuck::cast_slice(&bytes);
         let passes = inner
@@ -176,6 +191,7 @@ impl GpuTimer {
             })
             .collect();
         self.last = Some(PassTimings { passes });
+        true
     }
 
     pub fn last(&self) -> Option<&PassTimings> {

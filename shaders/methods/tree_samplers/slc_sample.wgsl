@@ -7,7 +7,9 @@
 // box; the VPL itself at a leaf) shaded as a VPL of the node's total flux, one shadow ray
 // (a substitute's ending sampling.substitute_offset short of it: slc_substitute_end),
 // divided by the probability of the path. Sum over slots (SST: mean over its samples).
-// Writes the estimate (or adds it), and per-pixel diagnostics.
+// Writes the estimate (or adds it), and, in diagnostic frames only (DIAGNOSTICS), the
+// per-pixel diagnostics, the frame counters and the pixel story: a timed frame compiles this
+// shader with DIAGNOSTICS = false and computes the same estimate without that work.
 // CPU twin: src/reference/slc.rs (cuts, weights, blending); tests check the estimator
 // statistically against the ground truth.
 #include "common/math.wgsl"
@@ -35,9 +37,13 @@
 // similar cut), z = samples evaluated (not dead), w = 1 + the block whose cut slot 0 used
 // (0: none).
 @group(0) @binding(11) var<storage, read_write> diag: array<vec4<f32>>;
-// [0] pixels with geometry, [1] fallback pixels, [2] traversal steps, [3] traversals,
-// [4] dead branches.
+// [0] pixels with geometry, [1] fallback pixels, then 64-bit counters as (low, high) word
+// pairs: [2..3] traversal steps, [4..5] traversals, [6..7] dead branches, [8..9] shadow rays
+// traced (twin: `methods::tree_samplers::pass::SamplingStats::from_words`).
 @group(0) @binding(12) var<storage, read_write> stats: array<atomic<u32>>;
+
+// Pipeline-overridable: false in timed frames (no diagnostics, no counters, no story).
+override DIAGNOSTICS: bool = true;
 
 // The pixel story (`trace_pixel`): what its samples did this frame. Layout (u32 words, f32
 // bitcast) in `methods::tree_samplers::pass::PixelTrace`: a 32-word header, then per sample (the first
@@ -51,7 +57,18 @@ const TRACE_SAMPLES: u32 = 64u;
 const TRACE_PATH: u32 = 24u;
 const NO_TRACE: u32 = 0xffffffffu;
 
-var<workgroup> wg_stats: array<atomic<u32>, 5>;
+// Per workgroup: pixels, fallback pixels, steps, traversals, dead branches, shadow rays.
+const WG_STATS: u32 = 6u;
+var<workgroup> wg_stats: array<atomic<u32>, 6>;
+
+// Adds v to the 64-bit counter at stats[i] (low word), stats[i + 1] (high word): the add
+// that wraps the low word carries one into the high word, so the pair is exact.
+fn add64(i: u32, v: u32) {
+    let old = atomicAdd(&stats[i], v);
+    if old > 0xffffffffu - v {
+        atomicAdd(&stats[i + 1u], 1u);
+    }
+}
 
 fn is_usable(i: u32) -> bool {
     return ((flags[i / 32u] >> (i % 32u)) & 1u) == 1u;
@@ -104,7 +121,8 @@ fn gauss2(rng: ptr<function, Rng>) -> vec2<f32> {
 }
 
 // Flux/pi x G x V of cluster `node` at x (without rho/pi).
-fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: u32) -> vec3<f32> {
+fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: u32,
+    rays: ptr<function, u32>) -> vec3<f32> {
     var pv: vec3<f32>;
     var nv: vec3<f32>;
     var flux: vec3<f32>;
@@ -135,6 +153,7 @@ fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: 
             e = slc_substitute_end(e, o, sp.substitute_offset);
         }
         lit = segment_visible(o, e);
+        *rays += 1u;
     }
     if tb != NO_TRACE {
         trace[tb + 6u] = bitcast<u32>(pv.x);
@@ -151,10 +170,12 @@ fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: 
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    if li < 5u {
-        atomicStore(&wg_stats[li], 0u);
+    if DIAGNOSTICS {
+        if li < WG_STATS {
+            atomicStore(&wg_stats[li], 0u);
+        }
+        workgroupBarrier();
     }
-    workgroupBarrier();
     let inside = gid.x < sp.width && gid.y < sp.height;
     var g = vec4<f32>(0.0);
     if inside {
@@ -167,13 +188,22 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
         if sp.accumulate == 0u {
             accum[k] = vec4<f32>(0.0);
         }
-        diag[k] = vec4<f32>(0.0);
+        if DIAGNOSTICS {
+            diag[k] = vec4<f32>(0.0);
+        }
     }
-    workgroupBarrier();
-    if li < 5u {
-        let v = atomicLoad(&wg_stats[li]);
-        if v > 0u {
-            atomicAdd(&stats[li], v);
+    if DIAGNOSTICS {
+        workgroupBarrier();
+        if li < WG_STATS {
+            let v = atomicLoad(&wg_stats[li]);
+            if v > 0u {
+                // [0], [1] 32-bit; the others 64-bit pairs from word 2 on.
+                if li < 2u {
+                    atomicAdd(&stats[li], v);
+                } else {
+                    add64(2u + 2u * (li - 2u), v);
+                }
+            }
         }
     }
 }
@@ -183,7 +213,6 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
     let n = normalize(textureLoad(gb_normal, vec2<i32>(px), 0).xyz);
     let albedo = textureLoad(gb_albedo, vec2<i32>(px), 0).rgb;
     var rng = rng_new(k, sp.seed, 0x51c5u);
-    atomicAdd(&wg_stats[0], 1u);
 
     // Blending weights of the 4 surrounding blocks (Algorithm 1).
     var blocks = array<u32, 4>(0u, 0u, 0u, 0u);
@@ -248,7 +277,8 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
             }
         }
     }
-    let tracing = sp.trace_pixel != NO_TRACE && sp.trace_pixel == (px.x | (px.y << 16u));
+    let tracing = DIAGNOSTICS && sp.trace_pixel != NO_TRACE
+        && sp.trace_pixel == (px.x | (px.y << 16u));
     if tracing {
         trace[0] = 1u;
         trace[1] = mode;
@@ -272,6 +302,8 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
     var walks = 0u;
     var evaluated = 0u;
     var first_block = 0u;
+    var dead = 0u;
+    var rays = 0u;
     for (var i = 0u; i < sp.cut_size; i++) {
         var start = 0u;
         var slot = 4u;
@@ -325,7 +357,6 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
         let walk = traverse(start, x, n, &rng, tb);
         steps += walk.steps;
         walks += 1u;
-        atomicAdd(&wg_stats[3], 1u);
         if tb != NO_TRACE {
             trace[tb + 2u] = walk.node;
             trace[tb + 3u] = walk.steps;
@@ -334,11 +365,11 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
             trace[tb + 4u] = select(select(0u, 1u, walk.node >= sp.leaves), 2u, walk.node == 0u);
         }
         if walk.node == 0u {
-            atomicAdd(&wg_stats[4], 1u);
+            dead += 1u;
             continue;
         }
         evaluated += 1u;
-        let c = evaluate(walk.node, x, n, &rng, tb) / walk.prob;
+        let c = evaluate(walk.node, x, n, &rng, tb, &rays) / walk.prob;
         if tb != NO_TRACE {
             trace[tb + 10u] = bitcast<u32>(c.x);
             trace[tb + 11u] = bitcast<u32>(c.y);
@@ -346,9 +377,15 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
         }
         sum += c;
     }
-    atomicAdd(&wg_stats[2], steps);
-    if fell_back {
-        atomicAdd(&wg_stats[1], 1u);
+    if DIAGNOSTICS {
+        atomicAdd(&wg_stats[0], 1u);
+        if fell_back {
+            atomicAdd(&wg_stats[1], 1u);
+        }
+        atomicAdd(&wg_stats[2], steps);
+        atomicAdd(&wg_stats[3], walks);
+        atomicAdd(&wg_stats[4], dead);
+        atomicAdd(&wg_stats[5], rays);
     }
     if mode == 2u {
         // From the root: every sample estimates the whole sum.
@@ -365,6 +402,8 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
     } else {
         accum[k] += vec4<f32>(radiance, 0.0);
     }
-    diag[k] = vec4<f32>(f32(steps) / f32(max(walks, 1u)), select(0.0, 1.0, fell_back),
-        f32(evaluated), f32(first_block));
+    if DIAGNOSTICS {
+        diag[k] = vec4<f32>(f32(steps) / f32(max(walks, 1u)), select(0.0, 1.0, fell_back),
+            f32(evaluated), f32(first_block));
+    }
 }

@@ -19,6 +19,7 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "sample_pass_ms",
         "sample_pass_ms_no_shadow_rays",
         "shadow_ray_share",
+        "sample_pass_ms_min",
     ]);
     // What each method spends: its sampling pass with shadow rays, and without them (the
     // same traversals and evaluations, every sample visible).
@@ -26,11 +27,15 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let mut cost = Vec::new();
     for (method, _) in methods() {
         let s = with(b, |s| s.gi.method = method);
-        let m = b.measure(&s, o.size, o.frames, false)?;
+        let m = b.measure(&s, o.size, o.per_config(), false)?;
         let mut no_rays = s.clone();
         no_rays.gi.shadow_rays = false;
-        let open = b.measure(&no_rays, o.size, o.frames, false)?;
-        cost.push((m.pass_ms(&SAMPLE_PASSES).0, open.pass_ms(&SAMPLE_PASSES).0));
+        let open = b.measure(&no_rays, o.size, o.per_config(), false)?;
+        cost.push((
+            m.pass_ms(&SAMPLE_PASSES).0,
+            open.pass_ms(&SAMPLE_PASSES).0,
+            m.pass_ms_min(&SAMPLE_PASSES),
+        ));
         ms.push(m);
     }
     let quant = |v: &[f32], q: f64| -> f64 {
@@ -49,7 +54,9 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let mut table = format!("traversal steps ({} spp):\n", b.base.sampling.cut_size);
     let mut bars = Vec::new();
     let mut hist = Vec::new();
-    for (i, ((m, (_, label)), (with_rays, no_rays))) in ms.iter().zip(methods()).zip(&cost).enumerate() {
+    for (i, ((m, (_, label)), (with_rays, no_rays, with_rays_min))) in
+        ms.iter().zip(methods()).zip(&cost).enumerate()
+    {
         let (med, p90) = m
             .steps
             .as_ref()
@@ -70,6 +77,7 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             num(*with_rays),
             num(*no_rays),
             num(1.0 - no_rays / with_rays),
+            num(*with_rays_min),
         ]);
         table.push_str(&format!(
             "  {label:<6} {:>6.2} per traversal, {:>7.1} per pixel (median pixel {med:.2}, p90 {p90:.2}); \
@@ -155,7 +163,8 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     })
 }
 
-/// Thesis fig. 7.5: SLC over block sizes k: cut-building GPU time, frame time, RMSE.
+/// Thesis fig. 7.5: SLC over block sizes k: cut-building and sampling GPU time (timed
+/// frames), frame wall clock (a separate column), RMSE.
 pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let mut csv = Csv::new(&[
         "scene",
@@ -164,8 +173,10 @@ pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "cuts_gpu_ms",
         "cuts_gpu_ms_std",
         "sample_gpu_ms",
-        "frame_ms",
-        "frame_ms_std",
+        "gi_gpu_ms",
+        "sample_gpu_ms_min",
+        "frame_wall_ms",
+        "frame_wall_ms_std",
         "rmse",
         "rmse_std",
         "ssim",
@@ -180,7 +191,7 @@ pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             s.gi.method = SLC;
             s.sampling.block_size = k;
         });
-        let m = b.measure(&s, o.size, o.frames, true)?;
+        let m = b.measure(&s, o.size, o.per_config(), true)?;
         let cuts = o.size.0.div_ceil(k) * o.size.1.div_ceil(k);
         let (c, cs) = m.pass_ms(&["slc_cuts"]);
         let (t, ts) = m.frame_ms();
@@ -192,6 +203,8 @@ pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             num(c),
             num(cs),
             num(m.pass_ms(&["slc_sample"]).0),
+            num(m.gi_ms().0),
+            num(m.pass_ms_min(&["slc_sample"])),
             num(t),
             num(ts),
             num(r),
@@ -200,14 +213,15 @@ pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             num(m.fallback_fraction()),
         ]);
         table.push_str(&format!(
-            "  k = {k:<3} {cuts:>6} cuts: {c:>9.3} ms to build, frame {t:>8.1} ms, RMSE {r:.4e}, SSIM {:.3}\n",
+            "  k = {k:<3} {cuts:>6} cuts: {c:>9.3} ms to build, GI {:>8.3} ms (GPU), frame {t:>8.1} ms (wall), RMSE {r:.4e}, SSIM {:.3}\n",
+            m.gi_ms().0,
             m.ssim().0
         ));
         if let Some(ind) = &m.indirect {
             b.write_gi_png(&img.join(format!("block_{k}.png")), ind)?;
             b.write_error_png(&img.join(format!("block_{k}_error.png")), ind, &gt)?;
         }
-        rows.push((k, c, t, r));
+        rows.push((k, c, m.gi_ms().0, r));
     }
     csv.write(&dir.join("blocks.csv"))?;
     plot::lines(
@@ -235,7 +249,7 @@ pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 points: rows.iter().map(|r| (r.0 as f64, r.1)).collect(),
             },
             plot::Series {
-                name: "frame (wall clock)".into(),
+                name: "GI: cuts + sampling (GPU)".into(),
                 color: 0,
                 points: rows.iter().map(|r| (r.0 as f64, r.2)).collect(),
             },
@@ -308,7 +322,7 @@ pub fn blending(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "config",
         "blending",
         "fallback",
-        "frame_ms",
+        "frame_wall_ms",
         "gi_gpu_ms",
         "rmse",
         "rmse_std",
@@ -326,7 +340,7 @@ pub fn blending(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             s.sampling.blending = *blend;
             s.sampling.fallback = *fb;
         });
-        let m = b.measure(&s, o.size, o.frames, true)?;
+        let m = b.measure(&s, o.size, o.per_config(), true)?;
         let (r, rs) = m.rmse();
         let rf = mean_std(
             &m.rmse_fallback

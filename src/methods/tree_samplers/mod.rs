@@ -390,12 +390,16 @@ impl Method for TreeSamplers {
                 ChildProbability::Defensive => 2,
             },
         };
-        self.traced = cx.trace_pixel.is_some();
+        // A timed frame leaves the last diagnostic frame's story (and statistics) in place.
+        if cx.diagnostics {
+            self.traced = cx.trace_pixel.is_some();
+        }
         let (gbuffer, accum) = match &half_targets {
             Some(h) => (&h.gbuffer, &h.accum),
             None => (&cx.targets.gbuffer, cx.gi_accum),
         };
         self.pass.record(
+            cx.diagnostics,
             device,
             cx.queue,
             enc,

@@ -3,7 +3,9 @@
 //! blends the cuts per pixel (or falls back), traverses the tree from each chosen node and
 //! evaluates one cluster per slot with a shadow ray.
 //! Reads: the tree, its flags, the VPLs in leaf order, BVH, G-buffer. Writes: the GI
-//! accumulation buffer, per-pixel diagnostics and frame counters ([`SlcBuffers`]).
+//! accumulation buffer and, in diagnostic frames only, per-pixel diagnostics, frame counters
+//! and the pixel story ([`SlcBuffers`]). Timed frames run the sampling shader compiled with
+//! `DIAGNOSTICS = false` (same estimate, none of that work, no readback).
 
 use crate::renderer::{
     frame::GbufferTargets, gpu_data::GpuSlcParams, readback::AsyncReadback, scene_gpu::SceneGpu, shaders,
@@ -11,37 +13,56 @@ use crate::renderer::{
 };
 
 use crate::renderer::passes::{
-    WG_1D, bind_group_seq, compute_pipeline, float_texture_entry, groups_image, run_compute,
-    sst_build::TreeBuffers, storage_entry, storage_texture_entry, uniform_entry,
+    WG_1D, bind_group_seq, compute_pipeline, compute_pipeline_with, float_texture_entry, groups_image,
+    run_compute, sst_build::TreeBuffers, storage_entry, storage_texture_entry, uniform_entry,
 };
 
-/// Frame counters written by `slc_sample` (u32 each).
-pub const STATS: usize = 5;
+/// Frame counter words written by `slc_sample`: two 32-bit counters, then four 64-bit ones
+/// as (low, high) pairs.
+pub const STATS: usize = 10;
 
-/// Counters of one frame of tree sampling.
+/// Counters of tree sampling: one frame's, or several frames' summed ([`SamplingStats::add`]).
+/// 64-bit: SST at 64 spp takes ~6e8 steps per 1280x720 frame, so a few frames' sum passes
+/// 2^32 (the 64-spp anomaly of the H100 sweeps was a u32 sum that wrapped).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SamplingStats {
     /// Pixels with geometry.
-    pub pixels: u32,
+    pub pixels: u64,
     /// Pixels without a similar cut (mock cut or other fallback).
-    pub fallback_pixels: u32,
+    pub fallback_pixels: u64,
     /// Traversal steps, all pixels.
-    pub steps: u32,
+    pub steps: u64,
     /// Traversals started.
-    pub traversals: u32,
+    pub traversals: u64,
     /// Traversals that ended in a dead branch (both children weigh 0).
-    pub dead: u32,
+    pub dead: u64,
+    /// Shadow rays traced (samples with G > 0 while shadow rays are on).
+    pub rays: u64,
 }
 
 impl SamplingStats {
+    /// Parses the counter words (layout in `slc_sample.wgsl`).
     pub fn from_words(w: &[u32]) -> Self {
-        let g = |i: usize| w.get(i).copied().unwrap_or(0);
+        let g = |i: usize| w.get(i).copied().unwrap_or(0) as u64;
+        let pair = |i: usize| g(i) | (g(i + 1) << 32);
         Self {
             pixels: g(0),
             fallback_pixels: g(1),
-            steps: g(2),
-            traversals: g(3),
-            dead: g(4),
+            steps: pair(2),
+            traversals: pair(4),
+            dead: pair(6),
+            rays: pair(8),
+        }
+    }
+    /// The sum of two frames' counters.
+    pub fn add(self, o: Self) -> Self {
+        Self {
+            pixels: self.pixels + o.pixels,
+            fallback_pixels: self.fallback_pixels + o.fallback_pixels,
+            steps: self.steps + o.steps,
+            traversals: self.traversals + o.traversals,
+            dead: self.dead + o.dead,
+            rays: self.rays + o.rays,
         }
     }
     /// Mean traversal steps per traversal (thesis fig. 7.2 counts per pixel and sample).
@@ -287,7 +308,10 @@ pub struct SlcPass {
     view_params: wgpu::Buffer,
     cuts: wgpu::ComputePipeline,
     cuts_layout: wgpu::BindGroupLayout,
+    /// The sampling pass with diagnostics (counters, per-pixel diagnostics, story) and
+    /// without (timed frames).
     sample: wgpu::ComputePipeline,
+    sample_timed: wgpu::ComputePipeline,
     sample_layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
     /// The counters of a recent frame, read back without blocking.
@@ -350,6 +374,14 @@ impl SlcPass {
             ),
             cuts: compute_pipeline(device, "slc_cuts", &[Some(&cuts_layout)], &cmod, "build_cuts"),
             sample: compute_pipeline(device, "slc_sample", &[Some(&sample_layout)], &smod, "main"),
+            sample_timed: compute_pipeline_with(
+                device,
+                "slc_sample::timed",
+                &[Some(&sample_layout)],
+                &smod,
+                "main",
+                &[("DIAGNOSTICS", 0.0)],
+            ),
             params: crate::renderer::passes::uniform_buffer::<GpuSlcParams>(device, "slc::params"),
             stats_readback: AsyncReadback::new(device, "slc::stats_readback", (STATS * 4) as u64),
             last_stats: None,
@@ -358,10 +390,13 @@ impl SlcPass {
         })
     }
 
-    /// Records the cuts (skipped for SST, which starts at the root) and the sampling.
+    /// Records the cuts (skipped for SST, which starts at the root) and the sampling; with
+    /// `diagnostics` the sampling also writes the per-pixel diagnostics, the counters (read
+    /// back after the frame) and the story, otherwise it touches none of them.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
+        diagnostics: bool,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
@@ -410,8 +445,10 @@ impl SlcPass {
             out.trace.as_entire_binding(),
         ];
         let bind = bind_group_seq(device, "slc_sample::bind_group", &self.sample_layout, &entries);
-        encoder.clear_buffer(&out.stats, 0, None);
-        encoder.clear_buffer(&out.trace, 0, None);
+        if diagnostics {
+            encoder.clear_buffer(&out.stats, 0, None);
+            encoder.clear_buffer(&out.trace, 0, None);
+        }
         let name = match p.method {
             1 => "sst_sample",
             2 => "rtslc_sample",
@@ -421,12 +458,18 @@ impl SlcPass {
             encoder,
             timer,
             name,
-            &self.sample,
+            if diagnostics {
+                &self.sample
+            } else {
+                &self.sample_timed
+            },
             &bind,
             groups_image(p.width, p.height),
         );
-        self.stats_readback
-            .record(encoder, &[(&out.stats, 0, 0, (STATS * 4) as u64)]);
+        if diagnostics {
+            self.stats_readback
+                .record(encoder, &[(&out.stats, 0, 0, (STATS * 4) as u64)]);
+        }
     }
 
     /// Draws one of the diagnostic views into `dst` (the GI resolution).
@@ -479,5 +522,43 @@ impl SlcPass {
             self.last_stats = Some(SamplingStats::from_words(bytemuck::cast_slice(&bytes)));
         }
         self.last_stats
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SamplingStats;
+
+    #[test]
+    fn counters_are_64_bit_from_the_gpu_words_and_when_summed() {
+        // 6e8 steps a frame (SST, 64 spp, 1280x720): the low word and a carried high word.
+        let steps: u64 = 600_000_000 + (3 << 32);
+        let words = [
+            900_000,
+            12,
+            steps as u32,
+            (steps >> 32) as u32,
+            58_000_000,
+            0,
+            7,
+            0,
+            u32::MAX,
+            1,
+        ];
+        let s = SamplingStats::from_words(&words);
+        assert_eq!(s.steps, steps);
+        assert_eq!(s.traversals, 58_000_000);
+        assert_eq!(s.rays, (1 << 32) + u32::MAX as u64);
+        // Eight frames of 6e8 steps pass 2^32: the sum keeps them (a u32 sum wrapped to
+        // 0.85 steps per traversal at 64 spp on the H100).
+        let frame = SamplingStats {
+            pixels: 921_600,
+            steps: 600_000_000,
+            traversals: 58_982_400,
+            ..Default::default()
+        };
+        let sum = (1..8).fold(frame, |a, _| a.add(frame));
+        assert_eq!(sum.steps, 4_800_000_000);
+        assert!((sum.steps_per_traversal() - frame.steps_per_traversal()).abs() < 1e-12);
     }
 }

@@ -1,6 +1,8 @@
 //! SST stages 8-9 (SST paper 3.3, thesis 4.2.1): VPL bounds, 64-bit sort keys (Morton |
 //! normal code | id) and a bitonic sort of (key, index) pairs padded to a power of two. Only
-//! the pairs move; the VPLs are permuted once afterwards (by the tree build).
+//! the pairs move; the VPLs are permuted once afterwards (by the tree build). Two variants
+//! ([`SortVariant`]): the parallel one runs in every frame, the baseline stays for `bench
+//! tree`'s before / after.
 //! Reads: the VPL array. Writes: [`SortBuffers`].
 
 use bytemuck::{Pod, Zeroable};
@@ -27,6 +29,100 @@ pub struct GpuSortParams {
 /// Dynamic-offset stride of the per-step uniforms, and the most steps (2^22 padded pairs).
 const STRIDE: u64 = 256;
 const MAX_STEPS: u64 = 22 * 23 / 2 + 1;
+/// Elements per workgroup-memory tile of the parallel sort (twin of `SORT_TILE`).
+pub const SORT_TILE: u32 = 512;
+/// Workgroup size of the parallel variant's kernels (twin of their `@workgroup_size`).
+pub const SORT_WG: u32 = 256;
+/// The entry points with that size.
+pub const SORT_WG_ENTRIES: [&str; 3] = ["vpl_bounds_parallel", "bitonic_pairs", "bitonic_tile"];
+/// VPLs per thread of the parallel bounds reduction (twin of `BOUNDS_PER_THREAD`).
+const BOUNDS_PER_THREAD: u32 = 8;
+
+/// How the bounds and the sort run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SortVariant {
+    /// Bounds by one 64-thread workgroup looping over every VPL; one global dispatch per
+    /// bitonic step (the workbench before issue 18; `bench tree` measures it beside).
+    Baseline,
+    /// Bounds as a parallel reduction; bitonic steps below the tile size in workgroup memory.
+    #[default]
+    Parallel,
+}
+
+/// One dispatch of the sort: a global step (`tile = false`, distance j in sequences of k) or
+/// a workgroup-memory one (`tile = true`: j = 0 sorts each tile, else steps j .. 1 of k).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SortDispatch {
+    pub tile: bool,
+    pub j: u32,
+    pub k: u32,
+}
+
+/// The dispatches of the parallel sort of `padded` elements, in order.
+pub fn parallel_dispatches(padded: u32) -> Vec<SortDispatch> {
+    let mut v = vec![SortDispatch {
+        tile: true,
+        j: 0,
+        k: 0,
+    }];
+    let mut k = 2 * SORT_TILE;
+    while k <= padded {
+        let mut j = k / 2;
+        while j >= SORT_TILE {
+            v.push(SortDispatch { tile: false, j, k });
+            j /= 2;
+        }
+        v.push(SortDispatch {
+            tile: true,
+            j: SORT_TILE / 2,
+            k,
+        });
+        k *= 2;
+    }
+    v
+}
+
+/// CPU twin of the parallel sort's schedule: applies each dispatch's compare-exchanges in
+/// order (the tile dispatches step by step), to check that it sorts.
+pub fn parallel_sort_cpu(keys: &mut [u64]) {
+    let padded = keys.len();
+    assert!(padded.is_power_of_two() || padded == 0);
+    let step = |keys: &mut [u64], j: usize, k: usize| {
+        for i in 0..padded {
+            let l = i ^ j;
+            if l > i {
+                let asc = i & k == 0;
+                if (asc && keys[l] < keys[i]) || (!asc && keys[i] < keys[l]) {
+                    keys.swap(i, l);
+                }
+            }
+        }
+    };
+    for d in parallel_dispatches(padded as u32) {
+        let (j, k) = (d.j as usize, d.k as usize);
+        match (d.tile, j) {
+            (true, 0) => {
+                let mut kk = 2;
+                while kk <= (SORT_TILE as usize).min(padded) {
+                    let mut jj = kk / 2;
+                    while jj > 0 {
+                        step(keys, jj, kk);
+                        jj /= 2;
+                    }
+                    kk *= 2;
+                }
+            }
+            (true, _) => {
+                let mut jj = j;
+                while jj > 0 {
+                    step(keys, jj, k);
+                    jj /= 2;
+                }
+            }
+            (false, _) => step(keys, j, k),
+        }
+    }
+}
 
 /// The (key, index) pairs (vec4<u32>: key high word, key low word, index, 0) and the bounds.
 pub struct SortBuffers {
@@ -51,7 +147,9 @@ impl SortBuffers {
             bounds: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("sst_sort::bounds"),
                 size: 32,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             count,
@@ -77,10 +175,14 @@ pub fn bitonic_steps(padded: u32) -> Vec<(u32, u32)> {
 
 pub struct SortPass {
     bounds: wgpu::ComputePipeline,
+    bounds_parallel: wgpu::ComputePipeline,
     keys: wgpu::ComputePipeline,
     step: wgpu::ComputePipeline,
+    pairs: wgpu::ComputePipeline,
+    tile: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
+    pub variant: SortVariant,
 }
 
 impl SortPass {
@@ -99,8 +201,18 @@ impl SortPass {
         let l = [Some(&layout)];
         Ok(Self {
             bounds: compute_pipeline(device, "sst_sort::bounds", &l, &module, "vpl_bounds"),
+            bounds_parallel: compute_pipeline(
+                device,
+                "sst_sort::bounds_parallel",
+                &l,
+                &module,
+                "vpl_bounds_parallel",
+            ),
             keys: compute_pipeline(device, "sst_sort::keys", &l, &module, "make_keys"),
             step: compute_pipeline(device, "sst_sort::bitonic", &l, &module, "bitonic_step"),
+            pairs: compute_pipeline(device, "sst_sort::bitonic_pairs", &l, &module, "bitonic_pairs"),
+            tile: compute_pipeline(device, "sst_sort::bitonic_tile", &l, &module, "bitonic_tile"),
+            variant: SortVariant::default(),
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("sst_sort::params"),
                 size: STRIDE * MAX_STEPS,
@@ -159,14 +271,24 @@ impl SortPass {
         };
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&base));
         encoder.push_debug_group("sst_keys");
+        // The bounds reduce by atomic max from zero.
+        encoder.clear_buffer(&out.bounds, 0, None);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("sst_keys"),
                 timestamp_writes: timer.compute_pass("sst_keys"),
             });
             pass.set_bind_group(0, &bind, &[0]);
-            pass.set_pipeline(&self.bounds);
-            pass.dispatch_workgroups(1, 1, 1);
+            match self.variant {
+                SortVariant::Baseline => {
+                    pass.set_pipeline(&self.bounds);
+                    pass.dispatch_workgroups(1, 1, 1);
+                }
+                SortVariant::Parallel => {
+                    pass.set_pipeline(&self.bounds_parallel);
+                    pass.dispatch_workgroups(out.count.max(1).div_ceil(SORT_WG * BOUNDS_PER_THREAD), 1, 1);
+                }
+            }
             pass.set_pipeline(&self.keys);
             pass.dispatch_workgroups(out.padded.div_ceil(WG_1D), 1, 1);
         }
@@ -182,15 +304,40 @@ impl SortPass {
         bind: &wgpu::BindGroup,
         out: &SortBuffers,
     ) {
-        let steps = bitonic_steps(out.padded);
-        for (n, (j, k)) in steps.iter().enumerate() {
-            let p = GpuSortParams {
-                count: out.count,
-                padded: out.padded,
-                j: *j,
-                k: *k,
-            };
-            queue.write_buffer(&self.params, (n as u64 + 1) * STRIDE, bytemuck::bytes_of(&p));
+        // Every dispatch's (j, k) at its own dynamic offset; (pipeline, workgroups) each.
+        let steps: Vec<(GpuSortParams, &wgpu::ComputePipeline, u32)> = match self.variant {
+            SortVariant::Baseline => bitonic_steps(out.padded)
+                .into_iter()
+                .map(|(j, k)| {
+                    let p = GpuSortParams {
+                        count: out.count,
+                        padded: out.padded,
+                        j,
+                        k,
+                    };
+                    (p, &self.step, out.padded.div_ceil(WG_1D))
+                })
+                .collect(),
+            SortVariant::Parallel if out.padded < 2 => Vec::new(),
+            SortVariant::Parallel => parallel_dispatches(out.padded)
+                .into_iter()
+                .map(|d| {
+                    let p = GpuSortParams {
+                        count: out.count,
+                        padded: out.padded,
+                        j: d.j,
+                        k: d.k,
+                    };
+                    if d.tile {
+                        (p, &self.tile, out.padded.div_ceil(SORT_TILE))
+                    } else {
+                        (p, &self.pairs, (out.padded / 2).div_ceil(SORT_WG))
+                    }
+                })
+                .collect(),
+        };
+        for (n, (p, _, _)) in steps.iter().enumerate() {
+            queue.write_buffer(&self.params, (n as u64 + 1) * STRIDE, bytemuck::bytes_of(p));
         }
         encoder.push_debug_group("sst_sort");
         {
@@ -198,10 +345,10 @@ impl SortPass {
                 label: Some("sst_sort"),
                 timestamp_writes: timer.compute_pass("sst_sort"),
             });
-            pass.set_pipeline(&self.step);
-            for n in 0..steps.len() as u64 {
-                pass.set_bind_group(0, bind, &[((n + 1) * STRIDE) as u32]);
-                pass.dispatch_workgroups(out.padded.div_ceil(WG_1D), 1, 1);
+            for (n, (_, pipeline, groups)) in steps.iter().enumerate() {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, bind, &[((n as u64 + 1) * STRIDE) as u32]);
+                pass.dispatch_workgroups(*groups, 1, 1);
             }
         }
         encoder.pop_debug_group();
@@ -255,6 +402,30 @@ pub fn read_pairs(ctx: &GpuContext, out: &SortBuffers) -> Result<Vec<(u64, u32)>
 #[cfg(test)]
 mod tests {
     use super::bitonic_steps;
+
+    #[test]
+    fn the_parallel_schedule_sorts_like_sort_unstable() {
+        use super::{SORT_TILE, parallel_dispatches, parallel_sort_cpu};
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for n in [1usize, 2, 8, 512, 1024, 4096, 16384] {
+            let mut keys: Vec<u64> = (0..n)
+                .map(|_| {
+                    state ^= state << 13;
+                    state ^= state >> 7;
+                    state ^= state << 17;
+                    state % 1000
+                })
+                .collect();
+            let mut want = keys.clone();
+            want.sort_unstable();
+            parallel_sort_cpu(&mut keys);
+            assert_eq!(keys, want, "n = {n}");
+        }
+        // 2^20: 1 tile sort + per k > 512 its global steps j >= 512 and one tile merge.
+        let d = parallel_dispatches(1 << 20);
+        assert_eq!(d.len(), 1 + 11 + (1..=11).sum::<usize>());
+        assert!(d.iter().all(|d| d.tile || d.j >= SORT_TILE));
+    }
 
     #[test]
     fn bitonic_step_count() {
