@@ -105,7 +105,13 @@ fn run_figures(out: &Path) -> Run {
         ],
         sweep: sweep
             .iter()
-            .map(|r| (r["method"].clone(), r["spp"].parse().unwrap(), num(r, "gi_gpu_ms_min")))
+            .map(|r| {
+                (
+                    r["method"].clone(),
+                    r["spp"].parse().unwrap(),
+                    num(r, "gi_gpu_ms_min"),
+                )
+            })
             .collect(),
     }
 }

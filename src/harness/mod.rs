@@ -411,7 +411,7 @@ impl Bench {
         for _ in 0..frames.diagnostic {
             self.frame_wait();
             if let Some(st) = self.r.sampling_stats_blocking() {
-                m.stats = Some(m.stats.map_or(st, |a| a.add(st)));
+                m.stats = Some(m.stats.map_or(st, |a| a + st));
             }
             let ind = self.r.read(Buffer::Indirect)?;
             // Steps and fallback flags are per GI pixel: read at full GI resolution only.

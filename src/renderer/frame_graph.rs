@@ -269,6 +269,9 @@ impl Renderer {
         }
         self.frames += 1;
         self.last_diagnostic = diagnostic;
+        if diagnostic {
+            self.diagnostic_requested = false;
+        }
         self.last_vpl_ok = vpl_ok;
     }
 

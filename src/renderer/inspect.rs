@@ -41,7 +41,12 @@ impl Renderer {
 
     /// Records the tree samples of frame pixel (x, y) from the next frame on (None: stop).
     pub fn set_trace_pixel(&mut self, pixel: Option<(u32, u32)>) {
-        self.trace_pixel = pixel.filter(|&(x, y)| x < 8192 && y < 8192);
+        let pixel = pixel.filter(|&(x, y)| x < 8192 && y < 8192);
+        if pixel != self.trace_pixel {
+            // Its story from the next frame, not the next scheduled diagnostic one.
+            self.diagnostic_requested = true;
+        }
+        self.trace_pixel = pixel;
     }
 
     /// What the traced pixel's samples did in the last tree-sampling frame (None: no trace,

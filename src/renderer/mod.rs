@@ -172,6 +172,9 @@ pub struct Renderer {
     frame_mode: FrameMode,
     /// Whether the last frame recorded diagnostics (else it was timed).
     last_diagnostic: bool,
+    /// In `FrameMode::Interleaved`: the next frame records diagnostics whatever its number
+    /// (a new pinned pixel or new settings show at once).
+    diagnostic_requested: bool,
     /// Whether the last frame had VPLs (redrawing its views without a new frame).
     last_vpl_ok: bool,
     /// While frozen: the thresholds the flags were last classified with.
@@ -281,6 +284,7 @@ impl Renderer {
             frames: 0,
             frame_mode: FrameMode::Diagnostic,
             last_diagnostic: false,
+            diagnostic_requested: false,
             last_vpl_ok: false,
             freeze: None,
             extra_views: Vec::new(),
@@ -375,6 +379,9 @@ impl Renderer {
         if settings.textures.anisotropy != self.settings.textures.anisotropy {
             self.scene.sampler = scene_gpu::texture_sampler(&self.ctx.device, settings.textures.anisotropy);
         }
+        if settings != self.settings {
+            self.diagnostic_requested = true;
+        }
         self.settings = settings;
         Ok(())
     }
@@ -400,7 +407,9 @@ impl Renderer {
         match self.frame_mode {
             FrameMode::Diagnostic => true,
             FrameMode::Timed => false,
-            FrameMode::Interleaved(n) => self.frames % n.max(1) as u64 == 0,
+            FrameMode::Interleaved(n) => {
+                self.diagnostic_requested || self.frames.is_multiple_of(n.max(1) as u64)
+            }
         }
     }
 

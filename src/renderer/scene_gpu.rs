@@ -9,6 +9,10 @@ use crate::scene::{Aabb, Bvh, Scene, TextureImage};
 pub struct SceneGpu {
     pub vertices: wgpu::Buffer,
     pub indices: wgpu::Buffer,
+    /// The same triangles in reverse order: the G-buffer's shading pass after the depth
+    /// pre-pass draws them so, so that among triangles at exactly the same depth the first in
+    /// file order wins, as in a single pass with depth test Less.
+    pub indices_reversed: wgpu::Buffer,
     pub index_count: u32,
     pub materials: wgpu::Buffer,
     pub textures: wgpu::Texture,
@@ -150,6 +154,12 @@ impl SceneGpu {
             contents: bytemuck::cast_slice(&indices),
             usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE,
         });
+        let reversed: Vec<u32> = indices.chunks(3).rev().flatten().copied().collect();
+        let indices_reversed = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene::indices_reversed"),
+            contents: bytemuck::cast_slice(&reversed),
+            usage: wgpu::BufferUsages::INDEX,
+        });
 
         // Texture array: every base-colour texture resampled to one power-of-two size.
         let limit = device
@@ -279,6 +289,7 @@ impl SceneGpu {
         SceneGpu {
             vertices,
             indices: index_buffer,
+            indices_reversed,
             index_count,
             materials,
             textures,

@@ -141,7 +141,15 @@ pub fn timings(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         false,
     )?;
     let mut csv = Csv::new(&[
-        "scene", "group", "passes", "median_ms", "mean_ms", "std_ms", "min_ms", "max_ms", "frames",
+        "scene",
+        "group",
+        "passes",
+        "median_ms",
+        "mean_ms",
+        "std_ms",
+        "min_ms",
+        "max_ms",
+        "frames",
     ]);
     let mut bars = Vec::new();
     let mut table = format!(

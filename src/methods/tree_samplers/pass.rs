@@ -54,8 +54,12 @@ impl SamplingStats {
             rays: pair(8),
         }
     }
-    /// The sum of two frames' counters.
-    pub fn add(self, o: Self) -> Self {
+}
+
+/// The sum of two frames' counters.
+impl std::ops::Add for SamplingStats {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
         Self {
             pixels: self.pixels + o.pixels,
             fallback_pixels: self.fallback_pixels + o.fallback_pixels,
@@ -65,6 +69,9 @@ impl SamplingStats {
             rays: self.rays + o.rays,
         }
     }
+}
+
+impl SamplingStats {
     /// Mean traversal steps per traversal (thesis fig. 7.2 counts per pixel and sample).
     pub fn steps_per_traversal(&self) -> f64 {
         self.steps as f64 / self.traversals.max(1) as f64
@@ -557,7 +564,7 @@ mod tests {
             traversals: 58_982_400,
             ..Default::default()
         };
-        let sum = (1..8).fold(frame, |a, _| a.add(frame));
+        let sum = (1..8).fold(frame, |a, _| a + frame);
         assert_eq!(sum.steps, 4_800_000_000);
         assert!((sum.steps_per_traversal() - frame.steps_per_traversal()).abs() < 1e-12);
     }

@@ -5,7 +5,9 @@
 //! (`gbuffer_depth`) rasterises the scene first and the shading pass (`gbuffer`) tests depth
 //! Equal without writing it, so every covered pixel is shaded and written once instead of
 //! once per fragment that passes the depth test in draw order (Sponza's single draw in file
-//! order). The values written are the same. [`OverdrawCounter`] counts the fragments of
+//! order). The shading pass draws the triangles in reverse order, so that at exact depth ties
+//! the first triangle in file order wins as with Less: the values written are the same.
+//! [`OverdrawCounter`] counts the fragments of
 //! each way (machine-independent: rasterisation rules and draw order), for `bench gbuffer`.
 
 use crate::renderer::{
@@ -188,15 +190,16 @@ impl GbufferPass {
                 },
             })
         };
-        let draw = |pass: &mut wgpu::RenderPass<'_>, pipeline: &wgpu::RenderPipeline| {
-            if scene.index_count > 0 {
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &bind, &[]);
-                pass.set_vertex_buffer(0, scene.vertices.slice(..));
-                pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..scene.index_count, 0, 0..1);
-            }
-        };
+        let draw =
+            |pass: &mut wgpu::RenderPass<'_>, pipeline: &wgpu::RenderPipeline, indices: &wgpu::Buffer| {
+                if scene.index_count > 0 {
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, &bind, &[]);
+                    pass.set_vertex_buffer(0, scene.vertices.slice(..));
+                    pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(0..scene.index_count, 0, 0..1);
+                }
+            };
         if self.prepass {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("gbuffer_depth::pass"),
@@ -213,7 +216,7 @@ impl GbufferPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            draw(&mut pass, &self.depth_only);
+            draw(&mut pass, &self.depth_only, &scene.indices);
         }
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -239,14 +242,14 @@ impl GbufferPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            draw(
-                &mut pass,
-                if self.prepass {
-                    &self.pipeline_equal
-                } else {
-                    &self.pipeline
-                },
-            );
+            // After the pre-pass every triangle at a pixel's nearest depth passes Equal and
+            // the last drawn stays: drawn in reverse, that is the first in file order, the
+            // one a single pass with Less keeps. The G-buffer is the same either way.
+            if self.prepass {
+                draw(&mut pass, &self.pipeline_equal, &scene.indices_reversed);
+            } else {
+                draw(&mut pass, &self.pipeline, &scene.indices);
+            }
         }
         encoder.pop_debug_group();
     }
