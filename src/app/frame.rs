@@ -345,7 +345,7 @@ impl WorkbenchApp {
                         ));
                     });
             } else {
-                ui.label("GPU timings pending");
+                ui.label("GPU timings: no timed frame yet");
             }
         });
     }

@@ -71,7 +71,11 @@ impl TimingsPanel {
     /// The bars and the history; returns the view to show while a bar is hovered.
     pub fn contents(&self, ui: &mut egui::Ui) -> Option<ViewBuffer> {
         let Some(last) = self.history.back() else {
-            ui.label("no timings yet (or timestamps not supported on this adapter)");
+            ui.label(
+                "no timed frame yet: while the comparison's ground truth fills in, every frame \
+                 advances it and is untimed, and every 4th frame records diagnostics (or \
+                 timestamps are not supported on this adapter)",
+            );
             return None;
         };
         ui.label(format!(
