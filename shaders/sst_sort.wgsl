@@ -59,6 +59,24 @@ fn merge_bounds(lo: vec3<f32>, hi: vec3<f32>) {
 var<workgroup> wg_lo: array<vec3<f32>, 256>;
 var<workgroup> wg_hi: array<vec3<f32>, 256>;
 
+// The workgroup's box (each of its `threads` invocations brings one) reduced in workgroup
+// memory, then merged into the buffer by invocation 0 (a workgroup without VPLs merges none).
+fn reduce_and_merge(li: u32, lo: vec3<f32>, hi: vec3<f32>, threads: u32) {
+    wg_lo[li] = lo;
+    wg_hi[li] = hi;
+    workgroupBarrier();
+    for (var s = threads / 2u; s > 0u; s >>= 1u) {
+        if li < s {
+            wg_lo[li] = min(wg_lo[li], wg_lo[li + s]);
+            wg_hi[li] = max(wg_hi[li], wg_hi[li + s]);
+        }
+        workgroupBarrier();
+    }
+    if li == 0u && wg_lo[0].x <= wg_hi[0].x {
+        merge_bounds(wg_lo[0], wg_hi[0]);
+    }
+}
+
 // Baseline: one workgroup of 64 loops over every VPL (serial on a GPU).
 @compute @workgroup_size(64, 1, 1)
 fn vpl_bounds(@builtin(local_invocation_index) li: u32) {
@@ -71,19 +89,7 @@ fn vpl_bounds(@builtin(local_invocation_index) li: u32) {
             hi = max(hi, v.position.xyz);
         }
     }
-    wg_lo[li] = lo;
-    wg_hi[li] = hi;
-    workgroupBarrier();
-    for (var s = 32u; s > 0u; s >>= 1u) {
-        if li < s {
-            wg_lo[li] = min(wg_lo[li], wg_lo[li + s]);
-            wg_hi[li] = max(wg_hi[li], wg_hi[li + s]);
-        }
-        workgroupBarrier();
-    }
-    if li == 0u && wg_lo[0].x <= wg_hi[0].x {
-        merge_bounds(wg_lo[0], wg_hi[0]);
-    }
+    reduce_and_merge(li, lo, hi, 64u);
 }
 
 // VPLs per thread of the parallel bounds (twin of `BOUNDS_PER_THREAD`).
@@ -108,19 +114,7 @@ fn vpl_bounds_parallel(@builtin(workgroup_id) wg: vec3<u32>,
             }
         }
     }
-    wg_lo[li] = lo;
-    wg_hi[li] = hi;
-    workgroupBarrier();
-    for (var s = 128u; s > 0u; s >>= 1u) {
-        if li < s {
-            wg_lo[li] = min(wg_lo[li], wg_lo[li + s]);
-            wg_hi[li] = max(wg_hi[li], wg_hi[li + s]);
-        }
-        workgroupBarrier();
-    }
-    if li == 0u && wg_lo[0].x <= wg_hi[0].x {
-        merge_bounds(wg_lo[0], wg_hi[0]);
-    }
+    reduce_and_merge(li, lo, hi, 256u);
 }
 
 fn expand_bits_10(v: u32) -> u32 {

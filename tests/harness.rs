@@ -4,35 +4,12 @@
 
 mod common;
 
-use std::{collections::HashMap, path::Path, process::Command};
+use std::{path::Path, process::Command};
+
+use common::read_csv;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_lightcut-workbench"))
-}
-
-/// Header and rows of a CSV written by the harness (no quoted cells in numeric columns).
-fn read_csv(path: &Path) -> (Vec<String>, Vec<HashMap<String, String>>) {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(str::to_string).collect();
-    let rows = lines
-        .map(|l| {
-            // Split on commas outside quotes.
-            let mut cells = Vec::new();
-            let (mut cur, mut quoted) = (String::new(), false);
-            for ch in l.chars() {
-                match ch {
-                    '"' => quoted = !quoted,
-                    ',' if !quoted => cells.push(std::mem::take(&mut cur)),
-                    c => cur.push(c),
-                }
-            }
-            cells.push(cur);
-            assert_eq!(cells.len(), header.len(), "{}: {l}", path.display());
-            header.iter().cloned().zip(cells).collect()
-        })
-        .collect();
-    (header, rows)
 }
 
 /// Asserts the columns exist, there are `min_rows` rows, and `finite` columns hold finite

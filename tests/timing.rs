@@ -10,21 +10,6 @@ mod common;
 
 use std::{collections::HashMap, path::Path, process::Command};
 
-fn read_csv(path: &Path) -> Vec<HashMap<String, String>> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(str::to_string).collect();
-    lines
-        .map(|l| {
-            header
-                .iter()
-                .cloned()
-                .zip(l.split(',').map(str::to_string))
-                .collect()
-        })
-        .collect()
-}
-
 fn num(row: &HashMap<String, String>, col: &str) -> f64 {
     row.get(col)
         .unwrap_or_else(|| panic!("no column {col} in {row:?}"))
@@ -79,16 +64,16 @@ fn run_figures(out: &Path) -> Run {
     );
     let d = out.join("default");
     // SLC's sampling pass at the base settings (32 spp, 8x8 blocks, full resolution).
-    let timings = read_csv(&d.join("timings.csv"));
+    let timings = common::read_csv(&d.join("timings.csv")).1;
     let gi_group = timings.iter().find(|r| r["group"] == "GI").expect("GI row");
-    let steps = read_csv(&d.join("steps.csv"));
+    let steps = common::read_csv(&d.join("steps.csv")).1;
     let steps_slc = steps.iter().find(|r| r["method"] == "SLC").expect("SLC row");
-    let sweep = read_csv(&d.join("equal_time.csv"));
+    let sweep = common::read_csv(&d.join("equal_time.csv")).1;
     let sweep_slc = sweep
         .iter()
         .find(|r| r["method"] == "SLC" && r["spp"] == "32")
         .expect("SLC at 32 spp");
-    let blocks = read_csv(&d.join("blocks.csv"));
+    let blocks = common::read_csv(&d.join("blocks.csv")).1;
     let block8 = blocks.iter().find(|r| r["block"] == "8").expect("k = 8");
     Run {
         fastest: [

@@ -156,6 +156,32 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
     Some(v[v.len() / 2])
 }
 
+/// Records `record` into a fresh encoder `repeat + 1` times back to back, each submitted and
+/// its timestamps waited for; returns the timings of all but the first (pipeline warm-up).
+fn time_back_to_back(
+    ctx: &GpuContext,
+    timer: &mut GpuTimer,
+    repeat: u32,
+    mut record: impl FnMut(&mut wgpu::CommandEncoder, &mut GpuTimer),
+) -> anyhow::Result<Vec<crate::renderer::timing::PassTimings>> {
+    let mut out = Vec::new();
+    for rep in 0..=repeat {
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        timer.begin_frame(true);
+        record(&mut enc, timer);
+        timer.resolve(&mut enc);
+        ctx.queue.submit([enc.finish()]);
+        timer.after_submit();
+        let t = timer
+            .collect_new_blocking(&ctx.device)
+            .ok_or_else(|| anyhow!("no timestamps came back"))?;
+        if rep > 0 {
+            out.push(t);
+        }
+    }
+    Ok(out)
+}
+
 /// The most rays of one `bench rays` dispatch (65535 workgroups of 64).
 pub const MAX_RAYS: u32 = 65535 * 64;
 
@@ -236,22 +262,13 @@ fn run_gbuffer(args: &BenchArgs) -> anyhow::Result<()> {
     let mut ms = [f64::NAN; 2];
     for (i, prepass) in [false, true].into_iter().enumerate() {
         pass.prepass = prepass;
-        let mut samples = Vec::new();
         // Back to back; the first repetition (pipelines) is dropped.
-        for rep in 0..=args.repeat {
-            let mut enc = device.create_command_encoder(&Default::default());
-            timer.begin_frame(true);
-            pass.record(device, &mut enc, &mut timer, &camera_buf, &gpu_scene, &targets);
-            timer.resolve(&mut enc);
-            ctx.queue.submit([enc.finish()]);
-            timer.after_submit();
-            let t = timer
-                .collect_new_blocking(device)
-                .ok_or_else(|| anyhow!("no timestamps came back"))?;
-            if rep > 0 {
-                samples.push(t.get("gbuffer_depth").unwrap_or(0.0) + t.get("gbuffer").unwrap_or(0.0));
-            }
-        }
+        let samples = time_back_to_back(&ctx, &mut timer, args.repeat, |enc, timer| {
+            pass.record(device, enc, timer, &camera_buf, &gpu_scene, &targets)
+        })?
+        .iter()
+        .map(|t| t.get("gbuffer_depth").unwrap_or(0.0) + t.get("gbuffer").unwrap_or(0.0))
+        .collect();
         ms[i] = median(samples).unwrap_or(f64::NAN);
     }
     println!(
@@ -368,37 +385,29 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
         let mut both = [[f64::NAN; 4]; 2];
         for (vi, (variant, name)) in variants.iter().enumerate() {
             sort.variant = *variant;
-            let mut samples: [Vec<f64>; 4] = Default::default();
             // The first repetition includes pipeline warm-up: dropped. Repetitions run back
             // to back (no CPU work between them but the timestamp readback).
-            for rep in 0..=args.repeat {
-                let mut enc = device.create_command_encoder(&Default::default());
-                timer.begin_frame(true);
-                sort.record(device, &ctx.queue, &mut enc, &mut timer, &buf, &sb);
-                let d = crate::renderer::settings::TreeSettings::default();
+            let d = crate::renderer::settings::TreeSettings::default();
+            let timed = time_back_to_back(&ctx, &mut timer, args.repeat, |enc, timer| {
+                sort.record(device, &ctx.queue, enc, timer, &buf, &sb);
                 build.record(
                     device,
                     &ctx.queue,
-                    &mut enc,
-                    &mut timer,
+                    enc,
+                    timer,
                     &buf,
                     &sb,
                     &tb,
                     d.v_min,
                     d.sigma_max,
                 );
-                timer.resolve(&mut enc);
-                ctx.queue.submit([enc.finish()]);
-                timer.after_submit();
-                let t = timer
-                    .collect_new_blocking(device)
-                    .ok_or_else(|| anyhow!("no timestamps came back"))?;
-                if rep > 0 {
-                    for (k, stage) in TREE_STAGES.iter().enumerate() {
-                        samples[k].push(t.get(stage).unwrap_or(f64::NAN));
-                    }
-                }
-            }
+            })?;
+            let samples: [Vec<f64>; 4] = std::array::from_fn(|k| {
+                timed
+                    .iter()
+                    .map(|t| t.get(TREE_STAGES[k]).unwrap_or(f64::NAN))
+                    .collect()
+            });
             let m = samples.map(|v| median(v).unwrap_or(f64::NAN));
             println!(
                 "{n:>9} {name:>9} {:>11.3} {:>11.3} {:>11.3} {:>11.3} {:>11.3} {:>12.2}",

@@ -282,13 +282,6 @@ impl Renderer {
         t
     }
 
-    /// Waits for the GPU and returns the last frame's per-pass timings.
-    pub fn wait_timings(&mut self) -> Option<PassTimings> {
-        let t = self.timer.collect_blocking(&self.ctx.device).cloned();
-        self.take_flux_total();
-        t
-    }
-
     /// Waits for the GPU and returns the timings of the last timed frame if they came back
     /// since the previous call (None: no timed frame, or no timestamps on this adapter).
     pub fn wait_new_timings(&mut self) -> Option<PassTimings> {

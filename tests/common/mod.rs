@@ -38,3 +38,28 @@ pub fn shared_scenes() -> Option<PathBuf> {
         None
     }
 }
+
+/// Header and rows of a CSV written by the harness (no quoted cells in numeric columns).
+pub fn read_csv(path: &std::path::Path) -> (Vec<String>, Vec<std::collections::HashMap<String, String>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(str::to_string).collect();
+    let rows = lines
+        .map(|l| {
+            // Split on commas outside quotes.
+            let mut cells = Vec::new();
+            let (mut cur, mut quoted) = (String::new(), false);
+            for ch in l.chars() {
+                match ch {
+                    '"' => quoted = !quoted,
+                    ',' if !quoted => cells.push(std::mem::take(&mut cur)),
+                    c => cur.push(c),
+                }
+            }
+            cells.push(cur);
+            assert_eq!(cells.len(), header.len(), "{}: {l}", path.display());
+            header.iter().cloned().zip(cells).collect()
+        })
+        .collect();
+    (header, rows)
+}
