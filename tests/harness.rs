@@ -78,6 +78,11 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "1",
             "--vpls",
             "1024",
+            // Lightcuts beside the three samplers, over two thresholds (tiny: CI time).
+            "--methods",
+            "slc,rtslc,sst,lightcuts",
+            "--sweep",
+            "lightcuts=0.2,0.05",
             "--out",
         ])
         .arg(&out)
@@ -111,29 +116,51 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     ] {
         assert!(groups.contains(&g), "timings.csv lacks {g}: {groups:?}");
     }
-    // 3 methods x spp {2, 8, 32 (the base cut size is added)}.
+    // 3 samplers x spp {2, 8, 32 (the base cut size is added)} + Lightcuts x 2 thresholds.
     check_csv(
         &d,
         "equal_time.csv",
-        &["method", "spp"],
+        &["method", "spp", "setting", "value", "method_stats"],
         &[
             "gi_gpu_ms",
-            "sample_gpu_ms",
             "frame_wall_ms",
             "rmse",
             "ssim",
             "mean_ratio",
             "bias_rmse",
             "noise_rmse",
-            "steps_per_traversal",
-            "steps_per_pixel",
         ],
-        9,
+        11,
     );
+    let (_, rows) = read_csv(&d.join("equal_time.csv"));
+    for r in &rows {
+        if r["method"] == "Lightcuts" {
+            assert_eq!(r["setting"], "relative_error", "{r:?}");
+            assert!(r["method_stats"].contains("mean_cut_size="), "{r:?}");
+        } else {
+            assert_eq!(r["setting"], "spp", "{r:?}");
+            assert_eq!(r["spp"], r["value"], "{r:?}");
+            for c in ["sample_gpu_ms", "steps_per_traversal", "steps_per_pixel"] {
+                assert!(r[c].parse::<f64>().is_ok_and(f64::is_finite), "{c}: {r:?}");
+            }
+        }
+    }
+    let lc: Vec<&str> = rows
+        .iter()
+        .filter(|r| r["method"] == "Lightcuts")
+        .map(|r| r["value"].as_str())
+        .collect();
+    assert_eq!(lc, ["0.2", "0.05"], "the Lightcuts sweep");
     check_csv(
         &d,
         "equal_time_matched.csv",
-        &["method", "extrapolated", "spp_at_matched_time"],
+        &[
+            "method",
+            "extrapolated",
+            "spp_at_matched_time",
+            "setting",
+            "value_at_matched_time",
+        ],
         &[
             "matched_gi_gpu_ms",
             "rmse_interpolated",
@@ -144,7 +171,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "measured_mean_ratio",
             "measured_bias_rmse",
         ],
-        3,
+        4,
     );
     check_csv(
         &d,
@@ -219,6 +246,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         "images/ground_truth.png",
         "images/equal_time_slc.png",
         "images/equal_time_sst_error.png",
+        "images/equal_time_lightcuts.png",
         "images/steps_rtslc.png",
         "images/block_1.png",
         "images/blend_no_blending.png",

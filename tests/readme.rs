@@ -32,6 +32,8 @@ const EXAMPLES: &[&str] = &[
     "-- render --scene default --width 320 --height 240 --method slc --frames 16 --compare-gt --out out/slc",
     "-- compare out/slc/indirect.exr out/slc/ground_truth_indirect.exr --exposure 3",
     "-- bench tree",
+    "-- render --scene default --width 320 --height 240 --method lightcuts --set methods.lightcuts.relative_error=0.02 --compare-gt --out out/lc",
+    "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",
     "-- --view albedo --settings docs/settings-example.toml --tree-stats",
     "-- --compare-gt --views \"final;GI only;traversal steps;A/B comparison\" --pin 150,70",
     "-- sheet --methods slc,rtslc,sst --frames 16 --out screenshots/comparison_sheet.png",
@@ -395,6 +397,52 @@ fn cli_examples_write_what_they_promise() {
     // Both variants, each size, in one run (issue 18's before / after).
     assert!(
         out.contains("baseline") && out.contains("parallel") && out.contains("speed-up"),
+        "{out}"
+    );
+
+    // Lightcuts with a relative error set by --set, against the ground truth of its VPLs.
+    let lc = tmp("lightcuts");
+    run_cli(&args(
+        "-- render --scene default --width 320 --height 240 --method lightcuts --set methods.lightcuts.relative_error=0.02 --compare-gt --out out/lc",
+        &[
+            ("--width", "32"),
+            ("--height", "24"),
+            ("--out", lc.to_str().unwrap()),
+        ],
+        &["--vpls", "256"],
+    ));
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(lc.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(m["method"], "lightcuts");
+    assert_eq!(m["method_stats"]["relative_error"].as_f64(), Some(0.02f32 as f64));
+    assert!(
+        m["method_stats"]["mean_cut_size"]
+            .as_f64()
+            .is_some_and(|v| v >= 1.0),
+        "{m}"
+    );
+    assert!(
+        m["vs_ground_truth"]["rmse"].as_f64().is_some_and(f64::is_finite),
+        "{m}"
+    );
+    assert!(lc.join("lightcut_size.png").is_file() && lc.join("lightcut_at_max_cut.png").is_file());
+    // The tree's pairing and Lightcuts' cost per relative error (the default scene here).
+    let out = run_cli(&args(
+        "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",
+        &[("--scene", "default"), ("--width", "24"), ("--height", "16")],
+        &[
+            "--vpls",
+            "256",
+            "--errors",
+            "0.2",
+            "--repeat",
+            "1",
+            "--cpu-pixels",
+            "40",
+        ],
+    ));
+    assert!(
+        out.contains("far-paired") && out.contains("mean cut") && out.contains("0.2"),
         "{out}"
     );
 

@@ -51,6 +51,9 @@ fn run_figures(out: &Path) -> Run {
             "8",
             "--vpls",
             "1024",
+            // The thesis's samplers only (their sampling pass is what this test compares).
+            "--methods",
+            "slc,rtslc,sst",
             "--out",
         ])
         .arg(out)

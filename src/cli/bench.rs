@@ -1,6 +1,8 @@
 //! `bench rays`: BVH shadow rays (and closest-hit rays) per second on the current adapter.
 //! `bench tree`: SST sort keys, bitonic sort, tree build and classify times (GPU timestamps)
 //! for 2^12 .. 2^20 VPLs, with the log-log slope of time against N.
+//! `bench gbuffer`: fragments and bytes per pixel with and without the depth pre-pass.
+//! `bench lightcuts`: `bench_lightcuts.rs`.
 
 use anyhow::anyhow;
 use clap::{Args, ValueEnum};
@@ -44,6 +46,10 @@ pub enum BenchKind {
     /// the depth pre-pass; machine-independent), bytes written per pixel, and GPU time of the
     /// single pass and of pre-pass + shading.
     Gbuffer,
+    /// Lightcuts on a scene's frame: the light tree's far-paired nodes per level, and per
+    /// relative error (--errors) the GPU time, cut size, shadow rays, max-cut pixels and the
+    /// share of refinements on far-paired nodes (docs/lightcuts.md).
+    Lightcuts,
 }
 
 #[derive(Args, Debug)]
@@ -73,6 +79,18 @@ pub struct BenchArgs {
     /// `bench tree`: largest VPL count, as a power of two (at most 20).
     #[arg(long, default_value_t = 20)]
     pub max_log2: u32,
+    /// `bench lightcuts`: relative errors.
+    #[arg(long, value_delimiter = ',', default_value = "0.2,0.1,0.05,0.02,0.01")]
+    pub errors: Vec<f32>,
+    /// `bench lightcuts`: the max cut size.
+    #[arg(long, default_value_t = 1024)]
+    pub max_cut: u32,
+    /// `bench lightcuts`: VPLs (default: the settings' 4096).
+    #[arg(long)]
+    pub vpls: Option<u32>,
+    /// `bench lightcuts`: pixels the CPU reference refines (a regular subset).
+    #[arg(long, default_value_t = 400)]
+    pub cpu_pixels: u32,
 }
 
 /// Area-weighted random points on the scene's triangles, with their geometric normals.
@@ -197,6 +215,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchKind::Rays => run_rays(args),
         BenchKind::Tree => run_tree(args),
         BenchKind::Gbuffer => run_gbuffer(args),
+        BenchKind::Lightcuts => super::bench_lightcuts::run(args),
     }
 }
 

@@ -1,6 +1,7 @@
 //! Headless commands sharing the renderer with the app: `render` and `bench`.
 
 pub mod bench;
+pub mod bench_lightcuts;
 pub mod compare;
 pub mod export_scene;
 pub mod methods;
@@ -162,6 +163,10 @@ pub struct SettingsArgs {
     /// Anisotropic texture filtering, 1..=16.
     #[arg(long)]
     pub anisotropy: Option<u16>,
+    /// Sets one settings field by its TOML path, e.g. `--set methods.lightcuts.max_cut=512`
+    /// or `--set gi.distance_epsilon=0.02` (repeatable; applied after the settings file).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
 }
 
 impl SettingsArgs {
@@ -179,6 +184,13 @@ impl SettingsArgs {
                 s
             }
         };
+        for kv in &self.set {
+            let (k, v) = kv
+                .split_once('=')
+                .ok_or_else(|| anyhow::anyhow!("--set {kv}: expected KEY=VALUE"))?;
+            s.set_path(k.trim(), v.trim())
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+        }
         if let Some(v) = self.shadow_res {
             s.shadow.resolution = v;
         }

@@ -202,8 +202,8 @@ pub struct RenderArgs {
     /// Frames to render before reading timings (the first frames include pipeline warm-up).
     #[arg(long, default_value_t = 3)]
     pub timing_frames: u32,
-    /// GI method by its CLI name: slc (the thesis; default), sst, rtslc, ground-truth,
-    /// reference, off (direct light only). `lightcut-workbench methods` lists them.
+    /// GI method by its CLI name: slc (the thesis; default), sst, rtslc, lightcuts,
+    /// ground-truth, reference, off (direct light only). `lightcut-workbench methods` lists them.
     /// Without it: the settings file's method (default slc).
     #[arg(long, value_parser = parse_method)]
     pub method: Option<MethodId>,
@@ -289,6 +289,16 @@ fn write_metrics(
         json["dead_branches"] = st.dead.into();
         json["traversals"] = st.traversals.into();
         json["shadow_rays"] = st.rays.into();
+    }
+    // A method's own statistics (Lightcuts' cut sizes, ...).
+    let ms = r.method_stats_blocking();
+    if !ms.is_empty() {
+        let line: Vec<String> = ms.iter().map(|(k, v)| format!("{k} {v:.4}")).collect();
+        println!("{}: {}", s.gi.method.info().short, line.join(", "));
+        json["method_stats"] = ms
+            .iter()
+            .map(|(k, v)| (k.to_string(), serde_json::json!(v)))
+            .collect();
     }
     if args.sampling.compare_gt {
         let mut g = s.clone();

@@ -25,7 +25,8 @@ pub enum Figure {
     All,
     /// Table 7.1: GPU time per pass (median, mean and spread over many timed frames).
     Timings,
-    /// Fig. 7.1 / 7.3: RMSE and SSIM over frame time for SLC, RTSLC, SST; equal-time table.
+    /// Fig. 7.1 / 7.3: RMSE and SSIM over GI GPU time for every per-frame method (SLC, RTSLC,
+    /// SST over spp; Lightcuts over its relative error); equal-time table.
     EqualTime,
     /// Fig. 7.2: traversal steps per pixel of the three samplers, heat maps.
     Steps,
@@ -93,6 +94,14 @@ pub struct ResultsArgs {
     /// Results folder (one sub-folder per scene).
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
+    /// The per-frame methods the sweeps compare, by CLI name (default: every per-frame method
+    /// of the registry; the thesis's checks need slc, rtslc and sst).
+    #[arg(long, value_delimiter = ',', value_parser = crate::cli::render::parse_method)]
+    pub methods: Vec<crate::methods::MethodId>,
+    /// A method's quality-knob values for the equal-time sweep, replacing its registry sweep:
+    /// `--sweep lightcuts=0.1,0.02` (relative error), `--sweep sst=4,16` (spp). Repeatable.
+    #[arg(long = "sweep", value_name = "METHOD=V1,V2,..")]
+    pub sweeps: Vec<String>,
     /// Number of VPLs (default 4096, as the thesis).
     #[arg(long)]
     pub vpls: Option<u32>,
@@ -131,7 +140,39 @@ impl ResultsArgs {
         {
             bail!("--upsampling-scales must be 0.25..=8");
         }
+        let methods = self.methods.clone();
+        if let Some(m) = methods.iter().find(|m| !m.per_frame()) {
+            bail!("--methods: {m} is not a per-frame method (the sweeps compare per-frame methods)");
+        }
+        let mut sweeps = Vec::new();
+        for arg in &self.sweeps {
+            let (name, values) = arg
+                .split_once('=')
+                .ok_or_else(|| anyhow::anyhow!("--sweep {arg}: expected METHOD=V1,V2,..."))?;
+            let m =
+                crate::methods::MethodId::parse(name.trim()).map_err(|e| anyhow::anyhow!("--sweep: {e}"))?;
+            if m.info().sweep.is_none() {
+                bail!("--sweep: {m} has no quality knob to sweep");
+            }
+            let v: Vec<f64> = values
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| anyhow::anyhow!("--sweep {arg}: the values must be numbers"))?;
+            if v.is_empty() || v.iter().any(|x| !x.is_finite() || *x < 0.0) {
+                bail!("--sweep {arg}: the values must be finite and >= 0");
+            }
+            // Each value must be a valid setting of the method.
+            for &x in &v {
+                let mut s = crate::renderer::settings::RenderSettings::default();
+                (m.info().sweep.map(|sw| sw.apply).unwrap_or(|_, _| ()))(&mut s, x);
+                (m.info().validate)(&s).map_err(|e| anyhow::anyhow!("--sweep {arg}: {e}"))?;
+            }
+            sweeps.push((m, v));
+        }
         Ok(Opts {
+            methods,
+            sweeps,
             size: (self.width, self.height),
             frames: self.frames,
             timing_frames: self.timing_frames,
@@ -285,6 +326,8 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         "frames": o.frames,
         "timing_frames": o.timing_frames,
         "spp": o.spp,
+        "methods": figures::methods(&o).iter().map(|(m, _)| m.cli()).collect::<Vec<_>>(),
+        "sweeps": o.sweeps.iter().map(|(m, v)| (m.cli().to_string(), v.clone())).collect::<std::collections::BTreeMap<_, _>>(),
         "blocks": o.blocks,
         "vpl_exponents": o.vpl_exponents,
         "scaling_size": [o.scaling_size.0, o.scaling_size.1],

@@ -130,6 +130,9 @@ pub struct Measured {
     pub steps: Option<(u32, u32, Vec<f32>)>,
     /// The pixels without a similar cut.
     pub fallback: Option<Vec<bool>>,
+    /// The method's own statistics (`Method::stats`: Lightcuts' cut sizes, ...), mean over
+    /// the diagnostic frames.
+    pub method_stats: Vec<(&'static str, f64)>,
 }
 
 impl Measured {
@@ -408,14 +411,22 @@ impl Bench {
         // Pixels without a similar cut: a property of the G-buffer and the cuts, the same
         // in every frame (read from the first).
         let mut fallback_mask: Option<Vec<bool>> = None;
+        let samples_tree = s.gi.method.samples_tree();
         for _ in 0..frames.diagnostic {
             self.frame_wait();
-            if let Some(st) = self.r.sampling_stats_blocking() {
+            if samples_tree && let Some(st) = self.r.sampling_stats_blocking() {
                 m.stats = Some(m.stats.map_or(st, |a| a + st));
+            }
+            let k = frames.diagnostic.max(1) as f64;
+            for (name, v) in self.r.method_stats_blocking() {
+                match m.method_stats.iter_mut().find(|(n, _)| *n == name) {
+                    Some((_, sum)) => *sum += v / k,
+                    None => m.method_stats.push((name, v / k)),
+                }
             }
             let ind = self.r.read(Buffer::Indirect)?;
             // Steps and fallback flags are per GI pixel: read at full GI resolution only.
-            if m.steps.is_none() && !s.sampling.half_resolution {
+            if samples_tree && m.steps.is_none() && !s.sampling.half_resolution {
                 let (w, h, steps, fb) = self.read_steps()?;
                 m.steps = Some((w, h, steps));
                 fallback_mask = Some(fb.clone());

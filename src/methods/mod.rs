@@ -15,6 +15,7 @@
 
 pub mod direct_only;
 pub mod ground_truth;
+pub mod lightcuts;
 pub mod reference;
 pub mod tree_samplers;
 
@@ -44,6 +45,7 @@ pub static REGISTRY: &[&MethodInfo] = &[
     &tree_samplers::SLC_INFO,
     &tree_samplers::SST_INFO,
     &tree_samplers::RTSLC_INFO,
+    &lightcuts::INFO,
     &ground_truth::INFO,
     &reference::INFO,
     &direct_only::INFO,
@@ -287,6 +289,7 @@ impl<'de> Deserialize<'de> for MethodView {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Legend {
     pub title: String,
+    /// The scale's ends: values, or with `log` their log10 (-4 and 0 for 1e-4 .. 1).
     pub lo: f32,
     pub hi: f32,
     /// log10 scale (else linear).
@@ -330,6 +333,19 @@ pub struct Module {
     pub entry_shaders: &'static [&'static str],
 }
 
+/// A per-frame method's quality knob: what `results` sweeps for its RMSE-vs-GPU-time curve
+/// (the tree samplers' samples per pixel, Lightcuts' relative error).
+pub struct Sweep {
+    /// The setting's name (CSV `setting` column, plot captions): "spp", "relative_error".
+    pub name: &'static str,
+    /// The values swept, cheapest first (empty: the harness's `--spp` list).
+    pub values: &'static [f64],
+    /// Sets it in a copy of the settings.
+    pub apply: fn(&mut RenderSettings, f64),
+    /// Whether the values are integers (interpolated values are rounded).
+    pub integer: bool,
+}
+
 /// One row of the registry: everything the workbench needs to know of a method.
 pub struct MethodInfo {
     pub id: MethodId,
@@ -369,6 +385,8 @@ pub struct MethodInfo {
     /// The tests (by name, `file::test`) that check it against a CPU reference or for
     /// convergence; the registry test checks that each exists.
     pub tests: &'static [&'static str],
+    /// Its quality knob for `results`' equal-time sweep (per-frame methods).
+    pub sweep: Option<&'static Sweep>,
 }
 
 /// What a method's `record` may use: the frame's resources and where to write.
@@ -376,6 +394,8 @@ pub struct FrameCx<'a> {
     /// Which method of the module runs (the tree samplers share one instance).
     pub method: MethodId,
     pub device: &'a wgpu::Device,
+    /// The adapter's kind (a CPU adapter such as lavapipe has limits a GPU has not).
+    pub adapter_type: wgpu::DeviceType,
     pub queue: &'a wgpu::Queue,
     pub errors: &'a ErrorSink,
     pub timer: &'a mut GpuTimer,
@@ -470,5 +490,11 @@ pub trait Method: Any {
     /// One line of its statistics for the GUI (non-blocking; None before there are any).
     fn status(&mut self) -> Option<String> {
         None
+    }
+    /// Its named statistics of the last diagnostic frame read back (`render` prints them and
+    /// writes them to metrics.json as `method_stats`; call after the GPU is idle). Empty when
+    /// it keeps none.
+    fn stats(&mut self) -> Vec<(&'static str, f64)> {
+        Vec::new()
     }
 }

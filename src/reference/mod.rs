@@ -10,11 +10,13 @@
 //! | `direct.wgsl` | [`direct::radiance`] with exact ray-traced visibility |
 //! | `display.wgsl` | `base::display::encode` |
 //! | `visualise.wgsl` (`vis_uint`) | `base::colormap::{id_color, false_color}` |
+//! | `methods/lightcuts/{lc_build, lightcuts}.wgsl` | [`lightcuts::build`], [`lightcuts::lightcut`] (and the error bound) |
 //! | `common/bvh.wgsl` | `scene::bvh::Bvh::{closest_hit, any_hit}` (and brute force) |
 
 pub mod direct;
 pub mod gbuffer;
 pub mod gi;
+pub mod lightcuts;
 pub mod slc;
 pub mod sst;
 pub mod sst_tree;

@@ -13,6 +13,7 @@ macro_rules! frame_cx {
         FrameCx {
             method: $method,
             device: &$r.ctx.device,
+            adapter_type: $r.ctx.adapter_info.device_type,
             queue: &$r.ctx.queue,
             errors: &$r.ctx.errors,
             timer: &mut $r.timer,

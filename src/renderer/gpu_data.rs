@@ -455,6 +455,64 @@ mod tests {
                 ],
             ),
             (
+                "methods/lightcuts/lc_build.wgsl",
+                "LcBuildParams",
+                size_of::<crate::methods::lightcuts::pass::GpuLcBuildParams>(),
+                {
+                    use crate::methods::lightcuts::pass::GpuLcBuildParams as P;
+                    vec![
+                        offset_of!(P, first),
+                        offset_of!(P, count),
+                        offset_of!(P, leaves),
+                        offset_of!(P, seed),
+                    ]
+                },
+            ),
+            (
+                "methods/lightcuts/lightcuts.wgsl",
+                "LcParams",
+                size_of::<crate::methods::lightcuts::pass::GpuLcParams>(),
+                {
+                    use crate::methods::lightcuts::pass::GpuLcParams as P;
+                    vec![
+                        offset_of!(P, width),
+                        offset_of!(P, height),
+                        offset_of!(P, leaves),
+                        offset_of!(P, max_cut),
+                        offset_of!(P, relative_error),
+                        offset_of!(P, epsilon),
+                        offset_of!(P, ray_offset),
+                        offset_of!(P, shadow_rays),
+                        offset_of!(P, accumulate),
+                        offset_of!(P, trace_pixel),
+                        offset_of!(P, first_pixel),
+                        offset_of!(P, slice),
+                        offset_of!(P, first),
+                        offset_of!(P, last),
+                        offset_of!(P, steps),
+                        offset_of!(P, _pad),
+                    ]
+                },
+            ),
+            (
+                "methods/lightcuts/lc_views.wgsl",
+                "LcViewParams",
+                size_of::<crate::methods::lightcuts::pass::GpuLcViewParams>(),
+                {
+                    use crate::methods::lightcuts::pass::GpuLcViewParams as P;
+                    vec![
+                        offset_of!(P, mode),
+                        offset_of!(P, scale_top),
+                        offset_of!(P, relative_error),
+                        offset_of!(P, exposure),
+                        offset_of!(P, tonemap),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                        offset_of!(P, _pad) + 8,
+                    ]
+                },
+            ),
+            (
                 "methods/ground_truth/ground_truth.wgsl",
                 "GtParams",
                 size_of::<GpuGtParams>(),

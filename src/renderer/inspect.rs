@@ -132,6 +132,17 @@ impl Renderer {
             .and_then(|(_, m)| m.status())
     }
 
+    /// The current method's named statistics of the last diagnostic frame (waits for the GPU).
+    pub fn method_stats_blocking(&mut self) -> Vec<(&'static str, f64)> {
+        let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+        let module = self.settings.gi.method.info().module.name;
+        self.methods
+            .iter_mut()
+            .find(|(n, _)| *n == module)
+            .map(|(_, m)| m.stats())
+            .unwrap_or_default()
+    }
+
     /// The GPU instance of `method`'s module.
     pub(super) fn method_instance(&self, method: MethodId) -> Option<&dyn Method> {
         let module = method.info().module.name;
@@ -139,6 +150,21 @@ impl Renderer {
             .iter()
             .find(|(n, _)| *n == module)
             .map(|(_, m)| m.as_ref())
+    }
+
+    /// The GPU instance of the method module whose type is `T` (tests and tools that read a
+    /// method's own buffers, e.g. `methods::lightcuts::Lightcuts`).
+    pub fn method_module<T: Method>(&self) -> Option<&T> {
+        self.methods
+            .iter()
+            .find_map(|(_, m)| (m.as_ref() as &dyn std::any::Any).downcast_ref::<T>())
+    }
+
+    /// `method_module`, mutable.
+    pub fn method_module_mut<T: Method>(&mut self) -> Option<&mut T> {
+        self.methods
+            .iter_mut()
+            .find_map(|(_, m)| (m.as_mut() as &mut dyn std::any::Any).downcast_mut::<T>())
     }
 
     /// The linear data behind a method's view (None: nothing rendered yet, or the current

@@ -34,6 +34,42 @@ impl RenderSettings {
         }
     }
 
+    /// Sets one field by its TOML path (`methods.lightcuts.max_cut`, `gi.distance_epsilon`) to
+    /// `value`, read as a TOML value (a bare word that is not one is a string). The error
+    /// names the key (an unknown field, a value of the wrong type). `validate` checks ranges.
+    pub fn set_path(&mut self, key: &str, value: &str) -> Result<(), String> {
+        let parts: Vec<&str> = key.split('.').map(str::trim).collect();
+        if parts.iter().any(|p| p.is_empty()) {
+            return Err(format!(
+                "--set {key}: the key is a dotted path such as gi.shadow_rays"
+            ));
+        }
+        let v: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {value}")) {
+            Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(value.to_string())),
+            Err(_) => toml::Value::String(value.to_string()),
+        };
+        let mut root = toml::Table::try_from(&*self).map_err(|e| format!("--set {key}: {e}"))?;
+        let mut t = &mut root;
+        for p in &parts[..parts.len() - 1] {
+            let entry = t
+                .entry(p.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            t = entry
+                .as_table_mut()
+                .ok_or_else(|| format!("--set {key}: {p} is a value, not a table"))?;
+        }
+        t.insert(parts[parts.len() - 1].to_string(), v);
+        *self = root
+            .try_into()
+            .map_err(|e: toml::de::Error| format!("--set {key}={value}: {}", e.message()))?;
+        // A method's table is read lazily: read it now so that an unknown field is named here.
+        if parts[0] == "methods" && parts.len() > 2 {
+            let id = MethodId::parse(parts[1]).map_err(|e| format!("--set {key}: {e}"))?;
+            (id.info().validate)(self).map_err(|e| format!("--set {key}={value}: {e}"))?;
+        }
+        Ok(())
+    }
+
     /// Stores a method's settings as its `[methods.<cli name>]` table.
     pub fn set_method<T: Serialize>(&mut self, id: MethodId, value: &T) -> Result<(), String> {
         let t = toml::Table::try_from(value).map_err(|e| format!("methods.{}: {e}", id.cli()))?;

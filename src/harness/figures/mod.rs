@@ -38,6 +38,10 @@ pub struct Opts {
     pub scaling_size: (u32, u32),
     /// Frame sizes of the upsampling table, as multiples of `size`.
     pub upsampling_scales: Vec<f32>,
+    /// The per-frame methods the sweeps compare (registry order; empty: every one).
+    pub methods: Vec<MethodId>,
+    /// A method's quality-knob values replacing its registry sweep (`results --sweep`).
+    pub sweeps: Vec<(MethodId, Vec<f64>)>,
 }
 
 impl Opts {
@@ -46,6 +50,26 @@ impl Opts {
         Frames {
             timed: self.timing_frames.max(1),
             diagnostic: self.frames.max(1),
+        }
+    }
+
+    /// The values of `method`'s quality knob in the equal-time sweep: `--sweep` for it, else
+    /// its registry sweep (the tree samplers' `--spp` list with `base_spp` added).
+    pub fn sweep_values(&self, method: MethodId, base_spp: u32) -> Vec<f64> {
+        if let Some((_, v)) = self.sweeps.iter().find(|(m, _)| *m == method) {
+            return v.clone();
+        }
+        match method.info().sweep {
+            Some(sw) if !sw.values.is_empty() => sw.values.to_vec(),
+            _ => {
+                let mut spp = self.spp.clone();
+                if !spp.contains(&base_spp) {
+                    spp.push(base_spp);
+                }
+                spp.sort_unstable();
+                spp.dedup();
+                spp.into_iter().map(f64::from).collect()
+            }
         }
     }
 }
@@ -91,9 +115,9 @@ pub struct Report {
 }
 
 /// The methods of every sweep, in the order (and colours) of every plot: the thesis's
-/// comparison first, SLC, RTSLC, SST (the checks index them so), then any other per-frame
-/// method of the registry.
-pub fn methods() -> Vec<(MethodId, &'static str)> {
+/// comparison first, SLC, RTSLC, SST, then any other per-frame method of the registry; only
+/// those of `o.methods` when it names some.
+pub fn methods(o: &Opts) -> Vec<(MethodId, &'static str)> {
     let thesis = [SLC, RTSLC, SST];
     let mut v = thesis.to_vec();
     v.extend(
@@ -101,7 +125,15 @@ pub fn methods() -> Vec<(MethodId, &'static str)> {
             .into_iter()
             .filter(|m| !thesis.contains(m)),
     );
-    v.into_iter().map(|m| (m, m.info().short)).collect()
+    v.into_iter()
+        .filter(|m| o.methods.is_empty() || o.methods.contains(m))
+        .map(|m| (m, m.info().short))
+        .collect()
+}
+
+/// The tree samplers among [`methods`] (the traversal figures).
+pub fn tree_methods(o: &Opts) -> Vec<(MethodId, &'static str)> {
+    methods(o).into_iter().filter(|(m, _)| m.samples_tree()).collect()
 }
 
 fn with(b: &Bench, f: impl FnOnce(&mut RenderSettings)) -> RenderSettings {
@@ -259,27 +291,33 @@ pub fn interp_loglog(points: &[(f64, f64)], x: f64) -> (f64, bool) {
     ((a.1 + t * (c.1 - a.1)).exp(), outside)
 }
 
-/// One point of the equal-time sweep: frame ms, RMSE, SSIM, samples per pixel.
-type SweepPoint = (f64, f64, f64, u32);
+/// One point of the equal-time sweep: GI GPU ms, RMSE, SSIM, the knob's value.
+type SweepPoint = (f64, f64, f64, f64);
 
-/// Thesis fig. 7.1 and 7.3: every sampler over a sweep of samples per pixel; RMSE and SSIM
-/// against the ground truth of the same VPLs over the GPU time of each method's whole GI
-/// cost (cuts + sampling + upsampling: [`gi_passes`], GPU timestamps of timed frames); the
-/// equal-time table (each method's RMSE interpolated at SLC's GI time at the base cut
-/// size), and the images, error maps and FLIP of each method at its sample count for that
-/// time. Frame wall clock stays a separate column.
+/// A knob value as the CSV writes it.
+fn knob(v: f64, integer: bool) -> String {
+    if integer {
+        format!("{}", v.round() as i64)
+    } else {
+        format!("{v}")
+    }
+}
+
+/// Thesis fig. 7.1 and 7.3, for every per-frame method: each over a sweep of its quality
+/// knob (samples per pixel for the tree samplers, the relative error for Lightcuts: the
+/// registry's `Sweep`), RMSE and SSIM against the ground truth of the same VPLs over the GPU
+/// time of the method's whole GI cost (its registry `timed_passes`, GPU timestamps of timed
+/// frames); the equal-time table (each method's RMSE interpolated at SLC's GI time at the
+/// base cut size), and the images, error maps and FLIP of each method at its knob's value
+/// for that time. Frame wall clock stays a separate column.
 pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let base_spp = b.base.sampling.cut_size;
-    let mut spp = o.spp.clone();
-    if !spp.contains(&base_spp) {
-        spp.push(base_spp);
-    }
-    spp.sort_unstable();
-    spp.dedup();
     let mut csv = Csv::new(&[
         "scene",
         "method",
         "spp",
+        "setting",
+        "value",
         "gi_gpu_ms",
         "gi_gpu_ms_std",
         "sample_gpu_ms",
@@ -296,24 +334,42 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
         "noise_rmse",
         "steps_per_traversal",
         "steps_per_pixel",
+        "method_stats",
     ]);
+    let ms = methods(o);
     let mut curves: Vec<Vec<SweepPoint>> = Vec::new();
-    for (method, label) in methods().iter() {
+    for (method, label) in ms.iter() {
+        let Some(sweep) = method.info().sweep else {
+            curves.push(Vec::new());
+            continue;
+        };
         let mut pts = Vec::new();
-        for &n in &spp {
+        for v in o.sweep_values(*method, base_spp) {
             let s = with(b, |s| {
                 s.gi.method = *method;
-                s.sampling.cut_size = n;
+                (sweep.apply)(s, v);
             });
             let m = b.measure(&s, o.size, o.per_config(), true)?;
             let (t, ts) = m.gi_ms();
             let (wall, wall_s) = m.frame_ms();
             let (r, rs) = m.rmse();
             let (q, qs) = m.ssim();
+            let value = knob(v, sweep.integer);
+            let stats: Vec<String> = m
+                .method_stats
+                .iter()
+                .map(|(k, x)| format!("{k}={x:.4}"))
+                .collect();
             csv.row(vec![
                 b.scene.clone(),
                 label.to_string(),
-                n.to_string(),
+                if sweep.name == "spp" {
+                    value.clone()
+                } else {
+                    String::new()
+                },
+                sweep.name.to_string(),
+                value.clone(),
                 num(t),
                 num(ts),
                 num(m.pass_ms(&SAMPLE_PASSES).0),
@@ -330,22 +386,23 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
                 num(m.noise_rmse),
                 num(m.steps_per_traversal()),
                 num(m.steps_per_pixel()),
+                format!("\"{}\"", stats.join(" ")),
             ]);
             eprintln!(
-                "[{}] {label} {n} spp: GI {t:.2} ms GPU (frame {wall:.1} ms wall), RMSE {r:.4e} (bias {:.2e}, noise {:.2e}, mean ratio {:.3}), SSIM {q:.3}",
+                "[{}] {label} {} {value}: GI {t:.2} ms GPU (frame {wall:.1} ms wall), RMSE {r:.4e} (bias {:.2e}, noise {:.2e}, mean ratio {:.3}), SSIM {q:.3}",
                 b.scene,
+                sweep.name,
                 m.bias_rmse,
                 m.noise_rmse,
                 mean_std(&m.mean_ratio).0
             );
-            pts.push((t, r, q, n));
+            pts.push((t, r, q, v));
         }
         curves.push(pts);
     }
     csv.write(&dir.join("equal_time.csv"))?;
     let series = |f: &dyn Fn(&SweepPoint) -> (f64, f64)| -> Vec<plot::Series> {
-        methods()
-            .iter()
+        ms.iter()
             .enumerate()
             .map(|(i, (_, l))| plot::Series {
                 name: l.to_string(),
@@ -354,10 +411,14 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
             })
             .collect()
     };
+    let knobs: Vec<String> = ms
+        .iter()
+        .filter_map(|(m, l)| m.info().sweep.map(|sw| format!("{l}: {}", sw.name)))
+        .collect();
     plot::lines(
         &dir.join("equal_time_rmse.png"),
-        &format!("{}: RMSE vs GI GPU time (spp {:?})", b.scene, spp),
-        "GI time (ms, GPU timestamps: cuts + sampling + upsampling)",
+        &format!("{}: RMSE vs GI GPU time (swept: {})", b.scene, knobs.join(", ")),
+        "GI time (ms, GPU timestamps of each method's passes)",
         "RMSE of one frame's GI (W/(m² sr))",
         &series(&|p| (p.0, p.1)),
         true,
@@ -366,19 +427,26 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
     plot::lines(
         &dir.join("equal_time_ssim.png"),
         &format!("{}: SSIM vs GI GPU time", b.scene),
-        "GI time (ms, GPU timestamps: cuts + sampling + upsampling)",
+        "GI time (ms, GPU timestamps of each method's passes)",
         "SSIM of one frame's GI",
         &series(&|p| (p.0, p.2)),
         true,
         false,
     )?;
-    // The matched time: SLC's GI at the base cut size.
-    let t_match = curves[0]
-        .iter()
-        .find(|p| p.3 == base_spp)
+    // The matched time: SLC's GI at the base cut size (else the first method's first point).
+    let slc = ms.iter().position(|(m, _)| *m == SLC);
+    let t_match = slc
+        .and_then(|i| curves[i].iter().find(|p| p.3 == base_spp as f64))
+        .or_else(|| curves.iter().flatten().next())
         .map_or(f64::NAN, |p| p.0);
-    let mut table =
-        format!("equal time: {t_match:.2} ms of GI on the GPU per frame (SLC at {base_spp} spp)\n");
+    let mut table = format!(
+        "equal time: {t_match:.2} ms of GI on the GPU per frame ({})\n",
+        if slc.is_some() {
+            format!("SLC at {base_spp} spp")
+        } else {
+            "the first method's first point".into()
+        }
+    );
     let mut at = Vec::new();
     let mut matched = Csv::new(&[
         "scene",
@@ -388,6 +456,8 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
         "ssim_interpolated",
         "extrapolated",
         "spp_at_matched_time",
+        "setting",
+        "value_at_matched_time",
         "measured_gi_gpu_ms",
         "measured_frame_wall_ms",
         "measured_rmse",
@@ -399,21 +469,32 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
     let gt = b.ground_truth(&b.base.clone(), o.size)?;
     let img = images(dir)?;
     b.write_gi_png(&img.join("ground_truth.png"), &gt)?;
-    for (i, (method, label)) in methods().iter().enumerate() {
+    for (i, (method, label)) in ms.iter().enumerate() {
+        let Some(sweep) = method.info().sweep else {
+            at.push((*method, f64::NAN));
+            continue;
+        };
         let rt: Vec<(f64, f64)> = curves[i].iter().map(|p| (p.0, p.1)).collect();
         let qt: Vec<(f64, f64)> = curves[i].iter().map(|p| (p.0, p.2)).collect();
-        let st: Vec<(f64, f64)> = curves[i].iter().map(|p| (p.0, p.3 as f64)).collect();
+        let st: Vec<(f64, f64)> = curves[i].iter().map(|p| (p.0, p.3)).collect();
         let (r, ex) = interp_loglog(&rt, t_match);
         let (q, _) = interp_loglog(&qt, t_match);
-        let (n, _) = interp_loglog(&st, t_match);
-        let n = if n.is_finite() {
-            (n.round() as u32).clamp(1, 64)
+        let (v, _) = interp_loglog(&st, t_match);
+        // The knob at that time, within the swept range (spp: rounded).
+        let (lo, hi) = st
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.1), hi.max(p.1)));
+        let v = if v.is_finite() && lo <= hi {
+            let v = v.clamp(lo, hi);
+            if sweep.integer { v.round() } else { v }
+        } else if sweep.name == "spp" {
+            base_spp as f64
         } else {
-            base_spp
+            st.first().map_or(f64::NAN, |p| p.1)
         };
         let s = with(b, |s| {
             s.gi.method = *method;
-            s.sampling.cut_size = n;
+            (sweep.apply)(s, v);
         });
         let m = b.measure(&s, o.size, o.per_config(), true)?;
         let flip = m.indirect.as_ref().map_or(f64::NAN, |ind| b.flip(ind, &gt));
@@ -425,6 +506,7 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
                 &gt,
             )?;
         }
+        let value = knob(v, sweep.integer);
         matched.row(vec![
             b.scene.clone(),
             label.to_string(),
@@ -432,7 +514,13 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
             num(r),
             num(q),
             ex.to_string(),
-            n.to_string(),
+            if sweep.name == "spp" {
+                value.clone()
+            } else {
+                String::new()
+            },
+            sweep.name.to_string(),
+            value.clone(),
             num(m.gi_ms().0),
             num(m.frame_ms().0),
             num(m.rmse().0),
@@ -442,28 +530,38 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
             num(m.bias_rmse),
         ]);
         table.push_str(&format!(
-            "  {label:<6} RMSE {r:.4e}{} SSIM {q:.3} · {n} spp at that time (measured: GI {:.2} ms GPU, RMSE {:.4e}, of it bias {:.2e}, mean {:.3}x GT, FLIP {flip:.4})\n",
+            "  {label:<9} RMSE {r:.4e}{} SSIM {q:.3} · {} {value} at that time (measured: GI {:.2} ms GPU, RMSE {:.4e}, of it bias {:.2e}, mean {:.3}x GT, FLIP {flip:.4})\n",
             if ex { " (extrapolated)" } else { "" },
+            sweep.name,
             m.gi_ms().0,
             m.rmse().0,
             m.bias_rmse,
             mean_std(&m.mean_ratio).0
         ));
-        at.push(r);
+        at.push((*method, r));
     }
     matched.write(&dir.join("equal_time_matched.csv"))?;
     let detail = format!("RMSE interpolated (log-log) at SLC's GI GPU time with {base_spp} spp");
-    let checks = vec![
-        check(
+    let rmse_of = |id: MethodId| at.iter().find(|(m, _)| *m == id).map(|(_, r)| *r);
+    let mut checks = Vec::new();
+    if let (Some(slc), Some(rtslc), Some(sst)) = (rmse_of(SLC), rmse_of(RTSLC), rmse_of(SST)) {
+        checks.push(check(
             b,
             "equal-time RMSE SLC / RTSLC",
-            at[0] / at[1],
+            slc / rtslc,
             0.8,
             false,
             detail.clone(),
-        ),
-        check(b, "equal-time RMSE SLC / SST", at[0] / at[2], 0.6, false, detail),
-    ];
+        ));
+        checks.push(check(
+            b,
+            "equal-time RMSE SLC / SST",
+            slc / sst,
+            0.6,
+            false,
+            detail,
+        ));
+    }
     Ok(Report { table, checks })
 }
 

@@ -25,7 +25,7 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     // same traversals and evaluations, every sample visible).
     let mut ms: Vec<Measured> = Vec::new();
     let mut cost = Vec::new();
-    for (method, _) in methods() {
+    for (method, _) in tree_methods(o) {
         let s = with(b, |s| s.gi.method = method);
         let m = b.measure(&s, o.size, o.per_config(), false)?;
         let mut no_rays = s.clone();
@@ -55,7 +55,7 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let mut bars = Vec::new();
     let mut hist = Vec::new();
     for (i, ((m, (_, label)), (with_rays, no_rays, with_rays_min))) in
-        ms.iter().zip(methods()).zip(&cost).enumerate()
+        ms.iter().zip(tree_methods(o)).zip(&cost).enumerate()
     {
         let (med, p90) = m
             .steps

@@ -32,6 +32,7 @@ pub static INFO: MethodInfo = MethodInfo {
     invalid_example: None,
     ui: |_, _, _| {},
     tests: &["direct_light::lit_quad_matches_rho_over_pi_e_cos_and_shadow_is_zero"],
+    sweep: None,
 };
 
 struct DirectOnly;

@@ -49,6 +49,7 @@ pub static INFO: MethodInfo = MethodInfo {
         "vpl::ground_truth_on_the_gpu_equals_a_cpu_evaluation_of_the_same_vpls",
         "slc::the_comparison_ground_truth_equals_the_ground_truth_method",
     ],
+    sweep: None,
 };
 
 fn validate(s: &RenderSettings) -> Result<(), String> {

@@ -46,6 +46,7 @@ pub static INFO: MethodInfo = MethodInfo {
         "vpl::converged_reference_converges_to_the_exact_sum_over_all_texels",
         "vpl::raising_the_reference_target_continues_and_a_view_change_restarts",
     ],
+    sweep: None,
 };
 
 fn validate(s: &RenderSettings) -> Result<(), String> {

@@ -107,6 +107,14 @@ const TESTS: &[&str] = &[
     "slc::the_pixel_story_matches_the_frame_and_the_tree",
 ];
 
+/// Samples per pixel (the cut size), over `results --spp`.
+pub static SPP_SWEEP: super::Sweep = super::Sweep {
+    name: "spp",
+    values: &[],
+    apply: |s, v| s.sampling.cut_size = v.round() as u32,
+    integer: true,
+};
+
 fn invalid_cut_size(s: &mut RenderSettings) -> &'static str {
     s.sampling.cut_size = 0;
     "sampling.cut_size"
@@ -132,6 +140,7 @@ pub static SLC_INFO: MethodInfo = MethodInfo {
     invalid_example: Some(invalid_cut_size),
     ui: ui::settings_ui,
     tests: TESTS,
+    sweep: Some(&SPP_SWEEP),
 };
 
 pub static SST_INFO: MethodInfo = MethodInfo {
@@ -154,6 +163,7 @@ pub static SST_INFO: MethodInfo = MethodInfo {
     invalid_example: Some(invalid_cut_size),
     ui: ui::settings_ui,
     tests: TESTS,
+    sweep: Some(&SPP_SWEEP),
 };
 
 pub static RTSLC_INFO: MethodInfo = MethodInfo {
@@ -176,6 +186,7 @@ pub static RTSLC_INFO: MethodInfo = MethodInfo {
     invalid_example: Some(invalid_cut_size),
     ui: ui::settings_ui,
     tests: TESTS,
+    sweep: Some(&SPP_SWEEP),
 };
 
 /// `[sampling]`: every field in range, or a message naming it.

@@ -1,0 +1,483 @@
+//! Lightcuts (Walter et al. 2005, "Lightcuts: a scalable approach to illumination", summarised
+//! in Rehfeld & Dachsbacher, "Lightcut Interpolation", section 2): the CPU twin of
+//! `shaders/methods/lightcuts/lc_build.wgsl` (normal cones and representative VPLs per node)
+//! and `lightcuts.wgsl` (the per-pixel cut refinement). Written for clarity, not speed.
+//!
+//! **The tree** is the frame's light tree (`sst_tree`: a perfect binary tree over the VPLs in
+//! Morton order, implicit indexing, root 1, leaf i at `leaves + i`), whose nodes carry the
+//! summed flux I_C and the bounding box of their VPLs. Lightcuts adds two things per node:
+//! - a **normal cone** (axis, half-angle) containing every VPL normal of the node, merged
+//!   bottom-up as the smallest cone around the children's cones ([`merge_cones`]);
+//! - a **representative VPL**, drawn bottom-up: a node takes its first child's representative
+//!   with probability lum(I_a) / (lum(I_a) + lum(I_b)), else its second child's, with a random
+//!   number per node and build ([`rep_random`]). A VPL j of node C is its representative with
+//!   probability lum(I_j) / lum(I_C) (the product telescopes), as Walter et al. choose it (3.1),
+//!   and a node shares its representative with one of its children, so refining it reuses
+//!   that evaluation (and its shadow ray).
+//!
+//! **A cluster's estimate** is its representative's contribution with the cluster's intensity:
+//! flux_j x lum(I_C) / lum(flux_j) (the representative's colour, the cluster's luminance). Over
+//! builds its mean is sum_j flux_j x f_j per channel, i.e. unbiased for a fixed cut (Walter et
+//! al. carry I_C itself, unbiased only when the cluster's VPLs share one colour).
+//!
+//! **The error bound** of a cluster (Walter et al. 4.1) for a Lambertian receiver at x with
+//! normal n: lum(I_C) / pi x cos_x_ub x cos_v_ub / max(d_min^2, eps^2), visibility bounded by
+//! 1, where d_min is the distance from x to the node's box, cos_x_ub bounds the cosine at the
+//! receiver over the box and cos_v_ub the emitter cosine over the box and the normal cone
+//! ([`cos_bound`], [`error_bound`]). The receiver's rho / pi is common to every cluster, so the
+//! refinement compares irradiance-like sums (sum of flux / pi x G x V, luminance): a node is
+//! refined while its bound exceeds `relative_error` x the current estimate and the cut is
+//! below `max_cut`. Leaves are exact (bound 0). The cut's choice depends on the estimates, so
+//! over builds the adaptive cut is not exactly unbiased (docs/lightcuts.md measures how far).
+
+use glam::Vec3;
+
+use crate::base::{
+    display::luminance,
+    gpu_layout::{GpuVpl, VPL_NONE},
+    sst_node::{SstNode, basis},
+};
+use crate::reference::vpl::{pcg_hash, u01};
+use crate::scene::bvh::{Bvh, Ray};
+
+/// Largest cut the GPU kernel can hold (its per-thread heap; Walter et al. cap cuts at 1000).
+pub const MAX_CUT: u32 = 1024;
+
+/// Added to every cone's half-angle in the bound (radians): covers the f32 rounding of the
+/// merges so that the bound stays a bound.
+pub const CONE_MARGIN: f32 = 1e-3;
+
+/// A cone of directions: every normal within `half_angle` of `axis`. Twin: `vec4` (axis,
+/// half-angle) in `lc_build.wgsl`; a negative half-angle marks an empty node.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cone {
+    pub axis: Vec3,
+    pub half_angle: f32,
+}
+
+impl Cone {
+    pub const EMPTY: Cone = Cone {
+        axis: Vec3::Z,
+        half_angle: -1.0,
+    };
+
+    pub fn is_empty(&self) -> bool {
+        self.half_angle < 0.0
+    }
+
+    /// The GPU's record: xyz axis, w half-angle.
+    pub fn to_gpu(self) -> [f32; 4] {
+        [self.axis.x, self.axis.y, self.axis.z, self.half_angle]
+    }
+
+    pub fn from_gpu(v: [f32; 4]) -> Cone {
+        Cone {
+            axis: Vec3::new(v[0], v[1], v[2]),
+            half_angle: v[3],
+        }
+    }
+}
+
+fn angle_between(a: Vec3, b: Vec3) -> f32 {
+    a.dot(b).clamp(-1.0, 1.0).acos()
+}
+
+/// The smallest cone containing cones `a` and `b` (the union of two cones on the sphere).
+/// Twin: `merge_cones` in `lc_build.wgsl`.
+pub fn merge_cones(a: Cone, b: Cone) -> Cone {
+    if a.is_empty() {
+        return b;
+    }
+    if b.is_empty() {
+        return a;
+    }
+    // `w` the wider cone, `n` the narrower.
+    let (w, n) = if a.half_angle >= b.half_angle {
+        (a, b)
+    } else {
+        (b, a)
+    };
+    let pi = std::f32::consts::PI;
+    let d = angle_between(w.axis, n.axis);
+    if (d + n.half_angle).min(pi) <= w.half_angle {
+        return w;
+    }
+    let half = 0.5 * (w.half_angle + d + n.half_angle);
+    if half >= pi {
+        return Cone {
+            axis: w.axis,
+            half_angle: pi,
+        };
+    }
+    // Rotate the wider axis towards the narrower by (half - w.half_angle).
+    let rot = half - w.half_angle;
+    let perp = n.axis - w.axis * w.axis.dot(n.axis);
+    let axis = if perp.length_squared() > 1e-12 {
+        (w.axis * rot.cos() + perp.normalize() * rot.sin()).normalize()
+    } else {
+        // Opposite axes: any perpendicular will do; the cone then spans both.
+        let (t, _) = basis(w.axis);
+        (w.axis * rot.cos() + t * rot.sin()).normalize()
+    };
+    Cone {
+        axis,
+        half_angle: half,
+    }
+}
+
+/// The random number node `node` uses to pick its representative in the build with `seed`.
+/// Twin: `rep_random` in `lc_build.wgsl`.
+pub fn rep_random(node: u32, seed: u32) -> f32 {
+    u01(pcg_hash(node ^ pcg_hash(seed)))
+}
+
+/// Per node (index = node id, node 0 unused): its normal cone and its representative (a leaf
+/// index into the sorted VPLs, `VPL_NONE` for an empty node).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LcTree {
+    pub cones: Vec<Cone>,
+    pub reps: Vec<u32>,
+}
+
+/// Cones and representatives over the frame's tree (`nodes`: 2 x leaves decoded nodes, the
+/// sorted VPLs one per leaf). Twin: `lc_build.wgsl` (one dispatch per level, bottom-up).
+pub fn build(nodes: &[SstNode], sorted: &[GpuVpl], seed: u32) -> LcTree {
+    let leaves = nodes.len() / 2;
+    let mut cones = vec![Cone::EMPTY; 2 * leaves];
+    let mut reps = vec![VPL_NONE; 2 * leaves];
+    for (i, v) in sorted.iter().enumerate().take(leaves) {
+        if v.id != VPL_NONE {
+            cones[leaves + i] = Cone {
+                axis: Vec3::from_array(v.normal).normalize(),
+                half_angle: 0.0,
+            };
+            reps[leaves + i] = i as u32;
+        }
+    }
+    for n in (1..leaves).rev() {
+        let (a, b) = (2 * n, 2 * n + 1);
+        cones[n] = merge_cones(cones[a], cones[b]);
+        reps[n] = pick_rep(
+            reps[a],
+            reps[b],
+            luminance(nodes[a].intensity),
+            luminance(nodes[b].intensity),
+            rep_random(n as u32, seed),
+        );
+    }
+    LcTree { cones, reps }
+}
+
+/// A node's representative from its children's (`u` uniform in [0, 1)).
+pub fn pick_rep(ra: u32, rb: u32, la: f32, lb: f32, u: f32) -> u32 {
+    if ra == VPL_NONE {
+        return rb;
+    }
+    if rb == VPL_NONE {
+        return ra;
+    }
+    if la + lb <= 0.0 || u * (la + lb) < la {
+        ra
+    } else {
+        rb
+    }
+}
+
+/// Upper bound of max(0, cos(angle between unit `axis` and p - x)) over p in the box
+/// [lo, hi]: the box's extent in the frame (t, b, axis) of the axis is [l, h] per axis; for
+/// h.z > 0 the cosine z / |p| is at most h.z / sqrt(dx^2 + dy^2 + h.z^2), where dx, dy are the
+/// smallest |x|, |y| of that extent (Walter et al. 4.1). Twin: `lc_cos_bound`.
+pub fn cos_bound(axis: Vec3, x: Vec3, lo: Vec3, hi: Vec3) -> f32 {
+    let (t, b) = basis(axis);
+    let c = 0.5 * (lo + hi) - x;
+    let r = 0.5 * (hi - lo);
+    let extent = |e: Vec3| {
+        let m = e.dot(c);
+        let s = e.abs().dot(r);
+        (m - s, m + s)
+    };
+    let (_, hz) = extent(axis);
+    if hz <= 0.0 {
+        return 0.0;
+    }
+    let nearest2 = |(l, h): (f32, f32)| {
+        if l <= 0.0 && h >= 0.0 {
+            0.0
+        } else {
+            (l * l).min(h * h)
+        }
+    };
+    let d2 = nearest2(extent(t)) + nearest2(extent(b));
+    if d2 <= 0.0 {
+        return 1.0;
+    }
+    (hz / (d2 + hz * hz).sqrt()).min(1.0)
+}
+
+/// Squared distance from x to the box [lo, hi] (0 inside).
+pub fn box_distance2(x: Vec3, lo: Vec3, hi: Vec3) -> f32 {
+    let d = (lo - x).max(Vec3::ZERO).max(x - hi);
+    d.dot(d)
+}
+
+/// Upper bound of the geometric term cos_x x cos_v / max(d^2, eps^2) of any VPL inside the
+/// box [lo, hi] with its normal inside `cone`, at a receiver x with normal n. Twin:
+/// `lc_geometry_bound`.
+pub fn geometry_bound(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cone: Cone, eps: f32) -> f32 {
+    if cone.is_empty() {
+        return 0.0;
+    }
+    let cx = cos_bound(n, x, lo, hi);
+    if cx <= 0.0 {
+        return 0.0;
+    }
+    // The emitter's cosine: the angle between its normal m and x - p is at least the angle
+    // between the cone's axis and x - p minus the cone's half-angle.
+    let c_axis = cos_bound(-cone.axis, x, lo, hi);
+    let phi = c_axis.clamp(0.0, 1.0).acos();
+    let theta = cone.half_angle + CONE_MARGIN;
+    let cv = if phi <= theta {
+        1.0
+    } else if phi - theta >= std::f32::consts::FRAC_PI_2 {
+        0.0
+    } else {
+        (phi - theta).cos()
+    };
+    cx * cv / box_distance2(x, lo, hi).max(eps * eps)
+}
+
+/// The error bound of node `node` at (x, n): 0 for leaves (exact) and empty nodes.
+/// Twin: `lc_error_bound`.
+pub fn error_bound(nodes: &[SstNode], lc: &LcTree, node: u32, x: Vec3, n: Vec3, eps: f32) -> f32 {
+    let leaves = (nodes.len() / 2) as u32;
+    let c = &nodes[node as usize];
+    if node >= leaves || c.is_empty() {
+        return 0.0;
+    }
+    luminance(c.intensity) / std::f32::consts::PI
+        * geometry_bound(x, n, c.bbox_min, c.bbox_max, lc.cones[node as usize], eps)
+}
+
+/// The exact (unbounded) geometric term of `vpl_geometry` in `common/vpl.wgsl`.
+pub fn vpl_geometry(pv: Vec3, nv: Vec3, x: Vec3, nx: Vec3, eps: f32) -> f32 {
+    let d = pv - x;
+    let dist2 = d.length_squared();
+    let w = d / dist2.max(1e-30).sqrt();
+    let (cx, cv) = (nx.dot(w), -nv.dot(w));
+    if cx <= 0.0 || cv <= 0.0 {
+        return 0.0;
+    }
+    cx * cv / dist2.max(eps * eps)
+}
+
+/// The refinement's settings (`LightcutsSettings` with the shading settings).
+#[derive(Clone, Copy, Debug)]
+pub struct CutParams {
+    pub relative_error: f32,
+    pub max_cut: u32,
+    pub eps: f32,
+    /// Shadow rays with this end-point offset; None: every VPL visible.
+    pub shadow_rays: Option<f32>,
+}
+
+/// One node of a pixel's final cut.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CutNode {
+    pub node: u32,
+    pub bound: f32,
+    /// Its estimate: flux / pi x G x V of the representative with the cluster's luminance.
+    pub estimate: Vec3,
+}
+
+/// A pixel's lightcut.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PixelCut {
+    /// Sum of the cut's estimates (irradiance-like: multiply by rho / pi for radiance).
+    pub sum: Vec3,
+    pub cut: Vec<CutNode>,
+    pub refinements: u32,
+    /// The largest bound left in the cut over lum(sum) (0 when every node is exact).
+    pub relative_bound: f32,
+    pub shadow_rays: u32,
+}
+
+impl PixelCut {
+    /// Radiance at a receiver of albedo `albedo`.
+    pub fn radiance(&self, albedo: Vec3) -> Vec3 {
+        albedo / std::f32::consts::PI * self.sum
+    }
+    /// Whether refinement stopped at the size limit with a bound above the threshold.
+    pub fn hit_max_cut(&self, p: &CutParams) -> bool {
+        self.relative_bound > p.relative_error
+    }
+}
+
+/// The lightcut of receiver (x, n): from the root, refine the node with the largest bound
+/// until the largest bound is at most `relative_error` x lum(estimate) or the cut holds
+/// `max_cut` nodes. Nodes of bound 0 (leaves, empty, facing away) are final at once. A child
+/// with its parent's representative reuses the parent's shadow ray. Twin: `lightcuts.wgsl`.
+pub fn lightcut(
+    nodes: &[SstNode],
+    lc: &LcTree,
+    sorted: &[GpuVpl],
+    bvh: &Bvh,
+    x: Vec3,
+    n: Vec3,
+    p: &CutParams,
+) -> PixelCut {
+    let pi = std::f32::consts::PI;
+    let leaves = (nodes.len() / 2) as u32;
+    let vpl = |node: u32| {
+        let v = &sorted[lc.reps[node as usize] as usize];
+        (
+            Vec3::from_slice(&v.position[..3]),
+            Vec3::from_array(v.normal),
+            Vec3::from_slice(&v.flux[..3]),
+        )
+    };
+    // The unshadowed estimate: the representative's flux / pi x G, the cluster's luminance.
+    let estimate = |node: u32| -> Vec3 {
+        if lc.reps[node as usize] == VPL_NONE {
+            return Vec3::ZERO;
+        }
+        let (pv, nv, flux) = vpl(node);
+        let lf = luminance(flux);
+        let g = vpl_geometry(pv, nv, x, n, p.eps);
+        if g <= 0.0 || lf <= 0.0 {
+            return Vec3::ZERO;
+        }
+        flux * (luminance(nodes[node as usize].intensity) / lf) / pi * g
+    };
+    let mut rays = 0u32;
+    let mut visible = |node: u32, e: Vec3| -> bool {
+        if e == Vec3::ZERO {
+            return false;
+        }
+        let Some(offset) = p.shadow_rays else {
+            return true;
+        };
+        rays += 1;
+        let (pv, nv, _) = vpl(node);
+        let o = x + n * offset;
+        let end = pv + nv * offset;
+        !bvh.any_hit(&Ray {
+            origin: o,
+            dir: end - o,
+            tmin: 1e-4,
+            tmax: 1.0 - 1e-4,
+        })
+    };
+    // Open nodes: (node, bound, estimate if visible, visible).
+    let mut open: Vec<(CutNode, bool)> = Vec::new();
+    let mut done: Vec<CutNode> = Vec::new();
+    let mut sum = Vec3::ZERO;
+    let mut refinements = 0;
+    if !nodes[1].is_empty() {
+        let bound = error_bound(nodes, lc, 1, x, n, p.eps);
+        if bound > 0.0 {
+            let e = estimate(1);
+            let vis = visible(1, e);
+            let e = if vis { e } else { Vec3::ZERO };
+            sum += e;
+            open.push((
+                CutNode {
+                    node: 1,
+                    bound,
+                    estimate: e,
+                },
+                vis,
+            ));
+        } else {
+            done.push(CutNode {
+                node: 1,
+                bound,
+                estimate: Vec3::ZERO,
+            });
+        }
+    }
+    // The open node with the largest bound (the first of equal ones).
+    while let Some(k) = (0..open.len()).reduce(|a, b| if open[b].0.bound > open[a].0.bound { b } else { a }) {
+        let (top, top_vis) = open[k];
+        if top.bound <= p.relative_error * luminance(sum) {
+            break;
+        }
+        if (open.len() + done.len()) as u32 >= p.max_cut {
+            break;
+        }
+        open.swap_remove(k);
+        sum -= top.estimate;
+        refinements += 1;
+        for child in [2 * top.node, 2 * top.node + 1] {
+            if nodes[child as usize].is_empty() {
+                continue;
+            }
+            let bound = error_bound(nodes, lc, child, x, n, p.eps);
+            let (e, vis) = if lc.reps[child as usize] == lc.reps[top.node as usize] {
+                (estimate(child), top_vis)
+            } else if bound > 0.0 || child >= leaves {
+                let e = estimate(child);
+                (e, visible(child, e))
+            } else {
+                (Vec3::ZERO, false)
+            };
+            let e = if vis { e } else { Vec3::ZERO };
+            sum += e;
+            let c = CutNode {
+                node: child,
+                bound,
+                estimate: e,
+            };
+            if bound > 0.0 {
+                open.push((c, vis))
+            } else {
+                done.push(c)
+            }
+        }
+    }
+    let lmax = open.iter().map(|c| c.0.bound).fold(0.0f32, f32::max);
+    let ls = luminance(sum);
+    let relative_bound = if lmax <= 0.0 {
+        0.0
+    } else if ls > 0.0 {
+        lmax / ls
+    } else {
+        3.0e38
+    };
+    done.extend(open.into_iter().map(|c| c.0));
+    PixelCut {
+        sum,
+        cut: done,
+        refinements,
+        relative_bound,
+        shadow_rays: rays,
+    }
+}
+
+/// Checks that `cut` (node ids) covers every non-empty leaf exactly once and no empty one:
+/// Ok, or the first problem found.
+pub fn check_cut(nodes: &[SstNode], cut: &[u32]) -> Result<(), String> {
+    let leaves = (nodes.len() / 2) as u32;
+    let mut covered = vec![0u32; leaves as usize];
+    for &c in cut {
+        if c == 0 || c >= 2 * leaves {
+            return Err(format!("node {c} is not a node of a tree of {leaves} leaves"));
+        }
+        let depth = 31 - c.leading_zeros();
+        let levels = leaves.trailing_zeros();
+        let span = 1u32 << (levels - depth);
+        let first = (c << (levels - depth)) - leaves;
+        for l in first..first + span {
+            covered[l as usize] += 1;
+        }
+    }
+    for (l, &k) in covered.iter().enumerate() {
+        let empty = nodes[leaves as usize + l].is_empty();
+        if !empty && k != 1 {
+            return Err(format!("leaf {l} is covered {k} times"));
+        }
+        if empty && k > 1 {
+            return Err(format!("empty leaf {l} is covered {k} times"));
+        }
+    }
+    Ok(())
+}
