@@ -15,6 +15,7 @@
 
 pub mod direct_only;
 pub mod ground_truth;
+pub mod lightcut_interpolation;
 pub mod lightcuts;
 pub mod reference;
 pub mod tree_samplers;
@@ -46,6 +47,7 @@ pub static REGISTRY: &[&MethodInfo] = &[
     &tree_samplers::SST_INFO,
     &tree_samplers::RTSLC_INFO,
     &lightcuts::INFO,
+    &lightcut_interpolation::INFO,
     &ground_truth::INFO,
     &reference::INFO,
     &direct_only::INFO,
@@ -404,6 +406,8 @@ pub struct FrameCx<'a> {
     /// Scene bounding radius (metres, > 0).
     pub scene_radius: f32,
     pub targets: &'a FrameTargets,
+    /// The frame's camera uniform (`GpuCamera`, common/camera.wgsl).
+    pub camera: &'a wgpu::Buffer,
     pub vpl_buffers: &'a VplBuffers,
     pub vpl_frame: &'a VplFrame,
     /// The VPL generation's parameter buffer (the reference reads the RSM pyramids with it).

@@ -270,6 +270,59 @@ pub fn vpl_geometry(pv: Vec3, nv: Vec3, x: Vec3, nx: Vec3, eps: f32) -> f32 {
     cx * cv / dist2.max(eps * eps)
 }
 
+/// A cluster's unshadowed estimate at receiver (x, n): its representative's flux / pi x G
+/// with the cluster's luminance (0 for an empty node). Twin: `estimate` in `lightcuts.wgsl`.
+pub fn cluster_estimate(
+    nodes: &[SstNode],
+    lc: &LcTree,
+    sorted: &[GpuVpl],
+    node: u32,
+    x: Vec3,
+    n: Vec3,
+    eps: f32,
+) -> Vec3 {
+    let rep = lc.reps[node as usize];
+    if rep == VPL_NONE {
+        return Vec3::ZERO;
+    }
+    let v = &sorted[rep as usize];
+    let flux = Vec3::from_slice(&v.flux[..3]);
+    let lf = luminance(flux);
+    let g = vpl_geometry(
+        Vec3::from_slice(&v.position[..3]),
+        Vec3::from_array(v.normal),
+        x,
+        n,
+        eps,
+    );
+    if g <= 0.0 || lf <= 0.0 {
+        return Vec3::ZERO;
+    }
+    flux * (luminance(nodes[node as usize].intensity) / lf) / std::f32::consts::PI * g
+}
+
+/// Whether the node's representative is visible from (x, n): one BVH shadow ray between the
+/// end points offset along their normals. Twin: `vpl_visible` (common/vpl_visibility.wgsl).
+pub fn representative_visible(
+    bvh: &Bvh,
+    lc: &LcTree,
+    sorted: &[GpuVpl],
+    node: u32,
+    x: Vec3,
+    n: Vec3,
+    offset: f32,
+) -> bool {
+    let v = &sorted[lc.reps[node as usize] as usize];
+    let o = x + n * offset;
+    let end = Vec3::from_slice(&v.position[..3]) + Vec3::from_array(v.normal) * offset;
+    !bvh.any_hit(&Ray {
+        origin: o,
+        dir: end - o,
+        tmin: 1e-4,
+        tmax: 1.0 - 1e-4,
+    })
+}
+
 /// The refinement's settings (`LightcutsSettings` with the shading settings).
 #[derive(Clone, Copy, Debug)]
 pub struct CutParams {
@@ -287,6 +340,8 @@ pub struct CutNode {
     pub bound: f32,
     /// Its estimate: flux / pi x G x V of the representative with the cluster's luminance.
     pub estimate: Vec3,
+    /// Its representative's visibility (false without a shadow ray when the estimate is 0).
+    pub visible: bool,
 }
 
 /// A pixel's lightcut.
@@ -325,29 +380,8 @@ pub fn lightcut(
     n: Vec3,
     p: &CutParams,
 ) -> PixelCut {
-    let pi = std::f32::consts::PI;
     let leaves = (nodes.len() / 2) as u32;
-    let vpl = |node: u32| {
-        let v = &sorted[lc.reps[node as usize] as usize];
-        (
-            Vec3::from_slice(&v.position[..3]),
-            Vec3::from_array(v.normal),
-            Vec3::from_slice(&v.flux[..3]),
-        )
-    };
-    // The unshadowed estimate: the representative's flux / pi x G, the cluster's luminance.
-    let estimate = |node: u32| -> Vec3 {
-        if lc.reps[node as usize] == VPL_NONE {
-            return Vec3::ZERO;
-        }
-        let (pv, nv, flux) = vpl(node);
-        let lf = luminance(flux);
-        let g = vpl_geometry(pv, nv, x, n, p.eps);
-        if g <= 0.0 || lf <= 0.0 {
-            return Vec3::ZERO;
-        }
-        flux * (luminance(nodes[node as usize].intensity) / lf) / pi * g
-    };
+    let estimate = |node: u32| cluster_estimate(nodes, lc, sorted, node, x, n, p.eps);
     let mut rays = 0u32;
     let mut visible = |node: u32, e: Vec3| -> bool {
         if e == Vec3::ZERO {
@@ -357,15 +391,7 @@ pub fn lightcut(
             return true;
         };
         rays += 1;
-        let (pv, nv, _) = vpl(node);
-        let o = x + n * offset;
-        let end = pv + nv * offset;
-        !bvh.any_hit(&Ray {
-            origin: o,
-            dir: end - o,
-            tmin: 1e-4,
-            tmax: 1.0 - 1e-4,
-        })
+        representative_visible(bvh, lc, sorted, node, x, n, offset)
     };
     // Open nodes: (node, bound, estimate if visible, visible).
     let mut open: Vec<(CutNode, bool)> = Vec::new();
@@ -384,6 +410,7 @@ pub fn lightcut(
                     node: 1,
                     bound,
                     estimate: e,
+                    visible: vis,
                 },
                 vis,
             ));
@@ -392,6 +419,7 @@ pub fn lightcut(
                 node: 1,
                 bound,
                 estimate: Vec3::ZERO,
+                visible: false,
             });
         }
     }
@@ -426,6 +454,7 @@ pub fn lightcut(
                 node: child,
                 bound,
                 estimate: e,
+                visible: vis,
             };
             if bound > 0.0 {
                 open.push((c, vis))

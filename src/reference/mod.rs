@@ -16,6 +16,7 @@
 pub mod direct;
 pub mod gbuffer;
 pub mod gi;
+pub mod lightcut_interpolation;
 pub mod lightcuts;
 pub mod slc;
 pub mod sst;

@@ -21,6 +21,7 @@ macro_rules! frame_cx {
             scene: &$r.scene,
             scene_radius: $r.scene.bounds.radius().max(1e-3),
             targets: &$r.targets,
+            camera: &$r.camera_buf,
             vpl_buffers: &$r.vpl_buffers,
             vpl_frame: &$r.vpl_frame,
             vpl_params: $r.vpl_gen.params_buffer(),

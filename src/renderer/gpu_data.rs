@@ -513,6 +513,58 @@ mod tests {
                 },
             ),
             (
+                "methods/lightcut_interpolation/li_interp.wgsl",
+                "LiParams",
+                size_of::<crate::methods::lightcut_interpolation::pass::GpuLiParams>(),
+                {
+                    use crate::methods::lightcut_interpolation::pass::GpuLiParams as P;
+                    vec![
+                        offset_of!(P, width),
+                        offset_of!(P, height),
+                        offset_of!(P, tiles_x),
+                        offset_of!(P, tiles_y),
+                        offset_of!(P, leaves),
+                        offset_of!(P, levels),
+                        offset_of!(P, max_cut),
+                        offset_of!(P, capacity),
+                        offset_of!(P, r_min_px),
+                        offset_of!(P, r_max_px),
+                        offset_of!(P, one_minus_cos_max),
+                        offset_of!(P, epsilon),
+                        offset_of!(P, coverage),
+                        offset_of!(P, radius_rays),
+                        offset_of!(P, ray_offset),
+                        offset_of!(P, shadow_rays),
+                        offset_of!(P, interp_visibility),
+                        offset_of!(P, accumulate),
+                        offset_of!(P, trace_pixel),
+                        offset_of!(P, steps),
+                        offset_of!(P, first),
+                        offset_of!(P, last),
+                        offset_of!(P, distance_epsilon),
+                        offset_of!(P, _pad),
+                    ]
+                },
+            ),
+            (
+                "methods/lightcut_interpolation/li_views.wgsl",
+                "LiViewParams",
+                size_of::<crate::methods::lightcut_interpolation::pass::GpuLiViewParams>(),
+                {
+                    use crate::methods::lightcut_interpolation::pass::GpuLiViewParams as P;
+                    vec![
+                        offset_of!(P, mode),
+                        offset_of!(P, scale_top),
+                        offset_of!(P, r_min_px),
+                        offset_of!(P, r_max_px),
+                        offset_of!(P, exposure),
+                        offset_of!(P, tonemap),
+                        offset_of!(P, tiles_x),
+                        offset_of!(P, tiles_y),
+                    ]
+                },
+            ),
+            (
                 "methods/ground_truth/ground_truth.wgsl",
                 "GtParams",
                 size_of::<GpuGtParams>(),

@@ -64,3 +64,15 @@ fn lc_geometry_bound(x: vec3<f32>, n: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>, c
     }
     return cx * cv / max(lc_box_distance2(x, lo, hi), eps * eps);
 }
+
+// A cluster's unshadowed estimate at (x, n) from its representative `v` (flux / pi x G with
+// the cluster's luminance `lum_cluster`). Twin: `cluster_estimate` in
+// src/reference/lightcuts.rs. Needs common/vpl.wgsl and common/color.wgsl.
+fn lc_estimate(v: Vpl, lum_cluster: f32, x: vec3<f32>, n: vec3<f32>, eps: f32) -> vec3<f32> {
+    let lf = luminance(v.flux.rgb);
+    let g = vpl_geometry(v.position.xyz, v.normal, x, n, eps);
+    if g <= 0.0 || lf <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    return v.flux.rgb * (lum_cluster / lf) / PI * g;
+}

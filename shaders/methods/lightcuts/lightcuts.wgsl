@@ -14,6 +14,14 @@
 // Writes the estimate (or adds it) and, in diagnostic frames only (DIAGNOSTICS), the
 // per-pixel diagnostics, the frame counters and the pinned pixel's cut. CPU twin: `lightcut`
 // in src/reference/lightcuts.rs.
+//
+// Lightcut Interpolation runs the same kernel in two more modes (MODE): 1 computes the cache
+// records' cuts (thread = record, its pixel in `lanes`; nodes whose bound is 0 are kept at the
+// top of the thread's scratch, and a last dispatch with `steps` 0 sorts the whole cut left to
+// right into `record_cuts`, node | visibility bit, its length into `rec_meta`); 2 computes
+// full lightcuts for the pixels the interpolation left (`lanes` is its selection, 8 words per
+// pixel, word 3 the records used; 0 = fallback) and marks them in the diagnostics (y = -1).
+// STATS_BASE moves the counters (modes 1 and 2 add to the interpolation's).
 #include "common/math.wgsl"
 #include "common/color.wgsl"
 #include "common/vpl.wgsl"
@@ -22,6 +30,8 @@
 #include "methods/lightcuts/lc_common.wgsl"
 
 override DIAGNOSTICS: bool = true;
+override MODE: u32 = 0u;
+override STATS_BASE: u32 = 0u;
 
 // Largest cut (src/reference/lightcuts.rs MAX_CUT; the trace's capacity).
 const LC_MAX_CUT: u32 = 1024u;
@@ -79,6 +89,10 @@ struct LcState {
 // The heaps: (node | LC_VISIBLE if its representative is visible, bound bits).
 @group(0) @binding(14) var<storage, read_write> scratch: array<vec2<u32>>;
 @group(0) @binding(15) var<storage, read_write> state: array<LcState>;
+@group(0) @binding(16) var<storage, read> lanes: array<u32>;
+@group(0) @binding(17) var<storage, read_write> record_cuts: array<u32>;
+// Word 0: records; word 8 + r: record r's cut length (li_common.wgsl).
+@group(0) @binding(18) var<storage, read_write> rec_meta: array<u32>;
 
 var<private> rays: u32;
 
@@ -95,10 +109,71 @@ fn heap_bound(e: vec2<u32>) -> f32 {
 }
 
 fn add64(i: u32, v: u32) {
-    let old = atomicAdd(&stats[i], v);
+    let old = atomicAdd(&stats[STATS_BASE + i], v);
     if old > 0xffffffffu - v {
-        atomicAdd(&stats[i + 1u], 1u);
+        atomicAdd(&stats[STATS_BASE + i + 1u], 1u);
     }
+}
+
+// A node final at once (bound 0): counted; records keep it at the top of the scratch.
+fn settle(lane: u32, settled: ptr<function, u32>, node: u32, vis: bool) {
+    if MODE == 1u {
+        heap_set(lane, lp.max_cut - 1u - *settled, vec2<u32>(node | select(0u, LC_VISIBLE, vis), 0u));
+    }
+    *settled += 1u;
+}
+
+// First leaf under a node (the left-to-right order of a cut).
+fn first_leaf(e: u32) -> u32 {
+    let node = e & ~LC_VISIBLE;
+    let levels = firstTrailingBit(lp.leaves);
+    return (node << (levels - firstLeadingBit(node))) - lp.leaves;
+}
+
+fn sift_down(base: u32, start: u32, end: u32) {
+    var i = start;
+    loop {
+        var c = 2u * i + 1u;
+        if c >= end {
+            break;
+        }
+        if c + 1u < end && first_leaf(record_cuts[base + c + 1u]) > first_leaf(record_cuts[base + c]) {
+            c += 1u;
+        }
+        let ci = record_cuts[base + c];
+        let ii = record_cuts[base + i];
+        if first_leaf(ci) <= first_leaf(ii) {
+            break;
+        }
+        record_cuts[base + c] = ii;
+        record_cuts[base + i] = ci;
+        i = c;
+    }
+}
+
+// Mode 1: the record's cut (heap [0, size), settled nodes at the top) into record_cuts, left
+// to right (heap sort).
+fn write_record(lane: u32, item: u32, size: u32, settled: u32) {
+    let n = size + settled;
+    let base = item * lp.max_cut;
+    for (var i = 0u; i < size; i++) {
+        record_cuts[base + i] = heap_get(lane, i).x;
+    }
+    for (var i = 0u; i < settled; i++) {
+        record_cuts[base + size + i] = heap_get(lane, lp.max_cut - 1u - i).x;
+    }
+    if n > 1u {
+        for (var s = n / 2u; s > 0u; s--) {
+            sift_down(base, s - 1u, n);
+        }
+        for (var end = n - 1u; end > 0u; end--) {
+            let t = record_cuts[base];
+            record_cuts[base] = record_cuts[base + end];
+            record_cuts[base + end] = t;
+            sift_down(base, 0u, end);
+        }
+    }
+    rec_meta[8u + item] = n;
 }
 
 fn heap_push(lane: u32, size: ptr<function, u32>, e: vec2<u32>) {
@@ -165,13 +240,7 @@ fn estimate(node: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     if rep == LC_NONE {
         return vec3<f32>(0.0);
     }
-    let v = sorted_vpls[rep];
-    let lf = luminance(v.flux.rgb);
-    let g = vpl_geometry(v.position.xyz, v.normal, x, n, lp.epsilon);
-    if g <= 0.0 || lf <= 0.0 {
-        return vec3<f32>(0.0);
-    }
-    return v.flux.rgb * (luminance(tree[node].intensity) / lf) / PI * g;
+    return lc_estimate(sorted_vpls[rep], luminance(tree[node].intensity), x, n, lp.epsilon);
 }
 
 // Whether the node's representative is visible from x (one shadow ray when the estimate is
@@ -204,13 +273,33 @@ fn trace_node(slot: u32, node: u32, e: vec4<f32>) {
 @compute @workgroup_size(64, 1, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let lane = gid.x;
-    let k = lp.first_pixel + gid.x;
-    if gid.x >= lp.slice || k >= lp.width * lp.height {
+    let item = lp.first_pixel + gid.x;
+    if gid.x >= lp.slice {
         return;
+    }
+    var k = item;
+    if MODE == 1u {
+        if item >= rec_meta[0] {
+            return;
+        }
+        k = lanes[item];
+    } else {
+        if item >= lp.width * lp.height {
+            return;
+        }
+        if MODE == 2u && lanes[8u * item + 3u] != 0u {
+            return;
+        }
     }
     let px = vec2<i32>(i32(k % lp.width), i32(k / lp.width));
     let g = textureLoad(gb_position, px, 0);
     if g.w == 0.0 {
+        if MODE == 1u {
+            if lp.last != 0u {
+                rec_meta[8u + item] = 0u;
+            }
+            return;
+        }
         if lp.accumulate == 0u {
             accum[k] = vec4<f32>(0.0);
         }
@@ -221,7 +310,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let x = g.xyz;
     let n = normalize(textureLoad(gb_normal, px, 0).xyz);
-    let traced = DIAGNOSTICS && (u32(px.x) | (u32(px.y) << 16u)) == lp.trace_pixel;
+    let traced = DIAGNOSTICS && MODE == 0u && (u32(px.x) | (u32(px.y) << 16u)) == lp.trace_pixel;
     var size = 0u;     // heap entries
     var settled = 0u;  // final nodes outside the heap
     var refinements = 0u;
@@ -240,7 +329,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 if traced {
                     trace_node(settled, 1u, vec4<f32>(0.0));
                 }
-                settled += 1u;
+                settle(lane, &settled, 1u, false);
             }
         }
     } else {
@@ -297,13 +386,30 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                     if traced {
                         trace_node(settled, child, vec4<f32>(select(vec3<f32>(0.0), e, vis), 0.0));
                     }
-                    settled += 1u;
+                    settle(lane, &settled, child, vis);
                 }
             }
         }
     }
     if lp.last == 0u {
         state[lane] = LcState(sum, size, settled, refinements, rays, done);
+        return;
+    }
+    if MODE == 1u {
+        write_record(lane, item, size, settled);
+        if DIAGNOSTICS {
+            var lmax = 0.0;
+            if size > 0u {
+                lmax = heap_bound(heap_get(lane, 0u));
+            }
+            atomicAdd(&stats[STATS_BASE], 1u);
+            if lmax > lp.relative_error * luminance(sum) {
+                atomicAdd(&stats[STATS_BASE + 1u], 1u);
+            }
+            add64(2u, size + settled);
+            add64(4u, refinements);
+            add64(6u, rays);
+        }
         return;
     }
     let albedo = textureLoad(gb_albedo, px, 0).rgb;
@@ -324,10 +430,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             rel = select(3.0e38, lmax / ls, ls > 0.0);
         }
         let cut = size + settled;
-        diag[k] = vec4<f32>(f32(cut), f32(refinements), rel, f32(rays));
-        atomicAdd(&stats[0], 1u);
+        if MODE == 2u {
+            diag[k] = vec4<f32>(f32(cut), -1.0, rel, f32(rays));
+        } else {
+            diag[k] = vec4<f32>(f32(cut), f32(refinements), rel, f32(rays));
+        }
+        atomicAdd(&stats[STATS_BASE], 1u);
         if rel > lp.relative_error {
-            atomicAdd(&stats[1], 1u);
+            atomicAdd(&stats[STATS_BASE + 1u], 1u);
         }
         add64(2u, cut);
         add64(4u, refinements);

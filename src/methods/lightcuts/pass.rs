@@ -90,7 +90,7 @@ pub struct GpuLcViewParams {
 }
 
 /// Dynamic-offset stride of the per-level build and per-slice uniforms; levels at most.
-const STRIDE: u64 = 256;
+pub const STRIDE: u64 = 256;
 /// Bytes of the heaps' scratch at most (slice x max_cut entries of 8 bytes).
 pub const SCRATCH_BUDGET: u64 = 128 << 20;
 const MAX_LEVELS: u64 = 32;
@@ -196,6 +196,10 @@ pub struct LcBuffers {
     pub state: wgpu::Buffer,
     pub slice: u32,
     pub max_cut: u32,
+    /// Bound where a mode does not use a binding (Lightcut Interpolation's lanes, records).
+    pub dummy: wgpu::Buffer,
+    /// The same for the read-write bindings (one usage per buffer and dispatch).
+    pub dummy_rw: wgpu::Buffer,
 }
 
 /// Pixels per slice for `pixels` pixels and cuts of `max_cut` within `budget` bytes: a
@@ -231,6 +235,8 @@ impl LcBuffers {
             stats: storage(device, "lightcuts::stats", 4 * STATS as u64),
             trace: storage(device, "lightcuts::trace", 4 * TRACE_WORDS),
             size,
+            dummy: storage(device, "lightcuts::dummy", 16),
+            dummy_rw: storage(device, "lightcuts::dummy_rw", 16),
         }
     }
 
@@ -245,15 +251,250 @@ impl LcBuffers {
     }
 }
 
-pub struct LightcutsPass {
-    build: wgpu::ComputePipeline,
-    build_layout: wgpu::BindGroupLayout,
-    build_params: wgpu::Buffer,
+/// The per-pixel cut kernel (`lightcuts.wgsl`) in one MODE: 0 the image, 1 Lightcut
+/// Interpolation's cache records, 2 its fallback pixels.
+pub struct CutKernel {
+    mode: u32,
     cut: wgpu::ComputePipeline,
     cut_timed: wgpu::ComputePipeline,
-    cut_layout: wgpu::BindGroupLayout,
-    /// Per-slice uniforms (grown as needed).
+    layout: wgpu::BindGroupLayout,
+    /// Per-dispatch uniforms (grown as needed).
     params: wgpu::Buffer,
+}
+
+/// What the cut kernel binds.
+pub struct CutBindings<'a> {
+    pub tree: &'a TreeBuffers,
+    pub scene: &'a SceneGpu,
+    pub gbuffer: &'a GbufferTargets,
+    pub cones: &'a wgpu::Buffer,
+    pub reps: &'a wgpu::Buffer,
+    pub accum: &'a wgpu::Buffer,
+    pub diag: &'a wgpu::Buffer,
+    pub stats: &'a wgpu::Buffer,
+    pub trace: &'a wgpu::Buffer,
+    pub scratch: &'a wgpu::Buffer,
+    pub state: &'a wgpu::Buffer,
+    /// Mode 1: the records' pixels; mode 2: the selection (8 words per pixel).
+    pub lanes: &'a wgpu::Buffer,
+    pub record_cuts: &'a wgpu::Buffer,
+    pub rec_meta: &'a wgpu::Buffer,
+}
+
+impl CutKernel {
+    pub fn new(device: &wgpu::Device, mode: u32, stats_base: u32) -> Result<Self, shaders::ShaderError> {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let module = shaders::create_module(device, "methods/lightcuts/lightcuts.wgsl")?;
+        let mut entries = vec![dynamic_uniform_entry(
+            0,
+            c,
+            std::mem::size_of::<GpuLcParams>() as u64,
+        )];
+        entries.extend((1..=6).map(|b| storage_entry(b, c, true)));
+        entries.extend((7..=9).map(float_texture_entry));
+        entries.extend((10..=15).map(|b| storage_entry(b, c, false)));
+        entries.push(storage_entry(16, c, true));
+        entries.push(storage_entry(17, c, false));
+        entries.push(storage_entry(18, c, false));
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lightcuts::layout"),
+            entries: &entries,
+        });
+        let (mode_f, base_f) = (mode as f64, stats_base as f64);
+        let consts = [("MODE", mode_f), ("STATS_BASE", base_f)];
+        let timed = [("DIAGNOSTICS", 0.0), ("MODE", mode_f), ("STATS_BASE", base_f)];
+        Ok(Self {
+            mode,
+            cut: compute_pipeline_with(device, "lightcuts", &[Some(&layout)], &module, "main", &consts),
+            cut_timed: compute_pipeline_with(
+                device,
+                "lightcuts_timed",
+                &[Some(&layout)],
+                &module,
+                "main",
+                &timed,
+            ),
+            layout,
+            params: slice_params(device, 1),
+        })
+    }
+
+    /// Records one compute pass named `name` (one timestamp pair): `items` threads (pixels
+    /// or record slots) in slices of `slice`, each slice's dispatches in order (mode 1 adds a
+    /// last dispatch that only writes the sorted cuts).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        diagnostics: bool,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        name: &str,
+        p: GpuLcParams,
+        items: u32,
+        slice: u32,
+        b: &CutBindings<'_>,
+    ) {
+        let slices = items.div_ceil(slice).max(1);
+        let refine = dispatches_per_slice(p.max_cut, b.tree.levels(), p.steps);
+        let per_slice = refine + (self.mode == 1) as u32;
+        let n = slices * per_slice;
+        if self.params.size() < n as u64 * STRIDE {
+            self.params = slice_params(device, n);
+        }
+        let mut all = Vec::with_capacity(n as usize * STRIDE as usize);
+        for i in 0..slices {
+            for j in 0..per_slice {
+                let write_out = self.mode == 1 && j == refine;
+                let sp = GpuLcParams {
+                    first_pixel: i * slice,
+                    slice,
+                    first: (j == 0) as u32,
+                    last: (j + 1 == per_slice) as u32,
+                    steps: if write_out { 0 } else { p.steps },
+                    ..p
+                };
+                let mut bytes = bytemuck::bytes_of(&sp).to_vec();
+                bytes.resize(STRIDE as usize, 0);
+                all.extend_from_slice(&bytes);
+            }
+        }
+        queue.write_buffer(&self.params, 0, &all);
+        let tv = wgpu::BindingResource::TextureView;
+        let entries = [
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: &self.params,
+                offset: 0,
+                size: wgpu::BufferSize::new(std::mem::size_of::<GpuLcParams>() as u64),
+            }),
+            b.tree.nodes.as_entire_binding(),
+            b.tree.sorted_vpls.as_entire_binding(),
+            b.cones.as_entire_binding(),
+            b.reps.as_entire_binding(),
+            b.scene.bvh_nodes.as_entire_binding(),
+            b.scene.bvh_triangles.as_entire_binding(),
+            tv(&b.gbuffer.position_view),
+            tv(&b.gbuffer.normal_view),
+            tv(&b.gbuffer.albedo_view),
+            b.accum.as_entire_binding(),
+            b.diag.as_entire_binding(),
+            b.stats.as_entire_binding(),
+            b.trace.as_entire_binding(),
+            b.scratch.as_entire_binding(),
+            b.state.as_entire_binding(),
+            b.lanes.as_entire_binding(),
+            b.record_cuts.as_entire_binding(),
+            b.rec_meta.as_entire_binding(),
+        ];
+        let bind = bind_group_seq(device, "lightcuts::bind_group", &self.layout, &entries);
+        encoder.push_debug_group(name);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(name),
+                timestamp_writes: timer.compute_pass(name),
+            });
+            pass.set_pipeline(if diagnostics { &self.cut } else { &self.cut_timed });
+            for i in 0..n {
+                pass.set_bind_group(0, &bind, &[(i as u64 * STRIDE) as u32]);
+                pass.dispatch_workgroups(slice / WG_1D, 1, 1);
+            }
+        }
+        encoder.pop_debug_group();
+    }
+}
+
+/// The build kernel (`lc_build.wgsl`): normal cones and representatives, bottom-up.
+pub struct BuildKernel {
+    build: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+}
+
+impl BuildKernel {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let module = shaders::create_module(device, "methods/lightcuts/lc_build.wgsl")?;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lightcuts_build::layout"),
+            entries: &[
+                dynamic_uniform_entry(0, c, std::mem::size_of::<GpuLcBuildParams>() as u64),
+                storage_entry(1, c, true),
+                storage_entry(2, c, true),
+                storage_entry(3, c, false),
+                storage_entry(4, c, false),
+            ],
+        });
+        Ok(Self {
+            build: compute_pipeline_with(device, "lightcuts_build", &[Some(&layout)], &module, "main", &[]),
+            params: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lightcuts_build::params"),
+                size: STRIDE * MAX_LEVELS,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            layout,
+        })
+    }
+
+    /// Records the build (every level, one compute pass named `name`) into `cones`, `reps`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        name: &str,
+        seed: u32,
+        tree: &TreeBuffers,
+        cones: &wgpu::Buffer,
+        reps: &wgpu::Buffer,
+    ) {
+        // Levels bottom-up: leaves (level L-1) first, the root last.
+        let levels = tree.levels();
+        let mut dispatches = Vec::new();
+        for (i, level) in (0..levels).rev().enumerate().take(MAX_LEVELS as usize) {
+            let bp = GpuLcBuildParams {
+                first: 1 << level,
+                count: 1 << level,
+                leaves: tree.leaves,
+                seed,
+            };
+            queue.write_buffer(&self.params, i as u64 * STRIDE, bytemuck::bytes_of(&bp));
+            dispatches.push((i as u64 * STRIDE, bp.count.div_ceil(WG_1D)));
+        }
+        let entries = [
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: &self.params,
+                offset: 0,
+                size: wgpu::BufferSize::new(std::mem::size_of::<GpuLcBuildParams>() as u64),
+            }),
+            tree.nodes.as_entire_binding(),
+            tree.sorted_vpls.as_entire_binding(),
+            cones.as_entire_binding(),
+            reps.as_entire_binding(),
+        ];
+        let bind = bind_group_seq(device, "lightcuts_build::bind_group", &self.layout, &entries);
+        encoder.push_debug_group(name);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(name),
+                timestamp_writes: timer.compute_pass(name),
+            });
+            pass.set_pipeline(&self.build);
+            for (offset, groups) in dispatches {
+                pass.set_bind_group(0, &bind, &[offset as u32]);
+                pass.dispatch_workgroups(groups, 1, 1);
+            }
+        }
+        encoder.pop_debug_group();
+    }
+}
+
+pub struct LightcutsPass {
+    build: BuildKernel,
+    cut: CutKernel,
     views: wgpu::ComputePipeline,
     views_layout: wgpu::BindGroupLayout,
     view_params: wgpu::Buffer,
@@ -264,40 +505,7 @@ pub struct LightcutsPass {
 impl LightcutsPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let c = wgpu::ShaderStages::COMPUTE;
-        let bmod = shaders::create_module(device, "methods/lightcuts/lc_build.wgsl")?;
-        let cmod = shaders::create_module(device, "methods/lightcuts/lightcuts.wgsl")?;
         let vmod = shaders::create_module(device, "methods/lightcuts/lc_views.wgsl")?;
-        let build_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lightcuts_build::layout"),
-            entries: &[
-                dynamic_uniform_entry(0, c, std::mem::size_of::<GpuLcBuildParams>() as u64),
-                storage_entry(1, c, true),
-                storage_entry(2, c, true),
-                storage_entry(3, c, false),
-                storage_entry(4, c, false),
-            ],
-        });
-        let cut_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lightcuts::layout"),
-            entries: &[
-                dynamic_uniform_entry(0, c, std::mem::size_of::<GpuLcParams>() as u64),
-                storage_entry(1, c, true),
-                storage_entry(2, c, true),
-                storage_entry(3, c, true),
-                storage_entry(4, c, true),
-                storage_entry(5, c, true),
-                storage_entry(6, c, true),
-                float_texture_entry(7),
-                float_texture_entry(8),
-                float_texture_entry(9),
-                storage_entry(10, c, false),
-                storage_entry(11, c, false),
-                storage_entry(12, c, false),
-                storage_entry(13, c, false),
-                storage_entry(14, c, false),
-                storage_entry(15, c, false),
-            ],
-        });
         let views_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lightcuts_views::layout"),
             entries: &[
@@ -308,24 +516,17 @@ impl LightcutsPass {
                 storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm),
             ],
         });
-        let pipe =
-            |label: &str, layout: &wgpu::BindGroupLayout, module: &wgpu::ShaderModule, k: &[(&str, f64)]| {
-                compute_pipeline_with(device, label, &[Some(layout)], module, "main", k)
-            };
         Ok(Self {
-            build: pipe("lightcuts_build", &build_layout, &bmod, &[]),
-            build_params: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("lightcuts_build::params"),
-                size: STRIDE * MAX_LEVELS,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
-            build_layout,
-            cut: pipe("lightcuts", &cut_layout, &cmod, &[]),
-            cut_timed: pipe("lightcuts_timed", &cut_layout, &cmod, &[("DIAGNOSTICS", 0.0)]),
-            cut_layout,
-            params: slice_params(device, 1),
-            views: pipe("lightcuts_views", &views_layout, &vmod, &[]),
+            build: BuildKernel::new(device)?,
+            cut: CutKernel::new(device, 0, 0)?,
+            views: compute_pipeline_with(
+                device,
+                "lightcuts_views",
+                &[Some(&views_layout)],
+                &vmod,
+                "main",
+                &[],
+            ),
             views_layout,
             view_params: uniform_buffer::<GpuLcViewParams>(device, "lightcuts_views::params"),
             stats_readback: AsyncReadback::new(device, "lightcuts::stats_readback", (STATS * 4) as u64),
@@ -350,129 +551,53 @@ impl LightcutsPass {
         accum: &wgpu::Buffer,
         out: &LcBuffers,
     ) {
-        // Levels bottom-up: leaves (level L-1) first, the root last.
-        let levels = tree.levels();
-        let mut dispatches = Vec::new();
-        for (i, level) in (0..levels).rev().enumerate() {
-            let bp = GpuLcBuildParams {
-                first: 1 << level,
-                count: 1 << level,
-                leaves: tree.leaves,
-                seed,
-            };
-            queue.write_buffer(&self.build_params, i as u64 * STRIDE, bytemuck::bytes_of(&bp));
-            dispatches.push((i as u64 * STRIDE, bp.count.div_ceil(WG_1D)));
-        }
-        let build_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("lightcuts_build::bind_group"),
-            layout: &self.build_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &self.build_params,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<GpuLcBuildParams>() as u64),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: tree.nodes.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: tree.sorted_vpls.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: out.cones.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: out.reps.as_entire_binding(),
-                },
-            ],
-        });
-        encoder.push_debug_group("lightcuts_build");
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("lightcuts_build"),
-                timestamp_writes: timer.compute_pass("lightcuts_build"),
-            });
-            pass.set_pipeline(&self.build);
-            for (offset, groups) in dispatches.into_iter().take(MAX_LEVELS as usize) {
-                pass.set_bind_group(0, &build_bind, &[offset as u32]);
-                pass.dispatch_workgroups(groups, 1, 1);
-            }
-        }
-        encoder.pop_debug_group();
-
-        let pixels = p.width * p.height;
-        let slices = pixels.div_ceil(out.slice).max(1);
-        let per_slice = dispatches_per_slice(p.max_cut, tree.levels(), p.steps);
-        let n = slices * per_slice;
-        if self.params.size() < n as u64 * STRIDE {
-            self.params = slice_params(device, n);
-        }
-        let mut all = Vec::with_capacity(n as usize * STRIDE as usize);
-        for i in 0..slices {
-            for j in 0..per_slice {
-                let sp = GpuLcParams {
-                    first_pixel: i * out.slice,
-                    slice: out.slice,
-                    first: (j == 0) as u32,
-                    last: (j + 1 == per_slice) as u32,
-                    ..p
-                };
-                let mut bytes = bytemuck::bytes_of(&sp).to_vec();
-                bytes.resize(STRIDE as usize, 0);
-                all.extend_from_slice(&bytes);
-            }
-        }
-        queue.write_buffer(&self.params, 0, &all);
-        let tv = wgpu::BindingResource::TextureView;
-        let entries = [
-            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                buffer: &self.params,
-                offset: 0,
-                size: wgpu::BufferSize::new(std::mem::size_of::<GpuLcParams>() as u64),
-            }),
-            tree.nodes.as_entire_binding(),
-            tree.sorted_vpls.as_entire_binding(),
-            out.cones.as_entire_binding(),
-            out.reps.as_entire_binding(),
-            scene.bvh_nodes.as_entire_binding(),
-            scene.bvh_triangles.as_entire_binding(),
-            tv(&gbuffer.position_view),
-            tv(&gbuffer.normal_view),
-            tv(&gbuffer.albedo_view),
-            accum.as_entire_binding(),
-            out.diag.as_entire_binding(),
-            out.stats.as_entire_binding(),
-            out.trace.as_entire_binding(),
-            out.scratch.as_entire_binding(),
-            out.state.as_entire_binding(),
-        ];
-        let bind = bind_group_seq(device, "lightcuts::bind_group", &self.cut_layout, &entries);
+        self.build.record(
+            device,
+            queue,
+            encoder,
+            timer,
+            "lightcuts_build",
+            seed,
+            tree,
+            &out.cones,
+            &out.reps,
+        );
         if diagnostics {
             encoder.clear_buffer(&out.stats, 0, None);
             encoder.clear_buffer(&out.trace, 0, None);
         }
-        // One compute pass (one timestamp pair): per slice, its dispatches in order.
-        encoder.push_debug_group("lightcuts");
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("lightcuts"),
-                timestamp_writes: timer.compute_pass("lightcuts"),
-            });
-            pass.set_pipeline(if diagnostics { &self.cut } else { &self.cut_timed });
-            for i in 0..n {
-                pass.set_bind_group(0, &bind, &[(i as u64 * STRIDE) as u32]);
-                pass.dispatch_workgroups(out.slice / WG_1D, 1, 1);
-            }
-        }
-        encoder.pop_debug_group();
+        let b = CutBindings {
+            tree,
+            scene,
+            gbuffer,
+            cones: &out.cones,
+            reps: &out.reps,
+            accum,
+            diag: &out.diag,
+            stats: &out.stats,
+            trace: &out.trace,
+            scratch: &out.scratch,
+            state: &out.state,
+            lanes: &out.dummy,
+            record_cuts: &out.dummy_rw,
+            rec_meta: &out.dummy_rw,
+        };
+        let items = p.width * p.height;
+        self.cut.record(
+            diagnostics,
+            device,
+            queue,
+            encoder,
+            timer,
+            "lightcuts",
+            p,
+            items,
+            out.slice,
+            &b,
+        );
         if diagnostics {
+            // A result nobody took yet would keep this frame's from being recorded.
+            self.poll_stats();
             self.stats_readback
                 .record(encoder, &[(&out.stats, 0, 0, (STATS * 4) as u64)]);
         }

@@ -1,0 +1,705 @@
+//! Lightcut Interpolation's GPU passes, in frame order: `li_build` (Lightcuts' cones and
+//! representatives), `li_radius`, `li_place`, `li_compact` (the cache records,
+//! `li_records.wgsl`), `li_record_cuts` (the records' lightcuts: `lightcuts.wgsl` MODE 1),
+//! `li_select` (each pixel's records and weights), `li_interp` (interpolated cuts, shaded),
+//! `li_fallback` (full lightcuts where no record fits: `lightcuts.wgsl` MODE 2), and the
+//! views. Reads: the light tree, BVH, G-buffer, camera. Writes: the GI accumulation, per-pixel
+//! diagnostics, counters and the pinned pixel's interpolation.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::methods::lightcuts::pass::{
+    BuildKernel, CutBindings, CutKernel, GpuLcParams, STRIDE, dispatches_per_slice, slice_pixels,
+};
+use crate::reference::lightcut_interpolation::{TILE, TILE_CAP};
+use crate::renderer::{
+    frame::GbufferTargets,
+    passes::sst_build::TreeBuffers,
+    passes::{
+        WG_1D, bind_group_seq, compute_pipeline_with, dynamic_uniform_entry, float_texture_entry,
+        groups_image, run_compute, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
+    },
+    readback::AsyncReadback,
+    scene_gpu::SceneGpu,
+    shaders,
+    timing::GpuTimer,
+};
+
+/// Workgroup size of `li_records.wgsl`'s tile kernels (`TILE_WG_ENTRIES`): a 16 x 16 tile
+/// per workgroup (`place_main`; `compact_main` runs one such group).
+pub const TILE_WG: u32 = TILE * TILE;
+pub const TILE_WG_ENTRIES: &[&str] = &["place_main", "compact_main"];
+
+/// Twin: `LiParams` in `li_common.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuLiParams {
+    pub width: u32,
+    pub height: u32,
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+    pub leaves: u32,
+    pub levels: u32,
+    pub max_cut: u32,
+    pub capacity: u32,
+    pub r_min_px: f32,
+    pub r_max_px: f32,
+    pub one_minus_cos_max: f32,
+    pub epsilon: f32,
+    pub coverage: f32,
+    pub radius_rays: u32,
+    pub ray_offset: f32,
+    pub shadow_rays: u32,
+    pub interp_visibility: u32,
+    pub accumulate: u32,
+    /// x | y << 16, or u32::MAX.
+    pub trace_pixel: u32,
+    /// Walk units per dispatch ([`walk_steps_per_dispatch`]).
+    pub steps: u32,
+    pub first: u32,
+    pub last: u32,
+    pub distance_epsilon: f32,
+    pub _pad: u32,
+}
+
+/// Twin: `LiViewParams` in `li_views.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuLiViewParams {
+    pub mode: u32,
+    pub scale_top: u32,
+    pub r_min_px: f32,
+    pub r_max_px: f32,
+    pub exposure: f32,
+    pub tonemap: u32,
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+}
+
+/// Walk units (lowest-edge steps and emitted nodes) per `li_interp` dispatch: all on a GPU,
+/// 32 on a CPU adapter (lavapipe's loop limit; docs/lightcuts.md).
+pub fn walk_steps_per_dispatch(device_type: wgpu::DeviceType) -> u32 {
+    if device_type == wgpu::DeviceType::Cpu {
+        32
+    } else {
+        u32::MAX
+    }
+}
+
+/// `li_interp` dispatches for cuts of `max_cut` nodes in a tree of `levels` levels: three
+/// input cuts and their gaps, and as many emitted nodes. Walks left unfinished are counted
+/// (`LiStats::unfinished`), never silently cut.
+pub fn walk_dispatches(max_cut: u32, levels: u32, steps: u32) -> u32 {
+    if steps == u32::MAX {
+        return 1;
+    }
+    let units = 6 * (max_cut as u64 + levels as u64 + 1);
+    units.div_ceil(steps.max(1) as u64).clamp(1, 4096) as u32
+}
+
+/// Counter words: the interpolation's (8), the records' lightcuts (8), the fallback's (8),
+/// and the records' metadata (8: records, dropped, tiles at their cap).
+pub const STATS_WORDS: usize = 32;
+const TRACE_WORDS: u64 = 16 + 2 * 4096;
+
+/// The frame's counters (diagnostic frames).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LiStats {
+    pub interpolated: u32,
+    pub unfinished: u32,
+    pub cut_nodes: u64,
+    pub shadow_rays: u64,
+    pub walk_steps: u64,
+    pub records: u32,
+    pub records_at_max_cut: u32,
+    pub record_cut_nodes: u64,
+    pub record_rays: u64,
+    pub fallback: u32,
+    pub fallback_cut_nodes: u64,
+    pub fallback_rays: u64,
+    pub dropped_records: u32,
+    pub capped_tiles: u32,
+}
+
+impl LiStats {
+    pub fn from_words(w: &[u32]) -> Self {
+        let w64 = |i: usize| w[i] as u64 | (w[i + 1] as u64) << 32;
+        Self {
+            interpolated: w[0],
+            unfinished: w[1],
+            cut_nodes: w64(2),
+            shadow_rays: w64(4),
+            walk_steps: w64(6),
+            records: w[8],
+            records_at_max_cut: w[9],
+            record_cut_nodes: w64(10),
+            record_rays: w64(14),
+            fallback: w[16],
+            fallback_cut_nodes: w64(18),
+            fallback_rays: w64(22),
+            dropped_records: w[25],
+            capped_tiles: w[26],
+        }
+    }
+    /// Pixels shaded (interpolated or fallback).
+    pub fn pixels(&self) -> u32 {
+        self.interpolated + self.fallback
+    }
+    pub fn fallback_fraction(&self) -> f64 {
+        self.fallback as f64 / self.pixels().max(1) as f64
+    }
+    /// Mean cut size over shaded pixels (interpolated and fallback cuts).
+    pub fn mean_cut(&self) -> f64 {
+        (self.cut_nodes + self.fallback_cut_nodes) as f64 / self.pixels().max(1) as f64
+    }
+    /// Shadow rays per shaded pixel, the records' included.
+    pub fn rays_per_pixel(&self) -> f64 {
+        (self.shadow_rays + self.record_rays + self.fallback_rays) as f64 / self.pixels().max(1) as f64
+    }
+    pub fn records_per_pixel(&self) -> f64 {
+        self.records as f64 / self.pixels().max(1) as f64
+    }
+    pub fn mean_record_cut(&self) -> f64 {
+        self.record_cut_nodes as f64 / self.records.max(1) as f64
+    }
+}
+
+/// The pinned pixel's interpolation in the last diagnostic frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TracedInterpolation {
+    pub pixel: u32,
+    pub records: Vec<u32>,
+    pub weights: Vec<f32>,
+    pub level_spread: f32,
+    pub shadow_rays: u32,
+    pub walk_steps: u32,
+    /// (node, interpolated visibility), left to right.
+    pub nodes: Vec<(u32, f32)>,
+}
+
+impl TracedInterpolation {
+    pub fn parse(w: &[u32]) -> Option<Self> {
+        if w.len() < 16 || w[8] == 0 {
+            return None;
+        }
+        let m = (w[1] as usize).min(3);
+        let n = (w[0] as usize).min(4096);
+        Some(Self {
+            pixel: w[8] - 1,
+            records: w[2..2 + m].to_vec(),
+            weights: w[5..5 + m].iter().map(|&b| f32::from_bits(b)).collect(),
+            level_spread: f32::from_bits(w[9]),
+            shadow_rays: w[10],
+            walk_steps: w[11],
+            nodes: (0..n)
+                .filter_map(|i| Some((*w.get(16 + 2 * i)?, f32::from_bits(*w.get(17 + 2 * i)?))))
+                .collect(),
+        })
+    }
+}
+
+fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(16),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Records at most for `pixels` pixels in `tiles` tiles: one per 8 pixels (at least 256),
+/// never more than the tiles can place.
+pub fn record_capacity(pixels: u32, tiles: u32) -> u32 {
+    (pixels / 8).max(256).min(tiles * TILE_CAP).max(1)
+}
+
+/// Per-node, per-record and per-pixel buffers (resized with the tree, frame and settings).
+pub struct LiBuffers {
+    pub size: (u32, u32),
+    pub leaves: u32,
+    pub max_cut: u32,
+    pub tiles: (u32, u32),
+    pub capacity: u32,
+    /// Whether `li_interp` carries its walk between dispatches (CPU adapters).
+    pub split_walk: bool,
+    pub cones: wgpu::Buffer,
+    pub reps: wgpu::Buffer,
+    pub radius: wgpu::Buffer,
+    pub tile_count: wgpu::Buffer,
+    pub tile_recs: wgpu::Buffer,
+    pub tile_offset: wgpu::Buffer,
+    pub records: wgpu::Buffer,
+    pub rec_meta: wgpu::Buffer,
+    pub record_cuts: wgpu::Buffer,
+    pub sel: wgpu::Buffer,
+    pub diag: wgpu::Buffer,
+    pub stats: wgpu::Buffer,
+    pub trace: wgpu::Buffer,
+    pub walk_state: wgpu::Buffer,
+    /// The lightcut kernel's heaps and state (records' and fallback slices).
+    pub scratch: wgpu::Buffer,
+    pub lc_state: wgpu::Buffer,
+    pub record_slice: u32,
+    pub fallback_slice: u32,
+}
+
+impl LiBuffers {
+    pub fn new(
+        device: &wgpu::Device,
+        leaves: u32,
+        size: (u32, u32),
+        max_cut: u32,
+        budget: u64,
+        split_walk: bool,
+    ) -> Self {
+        let pixels = size.0 * size.1;
+        let tiles = (size.0.div_ceil(TILE), size.1.div_ceil(TILE));
+        let nt = tiles.0 * tiles.1;
+        let capacity = record_capacity(pixels, nt);
+        let record_slice = slice_pixels(capacity, max_cut, budget);
+        let fallback_slice = slice_pixels(pixels, max_cut, budget);
+        let slice = record_slice.max(fallback_slice) as u64;
+        let px = pixels as u64;
+        let nodes = 2 * leaves as u64;
+        Self {
+            size,
+            leaves,
+            max_cut,
+            tiles,
+            capacity,
+            split_walk,
+            cones: storage(device, "li::cones", 16 * nodes),
+            reps: storage(device, "li::reps", 4 * nodes),
+            radius: storage(device, "li::radius", 8 * px),
+            tile_count: storage(device, "li::tile_count", 4 * nt as u64),
+            tile_recs: storage(device, "li::tile_recs", 4 * (nt * TILE_CAP) as u64),
+            tile_offset: storage(device, "li::tile_offset", 4 * nt as u64),
+            records: storage(device, "li::records", 4 * capacity as u64),
+            rec_meta: storage(device, "li::rec_meta", 4 * (8 + capacity as u64)),
+            record_cuts: storage(device, "li::record_cuts", 4 * capacity as u64 * max_cut as u64),
+            sel: storage(device, "li::sel", 32 * px),
+            diag: storage(device, "li::diag", 16 * px),
+            stats: storage(device, "li::stats", 4 * STATS_WORDS as u64),
+            trace: storage(device, "li::trace", 4 * TRACE_WORDS),
+            walk_state: storage(device, "li::walk_state", if split_walk { 96 * px } else { 16 }),
+            scratch: storage(device, "li::scratch", 8 * slice * max_cut as u64),
+            lc_state: storage(device, "li::lc_state", 32 * slice),
+            record_slice,
+            fallback_slice,
+        }
+    }
+
+    /// Bytes of the largest binding for these sizes (the scratch stays within its budget).
+    pub fn largest_binding(leaves: u32, size: (u32, u32), max_cut: u32, split_walk: bool) -> u64 {
+        let px = size.0 as u64 * size.1 as u64;
+        let nt = (size.0.div_ceil(TILE) * size.1.div_ceil(TILE)) as u64;
+        let cap = record_capacity(size.0 * size.1, nt as u32) as u64;
+        [
+            32 * leaves as u64,
+            32 * px,
+            4 * cap * max_cut as u64,
+            if split_walk { 96 * px } else { 0 },
+        ]
+        .into_iter()
+        .max()
+        .unwrap_or(0)
+    }
+
+    pub fn matches(&self, leaves: u32, size: (u32, u32), max_cut: u32, split_walk: bool) -> bool {
+        self.leaves == leaves && self.size == size && self.max_cut == max_cut && self.split_walk == split_walk
+    }
+}
+
+/// Everything a frame of the method binds from the renderer.
+pub struct FrameInputs<'a> {
+    pub tree: &'a TreeBuffers,
+    pub scene: &'a SceneGpu,
+    pub gbuffer: &'a GbufferTargets,
+    pub camera: &'a wgpu::Buffer,
+    pub accum: &'a wgpu::Buffer,
+}
+
+pub struct LiPass {
+    build: BuildKernel,
+    record_cuts: CutKernel,
+    fallback: CutKernel,
+    records_layout: wgpu::BindGroupLayout,
+    radius: wgpu::ComputePipeline,
+    place: wgpu::ComputePipeline,
+    compact: wgpu::ComputePipeline,
+    select_layout: wgpu::BindGroupLayout,
+    select: wgpu::ComputePipeline,
+    interp_layout: wgpu::BindGroupLayout,
+    interp: wgpu::ComputePipeline,
+    interp_timed: wgpu::ComputePipeline,
+    /// Per-dispatch uniforms (grown as needed).
+    params: wgpu::Buffer,
+    views_layout: wgpu::BindGroupLayout,
+    views: wgpu::ComputePipeline,
+    view_params: wgpu::Buffer,
+    stats_readback: AsyncReadback,
+    last_stats: Option<LiStats>,
+}
+
+fn params_buffer(device: &wgpu::Device, n: u32) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("li::params"),
+        size: n.max(1) as u64 * STRIDE,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+impl LiPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let rmod = shaders::create_module(device, "methods/lightcut_interpolation/li_records.wgsl")?;
+        let smod = shaders::create_module(device, "methods/lightcut_interpolation/li_select.wgsl")?;
+        let imod = shaders::create_module(device, "methods/lightcut_interpolation/li_interp.wgsl")?;
+        let vmod = shaders::create_module(device, "methods/lightcut_interpolation/li_views.wgsl")?;
+        let psize = std::mem::size_of::<GpuLiParams>() as u64;
+        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        let mut re = vec![
+            dynamic_uniform_entry(0, c, psize),
+            float_texture_entry(1),
+            float_texture_entry(2),
+        ];
+        re.push(uniform_entry(3, c));
+        re.extend([storage_entry(4, c, true), storage_entry(5, c, true)]);
+        re.extend((6..=11).map(|b| storage_entry(b, c, false)));
+        let records_layout = layout("li_records::layout", &re);
+        let mut se = vec![
+            dynamic_uniform_entry(0, c, psize),
+            float_texture_entry(1),
+            float_texture_entry(2),
+        ];
+        se.extend((3..=7).map(|b| storage_entry(b, c, true)));
+        se.push(storage_entry(8, c, false));
+        let select_layout = layout("li_select::layout", &se);
+        let mut ie = vec![dynamic_uniform_entry(0, c, psize)];
+        ie.extend((1..=3).map(float_texture_entry));
+        ie.extend((4..=11).map(|b| storage_entry(b, c, true)));
+        ie.extend((12..=16).map(|b| storage_entry(b, c, false)));
+        let interp_layout = layout("li_interp::layout", &ie);
+        let mut ve = vec![
+            uniform_entry(0, c),
+            float_texture_entry(1),
+            float_texture_entry(2),
+        ];
+        ve.extend((3..=9).map(|b| storage_entry(b, c, true)));
+        ve.push(storage_texture_entry(10, wgpu::TextureFormat::Rgba8Unorm));
+        let views_layout = layout("li_views::layout", &ve);
+        let pipe =
+            |label: &str,
+             l: &wgpu::BindGroupLayout,
+             m: &wgpu::ShaderModule,
+             entry: &str,
+             k: &[(&str, f64)]| { compute_pipeline_with(device, label, &[Some(l)], m, entry, k) };
+        Ok(Self {
+            build: BuildKernel::new(device)?,
+            record_cuts: CutKernel::new(device, 1, 8)?,
+            fallback: CutKernel::new(device, 2, 16)?,
+            radius: pipe("li_radius", &records_layout, &rmod, "radius_main", &[]),
+            place: pipe("li_place", &records_layout, &rmod, "place_main", &[]),
+            compact: pipe("li_compact", &records_layout, &rmod, "compact_main", &[]),
+            records_layout,
+            select: pipe("li_select", &select_layout, &smod, "main", &[]),
+            select_layout,
+            interp: pipe("li_interp", &interp_layout, &imod, "main", &[]),
+            interp_timed: pipe(
+                "li_interp_timed",
+                &interp_layout,
+                &imod,
+                "main",
+                &[("DIAGNOSTICS", 0.0)],
+            ),
+            interp_layout,
+            params: params_buffer(device, 4),
+            views: pipe("li_views", &views_layout, &vmod, "main", &[]),
+            views_layout,
+            view_params: uniform_buffer::<GpuLiViewParams>(device, "li_views::params"),
+            stats_readback: AsyncReadback::new(device, "li::stats_readback", (STATS_WORDS * 4) as u64),
+            last_stats: None,
+        })
+    }
+
+    /// Records every pass of a frame (module doc), `lc` the lightcut kernel's parameters for
+    /// the records and the fallback (its `steps` per dispatch).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        diagnostics: bool,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: GpuLiParams,
+        lc: GpuLcParams,
+        seed: u32,
+        f: &FrameInputs<'_>,
+        b: &LiBuffers,
+    ) {
+        // Uniforms: 0 the records' and selection's; 1.. the walk's dispatches.
+        let walks = walk_dispatches(p.max_cut, f.tree.levels(), p.steps);
+        let n = 1 + walks;
+        if self.params.size() < n as u64 * STRIDE {
+            self.params = params_buffer(device, n);
+        }
+        let mut all = Vec::with_capacity(n as usize * STRIDE as usize);
+        for i in 0..n {
+            let q = if i == 0 {
+                p
+            } else {
+                GpuLiParams {
+                    first: (i == 1) as u32,
+                    last: (i == walks) as u32,
+                    ..p
+                }
+            };
+            let mut bytes = bytemuck::bytes_of(&q).to_vec();
+            bytes.resize(STRIDE as usize, 0);
+            all.extend_from_slice(&bytes);
+        }
+        queue.write_buffer(&self.params, 0, &all);
+        let params = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.params,
+            offset: 0,
+            size: wgpu::BufferSize::new(std::mem::size_of::<GpuLiParams>() as u64),
+        });
+        let tv = wgpu::BindingResource::TextureView;
+        let g = f.gbuffer;
+
+        self.build.record(
+            device, queue, encoder, timer, "li_build", seed, f.tree, &b.cones, &b.reps,
+        );
+
+        let rentries = [
+            params.clone(),
+            tv(&g.position_view),
+            tv(&g.normal_view),
+            f.camera.as_entire_binding(),
+            f.scene.bvh_nodes.as_entire_binding(),
+            f.scene.bvh_triangles.as_entire_binding(),
+            b.radius.as_entire_binding(),
+            b.tile_count.as_entire_binding(),
+            b.tile_recs.as_entire_binding(),
+            b.tile_offset.as_entire_binding(),
+            b.records.as_entire_binding(),
+            b.rec_meta.as_entire_binding(),
+        ];
+        let rbind = bind_group_seq(device, "li_records::bind_group", &self.records_layout, &rentries);
+        let tiles = b.tiles.0 * b.tiles.1;
+        for (name, pipe, groups) in [
+            ("li_radius", &self.radius, groups_image(p.width, p.height)),
+            ("li_place", &self.place, (tiles, 1, 1)),
+            ("li_compact", &self.compact, (1, 1, 1)),
+        ] {
+            encoder.push_debug_group(name);
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(name),
+                    timestamp_writes: timer.compute_pass(name),
+                });
+                pass.set_pipeline(pipe);
+                pass.set_bind_group(0, &rbind, &[0]);
+                pass.dispatch_workgroups(groups.0, groups.1, groups.2);
+            }
+            encoder.pop_debug_group();
+        }
+
+        if diagnostics {
+            encoder.clear_buffer(&b.stats, 0, None);
+            encoder.clear_buffer(&b.trace, 0, None);
+        }
+        fn cut_bindings<'a>(
+            f: &FrameInputs<'a>,
+            b: &'a LiBuffers,
+            lanes: &'a wgpu::Buffer,
+        ) -> CutBindings<'a> {
+            CutBindings {
+                tree: f.tree,
+                scene: f.scene,
+                gbuffer: f.gbuffer,
+                cones: &b.cones,
+                reps: &b.reps,
+                accum: f.accum,
+                diag: &b.diag,
+                stats: &b.stats,
+                trace: &b.trace,
+                scratch: &b.scratch,
+                state: &b.lc_state,
+                lanes,
+                record_cuts: &b.record_cuts,
+                rec_meta: &b.rec_meta,
+            }
+        }
+        let rb = cut_bindings(f, b, &b.records);
+        self.record_cuts.record(
+            diagnostics,
+            device,
+            queue,
+            encoder,
+            timer,
+            "li_record_cuts",
+            GpuLcParams {
+                trace_pixel: u32::MAX,
+                accumulate: 0,
+                ..lc
+            },
+            b.capacity,
+            b.record_slice,
+            &rb,
+        );
+
+        let sentries = [
+            params.clone(),
+            tv(&g.position_view),
+            tv(&g.normal_view),
+            b.radius.as_entire_binding(),
+            b.tile_count.as_entire_binding(),
+            b.tile_offset.as_entire_binding(),
+            b.records.as_entire_binding(),
+            b.rec_meta.as_entire_binding(),
+            b.sel.as_entire_binding(),
+        ];
+        let sbind = bind_group_seq(device, "li_select::bind_group", &self.select_layout, &sentries);
+        encoder.push_debug_group("li_select");
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("li_select"),
+                timestamp_writes: timer.compute_pass("li_select"),
+            });
+            pass.set_pipeline(&self.select);
+            pass.set_bind_group(0, &sbind, &[0]);
+            let (x, y, z) = groups_image(p.width, p.height);
+            pass.dispatch_workgroups(x, y, z);
+        }
+        encoder.pop_debug_group();
+
+        let ientries = [
+            params,
+            tv(&g.position_view),
+            tv(&g.normal_view),
+            tv(&g.albedo_view),
+            b.rec_meta.as_entire_binding(),
+            b.record_cuts.as_entire_binding(),
+            b.sel.as_entire_binding(),
+            f.tree.nodes.as_entire_binding(),
+            f.tree.sorted_vpls.as_entire_binding(),
+            b.reps.as_entire_binding(),
+            f.scene.bvh_nodes.as_entire_binding(),
+            f.scene.bvh_triangles.as_entire_binding(),
+            f.accum.as_entire_binding(),
+            b.diag.as_entire_binding(),
+            b.stats.as_entire_binding(),
+            b.trace.as_entire_binding(),
+            b.walk_state.as_entire_binding(),
+        ];
+        let ibind = bind_group_seq(device, "li_interp::bind_group", &self.interp_layout, &ientries);
+        encoder.push_debug_group("li_interp");
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("li_interp"),
+                timestamp_writes: timer.compute_pass("li_interp"),
+            });
+            pass.set_pipeline(if diagnostics {
+                &self.interp
+            } else {
+                &self.interp_timed
+            });
+            for i in 1..n {
+                pass.set_bind_group(0, &ibind, &[(i as u64 * STRIDE) as u32]);
+                pass.dispatch_workgroups((p.width * p.height).div_ceil(WG_1D), 1, 1);
+            }
+        }
+        encoder.pop_debug_group();
+
+        let fb = cut_bindings(f, b, &b.sel);
+        self.fallback.record(
+            diagnostics,
+            device,
+            queue,
+            encoder,
+            timer,
+            "li_fallback",
+            GpuLcParams {
+                trace_pixel: u32::MAX,
+                ..lc
+            },
+            p.width * p.height,
+            b.fallback_slice,
+            &fb,
+        );
+        if diagnostics {
+            // A result nobody took yet would keep this frame's from being recorded.
+            self.poll_stats();
+            self.stats_readback
+                .record(encoder, &[(&b.stats, 0, 0, 96), (&b.rec_meta, 0, 96, 32)]);
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_view(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: GpuLiViewParams,
+        final_image: &wgpu::TextureView,
+        gb_position: &wgpu::TextureView,
+        b: &LiBuffers,
+        dst: &wgpu::TextureView,
+    ) {
+        queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
+        let entries = [
+            self.view_params.as_entire_binding(),
+            wgpu::BindingResource::TextureView(final_image),
+            wgpu::BindingResource::TextureView(gb_position),
+            b.diag.as_entire_binding(),
+            b.sel.as_entire_binding(),
+            b.radius.as_entire_binding(),
+            b.tile_count.as_entire_binding(),
+            b.tile_offset.as_entire_binding(),
+            b.records.as_entire_binding(),
+            b.rec_meta.as_entire_binding(),
+            wgpu::BindingResource::TextureView(dst),
+        ];
+        let bind = bind_group_seq(device, "li_views::bind_group", &self.views_layout, &entries);
+        run_compute(
+            encoder,
+            timer,
+            "li_views",
+            &self.views,
+            &bind,
+            groups_image(b.size.0, b.size.1),
+        );
+    }
+
+    pub fn after_submit(&self) {
+        self.stats_readback.after_submit();
+    }
+
+    pub fn last_stats(&self) -> Option<LiStats> {
+        self.last_stats
+    }
+
+    /// The counters of the latest diagnostic frame read back (non-blocking).
+    pub fn poll_stats(&mut self) -> Option<LiStats> {
+        if let Some(bytes) = self.stats_readback.try_take() {
+            self.last_stats = Some(LiStats::from_words(bytemuck::cast_slice(&bytes)));
+        }
+        self.last_stats
+    }
+}
+
+/// The lightcut kernel's dispatch count per slice for these settings (re-exported for the
+/// tests' expectations).
+pub fn record_dispatches(max_cut: u32, levels: u32, steps: u32) -> u32 {
+    dispatches_per_slice(max_cut, levels, steps) + 1
+}
