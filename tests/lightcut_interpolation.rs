@@ -351,6 +351,15 @@ fn gpu_records_selection_and_interpolation_equal_the_cpu_reference() {
     assert_eq!(ids, cpu.cut.iter().map(|n| n.node).collect::<Vec<_>>());
     assert!((tr.level_spread - cpu.level_spread).abs() <= 1e-4 * cpu.level_spread.max(1.0));
     assert_eq!(tr.walk_steps, cpu.steps);
+    // The story panel's data: the records' cuts, the interpolated cut, the disagreements.
+    let story = st.r.read_cut_story().unwrap().expect("a cut story");
+    assert_eq!(story.inputs.len(), tr.records.len());
+    for (input, &r) in story.inputs.iter().zip(&tr.records) {
+        let want: Vec<u32> = rec.cuts[r as usize].iter().map(|e| e & !VISIBLE).collect();
+        assert_eq!(input.nodes, want);
+    }
+    assert_eq!(story.cut.as_ref().map(|c| c.nodes.clone()), Some(ids.clone()));
+    assert_eq!(story.disagreements, cpu.disagreements);
 
     // The counters: every walk finished; fallback fraction as counted here.
     assert_eq!(st.stat("unfinished_walks"), 0.0);

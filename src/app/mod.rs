@@ -2,6 +2,7 @@
 //! display settings, status line. Only [`viewport_texture`] touches `egui_wgpu`'s textures.
 
 pub mod camera_control;
+pub mod cut_story;
 pub mod image_views;
 pub mod story_panel;
 pub mod timings_panel;

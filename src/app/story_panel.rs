@@ -41,6 +41,8 @@ pub struct StoryPanel {
     pub overlay: bool,
     /// Why there is no story (shown in the window).
     pub note: String,
+    /// The cut-based methods' story (Lightcuts, Lightcut Interpolation) and the tree's leaves.
+    pub cut_story: Option<crate::methods::CutStory>,
 }
 
 impl StoryPanel {
@@ -61,15 +63,28 @@ impl StoryPanel {
             self.note = "click a camera view to pin a pixel".into();
             return Ok(());
         }
+        self.cut_story = None;
         if !r.settings().gi.method.info().story {
             self.trace = None;
+            if pixel == self.pixel && now - self.read_at < 0.5 {
+                return Ok(());
+            }
+            self.pixel = pixel;
+            self.read_at = now;
+            self.leaves = r.tree_buffers().1.leaves;
+            self.cut_story = r.read_cut_story().map_err(|e| e.to_string())?;
+            if self.cut_story.is_some() {
+                return Ok(());
+            }
             let tellers: Vec<&str> = crate::methods::REGISTRY
                 .iter()
                 .filter(|m| m.story)
                 .map(|m| m.short)
                 .collect();
             self.note = format!(
-                "{} tells no pixel story; the methods that do: {}",
+                "{} tells no sample story (the methods that do: {}); a cut-based method's cut \
+                 story needs a diagnostic frame and a pixel with geometry (Lightcut \
+                 Interpolation's fallback pixels have none)",
                 r.settings().gi.method.name(),
                 tellers.join(", ")
             );
@@ -182,6 +197,10 @@ impl StoryPanel {
 
     /// The story (shown in the tool dock or its floating window).
     pub fn contents(&mut self, ui: &mut egui::Ui) {
+        if let Some(story) = &self.cut_story {
+            super::cut_story::contents(ui, story, self.leaves);
+            return;
+        }
         let Some(t) = self.trace.clone() else {
             ui.label(&self.note);
             return;

@@ -287,6 +287,26 @@ impl<'de> Deserialize<'de> for MethodView {
     }
 }
 
+/// One cut of a cut story: nodes of the frame's light tree (root 1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StoryCut {
+    pub label: String,
+    pub nodes: Vec<u32>,
+}
+
+/// The pinned pixel's cuts as a cut-based method tells them (Lightcuts: its cut; Lightcut
+/// Interpolation: the records' cuts, the interpolated cut and where the inputs disagree).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CutStory {
+    /// (what, value) rows of the story's table.
+    pub rows: Vec<(String, String)>,
+    /// Input cuts (drawn in colours) and the pixel's own cut (drawn last, white).
+    pub inputs: Vec<StoryCut>,
+    pub cut: Option<StoryCut>,
+    /// Leaf intervals [start, end) where the inputs disagree.
+    pub disagreements: Vec<(u32, u32)>,
+}
+
 /// A heat-map view's colour scale, as the GUI draws its legend.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Legend {
@@ -479,6 +499,11 @@ pub trait Method: Any {
     /// the story panel draws `PixelTrace`: blocks, blend weights, each sample's path, stop,
     /// point, shadow ray and contribution).
     fn read_story(&self, _ctx: &GpuContext) -> Result<Option<tree_samplers::pass::PixelTrace>, GpuError> {
+        Ok(None)
+    }
+    /// The pinned pixel's cut story in the last diagnostic frame (cut-based methods: the
+    /// story panel draws its cuts over the tree's levels and its table).
+    fn read_cut_story(&self, _ctx: &GpuContext) -> Result<Option<CutStory>, GpuError> {
         Ok(None)
     }
     /// Its rows in the pixel-values window at frame pixel (x, y) of a `frame`-sized image.

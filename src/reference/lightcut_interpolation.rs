@@ -261,6 +261,8 @@ pub struct Interpolated {
     pub level_spread: f32,
     /// Lowest-edge steps of the walk.
     pub steps: u32,
+    /// Leaf intervals [start, end) where the input cuts' levels differ (merged).
+    pub disagreements: Vec<(u32, u32)>,
 }
 
 /// The walk's cursor over one input cut.
@@ -330,6 +332,7 @@ pub fn interpolate(nodes: &[SstNode], cuts: &[&[u32]], weights: &[f32]) -> Inter
         cut: Vec::new(),
         level_spread: 0.0,
         steps: 0,
+        disagreements: Vec::new(),
     };
     if k == 0 {
         return out;
@@ -353,6 +356,12 @@ pub fn interpolate(nodes: &[SstNode], cuts: &[&[u32]], weights: &[f32]) -> Inter
         acc_l += width * lavg;
         acc_v += width * vavg;
         spread += width * (hi - lo) as f32;
+        if hi > lo {
+            match out.disagreements.last_mut() {
+                Some(last) if last.1 == pos => last.1 = e,
+                _ => out.disagreements.push((pos, e)),
+            }
+        }
         out.steps += 1;
         pos = e;
         let mut ended = 0;
@@ -395,6 +404,42 @@ pub fn interpolate(nodes: &[SstNode], cuts: &[&[u32]], weights: &[f32]) -> Inter
         }
     }
     out.level_spread = spread / leaves as f32;
+    out
+}
+
+/// The leaf intervals [start, end) where `cuts` (left to right, node | VISIBLE) put different
+/// levels, in a tree of 2^levels leaves (merged; the walk of [`interpolate`]).
+pub fn disagreements(cuts: &[&[u32]], levels: u32) -> Vec<(u32, u32)> {
+    let leaves = 1u32 << levels;
+    let k = cuts.len().min(3);
+    let mut cur = [Cursor {
+        next: 0,
+        end: 0,
+        level: 0,
+        vis: 0.0,
+    }; 3];
+    for j in 0..k {
+        load(cuts[j], &mut cur[j], 0, levels);
+    }
+    let mut out: Vec<(u32, u32)> = Vec::new();
+    let mut pos = 0;
+    while k > 0 && pos < leaves {
+        let e = cur[..k].iter().map(|c| c.end).min().unwrap_or(leaves);
+        let lo = cur[..k].iter().map(|c| c.level).min().unwrap_or(0);
+        let hi = cur[..k].iter().map(|c| c.level).max().unwrap_or(0);
+        if hi > lo {
+            match out.last_mut() {
+                Some(last) if last.1 == pos => last.1 = e,
+                _ => out.push((pos, e)),
+            }
+        }
+        pos = e;
+        for (j, c) in cur[..k].iter_mut().enumerate() {
+            if c.end == e && e < leaves {
+                load(cuts[j], c, e, levels);
+            }
+        }
+    }
     out
 }
 
@@ -516,6 +561,10 @@ mod tests {
             let out = interpolate(&nodes, &[&a, &b, &c], &w);
             check_interpolated(&nodes, &out.cut).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
             assert!(out.level_spread > 0.0, "seed {seed}: the inputs differ");
+            assert_eq!(out.disagreements, disagreements(&[&a, &b, &c], 8));
+            // The spread is the width-weighted level range: positive exactly where they differ.
+            let width: u32 = out.disagreements.iter().map(|(s, e)| e - s).sum();
+            assert!(width > 0 && out.level_spread * 256.0 >= width as f32 - 1e-3);
             // Two inputs too.
             let two = interpolate(&nodes, &[&a, &b], &[0.5, 0.5]);
             check_interpolated(&nodes, &two.cut).unwrap_or_else(|e| panic!("seed {seed}: {e}"));

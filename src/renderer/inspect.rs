@@ -61,6 +61,17 @@ impl Renderer {
         }
     }
 
+    /// The pinned pixel's cut story (cut-based methods; None without a pinned pixel).
+    pub fn read_cut_story(&self) -> Result<Option<methods::CutStory>, GpuError> {
+        if self.trace_pixel.is_none() {
+            return Ok(None);
+        }
+        match self.method_instance(self.settings.gi.method) {
+            Some(m) => m.read_cut_story(&self.ctx),
+            None => Ok(None),
+        }
+    }
+
     /// The top of the traversal-steps heat map: the depth of the tree (root to leaves).
     pub fn sampling_steps_scale(&self) -> f32 {
         methods::tree_samplers::steps_scale(self.tree.levels())

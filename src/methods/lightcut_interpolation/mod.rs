@@ -12,7 +12,8 @@ pub mod settings;
 mod ui;
 
 use super::{
-    FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
+    CutStory, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, StoryCut,
+    ViewCx, ViewInfo,
 };
 use crate::methods::lightcuts::{
     Lightcuts,
@@ -486,6 +487,81 @@ impl Method for LightcutInterpolation {
             b,
             cx.dst,
         );
+    }
+
+    /// The pinned pixel: its records (pixel, weight, cut), the interpolated cut, and where
+    /// the records' cuts disagree.
+    fn read_cut_story(&self, ctx: &GpuContext) -> Result<Option<CutStory>, GpuError> {
+        let Some(b) = &self.buffers else { return Ok(None) };
+        let Some(t) = self.read_traced(ctx)? else {
+            return Ok(None);
+        };
+        let word = |buf: &wgpu::Buffer, i: u64| -> Result<u32, GpuError> {
+            let bytes = readback::read_buffer_range(ctx, buf, 4 * i, 4)?;
+            Ok(bytemuck::pod_read_unaligned(&bytes[..4]))
+        };
+        let levels = b.leaves.trailing_zeros();
+        let mut story = CutStory::default();
+        let px = |k: u32| (k % b.size.0, k / b.size.0);
+        let (x, y) = px(t.pixel);
+        story.rows.push(("pixel".into(), format!("({x}, {y})")));
+        let mut cuts = Vec::new();
+        for (i, (&r, &w)) in t.records.iter().zip(&t.weights).enumerate() {
+            let pixel = word(&b.records, r as u64)?;
+            let len = word(&b.rec_meta, 8 + r as u64)?.min(b.max_cut);
+            let bytes = readback::read_buffer_range(
+                ctx,
+                &b.record_cuts,
+                4 * r as u64 * b.max_cut as u64,
+                4 * len.max(1) as u64,
+            )?;
+            let cut: Vec<u32> = bytemuck::pod_collect_to_vec::<u8, u32>(&bytes)
+                .into_iter()
+                .take(len as usize)
+                .collect();
+            let (rx, ry) = px(pixel);
+            let visible = cut
+                .iter()
+                .filter(|&&e| e & crate::reference::lightcut_interpolation::VISIBLE != 0)
+                .count();
+            story.rows.push((
+                format!("record {}", i + 1),
+                format!("#{r} at ({rx}, {ry}), weight {w:.3}, cut {len} nodes ({visible} visible)"),
+            ));
+            story.inputs.push(StoryCut {
+                label: format!("record #{r} (w {w:.2})"),
+                nodes: cut
+                    .iter()
+                    .map(|e| e & !crate::reference::lightcut_interpolation::VISIBLE)
+                    .collect(),
+            });
+            cuts.push(cut);
+        }
+        let refs: Vec<&[u32]> = cuts.iter().map(|c| c.as_slice()).collect();
+        story.disagreements = crate::reference::lightcut_interpolation::disagreements(&refs, levels);
+        let span: u32 = story.disagreements.iter().map(|(s, e)| e - s).sum();
+        story.rows.push((
+            "inputs disagree".into(),
+            format!(
+                "on {span} of {} leaves (level spread {:.2})",
+                b.leaves, t.level_spread
+            ),
+        ));
+        story.rows.push((
+            "interpolated cut".into(),
+            format!(
+                "{} nodes, {} walk steps, {} shadow rays ({})",
+                t.nodes.len(),
+                t.walk_steps,
+                t.shadow_rays,
+                self.settings.visibility.label()
+            ),
+        ));
+        story.cut = Some(StoryCut {
+            label: format!("interpolated ({} nodes)", t.nodes.len()),
+            nodes: t.nodes.iter().map(|n| n.0).collect(),
+        });
+        Ok(Some(story))
     }
 
     /// Per pixel: cut size, level spread (-1: fallback), records used, shadow rays.

@@ -13,7 +13,8 @@ pub mod settings;
 mod ui;
 
 use super::{
-    FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
+    CutStory, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, StoryCut,
+    ViewCx, ViewInfo,
 };
 use crate::renderer::{
     context::{GpuContext, GpuError},
@@ -319,6 +320,39 @@ impl Method for Lightcuts {
             &self.buffers,
             cx.dst,
         );
+    }
+
+    /// The pinned pixel's cut with its refinement counters.
+    fn read_cut_story(&self, ctx: &GpuContext) -> Result<Option<CutStory>, GpuError> {
+        let Some(t) = self.read_traced_cut(ctx)? else {
+            return Ok(None);
+        };
+        let w = self.buffers.size.0.max(1);
+        let visible = t.nodes.iter().filter(|n| n.estimate != [0.0; 3]).count();
+        Ok(Some(CutStory {
+            rows: vec![
+                ("pixel".into(), format!("({}, {})", t.pixel % w, t.pixel / w)),
+                (
+                    "cut".into(),
+                    format!(
+                        "{} nodes ({visible} contributing), {} refinements",
+                        t.nodes.len(),
+                        t.refinements
+                    ),
+                ),
+                (
+                    "largest bound left / estimate".into(),
+                    format!("{:.3e}", t.relative_bound),
+                ),
+                ("shadow rays".into(), t.shadow_rays.to_string()),
+            ],
+            inputs: Vec::new(),
+            cut: Some(StoryCut {
+                label: format!("lightcut ({} nodes)", t.nodes.len()),
+                nodes: t.nodes.iter().map(|n| n.node).collect(),
+            }),
+            disagreements: Vec::new(),
+        }))
     }
 
     /// Per pixel: cut size, refinements, largest bound left / estimate, shadow rays.

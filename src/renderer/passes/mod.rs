@@ -242,7 +242,8 @@ mod tests {
                     && ws == [super::sst_sort::SORT_WG, 1, 1];
                 // Lightcut Interpolation's tile kernels: one workgroup per 16 x 16 tile.
                 let tile = file == "methods/lightcut_interpolation/li_records.wgsl"
-                    && crate::methods::lightcut_interpolation::pass::TILE_WG_ENTRIES.contains(&ep.name.as_str())
+                    && crate::methods::lightcut_interpolation::pass::TILE_WG_ENTRIES
+                        .contains(&ep.name.as_str())
                     && ws == [crate::methods::lightcut_interpolation::pass::TILE_WG, 1, 1];
                 let ok = own || tile || ws == [WG_2D, WG_2D, 1] || ws == [WG_1D, 1, 1];
                 assert!(ok, "{file}::{} has workgroup size {ws:?}", ep.name);
