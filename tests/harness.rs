@@ -83,6 +83,9 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "slc,rtslc,sst,lightcuts",
             "--sweep",
             "lightcuts=0.2,0.05",
+            // The interpolation figure's cuts small (and `--set` reaching `results`).
+            "--set",
+            "methods.lightcut-interpolation.max_cut=64",
             "--out",
         ])
         .arg(&out)
@@ -224,6 +227,38 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         2,
     );
     check_csv(
+        &d,
+        "interpolation.csv",
+        &["method", "paper_time_vs_lightcuts", "method_stats", "max_cut"],
+        &[
+            "gi_gpu_ms",
+            "time_vs_lightcuts",
+            "rmse_vs_ground_truth",
+            "relative_rmse_vs_ground_truth",
+            "ssim_vs_ground_truth",
+            "rmse_vs_lightcuts",
+        ],
+        3,
+    );
+    let (_, rows) = read_csv(&d.join("interpolation.csv"));
+    let names: Vec<&str> = rows.iter().map(|r| r["method"].as_str()).collect();
+    assert_eq!(names, ["Lightcuts", "LI full vis.", "LI interp. vis."]);
+    for r in &rows {
+        assert_eq!(r["max_cut"], "64", "--set reaches the figure: {r:?}");
+    }
+    assert!(
+        rows[2]["method_stats"].contains("interpolation_rays_per_pixel=0.0000"),
+        "{:?}",
+        rows[2]
+    );
+    check_csv(
+        &d,
+        "interpolation_passes.csv",
+        &["method", "pass"],
+        &["median_ms", "share"],
+        2 + 2 * 8,
+    );
+    check_csv(
         &out,
         "checks.csv",
         &["scene", "check", "kind", "met"],
@@ -253,6 +288,9 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         "images/blend_recompute_error.png",
         "images/fallback_pixels.png",
         "images/upsampling_half.png",
+        "interpolation.png",
+        "images/interpolation_li_interp.png",
+        "images/interpolation_li_full_error.png",
     ] {
         decodes(&d.join(p));
     }
@@ -261,7 +299,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     assert_eq!(run["width"], 64);
     // Each figure's wall time and the share of it outside rendering / GPU waits.
     let times = run["scenes"][0]["figure_times"].as_array().unwrap();
-    assert_eq!(times.len(), 7, "{times:?}");
+    assert_eq!(times.len(), 8, "{times:?}");
     for t in times {
         let share = t["share_outside_gpu"].as_f64().unwrap();
         assert!(

@@ -33,6 +33,8 @@ const EXAMPLES: &[&str] = &[
     "-- compare out/slc/indirect.exr out/slc/ground_truth_indirect.exr --exposure 3",
     "-- bench tree",
     "-- render --scene default --width 320 --height 240 --method lightcuts --set methods.lightcuts.relative_error=0.02 --compare-gt --out out/lc",
+    "-- render --scene default --width 320 --height 240 --method lightcut-interpolation --set methods.lightcut-interpolation.visibility=interpolated --compare-gt --out out/li",
+    "-- results interpolation --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
     "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",
     "-- --view albedo --settings docs/settings-example.toml --tree-stats",
     "-- --compare-gt --views \"final;GI only;traversal steps;A/B comparison\" --pin 150,70",
@@ -426,6 +428,66 @@ fn cli_examples_write_what_they_promise() {
         "{m}"
     );
     assert!(lc.join("lightcut_size.png").is_file() && lc.join("lightcut_at_max_cut.png").is_file());
+    // Lightcut Interpolation with interpolated visibility: no ray of its own.
+    let li = tmp("li");
+    run_cli(&args(
+        "-- render --scene default --width 320 --height 240 --method lightcut-interpolation --set methods.lightcut-interpolation.visibility=interpolated --compare-gt --out out/li",
+        &[
+            ("--width", "32"),
+            ("--height", "24"),
+            ("--out", li.to_str().unwrap()),
+        ],
+        &["--vpls", "256"],
+    ));
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(li.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(m["method"], "lightcut-interpolation");
+    assert_eq!(
+        m["method_stats"]["interpolated_visibility"].as_f64(),
+        Some(1.0),
+        "{m}"
+    );
+    assert_eq!(
+        m["method_stats"]["interpolation_rays_per_pixel"].as_f64(),
+        Some(0.0),
+        "{m}"
+    );
+    assert!(
+        m["method_stats"]["records"].as_f64().is_some_and(|v| v >= 1.0),
+        "{m}"
+    );
+    assert!(
+        m["vs_ground_truth"]["rmse"].as_f64().is_some_and(f64::is_finite),
+        "{m}"
+    );
+    assert!(li.join("li_records.png").is_file() && li.join("li_level_spread.png").is_file());
+    // The interpolation paper's comparison (the default scene, tiny, here).
+    let lr = tmp("li-results");
+    run_cli(&args(
+        "-- results interpolation --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
+        &[("--scenes", "default"), ("--out", lr.to_str().unwrap())],
+        &[
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--frames",
+            "1",
+            "--timing-frames",
+            "2",
+            "--vpls",
+            "256",
+            "--set",
+            "methods.lightcut-interpolation.max_cut=32",
+        ],
+    ));
+    let csv =
+        std::fs::read_to_string(lr.join("default").join("interpolation.csv")).expect("interpolation.csv");
+    assert_eq!(csv.lines().count(), 4, "{csv}");
+    assert!(csv.contains("LI interp. vis."), "{csv}");
+    for d in [li, lr] {
+        let _ = std::fs::remove_dir_all(d);
+    }
     // The tree's pairing and Lightcuts' cost per relative error (the default scene here).
     let out = run_cli(&args(
         "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",

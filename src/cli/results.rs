@@ -38,12 +38,16 @@ pub enum Figure {
     Upsampling,
     /// VPL count sweep: tree build time, GI time, RMSE.
     Scaling,
+    /// Lightcut Interpolation's headline comparison (its paper's Fig. 8 / 10): Lightcuts vs
+    /// interpolation with full and interpolated visibility, GPU time per pass and error.
+    Interpolation,
 }
 
-const ORDER: [Figure; 7] = [
+const ORDER: [Figure; 8] = [
     Figure::Timings,
     Figure::Steps,
     Figure::EqualTime,
+    Figure::Interpolation,
     Figure::Blocks,
     Figure::Blending,
     Figure::Upsampling,
@@ -258,6 +262,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
                 Figure::Blending => figures::blending(&mut b, &o, &dir)?,
                 Figure::Upsampling => figures::upsampling(&mut b, &o, &dir)?,
                 Figure::Scaling => figures::scaling(&mut b, &o, &dir)?,
+                Figure::Interpolation => figures::interpolation(&mut b, &o, &dir)?,
                 Figure::All => unreachable!("expanded above"),
             };
             print!("{}", rep.table);

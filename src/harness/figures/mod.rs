@@ -2,9 +2,11 @@
 //! `<figure>.csv`, PNG plots and images into the scene's results folder, and returns a
 //! [`Report`]: a short text table and the ratio checks of issue 7 it covers.
 
+mod interpolation;
 mod resolution;
 mod sampling;
 
+pub use interpolation::interpolation;
 pub use resolution::{scaling, upsampling};
 pub use sampling::{blending, blocks, steps};
 
@@ -386,7 +388,7 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
                 num(m.noise_rmse),
                 num(m.steps_per_traversal()),
                 num(m.steps_per_pixel()),
-                format!("\"{}\"", stats.join(" ")),
+                stats.join(" "),
             ]);
             eprintln!(
                 "[{}] {label} {} {value}: GI {t:.2} ms GPU (frame {wall:.1} ms wall), RMSE {r:.4e} (bias {:.2e}, noise {:.2e}, mean ratio {:.3}), SSIM {q:.3}",
