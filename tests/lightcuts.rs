@@ -5,6 +5,8 @@
 
 mod common;
 
+use common::Setup;
+
 use glam::Vec3;
 use lightcut::{
     base::gpu_layout::GpuVpl,
@@ -18,22 +20,16 @@ use lightcut::{
         vpl::{pcg_hash, u01},
     },
     renderer::{
-        Buffer, FrameInput, Renderer,
+        Buffer,
         context::GpuContext,
-        readback::{ImageF32, read_storage_buffer},
+        readback::read_storage_buffer,
         settings::{RenderSettings, Tonemap, ViewBuffer},
     },
-    scene::{Camera, Scene, bvh::Bvh, default_scene},
+    scene::bvh::Bvh,
 };
 
 const W: u32 = 40;
 const H: u32 = 24;
-
-struct Setup {
-    r: Renderer,
-    scene: Scene,
-    cam: Camera,
-}
 
 fn settings(relative_error: f32, max_cut: u32) -> RenderSettings {
     let mut s = RenderSettings::default();
@@ -52,51 +48,12 @@ fn settings(relative_error: f32, max_cut: u32) -> RenderSettings {
 }
 
 fn setup(ctx: &GpuContext, s: RenderSettings) -> Setup {
-    let scene = default_scene::build();
-    let cam = scene.camera_or_default(None).unwrap();
-    let r = Renderer::new(ctx.clone(), &scene, (W, H), s).unwrap();
-    Setup { r, scene, cam }
+    Setup::new(ctx, s, (W, H))
 }
 
-impl Setup {
-    fn frame(&mut self) {
-        self.r.render(&FrameInput {
-            camera: &self.cam,
-            lights: &self.scene.lights,
-            view: ViewBuffer::Final,
-        });
-    }
-    fn set(&mut self, f: impl FnOnce(&mut RenderSettings)) {
-        let mut s = self.r.settings().clone();
-        f(&mut s);
-        self.r.set_settings(s).unwrap();
-    }
-    fn indirect(&self) -> ImageF32 {
-        self.r.read(Buffer::Indirect).unwrap()
-    }
-    fn lc(&self) -> &Lightcuts {
-        self.r
-            .method_module::<Lightcuts>()
-            .expect("lightcuts is registered")
-    }
-    /// The ground truth of the frame's VPLs (the tree frozen first, so that the VPLs stay).
-    fn ground_truth(&mut self) -> ImageF32 {
-        self.r.set_freeze_tree(true);
-        let s = self.r.settings().clone();
-        self.set(|s| {
-            s.gi.method = lightcut::methods::ground_truth::ID;
-            s.gi.rays_per_frame = 1 << 26;
-        });
-        loop {
-            self.frame();
-            if self.r.gi_progress().is_some_and(|p| p.finished()) {
-                break;
-            }
-        }
-        let gt = self.indirect();
-        self.r.set_settings(s).unwrap();
-        gt
-    }
+fn lc_of(st: &Setup) -> &Lightcuts {
+    st.r.method_module::<Lightcuts>()
+        .expect("lightcuts is registered")
 }
 
 /// A random unit vector from two uniform numbers.
@@ -225,7 +182,7 @@ fn gpu_lightcuts_equal_the_cpu_reference_and_cuts_are_valid() {
     st.frame();
     let (nodes, _) = st.r.read_tree().unwrap();
     let sorted = sorted_vpls(&st);
-    let gpu_lc: LcTree = st.lc().read_build(&ctx).unwrap();
+    let gpu_lc: LcTree = lc_of(&st).read_build(&ctx).unwrap();
     // The build: cones and representatives against the CPU's from the same tree and seed.
     let cpu_lc = build(&nodes, &sorted, Lightcuts::seed(&s, 0));
     let same_reps = gpu_lc
@@ -265,6 +222,7 @@ fn gpu_lightcuts_equal_the_cpu_reference_and_cuts_are_valid() {
         max_cut: 64,
         eps: s.gi.distance_epsilon,
         shadow_rays: Some(s.gi.ray_offset),
+        trace_every_node: false,
     };
     let (mut pixels, mut same_size, mut close, mut at_max) = (0, 0, 0, 0);
     let mut traced_cpu = None;
@@ -302,7 +260,7 @@ fn gpu_lightcuts_equal_the_cpu_reference_and_cuts_are_valid() {
     assert!(close >= pixels * 97 / 100, "radiance: {close} of {pixels} equal");
     assert!(at_max > 0 && at_max < pixels, "{at_max} pixels at max cut");
     // The pinned pixel's cut as the GPU traced it: valid, and the CPU's.
-    let tc = st.lc().read_traced_cut(&ctx).unwrap().expect("a traced cut");
+    let tc = lc_of(&st).read_traced_cut(&ctx).unwrap().expect("a traced cut");
     assert_eq!(tc.pixel, traced.1 * W + traced.0);
     let mut gpu_ids: Vec<u32> = tc.nodes.iter().map(|n| n.node).collect();
     check_cut(&nodes, &gpu_ids).unwrap();
@@ -338,7 +296,7 @@ fn threshold_zero_and_unlimited_cut_equal_the_ground_truth() {
     st.frame();
     let lc = st.indirect();
     let stats = st.r.method_stats_blocking();
-    let gt = st.ground_truth();
+    let gt = st.ground_truth_of_these_vpls();
     let (mut worst, mut lit) = (0.0f32, 0);
     for (a, b) in lc.pixels.iter().zip(&gt.pixels) {
         let (a, b) = (Vec3::from_slice(&a[..3]), Vec3::from_slice(&b[..3]));
@@ -370,7 +328,7 @@ fn the_mean_over_builds_of_a_fixed_cut_converges_to_the_ground_truth() {
     // docs/lightcuts.md.)
     let mut st = setup(&ctx, settings(0.0, 64));
     st.frame();
-    let gt = st.ground_truth();
+    let gt = st.ground_truth_of_these_vpls();
     st.set(|s| s.sampling.accumulate = true);
     let mut errs = Vec::new();
     for target in [16u32, 256] {

@@ -4,6 +4,8 @@
 
 mod common;
 
+use common::Setup;
+
 use glam::Vec3;
 use lightcut::methods::tree_samplers::{RTSLC, SLC, SST};
 use lightcut::{
@@ -13,64 +15,24 @@ use lightcut::{
         sst_tree::classify,
     },
     renderer::{
-        Buffer, FrameInput, Renderer,
+        Buffer, FrameInput,
         context::GpuContext,
         readback::{ImageF32, read_storage_buffer},
         settings::{ChildProbability, MethodId, RenderSettings, ViewBuffer},
     },
-    scene::{Camera, Scene, default_scene},
 };
 
 const W: u32 = 64;
 const H: u32 = 40;
 
-struct Setup {
-    r: Renderer,
-    scene: Scene,
-    cam: Camera,
-}
-
 fn setup(ctx: &GpuContext, s: RenderSettings) -> Setup {
-    let scene = default_scene::build();
-    let cam = scene.camera_or_default(None).unwrap();
-    let r = Renderer::new(ctx.clone(), &scene, (W, H), s).unwrap();
-    Setup { r, scene, cam }
+    Setup::new(ctx, s, (W, H))
 }
 
-impl Setup {
-    fn frame(&mut self) {
-        self.r.render(&FrameInput {
-            camera: &self.cam,
-            lights: &self.scene.lights,
-            view: ViewBuffer::Final,
-        });
-    }
-    fn set(&mut self, f: impl FnOnce(&mut RenderSettings)) {
-        let mut s = self.r.settings().clone();
-        f(&mut s);
-        self.r.set_settings(s).unwrap();
-    }
-    fn indirect(&self) -> ImageF32 {
-        self.r.read(Buffer::Indirect).unwrap()
-    }
-    fn diag(&self) -> Vec<[f32; 4]> {
-        let bytes = read_storage_buffer(&self.r.ctx, &self.r.slc_buffers().diag).unwrap();
-        bytemuck::cast_slice(&bytes).to_vec()
-    }
-    /// The ground truth of the frame's VPLs (runs it to the end).
-    fn ground_truth(&mut self) -> ImageF32 {
-        self.set(|s| {
-            s.gi.method = lightcut::methods::ground_truth::ID;
-            s.gi.rays_per_frame = 1 << 26;
-        });
-        loop {
-            self.frame();
-            if self.r.gi_progress().is_some_and(|p| p.finished()) {
-                break;
-            }
-        }
-        self.indirect()
-    }
+/// The sampler's per-pixel diagnostics.
+fn diag(st: &Setup) -> Vec<[f32; 4]> {
+    let bytes = read_storage_buffer(&st.r.ctx, &st.r.slc_buffers().diag).unwrap();
+    bytemuck::cast_slice(&bytes).to_vec()
 }
 
 fn settings(method: MethodId) -> RenderSettings {
@@ -166,7 +128,7 @@ fn blending_picks_cuts_by_their_weights_and_falls_back_to_the_mock_cut() {
     // Pixels to watch: geometry and at least two similar cuts with substantial weight.
     let mut watch = Vec::new();
     let mut mock_expected = 0;
-    let diag0 = st.diag();
+    let diag0 = diag(&st);
     for y in 0..H {
         for x in 0..W {
             if pos.get(x, y)[3] == 0.0 {
@@ -196,7 +158,7 @@ fn blending_picks_cuts_by_their_weights_and_falls_back_to_the_mock_cut() {
     let mut counts: Vec<std::collections::HashMap<u32, u32>> = vec![Default::default(); watch.len()];
     for _ in 0..frames {
         st.frame();
-        let d = st.diag();
+        let d = diag(&st);
         for (i, (x, y, _)) in watch.iter().enumerate() {
             let b = d[(y * W + x) as usize][3] as u32;
             assert!(b > 0, "slot 0 of ({x},{y}) used no cut");
@@ -480,7 +442,7 @@ fn pixel_values_equal_the_full_buffers() {
     let fin = st.r.read(Buffer::Final).unwrap();
     let pos = st.r.read(Buffer::Position).unwrap();
     let alb = st.r.read(Buffer::Albedo).unwrap();
-    let diag = st.diag();
+    let diag = diag(&st);
     for (x, y) in [(0, 0), (10, 7), (W - 1, H - 1), (33, 20)] {
         let rows = st.r.read_pixel(x, y).unwrap();
         let get = |name: &str| rows.iter().find(|r| r.0.starts_with(name)).map(|r| r.1).unwrap();

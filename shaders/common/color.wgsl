@@ -11,6 +11,13 @@ fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
     return select(hi, lo, x <= vec3<f32>(0.0031308));
 }
 
+// An image's displayed grey (sRGB of the tonemapped luminance at `exposure`): the
+// background the method views draw their marks on.
+fn display_grey(linear: vec3<f32>, exposure: f32, mode: u32) -> f32 {
+    let t = tonemap(max(linear * exposure, vec3<f32>(0.0)), mode);
+    return linear_to_srgb(vec3<f32>(luminance(t))).x;
+}
+
 // 0 = clamp, 1 = Reinhard on luminance, 2 = ACES filmic (Narkowicz 2015 fit).
 fn tonemap(c: vec3<f32>, mode: u32) -> vec3<f32> {
     if mode == 1u {

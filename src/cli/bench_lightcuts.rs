@@ -195,6 +195,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             max_cut: args.max_cut,
             eps: si.gi.distance_epsilon,
             shadow_rays: si.gi.shadow_rays.then_some(si.gi.ray_offset),
+            trace_every_node: false,
         };
         // Refined nodes = the inner nodes above each pixel's cut.
         let (mut refined, mut refined_far) = (0u64, 0u64);

@@ -1,5 +1,5 @@
 //! Lightcut Interpolation (Rehfeld & Dachsbacher 2016): the CPU twin of
-//! `shaders/methods/lightcut_interpolation/{li_records, li_shade}.wgsl`. Written for clarity,
+//! `shaders/methods/lightcut_interpolation/{li_records, li_select, li_interp}.wgsl`. Written for clarity,
 //! not speed; every function mirrors its kernel op for op where the results are compared.
 //!
 //! **Cache records** (section 3.1). The paper places records with Ulbrich's tile-based method
@@ -141,7 +141,8 @@ pub struct TilePixel {
 }
 
 /// Greedy record placement in one tile (the module doc): indices into `px` in the order
-/// chosen. Ties go to the lower index. Twin: `place` in `li_records.wgsl`.
+/// chosen. Ties go to the lower index; a record's own pixel is covered and never picked
+/// again. Twin: `place_main` in `li_records.wgsl`.
 pub fn place_tile(px: &[TilePixel], coverage: f32, wp: &WeightParams) -> Vec<u32> {
     let mut acc = vec![0.0f32; px.len()];
     let mut covered: Vec<bool> = px.iter().map(|p| !p.valid).collect();
@@ -149,7 +150,7 @@ pub fn place_tile(px: &[TilePixel], coverage: f32, wp: &WeightParams) -> Vec<u32
     while (chosen.len() as u32) < TILE_CAP && covered.iter().any(|c| !c) {
         let mut best = (0.0f32, u32::MAX);
         for (c, cp) in px.iter().enumerate() {
-            if !cp.valid {
+            if !cp.valid || chosen.contains(&(c as u32)) {
                 continue;
             }
             let mut gain = 0.0f32;
@@ -170,7 +171,8 @@ pub fn place_tile(px: &[TilePixel], coverage: f32, wp: &WeightParams) -> Vec<u32
         for (p, pp) in px.iter().enumerate() {
             if pp.valid {
                 acc[p] += weight(pp.record.position, pp.record.normal, &r, wp).max(0.0);
-                covered[p] = covered[p] || acc[p] >= coverage;
+                // The record's own pixel is covered (its weight there is 1 up to rounding).
+                covered[p] = covered[p] || acc[p] >= coverage || p as u32 == best.1;
             }
         }
     }
@@ -189,7 +191,7 @@ pub struct Selection {
 
 /// The best three of `candidates` (record id, raw weight), in the order given (ties keep the
 /// earlier one), their weights minus the fourth best and normalised (section 3.2). Twin:
-/// `select` in `li_shade.wgsl`.
+/// `li_select.wgsl`.
 pub fn select(candidates: impl IntoIterator<Item = (u32, f32)>, epsilon: f32) -> Selection {
     let mut ids = [u32::MAX; 4];
     let mut ws = [0.0f32; 4];

@@ -331,6 +331,10 @@ pub struct CutParams {
     pub eps: f32,
     /// Shadow rays with this end-point offset; None: every VPL visible.
     pub shadow_rays: Option<f32>,
+    /// Trace every node's representative, also where its estimate is 0 (Lightcut
+    /// Interpolation's records: their visibility bits are interpolated to pixels where the
+    /// node does contribute). Lightcuts itself skips those rays.
+    pub trace_every_node: bool,
 }
 
 /// One node of a pixel's final cut.
@@ -384,7 +388,7 @@ pub fn lightcut(
     let estimate = |node: u32| cluster_estimate(nodes, lc, sorted, node, x, n, p.eps);
     let mut rays = 0u32;
     let mut visible = |node: u32, e: Vec3| -> bool {
-        if e == Vec3::ZERO {
+        if e == Vec3::ZERO && !p.trace_every_node {
             return false;
         }
         let Some(offset) = p.shadow_rays else {
@@ -415,11 +419,12 @@ pub fn lightcut(
                 vis,
             ));
         } else {
+            let vis = p.trace_every_node && visible(1, estimate(1));
             done.push(CutNode {
                 node: 1,
                 bound,
                 estimate: Vec3::ZERO,
-                visible: false,
+                visible: vis,
             });
         }
     }
@@ -442,7 +447,7 @@ pub fn lightcut(
             let bound = error_bound(nodes, lc, child, x, n, p.eps);
             let (e, vis) = if lc.reps[child as usize] == lc.reps[top.node as usize] {
                 (estimate(child), top_vis)
-            } else if bound > 0.0 || child >= leaves {
+            } else if bound > 0.0 || child >= leaves || p.trace_every_node {
                 let e = estimate(child);
                 (e, visible(child, e))
             } else {

@@ -211,6 +211,38 @@ pub fn read_storage_buffer(ctx: &GpuContext, src: &wgpu::Buffer) -> Result<Vec<u
     read_buffer_range(ctx, src, 0, src.size())
 }
 
+/// A `size`-pixel image stored as one vec4<f32> per pixel, row-major (the methods'
+/// per-pixel diagnostics): None when the image has at most one pixel (not yet sized).
+pub fn read_vec4_image(
+    ctx: &GpuContext,
+    src: &wgpu::Buffer,
+    size: (u32, u32),
+) -> Result<Option<ImageF32>, GpuError> {
+    let n = size.0 as u64 * size.1 as u64;
+    if n <= 1 {
+        return Ok(None);
+    }
+    let bytes = read_buffer_range(ctx, src, 0, 16 * n)?;
+    Ok(Some(ImageF32 {
+        width: size.0,
+        height: size.1,
+        pixels: bytemuck::pod_collect_to_vec(&bytes),
+    }))
+}
+
+/// Pixel (x, y) of such an image (of width `width`).
+pub fn read_vec4_pixel(
+    ctx: &GpuContext,
+    src: &wgpu::Buffer,
+    width: u32,
+    x: u32,
+    y: u32,
+) -> Result<[f32; 4], GpuError> {
+    let off = (y as u64 * width as u64 + x as u64) * 16;
+    let bytes = read_buffer_range(ctx, src, off, 16)?;
+    Ok(bytemuck::pod_read_unaligned(&bytes[..16]))
+}
+
 /// Copies `size` bytes at `offset` (both multiples of 4) of a storage buffer and reads them.
 pub fn read_buffer_range(
     ctx: &GpuContext,

@@ -57,6 +57,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ),
     ("common/math.wgsl", include_str!("../../shaders/common/math.wgsl")),
     (
+        "common/stats64.wgsl",
+        include_str!("../../shaders/common/stats64.wgsl"),
+    ),
+    (
         "common/vpl_visibility.wgsl",
         include_str!("../../shaders/common/vpl_visibility.wgsl"),
     ),

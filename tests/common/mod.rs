@@ -63,3 +63,65 @@ pub fn read_csv(path: &std::path::Path) -> (Vec<String>, Vec<std::collections::H
         .collect();
     (header, rows)
 }
+
+use lightcut::renderer::{
+    Buffer, FrameInput, Renderer,
+    readback::ImageF32,
+    settings::{RenderSettings, ViewBuffer},
+};
+use lightcut::scene::{Camera, Scene, default_scene};
+
+/// A renderer on the default scene and its camera, at `size` (the GPU tests' fixture).
+pub struct Setup {
+    pub r: Renderer,
+    pub scene: Scene,
+    pub cam: Camera,
+}
+
+impl Setup {
+    pub fn new(ctx: &GpuContext, s: RenderSettings, size: (u32, u32)) -> Setup {
+        let scene = default_scene::build();
+        let cam = scene.camera_or_default(None).unwrap();
+        let r = Renderer::new(ctx.clone(), &scene, size, s).unwrap();
+        Setup { r, scene, cam }
+    }
+    pub fn frame(&mut self) {
+        self.r.render(&FrameInput {
+            camera: &self.cam,
+            lights: &self.scene.lights,
+            view: ViewBuffer::Final,
+        });
+    }
+    pub fn set(&mut self, f: impl FnOnce(&mut RenderSettings)) {
+        let mut s = self.r.settings().clone();
+        f(&mut s);
+        self.r.set_settings(s).unwrap();
+    }
+    pub fn indirect(&self) -> ImageF32 {
+        self.r.read(Buffer::Indirect).unwrap()
+    }
+    /// Switches to the ground truth (all of a frame's VPL batches at once) and runs it to
+    /// the end; the settings stay the ground truth's.
+    pub fn ground_truth(&mut self) -> ImageF32 {
+        self.set(|s| {
+            s.gi.method = lightcut::methods::ground_truth::ID;
+            s.gi.rays_per_frame = 1 << 26;
+        });
+        loop {
+            self.frame();
+            if self.r.gi_progress().is_some_and(|p| p.finished()) {
+                break;
+            }
+        }
+        self.indirect()
+    }
+    /// The ground truth of the current frame's VPLs (the tree frozen first, so that the
+    /// VPLs stay), then the settings as they were.
+    pub fn ground_truth_of_these_vpls(&mut self) -> ImageF32 {
+        self.r.set_freeze_tree(true);
+        let s = self.r.settings().clone();
+        let gt = self.ground_truth();
+        self.r.set_settings(s).unwrap();
+        gt
+    }
+}

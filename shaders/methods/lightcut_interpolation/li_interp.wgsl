@@ -18,6 +18,7 @@
 #include "common/sst_node.wgsl"
 #include "methods/lightcuts/lc_common.wgsl"
 #include "methods/lightcut_interpolation/li_common.wgsl"
+#include "common/stats64.wgsl"
 
 override DIAGNOSTICS: bool = true;
 
@@ -62,13 +63,6 @@ struct LiState {
 @group(0) @binding(14) var<storage, read_write> stats: array<atomic<u32>>;
 @group(0) @binding(15) var<storage, read_write> trace: array<u32>;
 @group(0) @binding(16) var<storage, read_write> state: array<LiState>;
-
-fn add64(i: u32, v: u32) {
-    let old = atomicAdd(&stats[i], v);
-    if old > 0xffffffffu - v {
-        atomicAdd(&stats[i + 1u], 1u);
-    }
-}
 
 fn first_leaf(node: u32) -> u32 {
     return (node << (lp.levels - firstLeadingBit(node))) - lp.leaves;
@@ -119,9 +113,12 @@ fn load(r: u32, next: u32, x: u32) -> Cursor {
     return c;
 }
 
+// level.w's top bit: the walk stopped inside a sync position's emission (resume there).
+const LI_PENDING: u32 = 0x80000000u;
+
 @compute @workgroup_size(64, 1, 1)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let k = gid.x;
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let k = gid.x + gid.y * groups.x * 64u;
     if k >= lp.width * lp.height {
         return;
     }
@@ -142,6 +139,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var acc = vec4<f32>(0.0);
     var sum = vec3<f32>(0.0);
     var rays = 0u;
+    var pending = false;
     if lp.first != 0u {
         for (var j = 0u; j < m; j++) {
             cur[j] = load(s.ids[j], 0u, 0u);
@@ -153,7 +151,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         pos = st.next.w;
         out = st.end.w;
-        size = st.level.w;
+        size = st.level.w & ~LI_PENDING;
+        pending = (st.level.w & LI_PENDING) != 0u;
         spread = st.vis.w;
         acc = st.acc;
         sum = st.sum.xyz;
@@ -161,51 +160,60 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var units = 0u;
     loop {
-        if pos >= lp.leaves || units >= lp.steps {
+        if (pos >= lp.leaves && !pending) || units >= lp.steps {
             break;
         }
-        // One lowest-edge step.
-        var e = 0xffffffffu;
-        var lavg = 0.0;
-        var vavg = 0.0;
-        var lo = 0xffffffffu;
-        var hi = 0u;
-        for (var j = 0u; j < m; j++) {
-            e = min(e, cur[j].end);
-            lavg += s.w[j] * f32(cur[j].level);
-            vavg += s.w[j] * cur[j].vis;
-            lo = min(lo, cur[j].level);
-            hi = max(hi, cur[j].level);
-        }
-        let width = f32(e - pos);
-        acc.x += width;
-        acc.y += width * lavg;
-        acc.z += width * vavg;
-        acc.w += 1.0;
-        spread += width * f32(hi - lo);
-        units += 1u;
-        pos = e;
-        var ended = 0u;
-        for (var j = 0u; j < m; j++) {
-            if cur[j].end == e {
-                ended += 1u;
-                if e < lp.leaves {
-                    cur[j] = load(s.ids[j], cur[j].next, e);
+        if !pending {
+            // One lowest-edge step.
+            var e = 0xffffffffu;
+            var lavg = 0.0;
+            var vavg = 0.0;
+            var lo = 0xffffffffu;
+            var hi = 0u;
+            for (var j = 0u; j < m; j++) {
+                e = min(e, cur[j].end);
+                lavg += s.w[j] * f32(cur[j].level);
+                vavg += s.w[j] * cur[j].vis;
+                lo = min(lo, cur[j].level);
+                hi = max(hi, cur[j].level);
+            }
+            let width = f32(e - pos);
+            acc.x += width;
+            acc.y += width * lavg;
+            acc.z += width * vavg;
+            acc.w += 1.0;
+            spread += width * f32(hi - lo);
+            units += 1u;
+            pos = e;
+            var ended = 0u;
+            for (var j = 0u; j < m; j++) {
+                if cur[j].end == e {
+                    ended += 1u;
+                    if e < lp.leaves {
+                        cur[j] = load(s.ids[j], cur[j].next, e);
+                    }
                 }
             }
+            if ended < min(m, 2u) {
+                continue;
+            }
         }
-        if ended < min(m, 2u) {
-            continue;
-        }
-        // A sync position: emit what the accumulator allows.
+        // A sync position: emit what the accumulator allows (at most the dispatch's budget;
+        // `pending` resumes here).
+        pending = true;
         loop {
             if out >= pos {
+                pending = false;
+                break;
+            }
+            if units >= lp.steps {
                 break;
             }
             let want = u32(clamp(i32(floor(acc.y / acc.x + 0.5)), 0, i32(lp.levels)));
             let l = max(want, aligned_level(out, lp.leaves));
             let w = 1u << (lp.levels - l);
             if out + w > pos {
+                pending = false;
                 break;
             }
             let node = (lp.leaves + out) >> (lp.levels - l);
@@ -256,7 +264,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         st.next.w = pos;
         st.end.w = out;
-        st.level.w = size;
+        st.level.w = size | select(0u, LI_PENDING, pending);
         st.vis.w = spread;
         st.acc = acc;
         st.sum = vec4<f32>(sum, bitcast<f32>(rays));
@@ -274,12 +282,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let level_spread = spread / f32(lp.leaves);
         diag[k] = vec4<f32>(f32(size), level_spread, f32(m), f32(rays));
         atomicAdd(&stats[0], 1u);
-        if pos < lp.leaves || out < lp.leaves {
+        if pos < lp.leaves || out < lp.leaves || pending {
             atomicAdd(&stats[1], 1u);
         }
-        add64(2u, size);
-        add64(4u, rays);
-        add64(6u, u32(acc.w));
+        stats_add64(2u, size);
+        stats_add64(4u, rays);
+        stats_add64(6u, u32(acc.w));
         if traced {
             trace[0] = size;
             trace[1] = m;

@@ -87,8 +87,15 @@ var<workgroup> w_idx: array<u32, 256>;
 var<workgroup> w_any: u32;
 
 @compute @workgroup_size(256, 1, 1)
-fn place_main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) t: u32) {
-    let tile = wid.x;
+fn place_main(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) t: u32,
+) {
+    let tile = wid.x + wid.y * groups.x;
+    if tile >= lp.tiles_x * lp.tiles_y {
+        return; // the whole workgroup: uniform
+    }
     let tx = tile % lp.tiles_x;
     let ty = tile / lp.tiles_x;
     let px = vec2<u32>(tx * LI_TILE + t % LI_TILE, ty * LI_TILE + t / LI_TILE);
@@ -109,6 +116,7 @@ fn place_main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
     w_acc[t] = 0.0;
     w_open[t] = select(0u, 1u, valid);
     var count = 0u;
+    var record = false; // this pixel is a record already (no second pick)
     loop {
         // Any pixel still uncovered?
         if t == 0u {
@@ -125,7 +133,7 @@ fn place_main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
         }
         // This pixel's gain as a record.
         var gain = 0.0;
-        if valid {
+        if valid && !record {
             let pr = w_pos[t];
             let nr = w_nrm[t];
             let rr = w_reach[t];
@@ -135,8 +143,8 @@ fn place_main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
                 }
             }
         }
-        w_gain[t] = select(0.0, gain, valid);
-        w_idx[t] = select(LI_NONE, t, valid && gain > 0.0);
+        w_gain[t] = select(0.0, gain, valid && !record);
+        w_idx[t] = select(LI_NONE, t, valid && !record && gain > 0.0);
         workgroupBarrier();
         // Argmax, ties to the lower index.
         for (var s = 128u; s > 0u; s >>= 1u) {
@@ -161,10 +169,12 @@ fn place_main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
         }
         if valid {
             w_acc[t] += max(li_weight(w_pos[t], w_nrm[t], w_pos[best], w_nrm[best], w_reach[best], lp.one_minus_cos_max), 0.0);
-            if w_acc[t] >= lp.coverage {
+            // The record's own pixel is covered (its weight there is 1 up to rounding).
+            if w_acc[t] >= lp.coverage || t == best {
                 w_open[t] = 0u;
             }
         }
+        record = record || t == best;
         count += 1u;
         workgroupBarrier();
     }

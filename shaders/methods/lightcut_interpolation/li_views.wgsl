@@ -44,9 +44,7 @@ fn log_scale(v: f32, lo: f32, hi: f32) -> f32 {
 }
 
 fn grey_final(px: vec2<i32>) -> vec3<f32> {
-    let f = textureLoad(final_image, px, 0).rgb * vp.exposure;
-    let t = tonemap(max(f, vec3<f32>(0.0)), vp.tonemap);
-    return vec3<f32>(linear_to_srgb(vec3<f32>(luminance(t))).x) * 0.8;
+    return vec3<f32>(display_grey(textureLoad(final_image, px, 0).rgb, vp.exposure, vp.tonemap)) * 0.8;
 }
 
 @compute @workgroup_size(8, 8, 1)

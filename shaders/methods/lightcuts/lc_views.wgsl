@@ -54,9 +54,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 c = false_color(log_scale(d.y + 1.0, 1.0, top));
             }
             default: {
-                let f = textureLoad(final_image, px, 0).rgb * vp.exposure;
-                let t = tonemap(max(f, vec3<f32>(0.0)), vp.tonemap);
-                c = vec3<f32>(linear_to_srgb(vec3<f32>(luminance(t))).x) * 0.8;
+                c = vec3<f32>(display_grey(textureLoad(final_image, px, 0).rgb, vp.exposure, vp.tonemap)) * 0.8;
                 if d.z > vp.relative_error {
                     c = vec3<f32>(0.95, 0.1, 0.1);
                 }

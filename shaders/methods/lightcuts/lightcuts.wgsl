@@ -28,6 +28,7 @@
 #include "common/vpl_visibility.wgsl"
 #include "common/sst_node.wgsl"
 #include "methods/lightcuts/lc_common.wgsl"
+#include "common/stats64.wgsl"
 
 override DIAGNOSTICS: bool = true;
 override MODE: u32 = 0u;
@@ -109,10 +110,7 @@ fn heap_bound(e: vec2<u32>) -> f32 {
 }
 
 fn add64(i: u32, v: u32) {
-    let old = atomicAdd(&stats[STATS_BASE + i], v);
-    if old > 0xffffffffu - v {
-        atomicAdd(&stats[STATS_BASE + i + 1u], 1u);
-    }
+    stats_add64(STATS_BASE + i, v);
 }
 
 // A node final at once (bound 0): counted; records keep it at the top of the scratch.
@@ -246,7 +244,9 @@ fn estimate(node: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 // Whether the node's representative is visible from x (one shadow ray when the estimate is
 // not 0 and shadow rays are on).
 fn visible(node: u32, e: vec3<f32>, x: vec3<f32>, n: vec3<f32>) -> bool {
-    if all(e == vec3<f32>(0.0)) {
+    // Records (MODE 1) trace every node: their bits are interpolated to pixels where the
+    // node contributes (`trace_every_node` in the CPU twin).
+    if all(e == vec3<f32>(0.0)) && MODE != 1u {
         return false;
     }
     if lp.shadow_rays == 0u {
@@ -329,7 +329,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 if traced {
                     trace_node(settled, 1u, vec4<f32>(0.0));
                 }
-                settle(lane, &settled, 1u, false);
+                settle(lane, &settled, 1u, MODE == 1u && visible(1u, estimate(1u, x, n), x, n));
             }
         }
     } else {
@@ -373,7 +373,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                     // The parent's representative: its shadow ray's answer.
                     vis = top_vis;
                     e = estimate(child, x, n);
-                } else if b > 0.0 || child >= lp.leaves {
+                } else if b > 0.0 || child >= lp.leaves || MODE == 1u {
                     e = estimate(child, x, n);
                     vis = visible(child, e, x, n);
                 }

@@ -21,6 +21,7 @@
 #include "common/box_term.wgsl"
 #include "common/slc.wgsl"
 #include "common/slc_params.wgsl"
+#include "common/stats64.wgsl"
 
 @group(0) @binding(0) var<uniform> sp: SlcParams;
 @group(0) @binding(1) var<storage, read> tree: array<SstNode>;
@@ -63,13 +64,6 @@ var<workgroup> wg_stats: array<atomic<u32>, 6>;
 
 // Adds v to the 64-bit counter at stats[i] (low word), stats[i + 1] (high word): the add
 // that wraps the low word carries one into the high word, so the pair is exact.
-fn add64(i: u32, v: u32) {
-    let old = atomicAdd(&stats[i], v);
-    if old > 0xffffffffu - v {
-        atomicAdd(&stats[i + 1u], 1u);
-    }
-}
-
 fn is_usable(i: u32) -> bool {
     return ((flags[i / 32u] >> (i % 32u)) & 1u) == 1u;
 }
@@ -201,7 +195,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
                 if li < 2u {
                     atomicAdd(&stats[li], v);
                 } else {
-                    add64(2u + 2u * (li - 2u), v);
+                    stats_add64(2u + 2u * (li - 2u), v);
                 }
             }
         }

@@ -31,9 +31,7 @@ struct ViewParams {
 @group(0) @binding(5) var dst: texture_storage_2d<rgba8unorm, write>;
 
 fn grey_final(px: vec2<i32>) -> vec3<f32> {
-    let c = textureLoad(final_image, px, 0).rgb * vp.exposure;
-    let t = tonemap(max(c, vec3<f32>(0.0)), vp.tonemap);
-    return vec3<f32>(linear_to_srgb(vec3<f32>(luminance(t))).x);
+    return vec3<f32>(display_grey(textureLoad(final_image, px, 0).rgb, vp.exposure, vp.tonemap));
 }
 
 @compute @workgroup_size(8, 8, 1)

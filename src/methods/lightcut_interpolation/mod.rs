@@ -417,6 +417,9 @@ impl Method for LightcutInterpolation {
         if cx.diagnostics {
             self.traced = cx.trace_pixel.is_some();
         }
+        if li != self.settings {
+            pass.clear_stats();
+        }
         self.settings = li;
         let f = FrameInputs {
             tree: cx.tree,
@@ -567,16 +570,10 @@ impl Method for LightcutInterpolation {
     /// Per pixel: cut size, level spread (-1: fallback), records used, shadow rays.
     fn read_view(&self, ctx: &GpuContext, _view: MethodView) -> Result<Option<ImageF32>, GpuError> {
         let Some(b) = &self.buffers else { return Ok(None) };
-        let n = b.size.0 as u64 * b.size.1 as u64;
-        if n <= 1 || self.state.is_none() {
+        if self.state.is_none() {
             return Ok(None);
         }
-        let bytes = readback::read_buffer_range(ctx, &b.diag, 0, 16 * n)?;
-        Ok(Some(ImageF32 {
-            width: b.size.0,
-            height: b.size.1,
-            pixels: bytemuck::pod_collect_to_vec(&bytes),
-        }))
+        readback::read_vec4_image(ctx, &b.diag, b.size)
     }
 
     fn pixel_rows(
@@ -593,8 +590,7 @@ impl Method for LightcutInterpolation {
             return Ok(Vec::new());
         }
         let k = y as u64 * b.size.0 as u64 + x as u64;
-        let d: [f32; 4] =
-            bytemuck::pod_read_unaligned(&readback::read_buffer_range(ctx, &b.diag, k * 16, 16)?[..16]);
+        let d = readback::read_vec4_pixel(ctx, &b.diag, b.size.0, x, y)?;
         let sel: [u32; 8] =
             bytemuck::pod_read_unaligned(&readback::read_buffer_range(ctx, &b.sel, k * 32, 32)?[..32]);
         let w = |i: usize| f32::from_bits(sel[i]);

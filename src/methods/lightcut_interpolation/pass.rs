@@ -281,7 +281,9 @@ impl LiBuffers {
             diag: storage(device, "li::diag", 16 * px),
             stats: storage(device, "li::stats", 4 * STATS_WORDS as u64),
             trace: storage(device, "li::trace", 4 * TRACE_WORDS),
-            walk_state: storage(device, "li::walk_state", if split_walk { 96 * px } else { 16 }),
+            // One LiState (96 bytes, li_interp.wgsl) at least: a binding smaller than the
+            // struct is rejected at dispatch.
+            walk_state: storage(device, "li::walk_state", if split_walk { 96 * px } else { 96 }),
             scratch: storage(device, "li::scratch", 8 * slice * max_cut as u64),
             lc_state: storage(device, "li::lc_state", 32 * slice),
             record_slice,
@@ -339,6 +341,13 @@ pub struct LiPass {
     view_params: wgpu::Buffer,
     stats_readback: AsyncReadback,
     last_stats: Option<LiStats>,
+}
+
+/// `n` workgroups of a 1D kernel as (x, y) within the 65535-per-dimension limit (the kernel
+/// numbers them `x + y * num_workgroups.x`).
+pub fn groups_1d_as_2d(n: u32) -> (u32, u32) {
+    let x = n.clamp(1, 65535);
+    (x, n.div_ceil(x).max(1))
 }
 
 fn params_buffer(device: &wgpu::Device, n: u32) -> wgpu::Buffer {
@@ -496,7 +505,10 @@ impl LiPass {
         let tiles = b.tiles.0 * b.tiles.1;
         for (name, pipe, groups) in [
             ("li_radius", &self.radius, groups_image(p.width, p.height)),
-            ("li_place", &self.place, (tiles, 1, 1)),
+            ("li_place", &self.place, {
+                let (gx, gy) = groups_1d_as_2d(tiles);
+                (gx, gy, 1)
+            }),
             ("li_compact", &self.compact, (1, 1, 1)),
         ] {
             encoder.push_debug_group(name);
@@ -687,6 +699,11 @@ impl LiPass {
 
     pub fn last_stats(&self) -> Option<LiStats> {
         self.last_stats
+    }
+
+    /// Forgets the counters (the settings changed: they described other settings).
+    pub fn clear_stats(&mut self) {
+        self.last_stats = None;
     }
 
     /// The counters of the latest diagnostic frame read back (non-blocking).

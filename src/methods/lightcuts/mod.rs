@@ -357,17 +357,10 @@ impl Method for Lightcuts {
 
     /// Per pixel: cut size, refinements, largest bound left / estimate, shadow rays.
     fn read_view(&self, ctx: &GpuContext, _view: MethodView) -> Result<Option<ImageF32>, GpuError> {
-        let b = &self.buffers;
-        let n = b.size.0 as u64 * b.size.1 as u64;
-        if n <= 1 || self.state.is_none() {
+        if self.state.is_none() {
             return Ok(None);
         }
-        let bytes = readback::read_buffer_range(ctx, &b.diag, 0, 16 * n)?;
-        Ok(Some(ImageF32 {
-            width: b.size.0,
-            height: b.size.1,
-            pixels: bytemuck::pod_collect_to_vec(&bytes),
-        }))
+        readback::read_vec4_image(ctx, &self.buffers.diag, self.buffers.size)
     }
 
     fn pixel_rows(
@@ -381,9 +374,7 @@ impl Method for Lightcuts {
         if b.size != frame || x >= frame.0 || y >= frame.1 || self.state.is_none() {
             return Ok(Vec::new());
         }
-        let off = (y as u64 * b.size.0 as u64 + x as u64) * 16;
-        let bytes = readback::read_buffer_range(ctx, &b.diag, off, 16)?;
-        let d: [f32; 4] = bytemuck::pod_read_unaligned(&bytes[..16]);
+        let d = readback::read_vec4_pixel(ctx, &b.diag, b.size.0, x, y)?;
         Ok(vec![(
             "lightcut (cut size, refinements, bound / estimate, shadow rays)",
             d,

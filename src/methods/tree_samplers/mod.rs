@@ -486,17 +486,7 @@ impl Method for TreeSamplers {
     /// The per-pixel diagnostics (steps per traversal, fell back, samples, 1 + block) at the
     /// GI resolution, whichever of the views asks.
     fn read_view(&self, ctx: &GpuContext, _view: MethodView) -> Result<Option<ImageF32>, GpuError> {
-        let b = &self.buffers;
-        let n = b.size.0 as u64 * b.size.1 as u64;
-        if n <= 1 {
-            return Ok(None);
-        }
-        let bytes = readback::read_buffer_range(ctx, &b.diag, 0, 16 * n)?;
-        Ok(Some(ImageF32 {
-            width: b.size.0,
-            height: b.size.1,
-            pixels: bytemuck::pod_collect_to_vec(&bytes),
-        }))
+        readback::read_vec4_image(ctx, &self.buffers.diag, self.buffers.size)
     }
 
     fn read_story(&self, ctx: &GpuContext) -> Result<Option<PixelTrace>, GpuError> {
@@ -521,9 +511,7 @@ impl Method for TreeSamplers {
         if dx >= b.size.0 || dy >= b.size.1 {
             return Ok(Vec::new());
         }
-        let off = (dy as u64 * b.size.0 as u64 + dx as u64) * 16;
-        let bytes = readback::read_buffer_range(ctx, &b.diag, off, 16)?;
-        let d: [f32; 4] = bytemuck::pod_read_unaligned(&bytes[..16]);
+        let d = readback::read_vec4_pixel(ctx, &b.diag, b.size.0, dx, dy)?;
         Ok(vec![("sampling (steps, fallback, samples, 1 + block)", d)])
     }
 
