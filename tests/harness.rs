@@ -78,11 +78,14 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "1",
             "--vpls",
             "1024",
-            // Lightcuts beside the three samplers, over two thresholds (tiny: CI time).
+            // Lightcuts and Lightcut Interpolation beside the three samplers, over two
+            // thresholds and one record reach (tiny: CI time).
             "--methods",
-            "slc,rtslc,sst,lightcuts",
+            "slc,rtslc,sst,lightcuts,lightcut-interpolation",
             "--sweep",
             "lightcuts=0.2,0.05",
+            "--sweep",
+            "lightcut-interpolation=2",
             // The interpolation figure's cuts small (and `--set` reaching `results`).
             "--set",
             "methods.lightcut-interpolation.max_cut=64",
@@ -119,7 +122,8 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     ] {
         assert!(groups.contains(&g), "timings.csv lacks {g}: {groups:?}");
     }
-    // 3 samplers x spp {2, 8, 32 (the base cut size is added)} + Lightcuts x 2 thresholds.
+    // 3 samplers x spp {2, 8, 32 (the base cut size is added)} + Lightcuts x 2 thresholds +
+    // Lightcut Interpolation x 1 reach.
     check_csv(
         &d,
         "equal_time.csv",
@@ -133,13 +137,17 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "bias_rmse",
             "noise_rmse",
         ],
-        11,
+        12,
     );
     let (_, rows) = read_csv(&d.join("equal_time.csv"));
     for r in &rows {
         if r["method"] == "Lightcuts" {
             assert_eq!(r["setting"], "relative_error", "{r:?}");
             assert!(r["method_stats"].contains("mean_cut_size="), "{r:?}");
+        } else if r["method"] == "LI" {
+            assert_eq!(r["setting"], "record_reach_scale", "{r:?}");
+            assert_eq!(r["value"], "2", "{r:?}");
+            assert!(r["method_stats"].contains("records_per_pixel="), "{r:?}");
         } else {
             assert_eq!(r["setting"], "spp", "{r:?}");
             assert_eq!(r["spp"], r["value"], "{r:?}");
@@ -282,6 +290,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         "images/equal_time_slc.png",
         "images/equal_time_sst_error.png",
         "images/equal_time_lightcuts.png",
+        "images/equal_time_li.png",
         "images/steps_rtslc.png",
         "images/block_1.png",
         "images/blend_no_blending.png",

@@ -120,7 +120,7 @@ pub static INFO: MethodInfo = MethodInfo {
     id: ID,
     aliases: &["li"],
     label: "Lightcut Interpolation",
-    short: "LC interp.",
+    short: "LI",
     about: "Lightcut Interpolation (Rehfeld & Dachsbacher 2016): exact lightcuts at image-space \
             cache records, per pixel the three best records' cuts interpolated into one valid \
             cut; shadow rays per node or interpolated visibility.",
@@ -334,12 +334,12 @@ impl Method for LightcutInterpolation {
             .as_ref()
             .is_some_and(|b| b.matches(leaves, cx.size, max_cut, split))
         {
-            let need = LiBuffers::largest_binding(leaves, cx.size, max_cut, split);
+            let need = LiBuffers::largest_binding(leaves, cx.size, split);
             let limit = cx.device.limits().max_storage_buffer_binding_size;
             if need > limit {
                 cx.errors.report(format!(
-                    "lightcut interpolation: {}x{} pixels, {leaves} leaves and cuts of {max_cut} \
-                     need a {} MiB buffer; this device binds at most {} MiB",
+                    "lightcut interpolation: {}x{} pixels and {leaves} leaves need a {} MiB \
+                     buffer; this device binds at most {} MiB",
                     cx.size.0,
                     cx.size.1,
                     need >> 20,
@@ -355,6 +355,7 @@ impl Method for LightcutInterpolation {
                 cx.size,
                 max_cut,
                 SCRATCH_BUDGET.min(limit),
+                limit,
                 split,
             ));
         }
@@ -666,8 +667,13 @@ impl Method for LightcutInterpolation {
 
     fn status(&mut self) -> Option<String> {
         let st = self.poll_stats()?;
+        let dropped = if st.dropped_records > 0 {
+            format!(" · {} records dropped (memory)", st.dropped_records)
+        } else {
+            String::new()
+        };
         Some(format!(
-            "{} records ({:.2}% of pixels, cuts of {:.0}) · cut {:.1} nodes per pixel · {:.1} shadow rays per pixel · fallback {:.2}%",
+            "{} records ({:.2}% of pixels, cuts of {:.0}) · cut {:.1} nodes per pixel · {:.1} shadow rays per pixel · fallback {:.2}%{dropped}",
             st.records,
             100.0 * st.records_per_pixel(),
             st.mean_record_cut(),

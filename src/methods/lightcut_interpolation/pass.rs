@@ -207,10 +207,15 @@ fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     })
 }
 
-/// Records at most for `pixels` pixels in `tiles` tiles: one per 8 pixels (at least 256),
-/// never more than the tiles can place.
-pub fn record_capacity(pixels: u32, tiles: u32) -> u32 {
-    (pixels / 8).max(256).min(tiles * TILE_CAP).max(1)
+/// Records at most in `tiles` tiles with cuts of `max_cut`: every record the tiles can place
+/// (detailed geometry at a low resolution places one for every 5 or 6 pixels: Sponza at
+/// 192 x 108), unless their cuts would not fit a binding of `limit` bytes; records past the
+/// capacity are dropped and counted (`dropped_records`), their pixels fall back.
+pub fn record_capacity(tiles: u32, max_cut: u32, limit: u64) -> u32 {
+    let fit = limit / (4 * max_cut.max(1) as u64);
+    (tiles as u64 * TILE_CAP as u64)
+        .min(fit)
+        .clamp(1, u32::MAX as u64) as u32
 }
 
 /// Per-node, per-record and per-pixel buffers (resized with the tree, frame and settings).
@@ -244,18 +249,20 @@ pub struct LiBuffers {
 }
 
 impl LiBuffers {
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         device: &wgpu::Device,
         leaves: u32,
         size: (u32, u32),
         max_cut: u32,
         budget: u64,
+        binding_limit: u64,
         split_walk: bool,
     ) -> Self {
         let pixels = size.0 * size.1;
         let tiles = (size.0.div_ceil(TILE), size.1.div_ceil(TILE));
         let nt = tiles.0 * tiles.1;
-        let capacity = record_capacity(pixels, nt);
+        let capacity = record_capacity(nt, max_cut, binding_limit);
         let record_slice = slice_pixels(capacity, max_cut, budget);
         let fallback_slice = slice_pixels(pixels, max_cut, budget);
         let slice = record_slice.max(fallback_slice) as u64;
@@ -292,19 +299,13 @@ impl LiBuffers {
     }
 
     /// Bytes of the largest binding for these sizes (the scratch stays within its budget).
-    pub fn largest_binding(leaves: u32, size: (u32, u32), max_cut: u32, split_walk: bool) -> u64 {
+    /// (The records' cuts fit by construction: [`record_capacity`].)
+    pub fn largest_binding(leaves: u32, size: (u32, u32), split_walk: bool) -> u64 {
         let px = size.0 as u64 * size.1 as u64;
-        let nt = (size.0.div_ceil(TILE) * size.1.div_ceil(TILE)) as u64;
-        let cap = record_capacity(size.0 * size.1, nt as u32) as u64;
-        [
-            32 * leaves as u64,
-            32 * px,
-            4 * cap * max_cut as u64,
-            if split_walk { 96 * px } else { 0 },
-        ]
-        .into_iter()
-        .max()
-        .unwrap_or(0)
+        [32 * leaves as u64, 32 * px, if split_walk { 96 * px } else { 0 }]
+            .into_iter()
+            .max()
+            .unwrap_or(0)
     }
 
     pub fn matches(&self, leaves: u32, size: (u32, u32), max_cut: u32, split_walk: bool) -> bool {
