@@ -101,7 +101,7 @@ def build_scene_dict(mi, scene_dir: Path, meta: dict, width: int, height: int, s
             "near_clip": 1e-3,
             "far_clip": 1e4,
             # Mitsuba cameras look down local +Z with +X image-left: build from look_at, never
-            # from the glTF node matrix (see /work/shared/docs/mitsuba-notes.md).
+            # from the glTF node matrix (see ../shared/docs/mitsuba-notes.md).
             "to_world": mi.ScalarTransform4f().look_at(origin=eye.tolist(), target=(eye + fwd).tolist(),
                                                         up=up.tolist()),
             "film": {
