@@ -28,7 +28,7 @@ use lightcut::{
         lightcuts::{CutParams, lightcut},
     },
     renderer::{
-        Buffer,
+        Buffer, FrameInput,
         context::GpuContext,
         readback::{ImageF32, read_storage_buffer},
         settings::{RenderSettings, Tonemap, ViewBuffer},
@@ -337,6 +337,56 @@ fn gpu_records_selection_and_interpolation_equal_the_cpu_reference() {
     }
     assert_eq!(story.cut.as_ref().map(|c| c.nodes.clone()), Some(ids.clone()));
     assert_eq!(story.disagreements, cpu.disagreements);
+    // The records view rings the pinned pixel's records in white (and no other pixel's).
+    st.r.render(&FrameInput {
+        camera: &st.cam,
+        lights: &st.scene.lights,
+        view: ViewBuffer::Method(li::RECORDS),
+    });
+    let (vw, vh, rgba) = st.r.read_view_rgba8().unwrap();
+    assert_eq!((vw, vh), (W, H));
+    let white = |x: i32, y: i32| {
+        if x < 0 || y < 0 || x >= W as i32 || y >= H as i32 {
+            return None;
+        }
+        let i = 4 * (y as usize * W as usize + x as usize);
+        Some(rgba[i..i + 3] == [255, 255, 255])
+    };
+    let ringed: Vec<(i32, i32)> = tr
+        .records
+        .iter()
+        .map(|&r| {
+            let k = rec.pixels[r as usize];
+            ((k % W) as i32, (k / W) as i32)
+        })
+        .collect();
+    for &(rx, ry) in &ringed {
+        let ring: Vec<bool> = (-2..=2)
+            .flat_map(|d| {
+                [
+                    (rx + d, ry - 2),
+                    (rx + d, ry + 2),
+                    (rx - 2, ry + d),
+                    (rx + 2, ry + d),
+                ]
+            })
+            .filter_map(|(x, y)| white(x, y))
+            .collect();
+        assert!(
+            !ring.is_empty() && ring.iter().all(|&w| w),
+            "record at ({rx}, {ry}) not ringed"
+        );
+    }
+    let whites = (0..H as i32)
+        .flat_map(|y| (0..W as i32).map(move |x| (x, y)))
+        .filter(|&(x, y)| white(x, y) == Some(true))
+        .filter(|&(x, y)| {
+            !ringed
+                .iter()
+                .any(|&(rx, ry)| (x - rx).abs().max((y - ry).abs()) == 2)
+        })
+        .count();
+    assert_eq!(whites, 0, "white pixels away from the pinned pixel's records");
 
     // The counters: every walk finished; fallback fraction as counted here.
     assert_eq!(stat(&mut st, "unfinished_walks"), 0.0);

@@ -561,6 +561,10 @@ mod tests {
                         offset_of!(P, tonemap),
                         offset_of!(P, tiles_x),
                         offset_of!(P, tiles_y),
+                        offset_of!(P, pinned),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                        offset_of!(P, _pad) + 8,
                     ]
                 },
             ),

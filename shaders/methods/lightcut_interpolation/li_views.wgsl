@@ -1,6 +1,7 @@
 // Lightcut Interpolation's views over the frame:
 //   mode 0: the cache records over the grey final image, 3 x 3 dots coloured by their reach
-//           from red (r_min_px) to green (r_max_px), as the paper's Fig. 4 (top);
+//           from red (r_min_px) to green (r_max_px), as the paper's Fig. 4 (top); the
+//           pinned pixel's records as white 5 x 5 rings;
 //   mode 1: interpolation weights: each pixel's records' colours (hashed ids) mixed by its
 //           weights (Fig. 4, middle); fallback pixels magenta;
 //   mode 2: the fallback mask: pixels that computed a full lightcut, red over the grey final;
@@ -20,6 +21,10 @@ struct LiViewParams {
     tonemap: u32,
     tiles_x: u32,
     tiles_y: u32,
+    pinned: u32, // the pinned pixel (row-major index), or LI_NONE
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 struct LiSel {
@@ -47,6 +52,20 @@ fn grey_final(px: vec2<i32>) -> vec3<f32> {
     return vec3<f32>(display_grey(textureLoad(final_image, px, 0).rgb, vp.exposure, vp.tonemap)) * 0.8;
 }
 
+// Whether record `id` is one of the pinned pixel's records.
+fn pinned_uses(id: u32) -> bool {
+    if vp.pinned == LI_NONE {
+        return false;
+    }
+    let s = sel[vp.pinned];
+    for (var i = 0u; i < s.ids.w; i++) {
+        if s.ids[i] == id {
+            return true;
+        }
+    }
+    return false;
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let size = textureDimensions(dst);
@@ -65,6 +84,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 c = grey_final(px);
             }
             let count = rec_meta[0];
+            var ringed = false; // drawn over every dot
             let tx = i32(gid.x / LI_TILE);
             let ty = i32(gid.y / LI_TILE);
             for (var dy = -1; dy <= 1; dy++) {
@@ -82,12 +102,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                         }
                         let r = records[id];
                         let q = vec2<i32>(i32(r % size.x), i32(r / size.x));
-                        if all(abs(q - px) <= vec2<i32>(1)) {
+                        let d = abs(q - px);
+                        if all(d <= vec2<i32>(1)) {
                             let f = clamp((radius[r].y - vp.r_min_px) / max(vp.r_max_px - vp.r_min_px, 1e-6), 0.0, 1.0);
                             c = mix(vec3<f32>(0.95, 0.1, 0.1), vec3<f32>(0.1, 0.9, 0.2), f);
                         }
+                        if max(d.x, d.y) == 2 && pinned_uses(id) {
+                            ringed = true;
+                        }
                     }
                 }
+            }
+            if ringed {
+                c = vec3<f32>(1.0);
             }
         }
         case 1u: {

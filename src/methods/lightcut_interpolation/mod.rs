@@ -76,7 +76,8 @@ const VIEWS: &[ViewInfo] = &[
     ViewInfo {
         name: RECORDS.name(),
         file: "li_records",
-        about: "cache records over the grey final image, coloured by reach (red R-, green R+)",
+        about: "cache records over the grey final image, coloured by reach (red R-, green R+); \
+                the pinned pixel's records ringed in white",
         passes: &["li_radius", "li_place", "li_compact"],
     },
     ViewInfo {
@@ -204,6 +205,9 @@ pub struct LightcutInterpolation {
     buffers: Option<LiBuffers>,
     state: Option<(u64, u32)>,
     traced: bool,
+    /// The pinned pixel of the last frame (row-major index; the records view marks its
+    /// records).
+    pinned: Option<u32>,
     settings: LightcutInterpolationSettings,
     steps: (u32, u32),
 }
@@ -214,6 +218,7 @@ fn create(_device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
         buffers: None,
         state: None,
         traced: false,
+        pinned: None,
         settings: LightcutInterpolationSettings::default(),
         steps: (0, 0),
     }))
@@ -418,6 +423,13 @@ impl Method for LightcutInterpolation {
         if cx.diagnostics {
             self.traced = cx.trace_pixel.is_some();
         }
+        if cx.diagnostics {
+            // (Timed frames trace nothing: the view keeps the last diagnostic frame's pin.)
+            self.pinned = cx
+                .trace_pixel
+                .filter(|&(x, y)| x < cx.size.0 && y < cx.size.1)
+                .map(|(x, y)| y * cx.size.0 + x);
+        }
         if li != self.settings {
             pass.clear_stats();
         }
@@ -479,6 +491,8 @@ impl Method for LightcutInterpolation {
             tonemap: cx.look.tonemap.gpu_id(),
             tiles_x: b.tiles.0,
             tiles_y: b.tiles.1,
+            pinned: self.pinned.unwrap_or(u32::MAX),
+            _pad: [0; 3],
         };
         pass.record_view(
             cx.device,

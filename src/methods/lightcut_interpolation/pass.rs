@@ -74,6 +74,9 @@ pub struct GpuLiViewParams {
     pub tonemap: u32,
     pub tiles_x: u32,
     pub tiles_y: u32,
+    /// The pinned pixel (row-major index), or u32::MAX.
+    pub pinned: u32,
+    pub _pad: [u32; 3],
 }
 
 /// Walk units (lowest-edge steps and emitted nodes) per `li_interp` dispatch: all on a GPU,
