@@ -42,16 +42,25 @@ impl AsyncReadback {
         self.state.load(Ordering::Acquire) == IDLE
     }
 
-    /// Records `(source, source offset, destination offset, bytes)` copies when idle; returns
-    /// whether it did.
+    /// Records `(source, source offset, destination offset, bytes)` copies unless a copy is
+    /// still in flight; returns whether it did. A finished result nobody took is dropped: the
+    /// new copy supersedes it (else a reader that polls rarely would keep every later frame's
+    /// copy from being recorded, and read a stale one).
     pub fn record(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         copies: &[(&wgpu::Buffer, u64, u64, u64)],
     ) -> bool {
-        if !self.is_idle() || copies.is_empty() {
+        if copies.is_empty() {
             return false;
         }
+        match self.state.load(Ordering::Acquire) {
+            READY => self.buffer.unmap(),
+            FAILED => {}
+            IDLE => {}
+            _ => return false,
+        }
+        self.state.store(IDLE, Ordering::Release);
         let mut len = 0;
         for &(src, src_offset, dst_offset, bytes) in copies {
             encoder.copy_buffer_to_buffer(src, src_offset, &self.buffer, dst_offset, bytes);
@@ -99,6 +108,48 @@ impl AsyncReadback {
             }
             _ => None,
         }
+    }
+}
+
+/// Frame counters of type `T` (parsed from u32 words) read back without blocking: record the
+/// copies in diagnostic frames, `after_submit` after the submit, `poll` later; `last` keeps
+/// the latest parsed ones.
+pub struct CounterReadback<T> {
+    readback: AsyncReadback,
+    parse: fn(&[u32]) -> T,
+    last: Option<T>,
+}
+
+impl<T: Copy> CounterReadback<T> {
+    pub fn new(device: &wgpu::Device, label: &str, bytes: u64, parse: fn(&[u32]) -> T) -> Self {
+        Self {
+            readback: AsyncReadback::new(device, label, bytes),
+            parse,
+            last: None,
+        }
+    }
+    /// Records `(source, source offset, destination offset, bytes)` copies (AsyncReadback).
+    pub fn record(&mut self, encoder: &mut wgpu::CommandEncoder, copies: &[(&wgpu::Buffer, u64, u64, u64)]) {
+        self.readback.record(encoder, copies);
+    }
+    pub fn after_submit(&self) {
+        self.readback.after_submit();
+    }
+    /// The counters last read back (without polling).
+    pub fn last(&self) -> Option<T> {
+        self.last
+    }
+    /// The counters of the latest copy read back (non-blocking; poll the device first for
+    /// the newest).
+    pub fn poll(&mut self) -> Option<T> {
+        if let Some(bytes) = self.readback.try_take() {
+            self.last = Some((self.parse)(bytemuck::cast_slice(&bytes)));
+        }
+        self.last
+    }
+    /// Forgets the counters (they described other settings).
+    pub fn clear(&mut self) {
+        self.last = None;
     }
 }
 

@@ -309,7 +309,7 @@ impl LightcutInterpolation {
 
     /// Counters of a recent diagnostic frame (non-blocking).
     pub fn poll_stats(&mut self) -> Option<LiStats> {
-        self.pass.as_mut()?.poll_stats()
+        self.pass.as_mut()?.stats.poll()
     }
 }
 
@@ -431,7 +431,7 @@ impl Method for LightcutInterpolation {
                 .map(|(x, y)| y * cx.size.0 + x);
         }
         if li != self.settings {
-            pass.clear_stats();
+            pass.stats.clear();
         }
         self.settings = li;
         let f = FrameInputs {
@@ -458,7 +458,7 @@ impl Method for LightcutInterpolation {
 
     fn after_submit(&mut self) {
         if let Some(p) = &self.pass {
-            p.after_submit();
+            p.stats.after_submit();
         }
     }
 
@@ -623,7 +623,7 @@ impl Method for LightcutInterpolation {
     }
 
     fn legend(&self, view: MethodView, _tree_levels: u32) -> Option<Legend> {
-        let st = self.pass.as_ref()?.last_stats();
+        let st = self.pass.as_ref()?.stats.last();
         if view == CUT_SIZE {
             Some(Legend {
                 title: match st {

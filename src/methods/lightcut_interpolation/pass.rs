@@ -8,18 +8,17 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::methods::lightcuts::pass::{
-    BuildKernel, CutBindings, CutKernel, GpuLcParams, STRIDE, dispatches_per_slice, slice_pixels,
-};
+use crate::methods::lightcuts::pass::{BuildKernel, CutBindings, CutKernel, GpuLcParams, slice_pixels};
 use crate::reference::lightcut_interpolation::{TILE, TILE_CAP};
 use crate::renderer::{
     frame::GbufferTargets,
     passes::sst_build::TreeBuffers,
     passes::{
-        WG_1D, bind_group_seq, compute_pipeline_with, dynamic_uniform_entry, float_texture_entry,
-        groups_image, run_compute, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
+        StridedUniforms, WG_1D, bind_group_seq, compute_pipeline_with, dynamic_uniform_entry,
+        float_texture_entry, groups_image, run_compute, storage_buffer, storage_entry, storage_texture_entry,
+        uniform_buffer, uniform_entry,
     },
-    readback::AsyncReadback,
+    readback::CounterReadback,
     scene_gpu::SceneGpu,
     shaders,
     timing::GpuTimer,
@@ -201,15 +200,6 @@ impl TracedInterpolation {
     }
 }
 
-fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: size.max(16),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
-}
-
 /// Records at most in `tiles` tiles with cuts of `max_cut`: every record the tiles can place
 /// (detailed geometry at a low resolution places one for every 5 or 6 pixels: Sponza at
 /// 192 x 108), unless their cuts would not fit a binding of `limit` bytes; records past the
@@ -278,24 +268,24 @@ impl LiBuffers {
             tiles,
             capacity,
             split_walk,
-            cones: storage(device, "li::cones", 16 * nodes),
-            reps: storage(device, "li::reps", 4 * nodes),
-            radius: storage(device, "li::radius", 8 * px),
-            tile_count: storage(device, "li::tile_count", 4 * nt as u64),
-            tile_recs: storage(device, "li::tile_recs", 4 * (nt * TILE_CAP) as u64),
-            tile_offset: storage(device, "li::tile_offset", 4 * nt as u64),
-            records: storage(device, "li::records", 4 * capacity as u64),
-            rec_meta: storage(device, "li::rec_meta", 4 * (8 + capacity as u64)),
-            record_cuts: storage(device, "li::record_cuts", 4 * capacity as u64 * max_cut as u64),
-            sel: storage(device, "li::sel", 32 * px),
-            diag: storage(device, "li::diag", 16 * px),
-            stats: storage(device, "li::stats", 4 * STATS_WORDS as u64),
-            trace: storage(device, "li::trace", 4 * TRACE_WORDS),
+            cones: storage_buffer(device, "li::cones", 16 * nodes),
+            reps: storage_buffer(device, "li::reps", 4 * nodes),
+            radius: storage_buffer(device, "li::radius", 8 * px),
+            tile_count: storage_buffer(device, "li::tile_count", 4 * nt as u64),
+            tile_recs: storage_buffer(device, "li::tile_recs", 4 * (nt * TILE_CAP) as u64),
+            tile_offset: storage_buffer(device, "li::tile_offset", 4 * nt as u64),
+            records: storage_buffer(device, "li::records", 4 * capacity as u64),
+            rec_meta: storage_buffer(device, "li::rec_meta", 4 * (8 + capacity as u64)),
+            record_cuts: storage_buffer(device, "li::record_cuts", 4 * capacity as u64 * max_cut as u64),
+            sel: storage_buffer(device, "li::sel", 32 * px),
+            diag: storage_buffer(device, "li::diag", 16 * px),
+            stats: storage_buffer(device, "li::stats", 4 * STATS_WORDS as u64),
+            trace: storage_buffer(device, "li::trace", 4 * TRACE_WORDS),
             // One LiState (96 bytes, li_interp.wgsl) at least: a binding smaller than the
             // struct is rejected at dispatch.
-            walk_state: storage(device, "li::walk_state", if split_walk { 96 * px } else { 96 }),
-            scratch: storage(device, "li::scratch", 8 * slice * max_cut as u64),
-            lc_state: storage(device, "li::lc_state", 32 * slice),
+            walk_state: storage_buffer(device, "li::walk_state", if split_walk { 96 * px } else { 96 }),
+            scratch: storage_buffer(device, "li::scratch", 8 * slice * max_cut as u64),
+            lc_state: storage_buffer(device, "li::lc_state", 32 * slice),
             record_slice,
             fallback_slice,
         }
@@ -338,13 +328,13 @@ pub struct LiPass {
     interp_layout: wgpu::BindGroupLayout,
     interp: wgpu::ComputePipeline,
     interp_timed: wgpu::ComputePipeline,
-    /// Per-dispatch uniforms (grown as needed).
-    params: wgpu::Buffer,
+    /// Uniforms: 0 the records' and selection's; 1.. the walk's dispatches.
+    params: StridedUniforms<GpuLiParams>,
     views_layout: wgpu::BindGroupLayout,
     views: wgpu::ComputePipeline,
     view_params: wgpu::Buffer,
-    stats_readback: AsyncReadback,
-    last_stats: Option<LiStats>,
+    /// The frame counters (diagnostic frames).
+    pub stats: CounterReadback<LiStats>,
 }
 
 /// `n` workgroups of a 1D kernel as (x, y) within the 65535-per-dimension limit (the kernel
@@ -352,15 +342,6 @@ pub struct LiPass {
 pub fn groups_1d_as_2d(n: u32) -> (u32, u32) {
     let x = n.clamp(1, 65535);
     (x, n.div_ceil(x).max(1))
-}
-
-fn params_buffer(device: &wgpu::Device, n: u32) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("li::params"),
-        size: n.max(1) as u64 * STRIDE,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
 }
 
 impl LiPass {
@@ -432,12 +413,16 @@ impl LiPass {
                 &[("DIAGNOSTICS", 0.0)],
             ),
             interp_layout,
-            params: params_buffer(device, 4),
+            params: StridedUniforms::new(device, "li::params", 4),
             views: pipe("li_views", &views_layout, &vmod, "main", &[]),
             views_layout,
             view_params: uniform_buffer::<GpuLiViewParams>(device, "li_views::params"),
-            stats_readback: AsyncReadback::new(device, "li::stats_readback", (STATS_WORDS * 4) as u64),
-            last_stats: None,
+            stats: CounterReadback::new(
+                device,
+                "li::stats_readback",
+                (STATS_WORDS * 4) as u64,
+                LiStats::from_words,
+            ),
         })
     }
 
@@ -460,30 +445,20 @@ impl LiPass {
         // Uniforms: 0 the records' and selection's; 1.. the walk's dispatches.
         let walks = walk_dispatches(p.max_cut, f.tree.levels(), p.steps);
         let n = 1 + walks;
-        if self.params.size() < n as u64 * STRIDE {
-            self.params = params_buffer(device, n);
-        }
-        let mut all = Vec::with_capacity(n as usize * STRIDE as usize);
-        for i in 0..n {
-            let q = if i == 0 {
-                p
-            } else {
-                GpuLiParams {
-                    first: (i == 1) as u32,
-                    last: (i == walks) as u32,
-                    ..p
+        let all: Vec<GpuLiParams> = (0..n)
+            .map(|i| {
+                if i == 0 {
+                    p
+                } else {
+                    GpuLiParams {
+                        first: (i == 1) as u32,
+                        last: (i == walks) as u32,
+                        ..p
+                    }
                 }
-            };
-            let mut bytes = bytemuck::bytes_of(&q).to_vec();
-            bytes.resize(STRIDE as usize, 0);
-            all.extend_from_slice(&bytes);
-        }
-        queue.write_buffer(&self.params, 0, &all);
-        let params = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-            buffer: &self.params,
-            offset: 0,
-            size: wgpu::BufferSize::new(std::mem::size_of::<GpuLiParams>() as u64),
-        });
+            })
+            .collect();
+        self.params.write(device, queue, &all);
         let tv = wgpu::BindingResource::TextureView;
         let g = f.gbuffer;
 
@@ -492,7 +467,7 @@ impl LiPass {
         );
 
         let rentries = [
-            params.clone(),
+            self.params.binding(),
             tv(&g.position_view),
             tv(&g.normal_view),
             f.camera.as_entire_binding(),
@@ -573,7 +548,7 @@ impl LiPass {
         );
 
         let sentries = [
-            params.clone(),
+            self.params.binding(),
             tv(&g.position_view),
             tv(&g.normal_view),
             b.radius.as_entire_binding(),
@@ -598,7 +573,7 @@ impl LiPass {
         encoder.pop_debug_group();
 
         let ientries = [
-            params,
+            self.params.binding(),
             tv(&g.position_view),
             tv(&g.normal_view),
             tv(&g.albedo_view),
@@ -628,9 +603,10 @@ impl LiPass {
             } else {
                 &self.interp_timed
             });
+            let (gx, gy) = groups_1d_as_2d((p.width * p.height).div_ceil(WG_1D));
             for i in 1..n {
-                pass.set_bind_group(0, &ibind, &[(i as u64 * STRIDE) as u32]);
-                pass.dispatch_workgroups((p.width * p.height).div_ceil(WG_1D), 1, 1);
+                pass.set_bind_group(0, &ibind, &[StridedUniforms::<GpuLiParams>::offset(i)]);
+                pass.dispatch_workgroups(gx, gy, 1);
             }
         }
         encoder.pop_debug_group();
@@ -652,9 +628,7 @@ impl LiPass {
             &fb,
         );
         if diagnostics {
-            // A result nobody took yet would keep this frame's from being recorded.
-            self.poll_stats();
-            self.stats_readback
+            self.stats
                 .record(encoder, &[(&b.stats, 0, 0, 96), (&b.rec_meta, 0, 96, 32)]);
         }
     }
@@ -696,31 +670,4 @@ impl LiPass {
             groups_image(b.size.0, b.size.1),
         );
     }
-
-    pub fn after_submit(&self) {
-        self.stats_readback.after_submit();
-    }
-
-    pub fn last_stats(&self) -> Option<LiStats> {
-        self.last_stats
-    }
-
-    /// Forgets the counters (the settings changed: they described other settings).
-    pub fn clear_stats(&mut self) {
-        self.last_stats = None;
-    }
-
-    /// The counters of the latest diagnostic frame read back (non-blocking).
-    pub fn poll_stats(&mut self) -> Option<LiStats> {
-        if let Some(bytes) = self.stats_readback.try_take() {
-            self.last_stats = Some(LiStats::from_words(bytemuck::cast_slice(&bytes)));
-        }
-        self.last_stats
-    }
-}
-
-/// The lightcut kernel's dispatch count per slice for these settings (re-exported for the
-/// tests' expectations).
-pub fn record_dispatches(max_cut: u32, levels: u32, steps: u32) -> u32 {
-    dispatches_per_slice(max_cut, levels, steps) + 1
 }

@@ -189,7 +189,7 @@ impl Lightcuts {
     }
     /// Counters of a recent diagnostic frame (non-blocking).
     pub fn poll_stats(&mut self) -> Option<LcStats> {
-        self.pass.poll_stats()
+        self.pass.stats.poll()
     }
     /// The seed of frame `frame_index`'s representatives.
     pub fn seed(s: &RenderSettings, frame_index: u64) -> u32 {
@@ -277,7 +277,7 @@ impl Method for Lightcuts {
     }
 
     fn after_submit(&mut self) {
-        self.pass.after_submit();
+        self.pass.stats.after_submit();
     }
 
     fn frames_averaged(&self) -> Option<u32> {
@@ -382,7 +382,7 @@ impl Method for Lightcuts {
     }
 
     fn legend(&self, view: MethodView, _tree_levels: u32) -> Option<Legend> {
-        let st = self.pass.last_stats();
+        let st = self.pass.stats.last();
         let top = decades(self.settings.max_cut) as f32;
         if view == CUT_SIZE {
             Some(Legend {
@@ -417,7 +417,7 @@ impl Method for Lightcuts {
     }
 
     fn stats(&mut self) -> Vec<(&'static str, f64)> {
-        match self.pass.poll_stats() {
+        match self.pass.stats.poll() {
             Some(st) => vec![
                 ("mean_cut_size", st.mean_cut()),
                 (
@@ -434,7 +434,7 @@ impl Method for Lightcuts {
     }
 
     fn status(&mut self) -> Option<String> {
-        let st = self.pass.poll_stats()?;
+        let st = self.pass.stats.poll()?;
         Some(format!(
             "lightcut {:.1} nodes per pixel · {:.1} shadow rays per pixel · {:.2}% pixels at max cut ({})",
             st.mean_cut(),

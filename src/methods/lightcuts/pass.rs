@@ -11,10 +11,11 @@ use crate::renderer::{
     frame::GbufferTargets,
     passes::sst_build::TreeBuffers,
     passes::{
-        WG_1D, bind_group_seq, compute_pipeline_with, dynamic_uniform_entry, float_texture_entry,
-        groups_image, run_compute, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
+        StridedUniforms, WG_1D, bind_group_seq, compute_pipeline_with, dynamic_uniform_entry,
+        float_texture_entry, groups_image, run_compute, storage_buffer, storage_entry, storage_texture_entry,
+        uniform_buffer, uniform_entry,
     },
-    readback::{self, AsyncReadback},
+    readback::{self, CounterReadback},
     scene_gpu::SceneGpu,
     shaders,
     timing::GpuTimer,
@@ -89,11 +90,10 @@ pub struct GpuLcViewParams {
     pub _pad: [u32; 3],
 }
 
-/// Dynamic-offset stride of the per-level build and per-slice uniforms; levels at most.
-pub const STRIDE: u64 = 256;
 /// Bytes of the heaps' scratch at most (slice x max_cut entries of 8 bytes).
 pub const SCRATCH_BUDGET: u64 = 128 << 20;
-const MAX_LEVELS: u64 = 32;
+/// Tree levels the build's uniforms start with (they grow).
+const MAX_LEVELS: u32 = 32;
 /// Counter words: pixels, pixels at max_cut, cut nodes, refinements, shadow rays (64 bit each).
 const STATS: usize = 8;
 const TRACE_WORDS: u64 = 8 + 8 * MAX_CUT as u64;
@@ -205,18 +205,10 @@ pub struct LcBuffers {
 /// Pixels per slice for `pixels` pixels and cuts of `max_cut` within `budget` bytes: a
 /// multiple of the workgroup size, at least one workgroup.
 pub fn slice_pixels(pixels: u32, max_cut: u32, budget: u64) -> u32 {
-    let fit = (budget / (8 * max_cut.max(1) as u64)).min(u32::MAX as u64) as u32;
+    // At most 65535 workgroups per dispatch (one dispatch per slice).
+    let fit = (budget / (8 * max_cut.max(1) as u64)).min(65535 * WG_1D as u64) as u32;
     let fit = (fit / WG_1D * WG_1D).max(WG_1D);
     fit.min(pixels.div_ceil(WG_1D) * WG_1D).max(WG_1D)
-}
-
-fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: size.max(16),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
 }
 
 impl LcBuffers {
@@ -224,19 +216,19 @@ impl LcBuffers {
         let nodes = 2 * leaves as u64;
         let slice = slice_pixels(size.0 * size.1, max_cut, budget);
         Self {
-            scratch: storage(device, "lightcuts::scratch", 8 * slice as u64 * max_cut as u64),
-            state: storage(device, "lightcuts::state", 32 * slice as u64),
+            scratch: storage_buffer(device, "lightcuts::scratch", 8 * slice as u64 * max_cut as u64),
+            state: storage_buffer(device, "lightcuts::state", 32 * slice as u64),
             slice,
             max_cut,
-            cones: storage(device, "lightcuts::cones", 16 * nodes),
-            reps: storage(device, "lightcuts::reps", 4 * nodes),
+            cones: storage_buffer(device, "lightcuts::cones", 16 * nodes),
+            reps: storage_buffer(device, "lightcuts::reps", 4 * nodes),
             leaves,
-            diag: storage(device, "lightcuts::diag", 16 * size.0 as u64 * size.1 as u64),
-            stats: storage(device, "lightcuts::stats", 4 * STATS as u64),
-            trace: storage(device, "lightcuts::trace", 4 * TRACE_WORDS),
+            diag: storage_buffer(device, "lightcuts::diag", 16 * size.0 as u64 * size.1 as u64),
+            stats: storage_buffer(device, "lightcuts::stats", 4 * STATS as u64),
+            trace: storage_buffer(device, "lightcuts::trace", 4 * TRACE_WORDS),
             size,
-            dummy: storage(device, "lightcuts::dummy", 16),
-            dummy_rw: storage(device, "lightcuts::dummy_rw", 16),
+            dummy: storage_buffer(device, "lightcuts::dummy", 16),
+            dummy_rw: storage_buffer(device, "lightcuts::dummy_rw", 16),
         }
     }
 
@@ -258,8 +250,8 @@ pub struct CutKernel {
     cut: wgpu::ComputePipeline,
     cut_timed: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
-    /// Per-dispatch uniforms (grown as needed).
-    params: wgpu::Buffer,
+    /// Per-dispatch uniforms.
+    params: StridedUniforms<GpuLcParams>,
 }
 
 /// What the cut kernel binds.
@@ -315,7 +307,7 @@ impl CutKernel {
                 &timed,
             ),
             layout,
-            params: slice_params(device, 1),
+            params: StridedUniforms::new(device, "lightcuts::params", 1),
         })
     }
 
@@ -340,10 +332,7 @@ impl CutKernel {
         let refine = dispatches_per_slice(p.max_cut, b.tree.levels(), p.steps);
         let per_slice = refine + (self.mode == 1) as u32;
         let n = slices * per_slice;
-        if self.params.size() < n as u64 * STRIDE {
-            self.params = slice_params(device, n);
-        }
-        let mut all = Vec::with_capacity(n as usize * STRIDE as usize);
+        let mut all = Vec::with_capacity(n as usize);
         for i in 0..slices {
             for j in 0..per_slice {
                 let write_out = self.mode == 1 && j == refine;
@@ -355,19 +344,13 @@ impl CutKernel {
                     steps: if write_out { 0 } else { p.steps },
                     ..p
                 };
-                let mut bytes = bytemuck::bytes_of(&sp).to_vec();
-                bytes.resize(STRIDE as usize, 0);
-                all.extend_from_slice(&bytes);
+                all.push(sp);
             }
         }
-        queue.write_buffer(&self.params, 0, &all);
+        self.params.write(device, queue, &all);
         let tv = wgpu::BindingResource::TextureView;
         let entries = [
-            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                buffer: &self.params,
-                offset: 0,
-                size: wgpu::BufferSize::new(std::mem::size_of::<GpuLcParams>() as u64),
-            }),
+            self.params.binding(),
             b.tree.nodes.as_entire_binding(),
             b.tree.sorted_vpls.as_entire_binding(),
             b.cones.as_entire_binding(),
@@ -396,7 +379,7 @@ impl CutKernel {
             });
             pass.set_pipeline(if diagnostics { &self.cut } else { &self.cut_timed });
             for i in 0..n {
-                pass.set_bind_group(0, &bind, &[(i as u64 * STRIDE) as u32]);
+                pass.set_bind_group(0, &bind, &[StridedUniforms::<GpuLcParams>::offset(i)]);
                 pass.dispatch_workgroups(slice / WG_1D, 1, 1);
             }
         }
@@ -408,7 +391,8 @@ impl CutKernel {
 pub struct BuildKernel {
     build: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
-    params: wgpu::Buffer,
+    /// One per level.
+    params: StridedUniforms<GpuLcBuildParams>,
 }
 
 impl BuildKernel {
@@ -427,12 +411,7 @@ impl BuildKernel {
         });
         Ok(Self {
             build: compute_pipeline_with(device, "lightcuts_build", &[Some(&layout)], &module, "main", &[]),
-            params: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("lightcuts_build::params"),
-                size: STRIDE * MAX_LEVELS,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
+            params: StridedUniforms::new(device, "lightcuts_build::params", MAX_LEVELS),
             layout,
         })
     }
@@ -440,7 +419,7 @@ impl BuildKernel {
     /// Records the build (every level, one compute pass named `name`) into `cones`, `reps`.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
-        &self,
+        &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
@@ -452,24 +431,18 @@ impl BuildKernel {
         reps: &wgpu::Buffer,
     ) {
         // Levels bottom-up: leaves (level L-1) first, the root last.
-        let levels = tree.levels();
-        let mut dispatches = Vec::new();
-        for (i, level) in (0..levels).rev().enumerate().take(MAX_LEVELS as usize) {
-            let bp = GpuLcBuildParams {
+        let per_level: Vec<GpuLcBuildParams> = (0..tree.levels())
+            .rev()
+            .map(|level| GpuLcBuildParams {
                 first: 1 << level,
                 count: 1 << level,
                 leaves: tree.leaves,
                 seed,
-            };
-            queue.write_buffer(&self.params, i as u64 * STRIDE, bytemuck::bytes_of(&bp));
-            dispatches.push((i as u64 * STRIDE, bp.count.div_ceil(WG_1D)));
-        }
+            })
+            .collect();
+        self.params.write(device, queue, &per_level);
         let entries = [
-            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                buffer: &self.params,
-                offset: 0,
-                size: wgpu::BufferSize::new(std::mem::size_of::<GpuLcBuildParams>() as u64),
-            }),
+            self.params.binding(),
             tree.nodes.as_entire_binding(),
             tree.sorted_vpls.as_entire_binding(),
             cones.as_entire_binding(),
@@ -483,9 +456,9 @@ impl BuildKernel {
                 timestamp_writes: timer.compute_pass(name),
             });
             pass.set_pipeline(&self.build);
-            for (offset, groups) in dispatches {
-                pass.set_bind_group(0, &bind, &[offset as u32]);
-                pass.dispatch_workgroups(groups, 1, 1);
+            for (i, bp) in per_level.iter().enumerate() {
+                pass.set_bind_group(0, &bind, &[StridedUniforms::<GpuLcBuildParams>::offset(i as u32)]);
+                pass.dispatch_workgroups(bp.count.div_ceil(WG_1D), 1, 1);
             }
         }
         encoder.pop_debug_group();
@@ -498,8 +471,8 @@ pub struct LightcutsPass {
     views: wgpu::ComputePipeline,
     views_layout: wgpu::BindGroupLayout,
     view_params: wgpu::Buffer,
-    stats_readback: AsyncReadback,
-    last_stats: Option<LcStats>,
+    /// The frame counters (diagnostic frames).
+    pub stats: CounterReadback<LcStats>,
 }
 
 impl LightcutsPass {
@@ -529,8 +502,12 @@ impl LightcutsPass {
             ),
             views_layout,
             view_params: uniform_buffer::<GpuLcViewParams>(device, "lightcuts_views::params"),
-            stats_readback: AsyncReadback::new(device, "lightcuts::stats_readback", (STATS * 4) as u64),
-            last_stats: None,
+            stats: CounterReadback::new(
+                device,
+                "lightcuts::stats_readback",
+                (STATS * 4) as u64,
+                LcStats::from_words,
+            ),
         })
     }
 
@@ -596,9 +573,7 @@ impl LightcutsPass {
             &b,
         );
         if diagnostics {
-            // A result nobody took yet would keep this frame's from being recorded.
-            self.poll_stats();
-            self.stats_readback
+            self.stats
                 .record(encoder, &[(&out.stats, 0, 0, (STATS * 4) as u64)]);
         }
     }
@@ -639,31 +614,6 @@ impl LightcutsPass {
             groups_image(out.size.0, out.size.1),
         );
     }
-
-    pub fn after_submit(&self) {
-        self.stats_readback.after_submit();
-    }
-
-    pub fn last_stats(&self) -> Option<LcStats> {
-        self.last_stats
-    }
-
-    /// The counters of the latest diagnostic frame read back (non-blocking).
-    pub fn poll_stats(&mut self) -> Option<LcStats> {
-        if let Some(bytes) = self.stats_readback.try_take() {
-            self.last_stats = Some(LcStats::from_words(bytemuck::cast_slice(&bytes)));
-        }
-        self.last_stats
-    }
-}
-
-fn slice_params(device: &wgpu::Device, slices: u32) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("lightcuts::params"),
-        size: slices.max(1) as u64 * STRIDE,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
 }
 
 /// Reads the last build's cones and representatives (node 0 unused).

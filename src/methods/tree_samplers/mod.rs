@@ -255,7 +255,7 @@ impl TreeSamplers {
     }
     /// Counters of a recent frame (non-blocking).
     pub fn poll_stats(&mut self) -> Option<SamplingStats> {
-        self.pass.poll_stats()
+        self.pass.stats.poll()
     }
     /// The half-resolution targets of the last frame (None when half resolution is off).
     pub fn half_targets(&self) -> Option<&HalfTargets> {
@@ -431,7 +431,7 @@ impl Method for TreeSamplers {
     }
 
     fn after_submit(&mut self) {
-        self.pass.after_submit();
+        self.pass.stats.after_submit();
     }
 
     fn frames_averaged(&self) -> Option<u32> {
@@ -518,7 +518,7 @@ impl Method for TreeSamplers {
     fn legend(&self, view: MethodView, tree_levels: u32) -> Option<Legend> {
         let hi = steps_scale(tree_levels);
         if view == STEPS {
-            let title = match self.pass.last_stats() {
+            let title = match self.pass.stats.last() {
                 Some(st) => format!(
                     "traversal steps per traversal (image mean {:.2})",
                     st.steps_per_traversal()
@@ -544,7 +544,7 @@ impl Method for TreeSamplers {
     }
 
     fn status(&mut self) -> Option<String> {
-        let st = self.pass.poll_stats()?;
+        let st = self.pass.stats.poll()?;
         Some(format!(
             "{:.2} steps per traversal · {:.1} per pixel · {:.2}% pixels without a similar cut · {} dead branches",
             st.steps_per_traversal(),

@@ -8,7 +8,7 @@
 //! `DIAGNOSTICS = false` (same estimate, none of that work, no readback).
 
 use crate::renderer::{
-    frame::GbufferTargets, gpu_data::GpuSlcParams, readback::AsyncReadback, scene_gpu::SceneGpu, shaders,
+    frame::GbufferTargets, gpu_data::GpuSlcParams, readback::CounterReadback, scene_gpu::SceneGpu, shaders,
     timing::GpuTimer,
 };
 
@@ -322,8 +322,8 @@ pub struct SlcPass {
     sample_layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
     /// The counters of a recent frame, read back without blocking.
-    stats_readback: AsyncReadback,
-    last_stats: Option<SamplingStats>,
+    /// The frame counters (diagnostic frames).
+    pub stats: CounterReadback<SamplingStats>,
 }
 
 impl SlcPass {
@@ -390,8 +390,12 @@ impl SlcPass {
                 &[("DIAGNOSTICS", 0.0)],
             ),
             params: crate::renderer::passes::uniform_buffer::<GpuSlcParams>(device, "slc::params"),
-            stats_readback: AsyncReadback::new(device, "slc::stats_readback", (STATS * 4) as u64),
-            last_stats: None,
+            stats: CounterReadback::new(
+                device,
+                "slc::stats_readback",
+                (STATS * 4) as u64,
+                SamplingStats::from_words,
+            ),
             cuts_layout,
             sample_layout,
         })
@@ -474,7 +478,7 @@ impl SlcPass {
             groups_image(p.width, p.height),
         );
         if diagnostics {
-            self.stats_readback
+            self.stats
                 .record(encoder, &[(&out.stats, 0, 0, (STATS * 4) as u64)]);
         }
     }
@@ -511,24 +515,6 @@ impl SlcPass {
             &bind,
             groups_image(out.size.0, out.size.1),
         );
-    }
-
-    /// Call after the frame's submit: starts the counters' readback.
-    pub fn after_submit(&self) {
-        self.stats_readback.after_submit();
-    }
-
-    /// The counters last read back (without polling).
-    pub fn last_stats(&self) -> Option<SamplingStats> {
-        self.last_stats
-    }
-
-    /// The counters of the latest frame read back (non-blocking).
-    pub fn poll_stats(&mut self) -> Option<SamplingStats> {
-        if let Some(bytes) = self.stats_readback.try_take() {
-            self.last_stats = Some(SamplingStats::from_words(bytemuck::cast_slice(&bytes)));
-        }
-        self.last_stats
     }
 }
 

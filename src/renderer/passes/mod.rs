@@ -129,6 +129,72 @@ pub(crate) fn storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -
     }
 }
 
+/// A storage buffer of `size` bytes (at least 16) that copies can read and write (readbacks,
+/// clears).
+pub(crate) fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(16),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Dynamic-offset stride of [`StridedUniforms`] (the largest `minUniformBufferOffsetAlignment`).
+pub(crate) const UNIFORM_STRIDE: u64 = 256;
+
+/// Per-dispatch uniforms of type `T`, `UNIFORM_STRIDE` bytes apart in one buffer (bound with a
+/// dynamic offset `i * UNIFORM_STRIDE` for dispatch i); the buffer grows as needed.
+pub(crate) struct StridedUniforms<T> {
+    buffer: wgpu::Buffer,
+    label: &'static str,
+    _t: std::marker::PhantomData<T>,
+}
+
+impl<T: bytemuck::Pod> StridedUniforms<T> {
+    pub fn new(device: &wgpu::Device, label: &'static str, count: u32) -> Self {
+        Self {
+            buffer: Self::create(device, label, count),
+            label,
+            _t: std::marker::PhantomData,
+        }
+    }
+    fn create(device: &wgpu::Device, label: &str, count: u32) -> wgpu::Buffer {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: count.max(1) as u64 * UNIFORM_STRIDE,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+    /// Writes `items` (item i at offset i * UNIFORM_STRIDE), growing the buffer first.
+    pub fn write(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, items: &[T]) {
+        let n = items.len() as u32;
+        if self.buffer.size() < n as u64 * UNIFORM_STRIDE {
+            self.buffer = Self::create(device, self.label, n);
+        }
+        let mut all = Vec::with_capacity(items.len() * UNIFORM_STRIDE as usize);
+        for it in items {
+            let start = all.len();
+            all.extend_from_slice(bytemuck::bytes_of(it));
+            all.resize(start + UNIFORM_STRIDE as usize, 0);
+        }
+        queue.write_buffer(&self.buffer, 0, &all);
+    }
+    /// The binding (one `T` at the dynamic offset).
+    pub fn binding(&self) -> wgpu::BindingResource<'_> {
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.buffer,
+            offset: 0,
+            size: wgpu::BufferSize::new(std::mem::size_of::<T>() as u64),
+        })
+    }
+    /// Dynamic offset of item `i`.
+    pub fn offset(i: u32) -> u32 {
+        (i as u64 * UNIFORM_STRIDE) as u32
+    }
+}
+
 /// A uniform buffer sized for `T`, written with `queue.write_buffer` before use.
 pub(crate) fn uniform_buffer<T>(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
