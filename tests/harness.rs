@@ -86,6 +86,9 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "lightcuts=0.2,0.05",
             "--sweep",
             "lightcut-interpolation=2",
+            // The culling study's eps_max sweep: one bound beside the base one.
+            "--sweep",
+            "light-culling=0.005",
             // The interpolation figure's cuts small (and `--set` reaching `results`).
             "--set",
             "methods.lightcut-interpolation.max_cut=64",
@@ -248,6 +251,39 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         ],
         3,
     );
+    // Stochastic vs clamped culling: 2 VPL counts x 2 visibilities x 2 ranges, then the
+    // second bound at the base count (1024 = 2^10) x 2 x 2.
+    check_csv(
+        &d,
+        "culling.csv",
+        &["ranges", "visibility", "vpls", "epsilon_max"],
+        &[
+            "gi_gpu_ms",
+            "vpls_in_range_per_pixel",
+            "rmse_vs_same_visibility_truth",
+            "mean_ratio",
+            "rmse_vs_true_ground_truth",
+            "shade_ms",
+        ],
+        12,
+    );
+    let (_, rows) = read_csv(&d.join("culling.csv"));
+    assert!(
+        rows.iter()
+            .any(|r| r["ranges"] == "clamped" && r["visibility"] == "rays")
+    );
+    assert!(rows.iter().any(|r| r["epsilon_max"].starts_with("0.005")));
+    for r in &rows {
+        let rays: f64 = r["shadow_rays_per_pixel"].parse().unwrap();
+        assert_eq!(rays == 0.0, r["visibility"] == "none", "{r:?}");
+    }
+    check_csv(
+        &d,
+        "culling_table1.csv",
+        &["paper_pass"],
+        &["our_ms", "paper_ms"],
+        3,
+    );
     let (_, rows) = read_csv(&d.join("interpolation.csv"));
     let names: Vec<&str> = rows.iter().map(|r| r["method"].as_str()).collect();
     assert_eq!(names, ["Lightcuts", "LI full vis.", "LI interp. vis."]);
@@ -297,6 +333,12 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         "images/blend_recompute_error.png",
         "images/fallback_pixels.png",
         "images/upsampling_half.png",
+        "culling_time_vpls.png",
+        "culling_rmse_vpls.png",
+        "culling_rmse_eps.png",
+        "culling_time_eps.png",
+        "images/culling_stochastic.png",
+        "images/culling_clamped_error.png",
         "interpolation.png",
         "images/interpolation_li_interp.png",
         "images/interpolation_li_full_error.png",
@@ -308,7 +350,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     assert_eq!(run["width"], 64);
     // Each figure's wall time and the share of it outside rendering / GPU waits.
     let times = run["scenes"][0]["figure_times"].as_array().unwrap();
-    assert_eq!(times.len(), 8, "{times:?}");
+    assert_eq!(times.len(), 9, "{times:?}");
     for t in times {
         let share = t["share_outside_gpu"].as_f64().unwrap();
         assert!(

@@ -34,6 +34,7 @@ const EXAMPLES: &[&str] = &[
     "-- bench tree",
     "-- render --scene default --width 320 --height 240 --method lightcuts --set methods.lightcuts.relative_error=0.02 --compare-gt --out out/lc",
     "-- render --scene default --width 320 --height 240 --method lightcut-interpolation --set methods.lightcut-interpolation.visibility=interpolated --compare-gt --out out/li",
+    "-- render --scene default --width 320 --height 240 --method light-culling --visibility none --compare-gt --out out/lcull",
     "-- results interpolation --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
     "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",
     "-- --view albedo --settings docs/settings-example.toml --tree-stats",
@@ -461,6 +462,41 @@ fn cli_examples_write_what_they_promise() {
         "{m}"
     );
     assert!(li.join("li_records.png").is_file() && li.join("li_level_spread.png").is_file());
+    // Stochastic Light Culling without visibility: no shadow ray, its views written.
+    let lcull = tmp("lcull");
+    run_cli(&args(
+        "-- render --scene default --width 320 --height 240 --method light-culling --visibility none --compare-gt --out out/lcull",
+        &[
+            ("--width", "32"),
+            ("--height", "24"),
+            ("--out", lcull.to_str().unwrap()),
+        ],
+        &["--vpls", "256"],
+    ));
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(lcull.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(m["method"], "light-culling");
+    assert_eq!(
+        m["method_stats"]["shadow_rays_per_pixel"].as_f64(),
+        Some(0.0),
+        "{m}"
+    );
+    assert!(
+        m["method_stats"]["vpls_in_range_per_pixel"]
+            .as_f64()
+            .is_some_and(|v| v > 0.0),
+        "{m}"
+    );
+    assert!(
+        m["vs_ground_truth"]["mean_ratio"]
+            .as_f64()
+            .is_some_and(f64::is_finite),
+        "{m}"
+    );
+    assert!(
+        lcull.join("culling_lights_per_tile.png").is_file() && lcull.join("culling_pattern.png").is_file()
+    );
+    let _ = std::fs::remove_dir_all(&lcull);
     // The interpolation paper's comparison (the default scene, tiny, here).
     let lr = tmp("li-results");
     run_cli(&args(

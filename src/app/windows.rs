@@ -93,7 +93,7 @@ impl WorkbenchApp {
             .default_width(420.0)
             .show(ctx, |ui| {
                 for e in &self.errors {
-                    ui.label(egui::RichText::new(e).color(ui.visuals().warn_fg_color));
+                    ui.label(egui::RichText::new(plain_text(e)).color(ui.visuals().warn_fg_color));
                 }
                 if ui.button("Dismiss").clicked() {
                     dismiss = true;
@@ -103,6 +103,19 @@ impl WorkbenchApp {
             self.errors.clear();
         }
     }
+}
+
+/// `s` with box-drawing characters (naga's error frames) as ASCII: the GUI's proportional
+/// font has none of them, and a missing glyph must not cost the message.
+pub(super) fn plain_text(s: &str) -> String {
+    s.chars()
+        .map(|c| match c {
+            '─' | '━' | '═' => '-',
+            '│' | '┃' | '║' => '|',
+            '\u{2500}'..='\u{257f}' => '+',
+            c => c,
+        })
+        .collect()
 }
 
 /// A false-colour legend in the bottom-left corner of `rect`.
@@ -180,6 +193,18 @@ pub(super) fn legend_with(
             label,
             font.clone(),
             text,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn shader_error_frames_become_ascii() {
+        let naga = "error: bad\n    ┌─ wgsl:190:9\n    │\n190 │     let x";
+        assert_eq!(
+            super::plain_text(naga),
+            "error: bad\n    +- wgsl:190:9\n    |\n190 |     let x"
         );
     }
 }

@@ -52,6 +52,15 @@ pub enum ChildProbabilityArg {
     Defensive,
 }
 
+/// Visibility for `--visibility`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VisibilityArg {
+    /// Every VPL visible (no shadow test).
+    None,
+    /// A BVH shadow ray per evaluated VPL or sample.
+    Rays,
+}
+
 /// Settings of the tree samplers (override `--settings`).
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct SamplingArgs {
@@ -82,6 +91,11 @@ pub struct SamplingArgs {
     /// No shadow rays for the ground truth and the tree samplers (every VPL / sample visible).
     #[arg(long)]
     pub no_shadow_rays: bool,
+    /// Visibility of the VPL methods and their ground truth: `rays` (BVH shadow rays) or
+    /// `none` (every VPL visible: the unshadowed estimate, as Stochastic Light Culling's
+    /// figures 1 and 4); the same switch as `--no-shadow-rays`.
+    #[arg(long, value_enum)]
+    pub visibility: Option<VisibilityArg>,
     /// GI at half resolution, joint-bilateral upsampled with the similarity S.
     #[arg(long)]
     pub half_res: bool,
@@ -147,6 +161,9 @@ impl SamplingArgs {
         }
         if self.no_shadow_rays {
             s.gi.shadow_rays = false;
+        }
+        if let Some(v) = self.visibility {
+            s.gi.shadow_rays = v == VisibilityArg::Rays;
         }
         if self.half_res {
             s.sampling.half_resolution = true;

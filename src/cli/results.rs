@@ -41,13 +41,18 @@ pub enum Figure {
     /// Lightcut Interpolation's headline comparison (its paper's Fig. 8 / 10): Lightcuts vs
     /// interpolation with full and interpolated visibility, GPU time per pass and error.
     Interpolation,
+    /// Stochastic Light Culling's study (its figs. 4-6, Table 1): stochastic vs clamped ranges
+    /// over the VPL count (--vpl-exponents) and eps_max (--sweep light-culling=..), with and
+    /// without visibility, GPU time and error.
+    Culling,
 }
 
-const ORDER: [Figure; 8] = [
+const ORDER: [Figure; 9] = [
     Figure::Timings,
     Figure::Steps,
     Figure::EqualTime,
     Figure::Interpolation,
+    Figure::Culling,
     Figure::Blocks,
     Figure::Blending,
     Figure::Upsampling,
@@ -257,6 +262,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
             let rep = match f {
                 Figure::Timings => figures::timings(&mut b, &o, &dir)?,
                 Figure::EqualTime => figures::equal_time(&mut b, &o, &dir)?,
+                Figure::Culling => figures::culling(&mut b, &o, &dir)?,
                 Figure::Steps => figures::steps(&mut b, &o, &dir)?,
                 Figure::Blocks => figures::blocks(&mut b, &o, &dir)?,
                 Figure::Blending => figures::blending(&mut b, &o, &dir)?,

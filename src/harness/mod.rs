@@ -200,7 +200,8 @@ pub struct Bench {
     /// final image).
     pub gi_exposure: f32,
     pub adapter: String,
-    gt: HashMap<(u32, u32, u32), (ImageF32, u64)>,
+    /// Ground truths by (VPL count, seed, width | height << 16, shadow rays).
+    gt: HashMap<(u32, u32, u32, bool), (ImageF32, u64)>,
     /// Progress lines to stderr.
     pub verbose: bool,
     /// Wall clock spent rendering and waiting for the GPU (the rest of a figure's wall time
@@ -288,7 +289,8 @@ impl Bench {
         Ok(h)
     }
 
-    /// The ground truth's GI for settings `s` at `size` (cached per VPL count, seed and size).
+    /// The ground truth's GI for settings `s` at `size` (cached per VPL count, seed, size and
+    /// visibility: without shadow rays, the unshadowed truth).
     pub fn ground_truth(&mut self, s: &RenderSettings, size: (u32, u32)) -> anyhow::Result<ImageF32> {
         Ok(self.ground_truth_and_hash(s, size)?.0)
     }
@@ -299,7 +301,7 @@ impl Bench {
         s: &RenderSettings,
         size: (u32, u32),
     ) -> anyhow::Result<(ImageF32, u64)> {
-        let key = (s.vpl.count, s.vpl.seed, size.0 | size.1 << 16);
+        let key = (s.vpl.count, s.vpl.seed, size.0 | size.1 << 16, s.gi.shadow_rays);
         if let Some(cached) = self.gt.get(&key) {
             return Ok(cached.clone());
         }

@@ -15,6 +15,7 @@
 
 pub mod direct_only;
 pub mod ground_truth;
+pub mod light_culling;
 pub mod lightcut_interpolation;
 pub mod lightcuts;
 pub mod reference;
@@ -48,6 +49,8 @@ pub static REGISTRY: &[&MethodInfo] = &[
     &tree_samplers::RTSLC_INFO,
     &lightcuts::INFO,
     &lightcut_interpolation::INFO,
+    &light_culling::INFO,
+    &light_culling::CLAMPED_INFO,
     &ground_truth::INFO,
     &reference::INFO,
     &direct_only::INFO,

@@ -569,6 +569,58 @@ mod tests {
                 },
             ),
             (
+                "methods/light_culling/lcull_ranges.wgsl",
+                "LcullParams",
+                size_of::<crate::methods::light_culling::pass::GpuLcullParams>(),
+                {
+                    use crate::methods::light_culling::pass::GpuLcullParams as P;
+                    vec![
+                        offset_of!(P, width),
+                        offset_of!(P, height),
+                        offset_of!(P, tile),
+                        offset_of!(P, n),
+                        offset_of!(P, tiles_x),
+                        offset_of!(P, tiles_y),
+                        offset_of!(P, tiles),
+                        offset_of!(P, cap),
+                        offset_of!(P, count),
+                        offset_of!(P, offset),
+                        offset_of!(P, seed),
+                        offset_of!(P, mode),
+                        offset_of!(P, epsilon_max),
+                        offset_of!(P, exposure),
+                        offset_of!(P, eps),
+                        offset_of!(P, ray_offset),
+                        offset_of!(P, shadow_rays),
+                        offset_of!(P, accumulate),
+                        offset_of!(P, filter_radius),
+                        offset_of!(P, trace_pixel),
+                        offset_of!(P, filter_normal_cos),
+                        offset_of!(P, filter_plane_tolerance),
+                        offset_of!(P, stride),
+                        offset_of!(P, _pad),
+                    ]
+                },
+            ),
+            (
+                "methods/light_culling/lcull_views.wgsl",
+                "LcullViewParams",
+                size_of::<crate::methods::light_culling::pass::GpuLcullViewParams>(),
+                {
+                    use crate::methods::light_culling::pass::GpuLcullViewParams as P;
+                    vec![
+                        offset_of!(P, mode),
+                        offset_of!(P, scale_top),
+                        offset_of!(P, exposure),
+                        offset_of!(P, tonemap),
+                        offset_of!(P, n),
+                        offset_of!(P, cap),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                    ]
+                },
+            ),
+            (
                 "methods/ground_truth/ground_truth.wgsl",
                 "GtParams",
                 size_of::<GpuGtParams>(),

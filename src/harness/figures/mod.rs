@@ -2,10 +2,12 @@
 //! `<figure>.csv`, PNG plots and images into the scene's results folder, and returns a
 //! [`Report`]: a short text table and the ratio checks of issue 7 it covers.
 
+mod culling;
 mod interpolation;
 mod resolution;
 mod sampling;
 
+pub use culling::culling;
 pub use interpolation::interpolation;
 pub use resolution::{scaling, upsampling};
 pub use sampling::{blending, blocks, steps};

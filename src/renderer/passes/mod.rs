@@ -311,7 +311,10 @@ mod tests {
                     && crate::methods::lightcut_interpolation::pass::TILE_WG_ENTRIES
                         .contains(&ep.name.as_str())
                     && ws == [crate::methods::lightcut_interpolation::pass::TILE_WG, 1, 1];
-                let ok = own || tile || ws == [WG_2D, WG_2D, 1] || ws == [WG_1D, 1, 1];
+                // Light culling's tile kernel: one workgroup per tile.
+                let culling = file == "methods/light_culling/lcull_tiles.wgsl"
+                    && ws == [crate::methods::light_culling::pass::TILE_WG, 1, 1];
+                let ok = own || tile || culling || ws == [WG_2D, WG_2D, 1] || ws == [WG_1D, 1, 1];
                 assert!(ok, "{file}::{} has workgroup size {ws:?}", ep.name);
             }
         }

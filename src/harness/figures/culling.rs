@@ -1,0 +1,385 @@
+//! Stochastic Light Culling's study (Tokuyoshi & Harada 2016, section 4.4, figures 4-6 and
+//! Table 1) on our scenes: stochastic against clamped ranges (appendix A) over the VPL count
+//! and over the error bound eps_max, without visibility (the paper's setting, against the
+//! unshadowed ground truth) and with shadow rays (against the true one): GI GPU time, VPLs
+//! per pixel, error, bias and noise; the clamped ranges at the stochastic ones' GPU time
+//! (figure 4's comparison) interpolated from the eps_max sweep; the paper's Table 1 beside our
+//! pass times.
+
+use super::*;
+use crate::methods::light_culling::{self as lcull, settings::LightCullingSettings};
+use crate::metrics;
+
+/// The paper's Table 1 (AMD R9 290X, 1920 x 1152, 65,536 VPLs, no shadows), ms:
+/// (our pass names, the paper's row, its time).
+pub const PAPER_TABLE_1: [(&[&str], &str, f64); 3] = [
+    (&["lcull_ranges"], "VPL sampling & light range computation", 0.05),
+    (
+        &["lcull_tiles", "lcull_shade"],
+        "interleaved sampling & tiled lighting",
+        3.98,
+    ),
+    (&["lcull_filter"], "geometry-aware filtering", 1.00),
+];
+
+struct Row {
+    mode: &'static str,
+    shadows: bool,
+    vpls: u32,
+    eps: f64,
+    gi_ms: f64,
+    gi_std: f64,
+    in_range: f64,
+    rays: f64,
+    rmse: f64,
+    bias: f64,
+    noise: f64,
+    mean_ratio: f64,
+    rmse_true: f64,
+    passes: Vec<(&'static str, f64)>,
+}
+
+fn stat(m: &Measured, k: &str) -> f64 {
+    m.method_stats
+        .iter()
+        .find(|(n, _)| *n == k)
+        .map_or(f64::NAN, |(_, v)| *v)
+}
+
+/// The study (module doc). Its VPL counts are `--vpl-exponents`, its error bounds the
+/// method's sweep (`--sweep light-culling=...`), its base bound the settings'.
+pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
+    let base: LightCullingSettings = b.base.method(lcull::ID).map_err(|e| anyhow::anyhow!(e))?;
+    let base_eps = base.epsilon_max as f64;
+    let mut eps_values = o.sweep_values(lcull::ID, 0);
+    if !eps_values.iter().any(|e| (e - base_eps).abs() < 1e-12) {
+        eps_values.push(base_eps);
+    }
+    eps_values.sort_by(f64::total_cmp);
+    let modes = [(lcull::ID, "stochastic"), (lcull::CLAMPED, "clamped")];
+    let img = images(dir)?;
+    let mut rows: Vec<Row> = Vec::new();
+    let run = |b: &mut Bench, mode: usize, shadows: bool, vpls: u32, eps: f64| -> anyhow::Result<Row> {
+        let s = with(b, |s| {
+            s.gi.method = modes[mode].0;
+            s.gi.shadow_rays = shadows;
+            s.vpl.count = vpls;
+            let _ = s.set_method(
+                lcull::ID,
+                &LightCullingSettings {
+                    epsilon_max: eps as f32,
+                    ..base.clone()
+                },
+            );
+        });
+        let m = b.measure(&s, o.size, o.per_config(), true)?;
+        // The true ground truth (shadow rays) for the image of the last diagnostic frame.
+        let truth = b.ground_truth(
+            &with(b, |t| {
+                t.vpl.count = vpls;
+                t.gi.shadow_rays = true;
+            }),
+            o.size,
+        )?;
+        let rmse_true = m.indirect.as_ref().map_or(f64::NAN, |x| {
+            metrics::compare_without_flip(x, &truth, b.gi_exposure, b.base.display.tonemap).rmse
+        });
+        let (gi_ms, gi_std) = m.gi_ms();
+        eprintln!(
+            "[{}] {} {} VPLs eps {eps}{}: GI {gi_ms:.3} ms GPU, RMSE {:.4e}",
+            b.scene,
+            modes[mode].1,
+            vpls,
+            if shadows { " shadow rays" } else { "" },
+            m.rmse().0
+        );
+        if vpls == b.base.vpl.count
+            && (eps - base_eps).abs() < 1e-12
+            && !shadows
+            && let Some(x) = &m.indirect
+        {
+            let gt = b.ground_truth(&s, o.size)?;
+            let stem = format!("culling_{}", modes[mode].1);
+            b.write_gi_png(&img.join(format!("{stem}.png")), x)?;
+            b.write_error_png(&img.join(format!("{stem}_error.png")), x, &gt)?;
+        }
+        Ok(Row {
+            mode: modes[mode].1,
+            shadows,
+            vpls,
+            eps,
+            gi_ms,
+            gi_std,
+            in_range: stat(&m, "vpls_in_range_per_pixel"),
+            rays: stat(&m, "shadow_rays_per_pixel"),
+            rmse: m.rmse().0,
+            bias: m.bias_rmse,
+            noise: m.noise_rmse,
+            mean_ratio: mean_std(&m.mean_ratio).0,
+            rmse_true,
+            passes: ["lcull_ranges", "lcull_tiles", "lcull_shade", "lcull_filter"]
+                .into_iter()
+                .map(|p| (p, m.pass_ms(&[p]).0))
+                .collect(),
+        })
+    };
+    // Over the VPL count at the base bound, then over the bound at the base count.
+    for &e in &o.vpl_exponents {
+        for shadows in [false, true] {
+            for mode in 0..2 {
+                rows.push(run(b, mode, shadows, 1 << e, base_eps)?);
+            }
+        }
+    }
+    for &eps in &eps_values {
+        for shadows in [false, true] {
+            for mode in 0..2 {
+                if (eps - base_eps).abs() < 1e-12
+                    && o.vpl_exponents.iter().any(|&e| 1 << e == b.base.vpl.count)
+                {
+                    continue; // measured above
+                }
+                rows.push(run(b, mode, shadows, b.base.vpl.count, eps)?);
+            }
+        }
+    }
+
+    let mut csv = Csv::new(&[
+        "scene",
+        "ranges",
+        "visibility",
+        "vpls",
+        "epsilon_max",
+        "gi_gpu_ms",
+        "gi_gpu_ms_std",
+        "vpls_in_range_per_pixel",
+        "shadow_rays_per_pixel",
+        "rmse_vs_same_visibility_truth",
+        "bias_rmse",
+        "noise_rmse",
+        "mean_ratio",
+        "rmse_vs_true_ground_truth",
+        "ranges_ms",
+        "tiles_ms",
+        "shade_ms",
+        "filter_ms",
+    ]);
+    for r in &rows {
+        let mut cells = vec![
+            b.scene.clone(),
+            r.mode.to_string(),
+            if r.shadows { "rays" } else { "none" }.to_string(),
+            r.vpls.to_string(),
+            num(r.eps),
+            num(r.gi_ms),
+            num(r.gi_std),
+            num(r.in_range),
+            num(r.rays),
+            num(r.rmse),
+            num(r.bias),
+            num(r.noise),
+            num(r.mean_ratio),
+            num(r.rmse_true),
+        ];
+        cells.extend(r.passes.iter().map(|p| num(p.1)));
+        csv.row(cells);
+    }
+    csv.write(&dir.join("culling.csv"))?;
+
+    let series = |pick: &dyn Fn(&Row) -> Option<(f64, f64)>| -> Vec<plot::Series> {
+        let mut v = Vec::new();
+        for (c, (mode, shadows)) in [
+            ("stochastic", false),
+            ("clamped", false),
+            ("stochastic", true),
+            ("clamped", true),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let mut points: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.mode == mode && r.shadows == shadows)
+                .filter_map(pick)
+                .filter(|p| p.0.is_finite() && p.1.is_finite() && p.0 > 0.0 && p.1 > 0.0)
+                .collect();
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            points.dedup_by(|a, b| a.0 == b.0);
+            if !points.is_empty() {
+                v.push(plot::Series {
+                    name: format!(
+                        "{mode}, {}",
+                        if shadows { "shadow rays" } else { "no visibility" }
+                    ),
+                    color: c,
+                    points,
+                });
+            }
+        }
+        v
+    };
+    let at_base_eps = |r: &Row| (r.eps - base_eps).abs() < 1e-12;
+    let at_base_n = |r: &Row| r.vpls == b.base.vpl.count;
+    plot::lines(
+        &dir.join("culling_time_vpls.png"),
+        &format!("{}: GI GPU time over the VPL count (eps_max {base_eps})", b.scene),
+        "VPLs",
+        "ms (GPU timestamps of the culling passes)",
+        &series(&|r| at_base_eps(r).then_some((r.vpls as f64, r.gi_ms))),
+        true,
+        true,
+    )?;
+    plot::lines(
+        &dir.join("culling_rmse_vpls.png"),
+        &format!(
+            "{}: RMSE over the VPL count (vs the same visibility's truth)",
+            b.scene
+        ),
+        "VPLs",
+        "RMSE of one frame's GI",
+        &series(&|r| at_base_eps(r).then_some((r.vpls as f64, r.rmse))),
+        true,
+        true,
+    )?;
+    plot::lines(
+        &dir.join("culling_rmse_eps.png"),
+        &format!("{}: RMSE over eps_max ({} VPLs)", b.scene, b.base.vpl.count),
+        "eps_max",
+        "RMSE of one frame's GI",
+        &series(&|r| at_base_n(r).then_some((r.eps, r.rmse))),
+        true,
+        true,
+    )?;
+    plot::lines(
+        &dir.join("culling_time_eps.png"),
+        &format!(
+            "{}: GI GPU time over eps_max ({} VPLs)",
+            b.scene, b.base.vpl.count
+        ),
+        "eps_max",
+        "ms (GPU timestamps)",
+        &series(&|r| at_base_n(r).then_some((r.eps, r.gi_ms))),
+        true,
+        true,
+    )?;
+
+    let mut table = format!(
+        "Stochastic vs clamped light culling ({}x{}, eps_max {base_eps}, {} x {} interleaving, {} filter radius; {}):\n",
+        o.size.0, o.size.1, base.interleave, base.interleave, base.filter_radius, b.adapter
+    );
+    for r in rows.iter().filter(|r| at_base_eps(r)) {
+        table.push_str(&format!(
+            "  {:<10} {:<5} {:>6} VPLs: GI {:>9.3} ms GPU, {:>6.1} VPLs in range/pixel, RMSE {:.4e} (bias {:.2e}), mean ratio {:.3}, RMSE vs true GT {:.4e}\n",
+            r.mode,
+            if r.shadows { "rays" } else { "none" },
+            r.vpls,
+            r.gi_ms,
+            r.in_range,
+            r.rmse,
+            r.bias,
+            r.mean_ratio,
+            r.rmse_true,
+        ));
+    }
+    // The paper's Table 1 beside our passes, at the largest VPL count without visibility.
+    let mut checks = Vec::new();
+    let top = o.vpl_exponents.iter().max().map(|&e| 1u32 << e);
+    let find = |mode: &str, shadows: bool, n: u32| {
+        rows.iter()
+            .find(|r| r.mode == mode && r.shadows == shadows && r.vpls == n && at_base_eps(r))
+    };
+    let mut t1 = Csv::new(&["scene", "vpls", "paper_pass", "our_passes", "our_ms", "paper_ms"]);
+    if let Some(n) = top
+        && let Some(r) = find("stochastic", false, n)
+    {
+        table.push_str(&format!(
+            "  Table 1 ({n} VPLs, no visibility; paper: R9 290X, 1920x1152, 65,536 VPLs):\n"
+        ));
+        for (ours, paper, pms) in PAPER_TABLE_1 {
+            let t: f64 = r
+                .passes
+                .iter()
+                .filter(|(p, _)| ours.contains(p))
+                .map(|p| p.1)
+                .sum();
+            table.push_str(&format!("    {paper:<40} ours {t:>9.3} ms, paper {pms:.2} ms\n"));
+            t1.row(vec![
+                b.scene.clone(),
+                n.to_string(),
+                paper.to_string(),
+                ours.join("+"),
+                num(t),
+                num(pms),
+            ]);
+        }
+        if let Some(c) = find("clamped", false, n) {
+            checks.push(check(
+                b,
+                "stochastic / clamped GI time, most VPLs",
+                r.gi_ms / c.gi_ms,
+                1.0,
+                false,
+                format!(
+                    "GI GPU time (timestamps of the four culling passes), median of {} timed frames, {n} VPLs, no visibility (the paper's fig. 6)",
+                    o.timing_frames
+                ),
+            ));
+        }
+    }
+    t1.write(&dir.join("culling_table1.csv"))?;
+    // Figure 4: the clamped ranges at the stochastic ones' time (log-log interpolation over
+    // the eps_max sweep), error against the unshadowed truth.
+    for shadows in [false, true] {
+        let st = rows
+            .iter()
+            .find(|r| r.mode == "stochastic" && r.shadows == shadows && at_base_n(r) && at_base_eps(r));
+        let mut cl: Vec<(f64, f64, f64)> = rows
+            .iter()
+            .filter(|r| r.mode == "clamped" && r.shadows == shadows && at_base_n(r))
+            .map(|r| (r.gi_ms, r.rmse, r.mean_ratio))
+            .collect();
+        cl.sort_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some(st) = st
+            && let Some((rmse, ratio)) = interpolate_at(&cl, st.gi_ms)
+        {
+            table.push_str(&format!(
+                "  at equal GI time ({:.3} ms, {}): stochastic RMSE {:.4e} (mean ratio {:.3}), clamped RMSE {rmse:.4e} (mean ratio {ratio:.3})\n",
+                st.gi_ms,
+                if shadows { "shadow rays" } else { "no visibility" },
+                st.rmse,
+                st.mean_ratio
+            ));
+        }
+    }
+    Ok(Report { table, checks })
+}
+
+/// (rmse, mean ratio) at time `t` on the curve `pts` (time, rmse, ratio; sorted by time),
+/// log-log between the neighbours; None outside the measured times.
+fn interpolate_at(pts: &[(f64, f64, f64)], t: f64) -> Option<(f64, f64)> {
+    let w = pts.windows(2).find(|w| w[0].0 <= t && t <= w[1].0)?;
+    let (a, b) = (w[0], w[1]);
+    if a.0 <= 0.0 || b.0 <= a.0 {
+        return Some((a.1, a.2));
+    }
+    let f = (t.ln() - a.0.ln()) / (b.0.ln() - a.0.ln());
+    let lerp_log = |x: f64, y: f64| {
+        if x > 0.0 && y > 0.0 {
+            (x.ln() + f * (y.ln() - x.ln())).exp()
+        } else {
+            x + f * (y - x)
+        }
+    };
+    Some((lerp_log(a.1, b.1), a.2 + f * (b.2 - a.2)))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn interpolation_at_equal_time_is_log_log_and_bounded() {
+        let pts = [(1.0, 1.0, 0.9), (4.0, 0.25, 1.0)];
+        let (r, m) = super::interpolate_at(&pts, 2.0).unwrap();
+        assert!((r - 0.5).abs() < 1e-12 && (m - 0.95).abs() < 1e-12);
+        assert!(super::interpolate_at(&pts, 8.0).is_none());
+    }
+}

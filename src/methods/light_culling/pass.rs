@@ -1,0 +1,384 @@
+//! Stochastic Light Culling's GPU passes, in frame order (Algorithm 1 of the paper):
+//! `lcull_ranges` (per VPL: fall-off and range), `lcull_tiles` (per tile: depth bounds and the
+//! light list), `lcull_shade` (per pixel: the list's VPLs, demodulated), `lcull_filter` (the
+//! interleaving's geometry-aware filter, x albedo, into the GI accumulation), and the views.
+//! Reads: the VPLs, G-buffer, camera, BVH. CPU twins: `crate::reference::light_culling`.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::methods::lightcut_interpolation::pass::groups_1d_as_2d;
+use crate::renderer::{
+    frame::GbufferTargets,
+    passes::{
+        WG_1D, bind_group_seq, compute_pipeline_with, float_texture_entry, groups_image, run_compute,
+        storage_buffer, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
+    },
+    readback::CounterReadback,
+    scene_gpu::SceneGpu,
+    shaders,
+    timing::GpuTimer,
+};
+
+/// Workgroup size of `lcull_tiles.wgsl` (one tile per workgroup).
+pub const TILE_WG: u32 = 256;
+
+/// Twin: `LcullParams` in `lcull_common.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuLcullParams {
+    pub width: u32,
+    pub height: u32,
+    pub tile: u32,
+    pub n: u32,
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+    pub tiles: u32,
+    pub cap: u32,
+    pub count: u32,
+    pub offset: u32,
+    pub seed: u32,
+    /// 0 stochastic, 1 clamped.
+    pub mode: u32,
+    pub epsilon_max: f32,
+    pub exposure: f32,
+    pub eps: f32,
+    pub ray_offset: f32,
+    pub shadow_rays: u32,
+    pub accumulate: u32,
+    pub filter_radius: u32,
+    pub trace_pixel: u32,
+    pub filter_normal_cos: f32,
+    pub filter_plane_tolerance: f32,
+    pub stride: u32,
+    pub _pad: u32,
+}
+
+/// Twin: `LcullViewParams` in `lcull_views.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuLcullViewParams {
+    pub mode: u32,
+    pub scale_top: u32,
+    pub exposure: f32,
+    pub tonemap: u32,
+    pub n: u32,
+    pub cap: u32,
+    pub _pad: [u32; 2],
+}
+
+pub const STATS_WORDS: usize = 16;
+
+/// A frame's counters (diagnostic frames).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LcullStats {
+    /// Sum of the tiles' list lengths (true counts, over the cap included).
+    pub list_entries: u64,
+    pub tiles_with_geometry: u32,
+    pub overflow_tiles: u32,
+    pub longest_list: u32,
+    pub pixels: u32,
+    /// VPLs whose fall-off was evaluated (list entries, or the subset in overflowing tiles).
+    pub tested: u64,
+    /// VPLs in range of their pixel (non-zero fall-off).
+    pub in_range: u64,
+    pub shadow_rays: u64,
+}
+
+impl LcullStats {
+    pub fn from_words(w: &[u32]) -> Self {
+        let w64 = |i: usize| w[i] as u64 | (w[i + 1] as u64) << 32;
+        Self {
+            list_entries: w64(0),
+            tiles_with_geometry: w[2],
+            overflow_tiles: w[3],
+            longest_list: w[4],
+            pixels: w[5],
+            tested: w64(6),
+            in_range: w64(8),
+            shadow_rays: w64(10),
+        }
+    }
+    fn per_pixel(&self, v: u64) -> f64 {
+        v as f64 / self.pixels.max(1) as f64
+    }
+    pub fn tested_per_pixel(&self) -> f64 {
+        self.per_pixel(self.tested)
+    }
+    pub fn in_range_per_pixel(&self) -> f64 {
+        self.per_pixel(self.in_range)
+    }
+    pub fn rays_per_pixel(&self) -> f64 {
+        self.per_pixel(self.shadow_rays)
+    }
+    pub fn mean_list(&self) -> f64 {
+        self.list_entries as f64 / self.tiles_with_geometry.max(1) as f64
+    }
+}
+
+/// Per-VPL, per-tile and per-pixel buffers (resized with the VPL capacity, the frame size and
+/// the tile layout).
+pub struct LcullBuffers {
+    pub size: (u32, u32),
+    pub vpl_capacity: u32,
+    pub tiles: u32,
+    pub cap: u32,
+    /// Two vec4 per VPL: (position, range), (threshold, floor, 0, 0).
+    pub lights: wgpu::Buffer,
+    pub tile_count: wgpu::Buffer,
+    pub tile_lists: wgpu::Buffer,
+    pub raw: wgpu::Buffer,
+    pub diag: wgpu::Buffer,
+    pub stats: wgpu::Buffer,
+}
+
+impl LcullBuffers {
+    pub fn new(device: &wgpu::Device, vpl_capacity: u32, size: (u32, u32), tiles: u32, cap: u32) -> Self {
+        let px = size.0 as u64 * size.1 as u64;
+        Self {
+            size,
+            vpl_capacity,
+            tiles,
+            cap,
+            lights: storage_buffer(device, "lcull::lights", 32 * vpl_capacity as u64),
+            tile_count: storage_buffer(device, "lcull::tile_count", 4 * tiles as u64),
+            tile_lists: storage_buffer(device, "lcull::tile_lists", 4 * tiles as u64 * cap as u64),
+            raw: storage_buffer(device, "lcull::raw", 16 * px),
+            diag: storage_buffer(device, "lcull::diag", 16 * px),
+            stats: storage_buffer(device, "lcull::stats", 4 * STATS_WORDS as u64),
+        }
+    }
+    /// Bytes of the tile lists for this layout (the largest binding).
+    pub fn list_bytes(tiles: u32, cap: u32) -> u64 {
+        4 * tiles as u64 * cap as u64
+    }
+    pub fn matches(&self, vpl_capacity: u32, size: (u32, u32), tiles: u32, cap: u32) -> bool {
+        self.vpl_capacity == vpl_capacity && self.size == size && self.tiles == tiles && self.cap == cap
+    }
+}
+
+/// Everything a frame of the method binds from the renderer.
+pub struct FrameInputs<'a> {
+    pub scene: &'a SceneGpu,
+    pub gbuffer: &'a GbufferTargets,
+    pub camera: &'a wgpu::Buffer,
+    pub vpls: &'a wgpu::Buffer,
+    pub accum: &'a wgpu::Buffer,
+}
+
+pub struct LcullPass {
+    params: wgpu::Buffer,
+    ranges_layout: wgpu::BindGroupLayout,
+    ranges: wgpu::ComputePipeline,
+    tiles_layout: wgpu::BindGroupLayout,
+    tiles: wgpu::ComputePipeline,
+    tiles_timed: wgpu::ComputePipeline,
+    shade_layout: wgpu::BindGroupLayout,
+    shade: wgpu::ComputePipeline,
+    shade_timed: wgpu::ComputePipeline,
+    filter: wgpu::ComputePipeline,
+    views_layout: wgpu::BindGroupLayout,
+    views: wgpu::ComputePipeline,
+    view_params: wgpu::Buffer,
+    pub stats: CounterReadback<LcullStats>,
+}
+
+impl LcullPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let rmod = shaders::create_module(device, "methods/light_culling/lcull_ranges.wgsl")?;
+        let tmod = shaders::create_module(device, "methods/light_culling/lcull_tiles.wgsl")?;
+        let smod = shaders::create_module(device, "methods/light_culling/lcull_shade.wgsl")?;
+        let vmod = shaders::create_module(device, "methods/light_culling/lcull_views.wgsl")?;
+        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        let ranges_layout = layout(
+            "lcull_ranges::layout",
+            &[
+                uniform_entry(0, c),
+                storage_entry(1, c, true),
+                storage_entry(2, c, false),
+            ],
+        );
+        let tiles_layout = layout(
+            "lcull_tiles::layout",
+            &[
+                uniform_entry(0, c),
+                uniform_entry(1, c),
+                float_texture_entry(2),
+                storage_entry(3, c, true),
+                storage_entry(4, c, false),
+                storage_entry(5, c, false),
+                storage_entry(6, c, false),
+            ],
+        );
+        let mut se = vec![uniform_entry(0, c), uniform_entry(1, c)];
+        se.extend((2..=4).map(float_texture_entry));
+        se.extend((5..=10).map(|b| storage_entry(b, c, true)));
+        se.extend((11..=14).map(|b| storage_entry(b, c, false)));
+        let shade_layout = layout("lcull_shade::layout", &se);
+        let views_layout = layout(
+            "lcull_views::layout",
+            &[
+                uniform_entry(0, c),
+                float_texture_entry(1),
+                float_texture_entry(2),
+                storage_entry(3, c, true),
+                storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm),
+            ],
+        );
+        let pipe =
+            |label: &str,
+             l: &wgpu::BindGroupLayout,
+             m: &wgpu::ShaderModule,
+             entry: &str,
+             k: &[(&str, f64)]| { compute_pipeline_with(device, label, &[Some(l)], m, entry, k) };
+        let timed = &[("DIAGNOSTICS", 0.0)];
+        Ok(Self {
+            params: uniform_buffer::<GpuLcullParams>(device, "lcull::params"),
+            ranges: pipe("lcull_ranges", &ranges_layout, &rmod, "main", &[]),
+            ranges_layout,
+            tiles: pipe("lcull_tiles", &tiles_layout, &tmod, "main", &[]),
+            tiles_timed: pipe("lcull_tiles_timed", &tiles_layout, &tmod, "main", timed),
+            tiles_layout,
+            shade: pipe("lcull_shade", &shade_layout, &smod, "shade_main", &[]),
+            shade_timed: pipe("lcull_shade_timed", &shade_layout, &smod, "shade_main", timed),
+            filter: pipe("lcull_filter", &shade_layout, &smod, "filter_main", &[]),
+            shade_layout,
+            views: pipe("lcull_views", &views_layout, &vmod, "main", &[]),
+            views_layout,
+            view_params: uniform_buffer::<GpuLcullViewParams>(device, "lcull_views::params"),
+            stats: CounterReadback::new(
+                device,
+                "lcull::stats_readback",
+                (STATS_WORDS * 4) as u64,
+                LcullStats::from_words,
+            ),
+        })
+    }
+
+    /// Records the frame's passes (module doc).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        diagnostics: bool,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: GpuLcullParams,
+        f: &FrameInputs<'_>,
+        b: &LcullBuffers,
+    ) {
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let tv = wgpu::BindingResource::TextureView;
+        let g = f.gbuffer;
+        let rbind = bind_group_seq(
+            device,
+            "lcull_ranges::bind_group",
+            &self.ranges_layout,
+            &[
+                self.params.as_entire_binding(),
+                f.vpls.as_entire_binding(),
+                b.lights.as_entire_binding(),
+            ],
+        );
+        let (gx, gy) = groups_1d_as_2d(p.count.div_ceil(WG_1D).max(1));
+        run_compute(encoder, timer, "lcull_ranges", &self.ranges, &rbind, (gx, gy, 1));
+
+        if diagnostics {
+            encoder.clear_buffer(&b.stats, 0, None);
+        }
+        let tbind = bind_group_seq(
+            device,
+            "lcull_tiles::bind_group",
+            &self.tiles_layout,
+            &[
+                self.params.as_entire_binding(),
+                f.camera.as_entire_binding(),
+                tv(&g.position_view),
+                b.lights.as_entire_binding(),
+                b.tile_count.as_entire_binding(),
+                b.tile_lists.as_entire_binding(),
+                b.stats.as_entire_binding(),
+            ],
+        );
+        let (tx, ty) = groups_1d_as_2d(p.tiles);
+        let tiles = if diagnostics {
+            &self.tiles
+        } else {
+            &self.tiles_timed
+        };
+        run_compute(encoder, timer, "lcull_tiles", tiles, &tbind, (tx, ty, 1));
+
+        let sbind = bind_group_seq(
+            device,
+            "lcull_shade::bind_group",
+            &self.shade_layout,
+            &[
+                self.params.as_entire_binding(),
+                f.camera.as_entire_binding(),
+                tv(&g.position_view),
+                tv(&g.normal_view),
+                tv(&g.albedo_view),
+                f.scene.bvh_nodes.as_entire_binding(),
+                f.scene.bvh_triangles.as_entire_binding(),
+                f.vpls.as_entire_binding(),
+                b.lights.as_entire_binding(),
+                b.tile_count.as_entire_binding(),
+                b.tile_lists.as_entire_binding(),
+                b.raw.as_entire_binding(),
+                b.diag.as_entire_binding(),
+                f.accum.as_entire_binding(),
+                b.stats.as_entire_binding(),
+            ],
+        );
+        let shade = if diagnostics {
+            &self.shade
+        } else {
+            &self.shade_timed
+        };
+        let groups = groups_image(p.width, p.height);
+        run_compute(encoder, timer, "lcull_shade", shade, &sbind, groups);
+        run_compute(encoder, timer, "lcull_filter", &self.filter, &sbind, groups);
+        if diagnostics {
+            let bytes = (STATS_WORDS * 4) as u64;
+            self.stats.record(encoder, &[(&b.stats, 0, 0, bytes)]);
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_view(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: GpuLcullViewParams,
+        final_image: &wgpu::TextureView,
+        gb_position: &wgpu::TextureView,
+        b: &LcullBuffers,
+        dst: &wgpu::TextureView,
+    ) {
+        queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
+        let entries = [
+            self.view_params.as_entire_binding(),
+            wgpu::BindingResource::TextureView(final_image),
+            wgpu::BindingResource::TextureView(gb_position),
+            b.diag.as_entire_binding(),
+            wgpu::BindingResource::TextureView(dst),
+        ];
+        let bind = bind_group_seq(device, "lcull_views::bind_group", &self.views_layout, &entries);
+        run_compute(
+            encoder,
+            timer,
+            "lcull_views",
+            &self.views,
+            &bind,
+            groups_image(b.size.0, b.size.1),
+        );
+    }
+}

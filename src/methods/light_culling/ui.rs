@@ -1,0 +1,44 @@
+//! Stochastic Light Culling's settings in the GUI (shared by the clamped baseline).
+
+use super::settings::{LightCullingSettings, MAX_FILTER_RADIUS, MAX_INTERLEAVE, MAX_LIST};
+use crate::methods::MethodId;
+use crate::renderer::settings::RenderSettings;
+
+pub fn settings_ui(ui: &mut egui::Ui, _method: MethodId, s: &mut RenderSettings) {
+    let id = super::ID;
+    let mut lc: LightCullingSettings = match s.method(id) {
+        Ok(v) => v,
+        Err(e) => {
+            ui.colored_label(egui::Color32::LIGHT_RED, e);
+            return;
+        }
+    };
+    let before = lc.clone();
+    ui.add(
+        egui::Slider::new(&mut lc.epsilon_max, 1e-5..=0.05)
+            .logarithmic(true)
+            .text("error bound eps_max"),
+    )
+    .on_hover_text(
+        "largest standard deviation (stochastic) or darkening (clamped) per VPL in exposed \
+         display units (paper 0.0005); shared by both variants",
+    );
+    ui.add(egui::Slider::new(&mut lc.interleave, 1..=MAX_INTERLEAVE).text("interleave n (n x n)"))
+        .on_hover_text("each pixel of an n x n pattern takes 1/n^2 of the VPLs (paper 8; 1 = off)");
+    ui.add(egui::Slider::new(&mut lc.filter_radius, 0..=MAX_FILTER_RADIUS).text("filter radius"))
+        .on_hover_text("geometry-aware filter window (2r+1)^2 (paper 17 x 17: 8; 0 = off)");
+    ui.add(egui::Slider::new(&mut lc.filter_normal_cos, 0.0..=1.0).text("filter normal cos"));
+    ui.add(egui::Slider::new(&mut lc.filter_plane_tolerance, 0.0..=0.2).text("filter plane tolerance"))
+        .on_hover_text("neighbours farther from the pixel's tangent plane than this x depth are skipped");
+    ui.add(egui::Slider::new(&mut lc.tile_size, 4..=32).text("tile size (pixels)"));
+    ui.add(
+        egui::Slider::new(&mut lc.max_lights_per_tile, 1..=MAX_LIST)
+            .logarithmic(true)
+            .text("max lights per tile"),
+    )
+    .on_hover_text("an overflowing tile is shaded by testing all its subset's VPLs (counted, shown)");
+    if lc != before {
+        // Cannot fail: the struct serialises to a table.
+        let _ = s.set_method(id, &lc);
+    }
+}

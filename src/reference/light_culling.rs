@@ -1,0 +1,634 @@
+//! CPU twin of Stochastic Light Culling (Tokuyoshi & Harada 2016, sections 3-4) and of the
+//! clamped-range baseline (its appendix A): per-VPL ranges, the interleaved tiles and their
+//! light lists, the fall-off and the per-pixel sum. Twins of
+//! `shaders/methods/light_culling/{lcull_common, lcull_ranges, lcull_tiles, lcull_shade}.wgsl`.
+//!
+//! Our VPL is a diffuse emitter of flux Phi: radiant intensity I(w') = Phi / pi x cos, so
+//! max I = max_rgb(Phi) / pi. Our fall-off is the workbench's bounded one,
+//! f(l) = 1 / max(l^2, eps^2) (`gi.distance_epsilon`), so the method is unbiased with respect
+//! to the ground truth of the same VPLs and the same eps.
+
+use glam::{UVec2, Vec3};
+
+use super::vpl::{pcg_hash, u01};
+
+/// Largest range we store (a VPL whose xi is 0 lights everything).
+pub const RANGE_INF: f32 = 1e30;
+
+/// Eq. 6 with max I = max_rgb(flux) / pi: alpha_i = 2 pi eps_max / (E max I)
+/// = 2 pi^2 eps_max / (E max_rgb(flux)). `exposure` is E (the display's 2^EV).
+pub fn alpha(epsilon_max: f32, exposure: f32, flux_max: f32) -> f32 {
+    let pi = std::f32::consts::PI;
+    2.0 * pi * pi * epsilon_max / (exposure * flux_max)
+}
+
+/// Appendix A: the clamped range for the same error bound,
+/// r_i = sqrt(E N max I / (pi eps_max)) = sqrt(E N max_rgb(flux) / (pi^2 eps_max)).
+pub fn clamped_range(epsilon_max: f32, exposure: f32, count: u32, flux_max: f32) -> f32 {
+    let pi = std::f32::consts::PI;
+    (exposure * count as f32 * flux_max / (pi * pi * epsilon_max)).sqrt()
+}
+
+/// The random number xi_i of VPL `i` in a frame (one per VPL, shared by every pixel: section
+/// 3.1). The paper uses the tiny encryption algorithm; we use the PCG hash of the workbench.
+/// Twin: `lcull_xi` in `lcull_common.wgsl`.
+pub fn xi(seed: u32, i: u32) -> f32 {
+    u01(pcg_hash(seed ^ pcg_hash(i ^ 0x6c8e_9cf5)))
+}
+
+/// How a VPL's contribution falls off: `f(l) > threshold ? max(floor, f(l)) : 0` with
+/// f(l) = 1 / max(l^2, eps^2). Stochastic (eq. 2): threshold = alpha xi, floor = alpha (the
+/// Russian roulette's f / p). Clamped: threshold = 1 / r^2, floor = 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Falloff {
+    pub threshold: f32,
+    pub floor: f32,
+}
+
+impl Falloff {
+    pub fn stochastic(alpha: f32, xi: f32) -> Self {
+        Self {
+            threshold: alpha * xi,
+            floor: alpha,
+        }
+    }
+    pub fn clamped(range: f32) -> Self {
+        Self {
+            threshold: 1.0 / (range * range),
+            floor: 0.0,
+        }
+    }
+    /// The estimate of f(l) at squared distance `l2`.
+    pub fn eval(self, l2: f32, eps: f32) -> f32 {
+        let f = 1.0 / l2.max(eps * eps);
+        if f > self.threshold {
+            f.max(self.floor)
+        } else {
+            0.0
+        }
+    }
+    /// The range beyond which `eval` is 0: eq. 3, r = f^-1(threshold) = 1 / sqrt(threshold)
+    /// (0 when even f(0) = 1 / eps^2 is not above the threshold).
+    pub fn range(self, eps: f32) -> f32 {
+        if self.threshold <= 0.0 {
+            RANGE_INF
+        } else if self.threshold * eps * eps >= 1.0 {
+            0.0
+        } else {
+            (1.0 / self.threshold.sqrt()).min(RANGE_INF)
+        }
+    }
+}
+
+/// A VPL's culling data: position, range and fall-off (range 0: never contributes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightRange {
+    pub position: Vec3,
+    pub range: f32,
+    pub falloff: Falloff,
+}
+
+/// Which ranges: the paper's stochastic ones or the clamped baseline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RangeMode {
+    Stochastic,
+    Clamped,
+}
+
+/// Parameters of the range pass.
+#[derive(Clone, Copy, Debug)]
+pub struct RangeParams {
+    pub mode: RangeMode,
+    pub epsilon_max: f32,
+    pub exposure: f32,
+    /// VPLs of the frame (N of appendix A).
+    pub count: u32,
+    pub seed: u32,
+    /// `gi.distance_epsilon`.
+    pub eps: f32,
+}
+
+/// Pass 1 of Algorithm 1 for VPL `i` (position, max_rgb(flux); a VPL without flux gets range 0).
+pub fn light_range(p: &RangeParams, i: u32, position: Vec3, flux_max: f32) -> LightRange {
+    if flux_max <= 0.0 || !flux_max.is_finite() {
+        return LightRange {
+            position,
+            range: 0.0,
+            falloff: Falloff {
+                threshold: f32::MAX,
+                floor: 0.0,
+            },
+        };
+    }
+    let falloff = match p.mode {
+        RangeMode::Stochastic => {
+            Falloff::stochastic(alpha(p.epsilon_max, p.exposure, flux_max), xi(p.seed, i))
+        }
+        RangeMode::Clamped => Falloff::clamped(clamped_range(p.epsilon_max, p.exposure, p.count, flux_max)),
+    };
+    LightRange {
+        position,
+        range: falloff.range(p.eps),
+        falloff,
+    }
+}
+
+/// Interleaved sampling (section 4.2): an n x n pattern, pixel (x, y) takes subset
+/// (x mod n) + n (y mod n). VPL i belongs to subset ((i / stride) mod n^2 + offset) mod n^2:
+/// runs of `stride` consecutive VPLs share a subset. Our VPLs come in Hammersley order (the
+/// warp's first coordinate i / N, the second the bit-reversed i), so with a stride near
+/// sqrt(N / n^2) (a power of two) each subset is a stratified sample of the whole RSM; a stride
+/// of 1 would give each subset one strip of it (the low bits of i fix the top bits of the
+/// second coordinate). `offset` is drawn per frame, so that every pixel sees every VPL with
+/// probability 1 / n^2 over frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Interleave {
+    pub n: u32,
+    pub offset: u32,
+    pub stride: u32,
+}
+
+impl Interleave {
+    /// The frame's interleaving for `count` VPLs and seed `seed`.
+    pub fn new(n: u32, count: u32, seed: u32) -> Self {
+        Self {
+            n,
+            offset: Self::offset_of(n, seed),
+            stride: Self::stride_for(count, n),
+        }
+    }
+    pub fn cells(self) -> u32 {
+        self.n * self.n
+    }
+    pub fn pixel_subset(self, x: u32, y: u32) -> u32 {
+        x % self.n + self.n * (y % self.n)
+    }
+    pub fn vpl_subset(self, i: u32) -> u32 {
+        let c = self.cells();
+        ((i / self.stride) % c + self.offset % c) % c
+    }
+    /// The k-th VPL of subset `s` (increasing in k). Twin: `lcull_member`.
+    pub fn member(self, s: u32, k: u32) -> u32 {
+        let c = self.cells();
+        let j = (s + c - self.offset % c) % c;
+        (k / self.stride) * self.stride * c + j * self.stride + k % self.stride
+    }
+    /// How many of `count` VPLs subset `s` holds. Twin: `lcull_members`.
+    pub fn members(self, s: u32, count: u32) -> u32 {
+        let c = self.cells();
+        let j = (s + c - self.offset % c) % c;
+        let block = self.stride * c;
+        let full = count / block;
+        let rem = count - full * block;
+        full * self.stride + rem.saturating_sub(j * self.stride).min(self.stride)
+    }
+    /// The VPLs of subset `s`, in increasing order.
+    pub fn subset(self, s: u32, count: u32) -> impl Iterator<Item = u32> {
+        (0..self.members(s, count)).map(move |k| self.member(s, k))
+    }
+    /// The frame's offset. Twin: computed on the CPU for the uniforms.
+    pub fn offset_of(n: u32, seed: u32) -> u32 {
+        pcg_hash(seed ^ 0x2545_f491) % (n * n).max(1)
+    }
+    /// The largest power of two at most sqrt(count / n^2) (at least 1).
+    pub fn stride_for(count: u32, n: u32) -> u32 {
+        let per = (count / (n * n).max(1)).max(1) as f64;
+        let s = per.sqrt().floor().max(1.0) as u32;
+        1 << (31 - s.leading_zeros())
+    }
+}
+
+/// The camera as the tile pass sees it (`GpuCamera`'s fields).
+#[derive(Clone, Copy, Debug)]
+pub struct TileCamera {
+    pub eye: Vec3,
+    /// Unit forward.
+    pub forward: Vec3,
+    /// right x tan(yfov / 2) x aspect.
+    pub right: Vec3,
+    /// up x tan(yfov / 2).
+    pub up: Vec3,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl TileCamera {
+    pub fn new(cam: &crate::scene::Camera, width: u32, height: u32) -> Self {
+        let aspect = width as f32 / height.max(1) as f32;
+        let t = (0.5 * cam.yfov).tan();
+        Self {
+            eye: cam.position,
+            forward: cam.forward,
+            right: cam.right() * t * aspect,
+            up: cam.up * t,
+            width,
+            height,
+        }
+    }
+    /// Direction through screen point (px, py) in pixels (edges at integers).
+    fn dir(&self, px: f32, py: f32) -> Vec3 {
+        let x = 2.0 * px / self.width as f32 - 1.0;
+        let y = 1.0 - 2.0 * py / self.height as f32;
+        self.forward + x * self.right + y * self.up
+    }
+}
+
+/// The tile layout: tiles of `tile` x `tile` pixels of one interleaving subset each (the
+/// subset's pixels de-interleaved into a (W / n) x (H / n) image, as Segovia et al.'s
+/// non-interleaved deferred shading).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TileGrid {
+    pub width: u32,
+    pub height: u32,
+    pub tile: u32,
+    pub n: u32,
+}
+
+impl TileGrid {
+    /// Tiles per subset (x, y).
+    pub fn per_subset(self) -> (u32, u32) {
+        (
+            self.width.div_ceil(self.n).div_ceil(self.tile),
+            self.height.div_ceil(self.n).div_ceil(self.tile),
+        )
+    }
+    pub fn count(self) -> u32 {
+        let (tx, ty) = self.per_subset();
+        tx * ty * self.n * self.n
+    }
+    /// (subset, tile x, tile y) of tile `t`.
+    pub fn coords(self, t: u32) -> (u32, u32, u32) {
+        let (tx, ty) = self.per_subset();
+        (t / (tx * ty), t % tx, (t / tx) % ty)
+    }
+    /// The tile of pixel (x, y). Twin: `lcull_tile_of` in `lcull_common.wgsl`.
+    pub fn tile_of(self, x: u32, y: u32) -> u32 {
+        let (tx, ty) = self.per_subset();
+        let s = x % self.n + self.n * (y % self.n);
+        let (dx, dy) = (x / self.n / self.tile, y / self.n / self.tile);
+        s * tx * ty + dy * tx + dx
+    }
+    /// Screen pixel of tile `t`'s local pixel (lx, ly), if on screen.
+    pub fn pixel(self, t: u32, lx: u32, ly: u32) -> Option<UVec2> {
+        let (s, tx, ty) = self.coords(t);
+        let x = (tx * self.tile + lx) * self.n + s % self.n;
+        let y = (ty * self.tile + ly) * self.n + s / self.n;
+        (x < self.width && y < self.height).then_some(UVec2::new(x, y))
+    }
+    /// The screen rectangle (pixel edges) tile `t`'s pixels span: x0, y0, x1, y1.
+    pub fn rect(self, t: u32) -> [f32; 4] {
+        let (s, tx, ty) = self.coords(t);
+        let (sx, sy) = (s % self.n, s / self.n);
+        let x0 = (tx * self.tile) * self.n + sx;
+        let y0 = (ty * self.tile) * self.n + sy;
+        let x1 = ((tx * self.tile + self.tile - 1) * self.n + sx + 1).min(self.width);
+        let y1 = ((ty * self.tile + self.tile - 1) * self.n + sy + 1).min(self.height);
+        [x0 as f32, y0 as f32, x1 as f32, y1 as f32]
+    }
+}
+
+/// A tile's culling volume: its sub-frustum (four planes through the eye, unit inward
+/// normals) between the least and greatest view depth of its pixels.
+#[derive(Clone, Copy, Debug)]
+pub struct TileBounds {
+    pub planes: [Vec3; 4],
+    pub depth: (f32, f32),
+}
+
+/// The tile's bounds from its pixels' view depths (None: no geometry in the tile).
+pub fn tile_bounds(cam: &TileCamera, grid: TileGrid, t: u32, depths: &[f32]) -> Option<TileBounds> {
+    if depths.is_empty() {
+        return None;
+    }
+    let lo = depths.iter().copied().fold(f32::MAX, f32::min);
+    let hi = depths.iter().copied().fold(0.0f32, f32::max);
+    let [x0, y0, x1, y1] = grid.rect(t);
+    Some(TileBounds {
+        planes: frustum_planes(cam, [x0, y0, x1, y1]),
+        depth: (lo, hi),
+    })
+}
+
+/// Inward unit normals of the four side planes through the eye and the rectangle's edges.
+/// Twin: `lcull_planes` in `lcull_tiles.wgsl`.
+pub fn frustum_planes(cam: &TileCamera, [x0, y0, x1, y1]: [f32; 4]) -> [Vec3; 4] {
+    let c = [cam.dir(x0, y0), cam.dir(x1, y0), cam.dir(x1, y1), cam.dir(x0, y1)];
+    let mid = cam.dir(0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let mut planes = [Vec3::ZERO; 4];
+    for k in 0..4 {
+        let n = c[k].cross(c[(k + 1) % 4]).normalize_or_zero();
+        planes[k] = if n.dot(mid) < 0.0 { -n } else { n };
+    }
+    planes
+}
+
+/// Whether a sphere (centre, radius) touches the tile's volume: inside or within `radius` of
+/// every side plane, and its view depth within `radius` of the depth bounds (the standard
+/// conservative sphere-frustum test of tiled lighting). Twin: `lcull_touches`.
+pub fn sphere_touches(cam: &TileCamera, b: &TileBounds, centre: Vec3, radius: f32) -> bool {
+    if radius <= 0.0 {
+        return false;
+    }
+    let v = centre - cam.eye;
+    let d = v.dot(cam.forward);
+    if d < b.depth.0 - radius || d > b.depth.1 + radius {
+        return false;
+    }
+    b.planes.iter().all(|n| n.dot(v) >= -radius)
+}
+
+/// View depth of a world point.
+pub fn view_depth(cam: &TileCamera, p: Vec3) -> f32 {
+    (p - cam.eye).dot(cam.forward)
+}
+
+/// The tile lists: for each tile, the VPLs of its subset (increasing index) whose range
+/// sphere touches it. `positions[y * width + x]` is the G-buffer position (None: no surface).
+pub fn tile_lists(
+    cam: &TileCamera,
+    grid: TileGrid,
+    il: Interleave,
+    positions: &[Option<Vec3>],
+    lights: &[LightRange],
+) -> Vec<Vec<u32>> {
+    (0..grid.count())
+        .map(|t| {
+            let mut depths = Vec::new();
+            for ly in 0..grid.tile {
+                for lx in 0..grid.tile {
+                    if let Some(p) = grid.pixel(t, lx, ly)
+                        && let Some(x) = positions[(p.y * grid.width + p.x) as usize]
+                    {
+                        depths.push(view_depth(cam, x).max(0.0));
+                    }
+                }
+            }
+            let Some(b) = tile_bounds(cam, grid, t, &depths) else {
+                return Vec::new();
+            };
+            let s = grid.coords(t).0;
+            il.subset(s, lights.len() as u32)
+                .filter(|&i| sphere_touches(cam, &b, lights[i as usize].position, lights[i as usize].range))
+                .collect()
+        })
+        .collect()
+}
+
+/// A VPL for shading: position, normal, rgb flux.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadeVpl {
+    pub position: Vec3,
+    pub normal: Vec3,
+    pub flux: Vec3,
+}
+
+/// The pixel's demodulated estimate (before albedo / pi): n^2 x sum over `list` of
+/// flux / pi x cos_x x cos_v x falloff(l) x V, with `visible(i)` the shadow ray (Algorithm 1,
+/// step 3). Twin: `lcull_shade.wgsl`.
+#[allow(clippy::too_many_arguments)]
+pub fn shade(
+    x: Vec3,
+    nx: Vec3,
+    list: &[u32],
+    vpls: &[ShadeVpl],
+    lights: &[LightRange],
+    il: Interleave,
+    eps: f32,
+    mut visible: impl FnMut(u32) -> bool,
+) -> Vec3 {
+    let pi = std::f32::consts::PI;
+    let mut sum = Vec3::ZERO;
+    for &i in list {
+        let v = vpls[i as usize];
+        let d = v.position - x;
+        let l2 = d.length_squared();
+        let f = lights[i as usize].falloff.eval(l2, eps);
+        if f <= 0.0 {
+            continue;
+        }
+        let w = d / l2.max(1e-30).sqrt();
+        let (cx, cv) = (nx.dot(w), -v.normal.dot(w));
+        if cx <= 0.0 || cv <= 0.0 || !visible(i) {
+            continue;
+        }
+        sum += v.flux / pi * (cx * cv * f);
+    }
+    sum * il.cells() as f32
+}
+
+/// The geometry-aware filter of interleaved sampling (section 4.2; Segovia et al. 2006): the
+/// mean of the demodulated estimates in a (2 radius + 1)^2 window over the pixels on the same
+/// surface: normals within `normal_cos` and the neighbour within `plane_tolerance` x view depth
+/// of the pixel's tangent plane. Twin: `lcull_filter` in `lcull_shade.wgsl`.
+#[allow(clippy::too_many_arguments)]
+pub fn filter_pixel(
+    x: u32,
+    y: u32,
+    width: u32,
+    height: u32,
+    radius: u32,
+    normal_cos: f32,
+    plane_tolerance: f32,
+    cam: &TileCamera,
+    surf: &[Option<(Vec3, Vec3)>],
+    raw: &[Vec3],
+) -> Vec3 {
+    let k = (y * width + x) as usize;
+    let Some((p, n)) = surf[k] else { return Vec3::ZERO };
+    let tol = plane_tolerance * view_depth(cam, p).max(1e-6);
+    let r = radius as i32;
+    let (mut sum, mut w) = (Vec3::ZERO, 0.0f32);
+    for dy in -r..=r {
+        for dx in -r..=r {
+            let (qx, qy) = (x as i32 + dx, y as i32 + dy);
+            if qx < 0 || qy < 0 || qx >= width as i32 || qy >= height as i32 {
+                continue;
+            }
+            let q = (qy as u32 * width + qx as u32) as usize;
+            let Some((pq, nq)) = surf[q] else { continue };
+            if n.dot(nq) >= normal_cos && (pq - p).dot(n).abs() <= tol {
+                sum += raw[q];
+                w += 1.0;
+            }
+        }
+    }
+    sum / w.max(1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn params(mode: RangeMode, epsilon_max: f32) -> RangeParams {
+        RangeParams {
+            mode,
+            epsilon_max,
+            exposure: 1.0,
+            count: 4096,
+            seed: 7,
+            eps: 0.05,
+        }
+    }
+
+    #[test]
+    fn the_fall_off_estimate_is_unbiased_and_bounded_by_its_range() {
+        // E[f_hat(l)] over xi = f(l) (eq. 2), and f_hat = 0 beyond r (eq. 3).
+        let a = alpha(0.0005, 1.0, 0.01);
+        let eps = 0.05;
+        for &l in &[0.01f32, 0.3, 1.0, 4.0, 30.0] {
+            let n = 200_000u32;
+            let mean = (0..n)
+                .map(|i| Falloff::stochastic(a, (i as f32 + 0.5) / n as f32).eval(l * l, eps) as f64)
+                .sum::<f64>()
+                / n as f64;
+            let f = 1.0 / (l * l).max(eps * eps) as f64;
+            assert!((mean - f).abs() < 1e-3 * f, "l {l}: mean {mean} vs f {f}");
+            for xi in [0.01f32, 0.5, 0.99] {
+                let fo = Falloff::stochastic(a, xi);
+                let r = fo.range(eps);
+                if l >= r * 1.0001 {
+                    assert_eq!(fo.eval(l * l, eps), 0.0, "beyond the range");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_range_is_monotone_in_the_error_bound_and_follows_eq_3_and_appendix_a() {
+        let eps = 0.05;
+        let mut last = f32::MAX;
+        for e in [1e-5f32, 1e-4, 5e-4, 2e-3, 1e-2] {
+            let p = params(RangeMode::Stochastic, e);
+            let r = light_range(&p, 3, Vec3::ZERO, 0.02).range;
+            let a = alpha(e, 1.0, 0.02);
+            let want = 1.0 / (a * xi(7, 3)).sqrt();
+            assert!((r - want).abs() < 1e-5 * want, "eq. 3: {r} vs {want}");
+            assert!(r < last, "the range shrinks as eps_max grows");
+            last = r;
+        }
+        // Eq. 6 by hand: eps_max 0.0005, E 2, flux 0.01: 2 pi (0.0005) / (2 x 0.01 / pi).
+        let pi = std::f32::consts::PI;
+        let a = alpha(0.0005, 2.0, 0.01);
+        assert!((a - 2.0 * pi * 0.0005 / (2.0 * 0.01 / pi)).abs() < 1e-6 * a);
+        // Appendix A: r = sqrt(E N I / (pi eps_max)), constant when N x flux is.
+        let r1 = clamped_range(0.0005, 1.0, 1024, 0.04);
+        let r2 = clamped_range(0.0005, 1.0, 4096, 0.01);
+        assert!((r1 - r2).abs() < 1e-4 * r1);
+        let i = 0.04 / pi;
+        assert!((r1 - (1024.0 * i / (pi * 0.0005)).sqrt()).abs() < 1e-4 * r1);
+        let c = light_range(&params(RangeMode::Clamped, 0.0005), 0, Vec3::ZERO, 0.01);
+        assert!((c.range - clamped_range(0.0005, 1.0, 4096, 0.01)).abs() < 1e-3 * c.range);
+        // Beyond the clamped range: 0; inside: f exactly (no floor).
+        assert_eq!(c.falloff.eval((c.range * 1.01).powi(2), eps), 0.0);
+        let l = 0.5 * c.range;
+        assert!((c.falloff.eval(l * l, eps) - 1.0 / (l * l)).abs() < 1e-6 / (l * l));
+        // No flux: never contributes.
+        assert_eq!(
+            light_range(&params(RangeMode::Stochastic, 0.01), 0, Vec3::ZERO, 0.0).range,
+            0.0
+        );
+    }
+
+    #[test]
+    fn the_interleaving_subsets_partition_the_vpls_and_the_pixels() {
+        for n in [1u32, 2, 3, 8] {
+            for (offset, total) in [(0u32, 1000u32), (1, 4096), (5, 777), (63, 65536), (7, 3)] {
+                let il = Interleave {
+                    n,
+                    offset: offset % (n * n),
+                    stride: Interleave::stride_for(total, n),
+                };
+                let mut seen = vec![0u32; total as usize];
+                for s in 0..il.cells() {
+                    let mut last = None;
+                    for i in il.subset(s, total) {
+                        assert!(i < total && last.is_none_or(|l| l < i), "increasing, in range");
+                        assert_eq!(il.vpl_subset(i), s);
+                        seen[i as usize] += 1;
+                        last = Some(i);
+                    }
+                }
+                assert!(
+                    seen.iter().all(|&c| c == 1),
+                    "n {n}, {total}: every VPL exactly once"
+                );
+                // Every screen pixel lies in exactly one tile, at the local pixel that maps back.
+                let grid = TileGrid {
+                    width: 37,
+                    height: 23,
+                    tile: 4,
+                    n,
+                };
+                let mut hits = vec![0u32; 37 * 23];
+                for t in 0..grid.count() {
+                    for ly in 0..grid.tile {
+                        for lx in 0..grid.tile {
+                            if let Some(p) = grid.pixel(t, lx, ly) {
+                                assert_eq!(grid.tile_of(p.x, p.y), t);
+                                let r = grid.rect(t);
+                                assert!(p.x as f32 >= r[0] && (p.x as f32) < r[2]);
+                                assert!(p.y as f32 >= r[1] && (p.y as f32) < r[3]);
+                                hits[(p.y * 37 + p.x) as usize] += 1;
+                            }
+                        }
+                    }
+                }
+                assert!(hits.iter().all(|&h| h == 1), "n {n}: every pixel in one tile");
+            }
+        }
+    }
+
+    #[test]
+    fn each_subset_of_hammersley_ordered_vpls_covers_the_unit_square() {
+        // 4096 VPLs, 8 x 8 subsets of 64: the stride puts one point of every subset in each
+        // cell of an 8 x 8 grid over the Hammersley square (a stride of 1 puts a subset in one
+        // strip of 1/64).
+        let (count, n) = (4096u32, 8u32);
+        let il = Interleave::new(n, count, 3);
+        assert_eq!(il.stride, 8);
+        for s in 0..il.cells() {
+            let mut cells = std::collections::HashSet::new();
+            for i in il.subset(s, count) {
+                let (u, v) = (i as f32 / count as f32, super::super::vpl::radical_inverse_2(i));
+                cells.insert(((u * 8.0) as u32, (v * 8.0) as u32));
+            }
+            assert_eq!(cells.len(), 64, "subset {s} covers every cell once");
+        }
+    }
+
+    #[test]
+    fn a_sphere_around_any_tile_point_touches_the_tile() {
+        // The culling is conservative: every pixel position within r of a light puts the
+        // light in the pixel's tile list.
+        let cam = TileCamera {
+            eye: Vec3::ZERO,
+            forward: Vec3::NEG_Z,
+            right: Vec3::X * 0.7,
+            up: Vec3::Y * 0.4,
+            width: 64,
+            height: 36,
+        };
+        let grid = TileGrid {
+            width: 64,
+            height: 36,
+            tile: 8,
+            n: 2,
+        };
+        let mut seed = 1u32;
+        let mut rnd = || {
+            seed = pcg_hash(seed);
+            u01(seed)
+        };
+        for _ in 0..2000 {
+            let (x, y) = ((rnd() * 64.0) as u32, (rnd() * 36.0) as u32);
+            let depth = 1.0 + 9.0 * rnd();
+            let t = grid.tile_of(x, y);
+            let pixel_dir = cam.dir(x as f32 + 0.5, y as f32 + 0.5);
+            let p = pixel_dir * depth;
+            let b = tile_bounds(&cam, grid, t, &[depth, depth + 0.5 * rnd()]).unwrap();
+            let r = 0.05 + rnd();
+            let c = p + Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or_zero() * r * 0.999;
+            assert!(sphere_touches(&cam, &b, c, r), "pixel ({x}, {y}) depth {depth}");
+        }
+    }
+}
