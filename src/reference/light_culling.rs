@@ -14,6 +14,8 @@ use super::vpl::{pcg_hash, u01};
 
 /// Largest range we store (a VPL whose xi is 0 lights everything).
 pub const RANGE_INF: f32 = 1e30;
+/// The threshold of a VPL that never contributes (no flux). Twin: `lcull_ranges.wgsl`.
+pub const NEVER: f32 = 3.0e38;
 
 /// Eq. 6 with max I = max_rgb(flux) / pi: alpha_i = 2 pi eps_max / (E max I)
 /// = 2 pi^2 eps_max / (E max_rgb(flux)). `exposure` is E (the display's 2^EV).
@@ -108,14 +110,15 @@ pub struct RangeParams {
     pub eps: f32,
 }
 
-/// Pass 1 of Algorithm 1 for VPL `i` (position, max_rgb(flux); a VPL without flux gets range 0).
+/// Pass 1 of Algorithm 1 for VPL `i` (position, max_rgb(flux); a VPL without flux, or an
+/// empty one (`VPL_NONE`: pass 0), gets range 0).
 pub fn light_range(p: &RangeParams, i: u32, position: Vec3, flux_max: f32) -> LightRange {
     if flux_max <= 0.0 || !flux_max.is_finite() {
         return LightRange {
             position,
             range: 0.0,
             falloff: Falloff {
-                threshold: f32::MAX,
+                threshold: NEVER,
                 floor: 0.0,
             },
         };
@@ -137,9 +140,11 @@ pub fn light_range(p: &RangeParams, i: u32, position: Vec3, flux_max: f32) -> Li
 /// (x mod n) + n (y mod n). VPL i belongs to subset ((i / stride) mod n^2 + offset) mod n^2:
 /// runs of `stride` consecutive VPLs share a subset. Our VPLs come in Hammersley order (the
 /// warp's first coordinate i / N, the second the bit-reversed i), so with a stride near
-/// sqrt(N / n^2) (a power of two) each subset is a stratified sample of the whole RSM; a stride
-/// of 1 would give each subset one strip of it (the low bits of i fix the top bits of the
-/// second coordinate). `offset` is drawn per frame, so that every pixel sees every VPL with
+/// sqrt(N / n^2) (a power of two) each subset is a stratified sample of the whole RSM (of one
+/// light's: with several lights, each light's VPL range need not start on a block boundary
+/// and the stratification weakens; the subsets still partition the VPLs); a stride of 1 would
+/// give each subset one strip of it (the low bits of i fix the top bits of the second
+/// coordinate). `offset` is drawn per frame, so that every pixel sees every VPL with
 /// probability 1 / n^2 over frames.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Interleave {
@@ -186,7 +191,7 @@ impl Interleave {
     pub fn subset(self, s: u32, count: u32) -> impl Iterator<Item = u32> {
         (0..self.members(s, count)).map(move |k| self.member(s, k))
     }
-    /// The frame's offset. Twin: computed on the CPU for the uniforms.
+    /// The frame's offset (the uniforms carry it to the kernels).
     pub fn offset_of(n: u32, seed: u32) -> u32 {
         pcg_hash(seed ^ 0x2545_f491) % (n * n).max(1)
     }
@@ -310,7 +315,7 @@ pub fn tile_bounds(cam: &TileCamera, grid: TileGrid, t: u32, depths: &[f32]) -> 
 }
 
 /// Inward unit normals of the four side planes through the eye and the rectangle's edges.
-/// Twin: `lcull_planes` in `lcull_tiles.wgsl`.
+/// Twin: the plane loop of `lcull_tiles.wgsl`'s `main`.
 pub fn frustum_planes(cam: &TileCamera, [x0, y0, x1, y1]: [f32; 4]) -> [Vec3; 4] {
     let c = [cam.dir(x0, y0), cam.dir(x1, y0), cam.dir(x1, y1), cam.dir(x0, y1)];
     let mid = cam.dir(0.5 * (x0 + x1), 0.5 * (y0 + y1));
@@ -324,7 +329,7 @@ pub fn frustum_planes(cam: &TileCamera, [x0, y0, x1, y1]: [f32; 4]) -> [Vec3; 4]
 
 /// Whether a sphere (centre, radius) touches the tile's volume: inside or within `radius` of
 /// every side plane, and its view depth within `radius` of the depth bounds (the standard
-/// conservative sphere-frustum test of tiled lighting). Twin: `lcull_touches`.
+/// conservative sphere-frustum test of tiled lighting). Twin: `touches` in `lcull_tiles.wgsl`.
 pub fn sphere_touches(cam: &TileCamera, b: &TileBounds, centre: Vec3, radius: f32) -> bool {
     if radius <= 0.0 {
         return false;
@@ -419,7 +424,7 @@ pub fn shade(
 /// The geometry-aware filter of interleaved sampling (section 4.2; Segovia et al. 2006): the
 /// mean of the demodulated estimates in a (2 radius + 1)^2 window over the pixels on the same
 /// surface: normals within `normal_cos` and the neighbour within `plane_tolerance` x view depth
-/// of the pixel's tangent plane. Twin: `lcull_filter` in `lcull_shade.wgsl`.
+/// of the pixel's tangent plane. Twin: `filter_main` in `lcull_shade.wgsl`.
 #[allow(clippy::too_many_arguments)]
 pub fn filter_pixel(
     x: u32,

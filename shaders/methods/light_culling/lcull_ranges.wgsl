@@ -20,7 +20,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let v = vpls[i];
     let flux_max = max(v.flux.r, max(v.flux.g, v.flux.b));
-    var threshold = 3.0e38;
+    var threshold = 3.0e38; // never passes (twin: reference::light_culling::NEVER)
     var floor_ = 0.0;
     var range = 0.0;
     if v.id != VPL_NONE && flux_max > 0.0 && flux_max < 3.0e38 {

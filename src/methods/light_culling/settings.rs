@@ -16,9 +16,11 @@ pub const MAX_FILTER_RADIUS: u32 = 16;
 pub struct LightCullingSettings {
     /// The user's error bound eps_max (section 3.2, eq. 6) in display units: the largest
     /// standard deviation one VPL may add to a pixel's exposed radiance E x L, with E the
-    /// display exposure 2^`display.exposure_ev`. Larger: smaller ranges, fewer VPLs per pixel,
-    /// more noise (stochastic) or more darkening (clamped, appendix A). Paper's real-time
-    /// results: 0.0005.
+    /// display exposure 2^`display.exposure_ev` (alpha from the VPL's own flux, as the paper;
+    /// with n x n interleaving a pixel's unfiltered estimate carries n^2 x that, which the
+    /// filter's average over the pattern brings back). Larger: smaller ranges, fewer VPLs per
+    /// pixel, more noise (stochastic) or more darkening (clamped, appendix A: the sum of all
+    /// VPLs' darkening at most eps_max). Paper's real-time results: 0.0005.
     pub epsilon_max: f32,
     /// Tile edge in pixels of the de-interleaved image (paper 16; 4..=32).
     pub tile_size: u32,

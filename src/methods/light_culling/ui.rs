@@ -20,8 +20,8 @@ pub fn settings_ui(ui: &mut egui::Ui, _method: MethodId, s: &mut RenderSettings)
             .text("error bound eps_max"),
     )
     .on_hover_text(
-        "largest standard deviation (stochastic) or darkening (clamped) per VPL in exposed \
-         display units (paper 0.0005); shared by both variants",
+        "largest standard deviation per VPL (stochastic; in the filtered image) or total \
+         darkening (clamped) in exposed display units (paper 0.0005); shared by both variants",
     );
     ui.add(egui::Slider::new(&mut lc.interleave, 1..=MAX_INTERLEAVE).text("interleave n (n x n)"))
         .on_hover_text("each pixel of an n x n pattern takes 1/n^2 of the VPLs (paper 8; 1 = off)");
