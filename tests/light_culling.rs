@@ -110,40 +110,63 @@ fn scaled(lights: &[LightRange], k: f32) -> Vec<LightRange> {
         .collect()
 }
 
-#[test]
-fn gpu_ranges_and_tile_lists_equal_the_cpu_reference() {
-    let Some(ctx) = common::gpu() else { return };
+/// One frame at eps_max 0.002 with a fixed seed: its settings, renderer and VPLs.
+fn fixed_frame(
+    ctx: &lightcut::renderer::context::GpuContext,
+) -> (LightCullingSettings, RenderSettings, Setup, Vec<GpuVpl>) {
     let lc = small(0.002);
     let mut s = settings(lc.clone());
     s.sampling.fixed_seed = true;
-    let mut st = Setup::new(&ctx, s.clone(), (W, H));
+    let mut st = Setup::new(ctx, s.clone(), (W, H));
     st.frame();
     let vpls = st.r.read_vpls().unwrap();
-    let n = vpls.len();
-    let gl = gpu_lights(&st, n);
-    // Ranges: eq. 6 and eq. 3 on the CPU from the same VPLs and seed.
-    let rp = range_params(&s, &lc, RangeMode::Stochastic, n as u32);
+    (lc, s, st, vpls)
+}
+
+/// The GPU's ranges and fall-offs against the CPU's for `mode`; the finite ranges.
+fn check_ranges(
+    s: &RenderSettings,
+    lc: &LightCullingSettings,
+    mode: RangeMode,
+    vpls: &[GpuVpl],
+    gl: &[LightRange],
+) -> Vec<f32> {
+    let rp = range_params(s, lc, mode, vpls.len() as u32);
+    let close = |a: f32, b: f32| (a - b).abs() <= 1e-5 * a.abs().max(b.abs()) + 1e-30;
     let mut finite = Vec::new();
     for (i, v) in vpls.iter().enumerate() {
         let c = light_range(&rp, i as u32, Vec3::from_slice(&v.position[..3]), flux_max(v));
         let g = gl[i];
-        assert_eq!(g.position, c.position, "VPL {i}");
-        let close = |a: f32, b: f32| (a - b).abs() <= 1e-5 * a.abs().max(b.abs()) + 1e-30;
+        assert_eq!(g.position, c.position, "{mode:?} VPL {i}");
         assert!(
             close(g.range, c.range),
-            "VPL {i}: range {} vs {}",
+            "{mode:?} VPL {i}: range {} vs {}",
             g.range,
             c.range
         );
         assert!(
             close(g.falloff.threshold, c.falloff.threshold),
-            "VPL {i}: {g:?} vs {c:?}"
+            "{mode:?} VPL {i}: {g:?} vs {c:?}"
         );
-        assert!(close(g.falloff.floor, c.falloff.floor), "VPL {i}: {g:?} vs {c:?}");
+        assert!(
+            close(g.falloff.floor, c.falloff.floor),
+            "{mode:?} VPL {i}: {g:?} vs {c:?}"
+        );
         if c.range > 0.0 {
             finite.push(c.range);
         }
     }
+    finite
+}
+
+#[test]
+fn gpu_ranges_and_tile_lists_equal_the_cpu_reference() {
+    let Some(ctx) = common::gpu() else { return };
+    let (lc, s, mut st, vpls) = fixed_frame(&ctx);
+    let n = vpls.len();
+    let gl = gpu_lights(&st, n);
+    // Ranges: eq. 6 and eq. 3 on the CPU from the same VPLs and seed.
+    let mut finite = check_ranges(&s, &lc, RangeMode::Stochastic, &vpls, &gl);
     finite.sort_by(f32::total_cmp);
     let median = finite[finite.len() / 2];
     eprintln!(
@@ -233,39 +256,22 @@ fn gpu_ranges_and_tile_lists_equal_the_cpu_reference() {
     assert_eq!(get("overflow_tiles"), over);
     assert_eq!(gpu_u32(&st, &lc_of(&st).buffers().tile_count), count);
 
-    // The clamped ranges (appendix A) against the CPU's.
+    // The clamped ranges (appendix A) against the CPU's: no Russian roulette (floor 0).
     st.set(|s| s.gi.method = light_culling::CLAMPED);
     st.frame();
     let gl = gpu_lights(&st, n);
-    let rp = range_params(&s, &lc, RangeMode::Clamped, n as u32);
-    for (i, v) in vpls.iter().enumerate() {
-        let c = light_range(&rp, i as u32, Vec3::from_slice(&v.position[..3]), flux_max(v));
-        let g = gl[i];
-        let close = |a: f32, b: f32| (a - b).abs() <= 1e-5 * a.abs().max(b.abs()) + 1e-30;
-        assert!(
-            close(g.range, c.range),
-            "clamped VPL {i}: range {} vs {}",
-            g.range,
-            c.range
-        );
-        assert!(
-            close(g.falloff.threshold, c.falloff.threshold),
-            "clamped VPL {i}: {g:?} vs {c:?}"
-        );
-        assert_eq!(g.falloff.floor, 0.0, "clamped VPL {i}: no Russian roulette");
-    }
+    check_ranges(&s, &lc, RangeMode::Clamped, &vpls, &gl);
+    assert!(
+        gl.iter().all(|g| g.falloff.floor == 0.0),
+        "clamped: no Russian roulette"
+    );
     assert!(ctx.errors.take().is_empty());
 }
 
 #[test]
 fn gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing() {
     let Some(ctx) = common::gpu() else { return };
-    let lc = small(0.002);
-    let mut s = settings(lc.clone());
-    s.sampling.fixed_seed = true;
-    let mut st = Setup::new(&ctx, s.clone(), (W, H));
-    st.frame();
-    let vpls = st.r.read_vpls().unwrap();
+    let (lc, s, mut st, vpls) = fixed_frame(&ctx);
     let n = vpls.len();
     let gl = gpu_lights(&st, n);
     let cam = TileCamera::new(&st.cam, W, H);

@@ -55,3 +55,8 @@ fn false_color(t: f32) -> vec3<f32> {
     let c6 = vec3<f32>(-5.4355, 4.6459, 26.3124);
     return clamp(c0 + x * (c1 + x * (c2 + x * (c3 + x * (c4 + x * (c5 + x * c6))))), vec3<f32>(0.0), vec3<f32>(1.0));
 }
+
+// v on a log scale from lo (0) to hi (1), clamped: the heat-map views' scale.
+fn log_scale(v: f32, lo: f32, hi: f32) -> f32 {
+    return clamp(log2(max(v, lo) / lo) / log2(hi / lo), 0.0, 1.0);
+}

@@ -26,10 +26,6 @@ struct LcullViewParams {
 @group(0) @binding(3) var<storage, read> diag: array<vec4<f32>>;
 @group(0) @binding(4) var dst: texture_storage_2d<rgba8unorm, write>;
 
-fn log_scale(v: f32, lo: f32, hi: f32) -> f32 {
-    return clamp(log2(max(v, lo) / lo) / log2(hi / lo), 0.0, 1.0);
-}
-
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let size = textureDimensions(dst);

@@ -44,10 +44,6 @@ struct LiSel {
 @group(0) @binding(9) var<storage, read> rec_meta: array<u32>;
 @group(0) @binding(10) var dst: texture_storage_2d<rgba8unorm, write>;
 
-fn log_scale(v: f32, lo: f32, hi: f32) -> f32 {
-    return clamp(log2(max(v, lo) / lo) / log2(hi / lo), 0.0, 1.0);
-}
-
 fn grey_final(px: vec2<i32>) -> vec3<f32> {
     return vec3<f32>(display_grey(textureLoad(final_image, px, 0).rgb, vp.exposure, vp.tonemap)) * 0.8;
 }
