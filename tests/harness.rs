@@ -92,6 +92,10 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             // The interpolation figure's cuts small (and `--set` reaching `results`).
             "--set",
             "methods.lightcut-interpolation.max_cut=64",
+            // The culling study at a looser base bound (shorter ranges: the sphere tree's
+            // per-pixel walks stay short at this size).
+            "--set",
+            "methods.light-culling.epsilon_max=0.002",
             "--out",
         ])
         .arg(&out)
@@ -251,8 +255,8 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         ],
         3,
     );
-    // Stochastic vs clamped culling: 2 VPL counts x 2 visibilities x 2 ranges, then the
-    // second bound at the base count (1024 = 2^10) x 2 x 2.
+    // Stochastic vs clamped culling and the sphere tree: 2 VPL counts x 2 visibilities x 3
+    // variants, then the second bound at the base count (1024 = 2^10) x 2 x 3.
     check_csv(
         &d,
         "culling.csv",
@@ -265,7 +269,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "rmse_vs_true_ground_truth",
             "shade_ms",
         ],
-        12,
+        18,
     );
     let (_, rows) = read_csv(&d.join("culling.csv"));
     assert!(
@@ -273,6 +277,10 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             .any(|r| r["ranges"] == "clamped" && r["visibility"] == "rays")
     );
     assert!(rows.iter().any(|r| r["epsilon_max"].starts_with("0.005")));
+    assert!(
+        rows.iter()
+            .any(|r| r["ranges"] == "tree" && r["visibility"] == "rays")
+    );
     for r in &rows {
         let rays: f64 = r["shadow_rays_per_pixel"].parse().unwrap();
         assert_eq!(rays == 0.0, r["visibility"] == "none", "{r:?}");

@@ -2,7 +2,9 @@
 //! against the CPU reference (`reference::light_culling`), no VPL in range missing from its
 //! pixel's tile, the shading and the geometry-aware filter against the CPU, overflowing tiles
 //! counted and shaded the same, and the estimator's unbiasedness over frames (the clamped
-//! baseline's darkening beside it). Tiny sizes: 250 VPLs, 48 x 32 pixels.
+//! baseline's darkening beside it, and the clamped-vs-stochastic difference view's data); the
+//! bounding-sphere-tree variant (section 5) against the CPU and its unbiasedness. Tiny sizes:
+//! 250 VPLs, 48 x 32 pixels.
 
 mod common;
 
@@ -12,15 +14,18 @@ use glam::Vec3;
 use lightcut::{
     base::gpu_layout::{GpuVpl, VPL_NONE},
     methods::light_culling::{self, LightCulling, settings::LightCullingSettings},
+    methods::overlay::Prim,
     metrics,
     reference::light_culling::{
-        Interleave, LightRange, RangeMode, RangeParams, ShadeVpl, TileCamera, filter_pixel, light_range,
-        shade, tile_lists,
+        Interleave, LightRange, RangeMode, RangeParams, ShadeVpl, TREE_STREAM_RESERVOIR, TREE_STREAM_RIS,
+        TileCamera, filter_pixel, light_range, shade, tile_lists, tree_max_ranges, tree_rng, tree_shade,
+        tree_traverse,
     },
+    reference::vpl::{pcg_hash, u01},
     renderer::{
-        Buffer,
+        Buffer, FrameInput,
         readback::read_storage_buffer,
-        settings::{RenderSettings, Tonemap},
+        settings::{RenderSettings, Tonemap, ViewBuffer},
     },
     scene::bvh::{Bvh, Ray},
 };
@@ -55,7 +60,11 @@ fn lc_of(st: &Setup) -> &LightCulling {
 }
 
 fn gpu_lights(st: &Setup, n: usize) -> Vec<LightRange> {
-    let bytes = read_storage_buffer(&st.r.ctx, &lc_of(st).buffers().lights).unwrap();
+    lights_of(st, &lc_of(st).buffers().lights, n)
+}
+
+fn lights_of(st: &Setup, buffer: &wgpu::Buffer, n: usize) -> Vec<LightRange> {
+    let bytes = read_storage_buffer(&st.r.ctx, buffer).unwrap();
     let f: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
     (0..n)
         .map(|i| LightRange {
@@ -71,6 +80,20 @@ fn gpu_lights(st: &Setup, n: usize) -> Vec<LightRange> {
 
 fn gpu_u32(st: &Setup, b: &wgpu::Buffer) -> Vec<u32> {
     bytemuck::pod_collect_to_vec(&read_storage_buffer(&st.r.ctx, b).unwrap())
+}
+
+fn shade_vpls(vpls: &[GpuVpl]) -> Vec<ShadeVpl> {
+    vpls.iter()
+        .map(|v| ShadeVpl {
+            position: Vec3::from_slice(&v.position[..3]),
+            normal: Vec3::from_array(v.normal),
+            flux: if v.id == VPL_NONE {
+                Vec3::ZERO
+            } else {
+                Vec3::from_slice(&v.flux[..3])
+            },
+        })
+        .collect()
 }
 
 fn flux_max(v: &GpuVpl) -> f32 {
@@ -241,6 +264,50 @@ fn gpu_ranges_and_tile_lists_equal_the_cpu_reference() {
         }
     }
 
+    // The pinned pixel's overlay: the range spheres of its tile's list, those holding its
+    // point first (green), and the pixel itself.
+    let (px, py) = (W / 2, H / 2);
+    let pin = pos[(py * W + px) as usize].expect("geometry at the centre");
+    st.r.set_trace_pixel(Some((px, py)));
+    let ov = st.r.read_method_overlay().unwrap().expect("an overlay");
+    let t = grid.tile_of(px, py) as usize;
+    let listed = &lists[t * cap..t * cap + count[t] as usize];
+    let spheres: Vec<(Vec3, f32)> = ov
+        .prims
+        .iter()
+        .filter_map(|p| match *p {
+            Prim::Sphere { center, radius, .. } => Some((center, radius)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(spheres.len(), listed.len().min(light_culling::OVERLAY_SPHERES));
+    let holds = |c: Vec3, r: f32| c.distance(pin) < r;
+    let inside = listed
+        .iter()
+        .filter(|&&i| holds(gl[i as usize].position, gl[i as usize].range))
+        .count();
+    for (k, &(c, r)) in spheres.iter().enumerate() {
+        let l = listed
+            .iter()
+            .map(|&i| gl[i as usize])
+            .find(|l| l.position == c)
+            .expect("a sphere of a listed VPL");
+        assert_eq!(r, l.range);
+        assert_eq!(
+            holds(c, r),
+            k < inside,
+            "the spheres holding the pixel come first"
+        );
+    }
+    assert!(
+        ov.rows
+            .iter()
+            .any(|(k, v)| k.contains("holding") && v.starts_with(&format!("{inside} of {}", listed.len()))),
+        "{:?}",
+        ov.rows
+    );
+    st.r.set_trace_pixel(None);
+
     // A cap of 2: tiles over it are counted (diagnostics), their true counts kept.
     let over = count.iter().filter(|&&c| c > 2).count() as f64;
     st.set(|s| {
@@ -282,18 +349,7 @@ fn gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing()
     let lists = gpu_u32(&st, &b.tile_lists);
     let raw: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &b.raw).unwrap());
     let cap = lc.max_lights_per_tile as usize;
-    let sv: Vec<ShadeVpl> = vpls
-        .iter()
-        .map(|v| ShadeVpl {
-            position: Vec3::from_slice(&v.position[..3]),
-            normal: Vec3::from_array(v.normal),
-            flux: if v.id == VPL_NONE {
-                Vec3::ZERO
-            } else {
-                Vec3::from_slice(&v.flux[..3])
-            },
-        })
-        .collect();
+    let sv = shade_vpls(&vpls);
     let bvh = Bvh::build(&st.scene.positions, &st.scene.indices);
     let pos = st.r.read(Buffer::Position).unwrap();
     let nrm = st.r.read(Buffer::Normal).unwrap();
@@ -478,6 +534,225 @@ fn the_mean_over_frames_converges_to_the_unshadowed_ground_truth_and_clamping_da
     assert!(
         darkening[1] > 2.0 * darkening[0],
         "more darkening for a looser bound: {darkening:?}"
+    );
+
+    // The difference view: kept for drawing, the stochastic method's frames also run the
+    // clamped companion (deterministic without interleaving: its mean is the clamped image).
+    // Its data: both means' luminances and their relative difference (the sign is not
+    // asserted: 16 frames of the stochastic image share each frame's xi over all pixels).
+    let clamped = st.indirect();
+    st.r.keep_views(vec![light_culling::DIFFERENCE]);
+    st.set(|s| {
+        s.gi.method = light_culling::ID;
+        s.sampling.accumulate = true;
+    });
+    while st.r.sampling_frames() < 16 {
+        st.frame();
+    }
+    let view = ViewBuffer::Method(light_culling::DIFFERENCE);
+    st.r.redraw_view(&FrameInput {
+        camera: &st.cam,
+        lights: &st.scene.lights,
+        view,
+    });
+    let d =
+        st.r.read_view_buffer(view)
+            .unwrap()
+            .expect("the difference view's data");
+    let own = st.indirect();
+    let lum = |p: &[f32; 4]| lightcut::base::display::luminance(Vec3::from_slice(&p[..3]));
+    let (mut cl, mut sto, mut rel, mut px) = (0.0f64, 0.0f64, 0.0f64, 0);
+    for k in 0..d.pixels.len() {
+        let v = d.pixels[k];
+        let (want_c, want_s) = (lum(&clamped.pixels[k]), lum(&own.pixels[k]));
+        assert!(
+            (v[1] - want_c).abs() <= 1e-4 * want_c.abs().max(1e-4),
+            "pixel {k}: clamped {} vs {want_c}",
+            v[1]
+        );
+        assert!(
+            (v[2] - want_s).abs() <= 1e-4 * want_s.abs().max(1e-4),
+            "pixel {k}: stochastic {} vs {want_s}",
+            v[2]
+        );
+        let mean = 0.5 * (v[1] + v[2]);
+        let want_rel = if mean > 0.0 { (v[1] - v[2]) / mean } else { 0.0 };
+        assert!(
+            (v[0] - want_rel).abs() <= 1e-4 * want_rel.abs().max(1.0),
+            "pixel {k}: {v:?}"
+        );
+        cl += v[1] as f64;
+        sto += v[2] as f64;
+        if v[3] > 0.0 {
+            rel += v[0] as f64;
+            px += 1;
+        }
+    }
+    eprintln!(
+        "difference view: clamped / stochastic {:.4}, mean relative difference {:.4}",
+        cl / sto,
+        rel / px as f64
+    );
+    assert!(cl > 0.0 && sto > 0.0 && px > 0);
+    assert!(ctx.errors.take().is_empty());
+}
+
+/// The bounding-sphere tree over the frame's VPLs (section 5) against the CPU (leaf ranges,
+/// node bounds, the traversal's lists with the same reservoir stream, the one-ray shading),
+/// then its unbiasedness without visibility.
+#[test]
+fn the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_truth() {
+    let Some(ctx) = common::gpu() else { return };
+    // k = 4: most pixels have more VPLs in range (the reservoir and min(k / m, 1) work).
+    let lc = LightCullingSettings {
+        reservoir_k: 4,
+        ..small(0.002)
+    };
+    let mut s = settings(lc.clone());
+    s.gi.method = light_culling::TREE;
+    s.sampling.fixed_seed = true;
+    let mut st = Setup::new(&ctx, s.clone(), (W, H));
+    st.frame();
+    let (_, tb) = st.r.tree_buffers();
+    let leaves = tb.leaves;
+    let sorted: Vec<GpuVpl> =
+        bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &tb.sorted_vpls).unwrap());
+    let nodes = lightcut::renderer::passes::sst_build::read_nodes(&ctx, tb).unwrap();
+    let t = lc_of(&st).tree_buffers().expect("the tree variant's buffers");
+    assert_eq!(t.leaves, leaves);
+    let gl = lights_of(&st, &t.lights, leaves as usize);
+    // Leaf ranges: eqs. 3 and 6 with xi of the leaf index.
+    check_ranges(&s, &lc, RangeMode::Stochastic, &sorted[..leaves as usize], &gl);
+    // Node bounds: the largest range below each node.
+    let bits = gpu_u32(&st, &t.max_range);
+    let ranges: Vec<f32> = gl.iter().map(|l| l.range).collect();
+    let cpu_max = tree_max_ranges(leaves, &ranges);
+    for n in 1..leaves as usize {
+        assert_eq!(f32::from_bits(bits[n]), cpu_max[n], "node {n}");
+    }
+    // The traversal, pixel by pixel, with the same reservoir stream.
+    let boxes: Vec<(Vec3, Vec3)> = nodes
+        .iter()
+        .map(|n| (Vec3::from_array(n.bbox_min), Vec3::from_array(n.bbox_max)))
+        .collect();
+    let list = gpu_u32(&st, &t.list);
+    let mv = gpu_u32(&st, &t.m);
+    let raw: Vec<[f32; 4]> =
+        bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &lc_of(&st).buffers().raw).unwrap());
+    let sv = shade_vpls(&sorted);
+    let bvh = Bvh::build(&st.scene.positions, &st.scene.indices);
+    let pos = st.r.read(Buffer::Position).unwrap();
+    let nrm = st.r.read(Buffer::Normal).unwrap();
+    let seed = LightCulling::seed(&s, 0);
+    let (eps, off, k) = (s.gi.distance_epsilon, s.gi.ray_offset, lc.reservoir_k);
+    let (mut px, mut same, mut over_k, mut lit, mut close) = (0, 0, 0, 0, 0);
+    for y in 0..H {
+        for x in 0..W {
+            let p = (y * W + x) as usize;
+            let g = pos.pixels[p];
+            if g[3] == 0.0 {
+                continue;
+            }
+            px += 1;
+            let xp = Vec3::new(g[0], g[1], g[2]);
+            let cpu = tree_traverse(
+                leaves,
+                &boxes,
+                &cpu_max,
+                &gl,
+                xp,
+                eps,
+                k,
+                tree_rng(seed, p as u32, TREE_STREAM_RESERVOIR),
+            );
+            let (m, visited) = (mv[2 * p], mv[2 * p + 1]);
+            let gpu_list = &list[p * k as usize..p * k as usize + m.min(k) as usize];
+            if cpu.m == m && cpu.visited == visited && cpu.list == gpu_list {
+                same += 1;
+            }
+            over_k += (m > k) as u32;
+            // The shading from the GPU's list, with the same resampling number.
+            let nx = Vec3::from_slice(&nrm.pixels[p][..3]).normalize();
+            let u = u01(pcg_hash(tree_rng(seed, p as u32, TREE_STREAM_RIS)));
+            let (want, _) = tree_shade(xp, nx, gpu_list, m, k, &sv, &gl, eps, u, |i| {
+                let v = sv[i as usize];
+                let o = xp + nx * off;
+                let e = v.position + v.normal * off;
+                !bvh.any_hit(&Ray {
+                    origin: o,
+                    dir: e - o,
+                    tmin: 1e-4,
+                    tmax: 1.0 - 1e-4,
+                })
+            });
+            let got = Vec3::from_slice(&raw[p][..3]);
+            if want.max_element() > 1e-6 {
+                lit += 1;
+                if (got - want).abs().max_element() <= 1e-3 * want.max_element() {
+                    close += 1;
+                }
+            }
+        }
+    }
+    eprintln!(
+        "tree: {same} of {px} pixels' traversals equal the CPU's ({over_k} over k = {k}); {close} of {lit} lit \
+         pixels' shading within 1e-3"
+    );
+    assert!(same >= px * 99 / 100, "{same} of {px}");
+    // The pinned pixel's overlay: the range spheres of its list (all hold its point).
+    let (cx, cy) = (W / 2, H / 2);
+    let p = (cy * W + cx) as usize;
+    st.r.set_trace_pixel(Some((cx, cy)));
+    let ov = st.r.read_method_overlay().unwrap().expect("an overlay");
+    let want: Vec<(Vec3, f32)> = list[p * k as usize..p * k as usize + mv[2 * p].min(k) as usize]
+        .iter()
+        .map(|&j| (gl[j as usize].position, gl[j as usize].range))
+        .collect();
+    let got: Vec<(Vec3, f32)> = ov
+        .prims
+        .iter()
+        .filter_map(|q| match *q {
+            Prim::Sphere { center, radius, .. } => Some((center, radius)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(got.len(), want.len());
+    assert!(got.iter().all(|g| want.contains(g)), "{got:?} vs {want:?}");
+    st.r.set_trace_pixel(None);
+    assert!(over_k > px / 4, "the reservoir is exercised: {over_k} of {px}");
+    assert!(lit > 100 && close >= lit * 98 / 100, "{close} of {lit}");
+
+    // Unbiased: without visibility the mean over frames converges to the unshadowed truth.
+    st.set(|s| {
+        s.gi.shadow_rays = false;
+        s.sampling.fixed_seed = false;
+    });
+    st.frame();
+    let gt = st.ground_truth_of_these_vpls();
+    st.set(|s| s.sampling.accumulate = true);
+    let mut errs = Vec::new();
+    for target in [16u32, 256] {
+        while st.r.sampling_frames() < target {
+            st.frame();
+        }
+        let m = metrics::compare(&st.indirect(), &gt, 3.0, Tonemap::Aces);
+        errs.push((target, m.rmse, m.mean_ratio));
+    }
+    let stats = st.r.method_stats_blocking();
+    eprintln!("tree vs unshadowed ground truth (frames, RMSE, mean ratio): {errs:?}; {stats:?}");
+    let ratio = errs[0].1 / errs[1].1;
+    assert!(ratio > 2.5 && ratio < 6.5, "RMSE ratio {ratio}");
+    assert!(
+        (errs[1].2 - 1.0).abs() < 0.03,
+        "mean ratio after 256 frames {}",
+        errs[1].2
+    );
+    let get = |name: &str| stats.iter().find(|(n, _)| *n == name).unwrap().1;
+    assert!(get("shadow_rays_per_pixel") == 0.0);
+    // The walk skips subtrees: well under the tree's 2 leaves - 1 nodes (0.47 on lavapipe).
+    assert!(
+        get("tree_nodes_visited_per_pixel") < 0.75 * (2 * leaves - 1) as f64,
+        "the tree culls: {stats:?}"
     );
     assert!(ctx.errors.take().is_empty());
 }

@@ -257,13 +257,13 @@ fn gui_examples_open_what_they_promise() {
         eprintln!("SKIPPED the shared-scene GUI examples: ../shared/scenes not found");
         return;
     }
-    let h = gui("-- --scene scenes/sponza.toml", egui::vec2(700.0, 500.0), 2);
+    let h = gui("-- --scene scenes/sponza.toml", egui::vec2(400.0, 300.0), 1);
     assert_eq!(h.state().open().expect("a scene").scene.name, "Sponza");
     drop(h);
     let h = gui(
         "-- --scene ../shared/scenes/breakfast_room/BreakfastRoom.gltf --camera CameraMain",
-        egui::vec2(700.0, 500.0),
-        2,
+        egui::vec2(400.0, 300.0),
+        1,
     );
     assert_eq!(h.state().open().expect("a scene").camera.name, "CameraMain");
 }

@@ -238,18 +238,22 @@ fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
     // relative RMSE 2.9 / 1.2 / 0.65 after 64 / 1024 / 4096 frames on this view.)
     // Every child probability (the thesis's, RTSLC's MinMax, the defensive mix) has the
     // support of the box term, so each converges.
+    // One ground truth for the three (the VPLs do not change between frames); 8 -> 128 frames.
+    let mut st = setup(&ctx, settings(RTSLC));
+    let gt = st.ground_truth();
     for cp in ChildProbability::ALL {
-        let mut st = setup(&ctx, settings(RTSLC));
-        let gt = st.ground_truth();
         st.set(|s| {
             s.gi.method = RTSLC;
             s.sampling.block_size = 1;
             s.sampling.accumulate = true;
             s.sampling.child_probability = cp;
         });
+        // The first frame of the new setting restarts the average.
+        st.frame();
+        assert_eq!(st.r.sampling_frames(), 1, "{cp:?}: the average restarts");
         let mut errs = Vec::new();
-        let mut done = 0;
-        for target in [16u32, 64, 256] {
+        let mut done = 1;
+        for target in [8u32, 32, 128] {
             while st.r.sampling_frames() < target {
                 st.frame();
                 done += 1;
@@ -261,18 +265,19 @@ fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
         eprintln!(
             "RTSLC ({cp:?}) vs ground truth (frames, RMSE, block error, mean ratio): {errs:?} ({done} frames)"
         );
-        let (_, r16, b16, _) = errs[0];
-        let (_, r256, b256, m256) = errs[2];
-        // 16x the frames: errors fall about 4x (1/sqrt(frames)); allow 2.5x..6.5x.
+        let (_, r8, b8, _) = errs[0];
+        let (_, r128, b128, m128) = errs[2];
+        // 16x the frames: errors fall about 4x (1/sqrt(frames)); allow 2.5x..7.5x (the
+        // defensive mix's 8-frame error is heavy-tailed: 6.0x on lavapipe).
         assert!(
-            r16 / r256 > 2.5 && r16 / r256 < 6.5,
+            r8 / r128 > 2.5 && r8 / r128 < 7.5,
             "{cp:?}: RMSE ratio {}",
-            r16 / r256
+            r8 / r128
         );
-        assert!(b16 / b256 > 2.5, "{cp:?}: block error ratio {}", b16 / b256);
+        assert!(b8 / b128 > 2.5, "{cp:?}: block error ratio {}", b8 / b128);
         assert!(
-            (m256 - 1.0).abs() < 0.02,
-            "{cp:?}: mean ratio after 256 frames {m256}"
+            (m128 - 1.0).abs() < 0.02,
+            "{cp:?}: mean ratio after 128 frames {m128}"
         );
     }
     assert!(ctx.errors.take().is_empty());

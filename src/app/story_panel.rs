@@ -43,6 +43,8 @@ pub struct StoryPanel {
     pub note: String,
     /// The cut-based methods' story (Lightcuts, Lightcut Interpolation) and the tree's leaves.
     pub cut_story: Option<crate::methods::CutStory>,
+    /// A method's own overlay of the pixel (light culling: its tile's range spheres).
+    pub method_overlay: Option<crate::methods::overlay::MethodOverlay>,
 }
 
 impl StoryPanel {
@@ -59,11 +61,12 @@ impl StoryPanel {
         r.set_trace_pixel(pixel);
         if pixel.is_none() {
             self.trace = None;
+            self.cut_story = None;
+            self.method_overlay = None;
             self.pixel = None;
             self.note = "click a camera view to pin a pixel".into();
             return Ok(());
         }
-        self.cut_story = None;
         if !r.settings().gi.method.info().story {
             self.trace = None;
             if pixel == self.pixel && now - self.read_at < 0.5 {
@@ -72,8 +75,14 @@ impl StoryPanel {
             self.pixel = pixel;
             self.read_at = now;
             self.leaves = r.tree_buffers().1.leaves;
+            self.method_overlay = None;
             self.cut_story = r.read_cut_story().map_err(|e| e.to_string())?;
             if self.cut_story.is_some() {
+                self.method_overlay = None;
+                return Ok(());
+            }
+            self.method_overlay = r.read_method_overlay().map_err(|e| e.to_string())?;
+            if self.method_overlay.is_some() {
                 return Ok(());
             }
             let tellers: Vec<&str> = crate::methods::REGISTRY
@@ -84,12 +93,15 @@ impl StoryPanel {
             self.note = format!(
                 "{} tells no sample story (the methods that do: {}); a cut-based method's cut \
                  story needs a diagnostic frame and a pixel with geometry (Lightcut \
-                 Interpolation's fallback pixels have none)",
+                 Interpolation's fallback pixels have none), and light culling's range spheres \
+                 a frame and a pixel with geometry",
                 r.settings().gi.method.name(),
                 tellers.join(", ")
             );
             return Ok(());
         }
+        self.cut_story = None;
+        self.method_overlay = None;
         if pixel == self.pixel && now - self.read_at < 0.5 {
             return Ok(());
         }
@@ -158,6 +170,9 @@ impl StoryPanel {
     /// and shadow ray; the selected sample's path as boxes and its end node's 1-sigma
     /// ellipse (without a selection: every end node's ellipse).
     pub fn overlay(&self) -> Vec<Prim> {
+        if let Some(m) = self.method_overlay.as_ref().filter(|_| self.overlay && self.show) {
+            return m.prims.clone();
+        }
         let Some(t) = self.trace.as_ref().filter(|_| self.overlay && self.show) else {
             return Vec::new();
         };
@@ -199,6 +214,23 @@ impl StoryPanel {
     pub fn contents(&mut self, ui: &mut egui::Ui) {
         if let Some(story) = &self.cut_story {
             super::cut_story::contents(ui, story, self.leaves);
+            return;
+        }
+        if let Some(m) = &self.method_overlay {
+            let (x, y) = self.pixel.unwrap_or_default();
+            ui.label(format!("Pixel ({x}, {y}) · last frame · {}", m.title));
+            ui.checkbox(&mut self.overlay, "draw it in the camera views")
+                .on_hover_text(&m.key);
+            ui.label(egui::RichText::new(&m.key).small());
+            egui::Grid::new("method_overlay_rows")
+                .striped(true)
+                .show(ui, |ui| {
+                    for (k, v) in &m.rows {
+                        ui.label(k);
+                        ui.label(v);
+                        ui.end_row();
+                    }
+                });
             return;
         }
         let Some(t) = self.trace.clone() else {

@@ -460,6 +460,18 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     // (untimed; the accumulation restarts with the settings change). A progressive method
     // goes on in timed frames (below), each adding its GPU time.
     r.set_settings(image_settings)?;
+    // The method's views are drawn after the image frames: those needing work in the frames
+    // (light culling's clamped-vs-stochastic difference) are announced now.
+    if wants(Output::Png) {
+        r.keep_views(
+            method
+                .info()
+                .views
+                .iter()
+                .map(|v| MethodView::new(v.name))
+                .collect(),
+        );
+    }
     let mut frames_averaged = None;
     if method.per_frame() {
         r.set_frame_mode(FrameMode::Diagnostic);

@@ -18,6 +18,7 @@ pub mod ground_truth;
 pub mod light_culling;
 pub mod lightcut_interpolation;
 pub mod lightcuts;
+pub mod overlay;
 pub mod reference;
 pub mod tree_samplers;
 
@@ -51,6 +52,7 @@ pub static REGISTRY: &[&MethodInfo] = &[
     &lightcut_interpolation::INFO,
     &light_culling::INFO,
     &light_culling::CLAMPED_INFO,
+    &light_culling::TREE_INFO,
     &ground_truth::INFO,
     &reference::INFO,
     &direct_only::INFO,
@@ -451,6 +453,9 @@ pub struct FrameCx<'a> {
     /// Otherwise a timed frame: record only the work the method's image needs, no
     /// diagnostics and no readbacks (`renderer::FrameMode`).
     pub diagnostics: bool,
+    /// The method views drawn for this frame (or kept for drawing after it): a view whose
+    /// data needs work in the frame checks for itself here.
+    pub views: &'a [MethodView],
 }
 
 /// What a method's view drawing may use.
@@ -507,6 +512,17 @@ pub trait Method: Any {
     /// The pinned pixel's cut story in the last diagnostic frame (cut-based methods: the
     /// story panel draws its cuts over the tree's levels and its table).
     fn read_cut_story(&self, _ctx: &GpuContext) -> Result<Option<CutStory>, GpuError> {
+        Ok(None)
+    }
+    /// Its overlay for the pinned frame pixel (x, y) whose surface point is `position`: a
+    /// table and world-space primitives (the story window shows them when the method tells
+    /// no sample or cut story). None: it has none.
+    fn read_overlay(
+        &self,
+        _ctx: &GpuContext,
+        _pixel: (u32, u32),
+        _position: glam::Vec3,
+    ) -> Result<Option<overlay::MethodOverlay>, GpuError> {
         Ok(None)
     }
     /// Its rows in the pixel-values window at frame pixel (x, y) of a `frame`-sized image.

@@ -1,7 +1,9 @@
 //! CPU twin of Stochastic Light Culling (Tokuyoshi & Harada 2016, sections 3-4) and of the
 //! clamped-range baseline (its appendix A): per-VPL ranges, the interleaved tiles and their
-//! light lists, the fall-off and the per-pixel sum. Twins of
-//! `shaders/methods/light_culling/{lcull_common, lcull_ranges, lcull_tiles, lcull_shade}.wgsl`.
+//! light lists, the fall-off and the per-pixel sum; and of section 5's bounding-sphere tree
+//! (node bounds, the per-pixel walk with reservoir sampling, the resampled one-ray shading).
+//! Twins of `shaders/methods/light_culling/{lcull_common, lcull_light, lcull_tiles,
+//! lcull_shade, lcull_tree}.wgsl`.
 //!
 //! Our VPL is a diffuse emitter of flux Phi: radiant intensity I(w') = Phi / pi x cos, so
 //! max I = max_rgb(Phi) / pi. Our fall-off is the workbench's bounded one,
@@ -460,6 +462,170 @@ pub fn filter_pixel(
     sum / w.max(1.0)
 }
 
+/// The tree variant's random streams (section 5; twin: `tree_rng` in `lcull_tree.wgsl`):
+/// reservoir sampling in the traversal, the resampling's one number in the shading.
+pub const TREE_STREAM_RESERVOIR: u32 = 0x2545_f491;
+pub const TREE_STREAM_RIS: u32 = 0x68e3_1da4;
+
+/// The first state of a pixel's stream (pixel = y x width + x).
+pub fn tree_rng(seed: u32, pixel: u32, stream: u32) -> u32 {
+    pcg_hash(seed ^ pcg_hash(pixel ^ stream))
+}
+
+/// Per node of the implicit light tree (root 1, children 2n and 2n + 1, leaf j at
+/// leaves + j; entry 0 unused): the largest range of the leaves below it (0: none). Twin:
+/// the atomicMax walk of `leaves_main` (which leaves the leaf entries 0: the traversal tests
+/// leaves by their own range).
+pub fn tree_max_ranges(leaves: u32, ranges: &[f32]) -> Vec<f32> {
+    let l = leaves as usize;
+    let mut v = vec![0.0f32; 2 * l];
+    for (j, r) in ranges.iter().enumerate().take(l) {
+        v[l + j] = r.max(0.0);
+    }
+    for n in (1..l).rev() {
+        v[n] = v[2 * n].max(v[2 * n + 1]);
+    }
+    for x in v.iter_mut().skip(l) {
+        *x = 0.0;
+    }
+    v
+}
+
+/// Whether an internal node's bounding sphere holds x: centre the middle of its VPLs' box,
+/// radius half the box's diagonal + the largest range below it (it holds every range sphere
+/// below), tested conservatively by a relative 1e-5 and 1e-6 of the centre's largest
+/// coordinate. Twin: `node_hit`.
+pub fn tree_node_hit(bbox_min: Vec3, bbox_max: Vec3, max_range: f32, x: Vec3) -> bool {
+    if max_range <= 0.0 {
+        return false;
+    }
+    let c = 0.5 * (bbox_min + bbox_max);
+    let radius = (0.5 * (bbox_max - bbox_min).length() + max_range) * 1.00001 + 1e-6 * c.abs().max_element();
+    (x - c).length_squared() <= radius * radius
+}
+
+/// A pixel's traversal: its k-entry list, m (the VPLs in range) and the nodes visited.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TreeList {
+    pub list: Vec<u32>,
+    pub m: u32,
+    pub visited: u32,
+}
+
+/// The stackless walk of the implicit tree from the root: a node is entered when its sphere
+/// holds x, a leaf listed when its fall-off is non-zero at x; k of the m listed by reservoir
+/// sampling (Algorithm 3) with the stream `rng`. `boxes[n]` is node n's VPL box, `lights`
+/// the leaves' ranges and fall-offs. Twin: `traverse_main`.
+#[allow(clippy::too_many_arguments)]
+pub fn tree_traverse(
+    leaves: u32,
+    boxes: &[(Vec3, Vec3)],
+    max_range: &[f32],
+    lights: &[LightRange],
+    x: Vec3,
+    eps: f32,
+    k: u32,
+    mut rng: u32,
+) -> TreeList {
+    let mut list = vec![0u32; k as usize];
+    let (mut m, mut visited, mut n) = (0u32, 0u32, 1u32);
+    loop {
+        visited += 1;
+        let mut descend = false;
+        if n >= leaves {
+            let j = n - leaves;
+            let l = lights[j as usize];
+            if l.falloff.eval((l.position - x).length_squared(), eps) > 0.0 {
+                if m < k {
+                    list[m as usize] = j;
+                } else {
+                    rng = pcg_hash(rng);
+                    let r = (u01(rng) * (m + 1) as f32) as u32;
+                    if r < k {
+                        list[r as usize] = j;
+                    }
+                }
+                m += 1;
+            }
+        } else {
+            let (lo, hi) = boxes[n as usize];
+            descend = tree_node_hit(lo, hi, max_range[n as usize], x);
+        }
+        if descend {
+            n *= 2;
+            continue;
+        }
+        while n & 1 == 1 {
+            n >>= 1;
+        }
+        if n == 0 {
+            break;
+        }
+        n += 1;
+    }
+    list.truncate(m.min(k) as usize);
+    TreeList { list, m, visited }
+}
+
+/// Eq. 9 for a VPL (a point light) seen from x with normal nx:
+/// g_i = f(l) max I_i max(-w . n_i, 0) max(w . n_x, 0), max I = max_rgb(flux) / pi. The
+/// paper's second factor, printed with the light's normal n_i over the triangle's vertices,
+/// can only be the receiver's (with n_i it is 0 wherever the first is positive); no BRDF, as
+/// the paper. Twin: `importance`.
+pub fn tree_importance(v: &ShadeVpl, x: Vec3, nx: Vec3, eps: f32) -> f32 {
+    let d = v.position - x;
+    let l2 = d.length_squared();
+    let w = d * (1.0 / l2.max(1e-30).sqrt());
+    let cv = (-v.normal.dot(w)).max(0.0);
+    let cx = nx.dot(w).max(0.0);
+    v.flux.max_element() / std::f32::consts::PI * cv * cx / l2.max(eps * eps)
+}
+
+/// The pixel's demodulated estimate from its list (section 5.3.2): one VPL i resampled by
+/// q(i) = g_i / sum g (eq. 8) with the uniform `u`, its contribution (stochastic fall-off,
+/// i.e. f / p_i, and the shadow ray `visible(i)`) over min(k / m, 1) q(i) (eq. 10). Returns
+/// the estimate and the VPL shaded. Twin: `shade_main` of `lcull_tree.wgsl`.
+#[allow(clippy::too_many_arguments)]
+pub fn tree_shade(
+    x: Vec3,
+    nx: Vec3,
+    list: &[u32],
+    m: u32,
+    k: u32,
+    vpls: &[ShadeVpl],
+    lights: &[LightRange],
+    eps: f32,
+    u: f32,
+    mut visible: impl FnMut(u32) -> bool,
+) -> (Vec3, Option<u32>) {
+    let g: Vec<f32> = list
+        .iter()
+        .map(|&i| tree_importance(&vpls[i as usize], x, nx, eps))
+        .collect();
+    let total: f32 = g.iter().sum();
+    if total <= 0.0 {
+        return (Vec3::ZERO, None);
+    }
+    let target = u * total;
+    let (mut acc, mut pick, mut g_pick) = (0.0f32, 0usize, 0.0f32);
+    for (j, &gj) in g.iter().enumerate() {
+        if gj > 0.0 {
+            pick = j;
+            g_pick = gj;
+        }
+        acc += gj;
+        if target < acc && gj > 0.0 {
+            break;
+        }
+    }
+    let i = list[pick];
+    let c = shade(x, nx, &[i], vpls, lights, Interleave::new(1, 1, 0), eps, |_| {
+        visible(i)
+    });
+    let keep = (k as f32 / m as f32).min(1.0);
+    (c * total / (keep * g_pick), Some(i))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -599,6 +765,129 @@ mod tests {
             }
             assert_eq!(cells.len(), 64, "subset {s} covers every cell once");
         }
+    }
+
+    /// A small tree: its VPLs, leaf ranges, node boxes and largest ranges below each node.
+    type SmallTree = (Vec<ShadeVpl>, Vec<LightRange>, Vec<(Vec3, Vec3)>, Vec<f32>);
+
+    /// 13 VPLs and 3 padding leaves under a 16-leaf tree.
+    fn small_tree(seed: u32) -> SmallTree {
+        let leaves = 16usize;
+        let mut h = seed;
+        let mut r = || {
+            h = pcg_hash(h);
+            u01(h)
+        };
+        let mut vpls = Vec::new();
+        let mut lights = Vec::new();
+        let p = RangeParams {
+            seed: seed ^ 0x55,
+            ..params(RangeMode::Stochastic, 0.02)
+        };
+        for j in 0..leaves {
+            let position = Vec3::new(4.0 * r(), 4.0 * r(), 4.0 * r());
+            let normal = Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize_or(Vec3::Z);
+            let flux = if j < 13 {
+                Vec3::new(r(), r(), r()) * 0.5
+            } else {
+                Vec3::ZERO
+            };
+            vpls.push(ShadeVpl {
+                position,
+                normal,
+                flux,
+            });
+            lights.push(light_range(&p, j as u32, position, flux.max_element()));
+        }
+        let mut boxes = vec![(Vec3::splat(f32::MAX), Vec3::splat(-f32::MAX)); 2 * leaves];
+        for j in 0..13 {
+            boxes[leaves + j] = (vpls[j].position, vpls[j].position);
+        }
+        for n in (1..leaves).rev() {
+            let (a, b) = (boxes[2 * n], boxes[2 * n + 1]);
+            boxes[n] = (a.0.min(b.0), a.1.max(b.1));
+        }
+        let ranges: Vec<f32> = lights.iter().map(|l| l.range).collect();
+        let max = tree_max_ranges(leaves as u32, &ranges);
+        (vpls, lights, boxes, max)
+    }
+
+    #[test]
+    fn the_tree_lists_exactly_the_vpls_in_range_and_its_one_sample_estimate_is_unbiased() {
+        let (vpls, lights, boxes, max) = small_tree(3);
+        let eps = 0.05;
+        let in_range = |x: Vec3| -> Vec<u32> {
+            (0..16u32)
+                .filter(|&j| {
+                    lights[j as usize]
+                        .falloff
+                        .eval((lights[j as usize].position - x).length_squared(), eps)
+                        > 0.0
+                })
+                .collect()
+        };
+        // A list as large as the tree: exactly the VPLs in range, in leaf order.
+        let mut h = 11u32;
+        let mut seen_culling = false;
+        for _ in 0..300 {
+            h = pcg_hash(h);
+            let x = Vec3::new(u01(h), u01(pcg_hash(h ^ 1)), u01(pcg_hash(h ^ 2))) * 6.0 - 1.0;
+            let t = tree_traverse(16, &boxes, &max, &lights, x, eps, 16, h);
+            let want = in_range(x);
+            assert_eq!(t.list, want, "at {x}");
+            assert_eq!(t.m as usize, want.len());
+            seen_culling |= t.visited < 31;
+        }
+        assert!(seen_culling, "some traversals skip subtrees");
+        // Find a point with m >= 5, then k = 2: each VPL in range is listed with probability
+        // k / m (Algorithm 3), and the resampled one-ray estimate averages to the sum over all
+        // of them (eq. 10).
+        let (x, want) = (0..2000u32)
+            .map(|i| {
+                let g = pcg_hash(i ^ 0xabc);
+                Vec3::new(u01(g), u01(pcg_hash(g ^ 1)), u01(pcg_hash(g ^ 2))) * 4.0
+            })
+            .map(|x| (x, in_range(x)))
+            .find(|(_, w)| w.len() >= 5)
+            .expect("a point with 5 VPLs in range");
+        let m = want.len() as f64;
+        let nx = (vpls[want[0] as usize].position - x).normalize();
+        let exact = shade(
+            x,
+            nx,
+            &want,
+            &vpls,
+            &lights,
+            Interleave::new(1, 1, 0),
+            eps,
+            |_| true,
+        );
+        let trials = 200_000u32;
+        let mut listed = [0u32; 16];
+        let mut sum = glam::DVec3::ZERO;
+        for s in 0..trials {
+            let t = tree_traverse(16, &boxes, &max, &lights, x, eps, 2, pcg_hash(s ^ 0x9e37));
+            assert_eq!(t.list.len(), 2);
+            for &j in &t.list {
+                listed[j as usize] += 1;
+            }
+            let u = u01(pcg_hash(s ^ 0x1234_5678));
+            let (v, _) = tree_shade(x, nx, &t.list, t.m, 2, &vpls, &lights, eps, u, |_| true);
+            sum += v.as_dvec3();
+        }
+        let p = 2.0 / m;
+        let sigma = (p * (1.0 - p) / trials as f64).sqrt();
+        for &j in &want {
+            let f = listed[j as usize] as f64 / trials as f64;
+            assert!((f - p).abs() < 5.0 * sigma, "VPL {j} listed {f} vs {p}");
+        }
+        let mean = sum / trials as f64;
+        let e = exact.as_dvec3();
+        assert!(e.max_element() > 0.0);
+        assert!(
+            (mean - e).abs().max_element() < 0.02 * e.max_element(),
+            "mean {mean} vs exact {e}"
+        );
     }
 
     #[test]

@@ -32,6 +32,7 @@ macro_rules! frame_cx {
             frame_index: $r.frames,
             trace_pixel: $trace,
             diagnostics: $diag,
+            views: &$r.frame_views,
         }
     };
 }
@@ -50,6 +51,14 @@ impl Renderer {
     /// their parameter buffers).
     pub fn render_views(&mut self, input: &FrameInput<'_>, views: &[ViewSpec]) {
         let first = views.first().copied().unwrap_or_default();
+        self.frame_views.clone_from(&self.kept_views);
+        for v in views {
+            if let ViewBuffer::Method(m) = v.buffer
+                && !self.frame_views.contains(&m)
+            {
+                self.frame_views.push(m);
+            }
+        }
         let device = self.ctx.device.clone();
         let queue = self.ctx.queue.clone();
         let size = self.targets.size;

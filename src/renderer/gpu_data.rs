@@ -598,7 +598,7 @@ mod tests {
                         offset_of!(P, filter_normal_cos),
                         offset_of!(P, filter_plane_tolerance),
                         offset_of!(P, stride),
-                        offset_of!(P, _pad),
+                        offset_of!(P, leaves),
                     ]
                 },
             ),
@@ -615,6 +615,10 @@ mod tests {
                         offset_of!(P, tonemap),
                         offset_of!(P, n),
                         offset_of!(P, cap),
+                        offset_of!(P, own_scale),
+                        offset_of!(P, companion_scale),
+                        offset_of!(P, own_is_clamped),
+                        offset_of!(P, range),
                         offset_of!(P, _pad),
                         offset_of!(P, _pad) + 4,
                     ]

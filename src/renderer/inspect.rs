@@ -39,6 +39,14 @@ impl Renderer {
         Ok(rows)
     }
 
+    /// Method views that will be drawn after the coming frames although the frames show
+    /// another (`render` writes every view of its method after its image frames): a view
+    /// needing work in the frame itself gets it (light culling's clamped-vs-stochastic
+    /// difference accumulates its companion image).
+    pub fn keep_views(&mut self, views: Vec<methods::MethodView>) {
+        self.kept_views = views;
+    }
+
     /// Records the tree samples of frame pixel (x, y) from the next frame on (None: stop).
     pub fn set_trace_pixel(&mut self, pixel: Option<(u32, u32)>) {
         let pixel = pixel.filter(|&(x, y)| x < 8192 && y < 8192);
@@ -68,6 +76,26 @@ impl Renderer {
         }
         match self.method_instance(self.settings.gi.method) {
             Some(m) => m.read_cut_story(&self.ctx),
+            None => Ok(None),
+        }
+    }
+
+    /// The method's overlay for the pinned pixel (None without a pinned pixel, without
+    /// geometry there, or when the method draws none).
+    pub fn read_method_overlay(&self) -> Result<Option<methods::overlay::MethodOverlay>, GpuError> {
+        let Some((x, y)) = self.trace_pixel else {
+            return Ok(None);
+        };
+        let t = &self.targets;
+        if x >= t.size.0 || y >= t.size.1 {
+            return Ok(None);
+        }
+        let g = readback::read_texels(&self.ctx, &[(&t.gbuffer.position, x, y)])?;
+        let Some(g) = g.first().filter(|g| g[3] != 0.0) else {
+            return Ok(None);
+        };
+        match self.method_instance(self.settings.gi.method) {
+            Some(m) => m.read_overlay(&self.ctx, (x, y), glam::Vec3::new(g[0], g[1], g[2])),
             None => Ok(None),
         }
     }

@@ -188,6 +188,11 @@ pub struct Renderer {
     snapshots: Vec<views::Snapshot>,
     /// Frame pixel whose tree samples `slc_sample` records (the pixel story).
     trace_pixel: Option<(u32, u32)>,
+    /// Method views drawn after the frames (`render`'s PNGs) besides the frame's own specs:
+    /// a view that needs extra work in the frame (light culling's difference) gets it.
+    kept_views: Vec<methods::MethodView>,
+    /// The method views of this frame (`kept_views` and the specs of `render_views`).
+    frame_views: Vec<methods::MethodView>,
 }
 
 /// Refuses settings whose buffers the device cannot bind (instead of failing every frame).
@@ -291,6 +296,8 @@ impl Renderer {
             view_generation: 0,
             snapshots: Vec::new(),
             trace_pixel: None,
+            kept_views: Vec::new(),
+            frame_views: Vec::new(),
             ctx,
         })
     }

@@ -10,11 +10,11 @@ struct LcullParams {
     tiles_x: u32,       // tiles per subset, x
     tiles_y: u32,
     tiles: u32,         // all tiles: tiles_x x tiles_y x n^2
-    cap: u32,           // list entries per tile
+    cap: u32,           // list entries per tile (the tree variant: its reservoir's k)
     count: u32,         // VPLs of the frame (N)
     offset: u32,        // the frame's interleaving offset
     seed: u32,          // the frame's xi seed
-    mode: u32,          // 0 stochastic (eqs. 1-3, 6), 1 clamped (appendix A)
+    mode: u32,          // 0 stochastic (eqs. 1-3, 6), 1 clamped (appendix A), 2 tree (section 5)
     epsilon_max: f32,
     exposure: f32,      // E = 2^display.exposure_ev
     eps: f32,           // gi.distance_epsilon: f(l) = 1 / max(l^2, eps^2)
@@ -26,7 +26,7 @@ struct LcullParams {
     filter_normal_cos: f32,
     filter_plane_tolerance: f32,
     stride: u32,        // runs of `stride` consecutive VPLs share an interleaving subset
-    _pad1: u32,
+    leaves: u32,        // the tree variant: leaves of the light tree (a power of two)
 };
 
 const LCULL_RANGE_INF: f32 = 1e30;

@@ -33,40 +33,7 @@
 
 override DIAGNOSTICS: bool = true;
 
-struct Term {
-    value: vec3<f32>,
-    in_range: u32,
-    ray: u32,
-};
-
-// VPL i's contribution to (x, nx) without albedo / pi.
-fn term(i: u32, x: vec3<f32>, nx: vec3<f32>) -> Term {
-    var t = Term(vec3<f32>(0.0), 0u, 0u);
-    let l = lights[2u * i];
-    let fo = lights[2u * i + 1u];
-    let d = l.xyz - x;
-    let l2 = dot(d, d);
-    let f = lcull_falloff(l2, params.eps, fo.x, fo.y);
-    if f <= 0.0 {
-        return t;
-    }
-    t.in_range = 1u;
-    let v = vpls[i];
-    let w = d * inverseSqrt(max(l2, 1e-30));
-    let cx = dot(nx, w);
-    let cv = -dot(v.normal, w);
-    if cx <= 0.0 || cv <= 0.0 {
-        return t;
-    }
-    if params.shadow_rays != 0u {
-        t.ray = 1u;
-        if !vpl_visible(v.position.xyz, v.normal, x, nx, params.ray_offset) {
-            return t;
-        }
-    }
-    t.value = v.flux.rgb / PI * (cx * cv * f);
-    return t;
-}
+#include "methods/light_culling/lcull_term.wgsl"
 
 @compute @workgroup_size(8, 8, 1)
 fn shade_main(@builtin(global_invocation_id) gid: vec3<u32>) {

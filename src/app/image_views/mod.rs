@@ -252,20 +252,7 @@ pub struct ViewEvents {
     pub snapshot: Option<AbSource>,
 }
 
-/// A world-space overlay primitive drawn over the camera views (the pixel story).
-#[derive(Clone, Copy, Debug)]
-pub enum Prim {
-    Point(glam::Vec3, egui::Color32),
-    Line(glam::Vec3, glam::Vec3, egui::Color32),
-    /// Axis-aligned box (min, max).
-    Box(glam::Vec3, glam::Vec3, egui::Color32),
-    /// Ellipse centre + the two semi-axes (world vectors).
-    Ellipse {
-        center: glam::Vec3,
-        axes: [glam::Vec3; 2],
-        color: egui::Color32,
-    },
-}
+pub use crate::methods::overlay::Prim;
 
 /// Everything a pane needs to draw itself.
 pub struct PaneContext<'a> {
@@ -540,6 +527,16 @@ fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
                 painter.line_segment([pa, pb], egui::Stroke::new(w, c));
             }
         };
+        let ellipse = |center: glam::Vec3, axes: [glam::Vec3; 2], color: egui::Color32, w: f32| {
+            let n = 48;
+            let at = |k: u32| {
+                let a = k as f32 / n as f32 * std::f32::consts::TAU;
+                center + axes[0] * a.cos() + axes[1] * a.sin()
+            };
+            for k in 0..n {
+                line(at(k), at(k + 1), color, w);
+            }
+        };
         for prim in cx.overlay {
             match *prim {
                 Prim::Point(p, c) => {
@@ -564,14 +561,20 @@ fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
                         }
                     }
                 }
-                Prim::Ellipse { center, axes, color } => {
-                    let n = 32;
-                    let at = |k: u32| {
-                        let a = k as f32 / n as f32 * std::f32::consts::TAU;
-                        center + axes[0] * a.cos() + axes[1] * a.sin()
-                    };
-                    for k in 0..n {
-                        line(at(k), at(k + 1), color, 1.5);
+                Prim::Ellipse { center, axes, color } => ellipse(center, axes, color, 1.5),
+                Prim::Sphere {
+                    center,
+                    radius,
+                    color,
+                } => {
+                    // Three great circles.
+                    let (x, y, z) = (
+                        glam::Vec3::X * radius,
+                        glam::Vec3::Y * radius,
+                        glam::Vec3::Z * radius,
+                    );
+                    for axes in [[x, y], [y, z], [z, x]] {
+                        ellipse(center, axes, color, 1.0);
                     }
                 }
             }

@@ -4,7 +4,8 @@
 //! unshadowed ground truth) and with shadow rays (against the true one): GI GPU time, VPLs
 //! per pixel, error, bias and noise; the clamped ranges at the stochastic ones' GPU time
 //! (figure 4's comparison) interpolated from the eps_max sweep; the paper's Table 1 beside our
-//! pass times.
+//! pass times. Section 5's bounding-sphere-tree variant runs beside them on the same VPLs and
+//! bounds (per-pixel culling, k-entry reservoir lists, one shadow ray).
 
 use super::*;
 use crate::methods::light_culling::{self as lcull, settings::LightCullingSettings};
@@ -41,7 +42,13 @@ struct Row {
     mean_ratio: f64,
     rmse_true: f64,
     passes: Vec<(&'static str, f64)>,
+    /// The frame's light-tree build (sst_keys, sst_sort, sst_build, sst_classify): every
+    /// method's frame runs it, the tree variant needs it (the other variants do not).
+    tree_build_ms: f64,
 }
+
+/// The light tree's build passes (shared frame work, not in any method's GI time).
+const TREE_BUILD: [&str; 4] = ["sst_keys", "sst_sort", "sst_build", "sst_classify"];
 
 fn stat(m: &Measured, k: &str) -> f64 {
     m.method_stats
@@ -60,7 +67,24 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         eps_values.push(base_eps);
     }
     eps_values.sort_by(f64::total_cmp);
-    let modes = [(lcull::ID, "stochastic"), (lcull::CLAMPED, "clamped")];
+    let modes = [
+        (lcull::ID, "stochastic"),
+        (lcull::CLAMPED, "clamped"),
+        (lcull::TREE, "tree"),
+    ];
+    // Each variant's passes: ranges, culling, shading, filter (the CSV's four pass columns).
+    let passes_of = |mode: usize| -> [&'static str; 4] {
+        if modes[mode].0 == lcull::TREE {
+            [
+                "lcull_tree_leaves",
+                "lcull_tree_traverse",
+                "lcull_tree_shade",
+                "lcull_filter",
+            ]
+        } else {
+            ["lcull_ranges", "lcull_tiles", "lcull_shade", "lcull_filter"]
+        }
+    };
     let img = images(dir)?;
     let mut rows: Vec<Row> = Vec::new();
     let run = |b: &mut Bench, mode: usize, shadows: bool, vpls: u32, eps: f64| -> anyhow::Result<Row> {
@@ -121,23 +145,24 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             noise: m.noise_rmse,
             mean_ratio: mean_std(&m.mean_ratio).0,
             rmse_true,
-            passes: ["lcull_ranges", "lcull_tiles", "lcull_shade", "lcull_filter"]
+            passes: passes_of(mode)
                 .into_iter()
                 .map(|p| (p, m.pass_ms(&[p]).0))
                 .collect(),
+            tree_build_ms: m.pass_ms(&TREE_BUILD).0,
         })
     };
     // Over the VPL count at the base bound, then over the bound at the base count.
     for &e in &o.vpl_exponents {
         for shadows in [false, true] {
-            for mode in 0..2 {
+            for mode in 0..modes.len() {
                 rows.push(run(b, mode, shadows, 1 << e, base_eps)?);
             }
         }
     }
     for &eps in &eps_values {
         for shadows in [false, true] {
-            for mode in 0..2 {
+            for mode in 0..modes.len() {
                 if (eps - base_eps).abs() < 1e-12
                     && o.vpl_exponents.iter().any(|&e| 1 << e == b.base.vpl.count)
                 {
@@ -163,10 +188,14 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "noise_rmse",
         "mean_ratio",
         "rmse_vs_true_ground_truth",
+        // Tiled: lcull_ranges, lcull_tiles, lcull_shade; tree: lcull_tree_leaves,
+        // lcull_tree_traverse, lcull_tree_shade; both lcull_filter.
         "ranges_ms",
-        "tiles_ms",
+        "culling_ms",
         "shade_ms",
         "filter_ms",
+        // The frame's light-tree build (the tree variant needs it; in no variant's GI time).
+        "tree_build_ms",
     ]);
     for r in &rows {
         let mut cells = vec![
@@ -186,6 +215,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             num(r.rmse_true),
         ];
         cells.extend(r.passes.iter().map(|p| num(p.1)));
+        cells.push(num(r.tree_build_ms));
         csv.row(cells);
     }
     csv.write(&dir.join("culling.csv"))?;
@@ -195,8 +225,10 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         for (c, (mode, shadows)) in [
             ("stochastic", false),
             ("clamped", false),
+            ("tree", false),
             ("stochastic", true),
             ("clamped", true),
+            ("tree", true),
         ]
         .into_iter()
         .enumerate()
@@ -268,16 +300,28 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     )?;
 
     let mut table = format!(
-        "Stochastic vs clamped light culling ({}x{}, eps_max {base_eps}, {} x {} interleaving, {} filter radius; {}):\n",
-        o.size.0, o.size.1, base.interleave, base.interleave, base.filter_radius, b.adapter
+        "Stochastic vs clamped light culling, and the bounding-sphere tree ({}x{}, eps_max {base_eps}, {} x {} interleaving, {} filter radius; tree: k = {}, filter radius {}; {}):\n",
+        o.size.0,
+        o.size.1,
+        base.interleave,
+        base.interleave,
+        base.filter_radius,
+        base.reservoir_k,
+        base.tree_filter_radius,
+        b.adapter
     );
     for r in rows.iter().filter(|r| at_base_eps(r)) {
         table.push_str(&format!(
-            "  {:<10} {:<5} {:>6} VPLs: GI {:>9.3} ms GPU, {:>6.1} VPLs in range/pixel, RMSE {:.4e} (bias {:.2e}), mean ratio {:.3}, RMSE vs true GT {:.4e}\n",
+            "  {:<10} {:<5} {:>6} VPLs: GI {:>9.3} ms GPU{}, {:>6.1} VPLs in range/pixel, RMSE {:.4e} (bias {:.2e}), mean ratio {:.3}, RMSE vs true GT {:.4e}\n",
             r.mode,
             if r.shadows { "rays" } else { "none" },
             r.vpls,
             r.gi_ms,
+            if r.mode == "tree" {
+                format!(" (+ {:.3} ms light-tree build)", r.tree_build_ms)
+            } else {
+                String::new()
+            },
             r.in_range,
             r.rmse,
             r.bias,

@@ -16,6 +16,7 @@ pub mod pass;
 pub mod settings;
 mod ui;
 
+use super::overlay::{MethodOverlay, Prim};
 use super::{
     FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
 };
@@ -26,13 +27,18 @@ use crate::renderer::{
     settings::RenderSettings,
     shaders::ShaderError,
 };
-use pass::{FrameInputs, GpuLcullParams, GpuLcullViewParams, LcullBuffers, LcullPass, LcullStats};
+use pass::{
+    FrameInputs, GpuLcullParams, GpuLcullViewParams, LcullBuffers, LcullPass, LcullStats, TreeCullBuffers,
+    TreeInputs,
+};
 use settings::LightCullingSettings;
 
 /// The paper's stochastic light culling.
 pub const ID: MethodId = MethodId::new("light-culling");
 /// The clamped-range baseline (appendix A).
 pub const CLAMPED: MethodId = MethodId::new("light-culling-clamped");
+/// Section 5's bounding-sphere-tree culling with per-pixel reservoir lists and one shadow ray.
+pub const TREE: MethodId = MethodId::new("light-culling-tree");
 
 macro_rules! shader {
     ($name:literal) => {
@@ -48,7 +54,10 @@ pub static MODULE: Module = Module {
     create,
     shaders: &[
         shader!("lcull_common.wgsl"),
+        shader!("lcull_light.wgsl"),
+        shader!("lcull_term.wgsl"),
         shader!("lcull_ranges.wgsl"),
+        shader!("lcull_tree.wgsl"),
         shader!("lcull_tiles.wgsl"),
         shader!("lcull_shade.wgsl"),
         shader!("lcull_views.wgsl"),
@@ -57,6 +66,7 @@ pub static MODULE: Module = Module {
         "methods/light_culling/lcull_ranges.wgsl",
         "methods/light_culling/lcull_tiles.wgsl",
         "methods/light_culling/lcull_shade.wgsl",
+        "methods/light_culling/lcull_tree.wgsl",
         "methods/light_culling/lcull_views.wgsl",
     ],
 };
@@ -69,6 +79,33 @@ pub const OVERFLOW: MethodView = MethodView::new("culling overflow");
 pub const PATTERN: MethodView = MethodView::new("culling pattern");
 /// The share of the tile's list in range of each pixel.
 pub const IN_RANGE: MethodView = MethodView::new("culling list share in range");
+/// Clamped minus stochastic, relative (the darkening the paper is about).
+pub const DIFFERENCE: MethodView = MethodView::new("culling clamped vs stochastic");
+/// The difference view's colour scale: relative differences of +-this map to its ends.
+pub const DIFFERENCE_RANGE: f32 = 0.5;
+/// The tree variant: VPLs in range of the pixel (log heat map).
+pub const TREE_IN_RANGE: MethodView = MethodView::new("culling tree VPLs in range");
+/// The tree variant: nodes its traversal visited (log heat map).
+pub const TREE_VISITED: MethodView = MethodView::new("culling tree nodes visited");
+
+const TREE_VIEWS: &[ViewInfo] = &[
+    ViewInfo {
+        name: TREE_IN_RANGE.name(),
+        file: "culling_tree_vpls_in_range",
+        about: "m: the VPLs whose stochastic range holds the pixel's point (the traversal's \
+                overlapping leaves; the list keeps k of them), log scale",
+        passes: &["lcull_tree_traverse"],
+    },
+    ViewInfo {
+        name: TREE_VISITED.name(),
+        file: "culling_tree_nodes_visited",
+        about: "bounding-sphere-tree nodes the pixel's traversal visited, log scale",
+        passes: &["lcull_tree_traverse"],
+    },
+];
+
+/// Range spheres drawn for the pinned pixel's tile at most (those holding the pixel first).
+pub const OVERLAY_SPHERES: usize = 64;
 
 const VIEWS: &[ViewInfo] = &[
     ViewInfo {
@@ -97,6 +134,14 @@ const VIEWS: &[ViewInfo] = &[
                 fall-off / VPLs tested, 0 .. 1): how tight the tile's bounds are",
         passes: &["lcull_shade"],
     },
+    ViewInfo {
+        name: DIFFERENCE.name(),
+        file: "culling_clamped_vs_stochastic",
+        about: "(clamped - stochastic) / their mean per pixel, each averaged over its frames: \
+                the clamped ranges' darkening (low, blue) against the unbiased stochastic \
+                image; while shown, diagnostic frames also run the other variant",
+        passes: &["lcull_companion_shade"],
+    },
 ];
 
 fn invalid_example(s: &mut RenderSettings) -> &'static str {
@@ -113,6 +158,9 @@ const TESTS: &[&str] = &[
     "light_culling::gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing",
     "light_culling::the_mean_over_frames_converges_to_the_unshadowed_ground_truth_and_clamping_darkens",
 ];
+
+const TREE_TESTS: &[&str] =
+    &["light_culling::the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_truth"];
 
 pub static INFO: MethodInfo = MethodInfo {
     id: ID,
@@ -160,6 +208,36 @@ pub static CLAMPED_INFO: MethodInfo = MethodInfo {
     sweep: Some(&SWEEP),
 };
 
+pub static TREE_INFO: MethodInfo = MethodInfo {
+    id: TREE,
+    aliases: &["light-culling-sphere-tree"],
+    label: "Light culling, bounding-sphere tree",
+    short: "tree culling",
+    about: "Stochastic Light Culling's section 5: the same stochastic ranges culled per pixel \
+            through a bounding-sphere tree of the VPLs, k of the overlapping VPLs kept by \
+            reservoir sampling, one of them shaded (resampled importance sampling, one \
+            shadow ray).",
+    progress_unit: "",
+    kind: Kind::PerFrame,
+    module: &MODULE,
+    reads: &[Resource::Gbuffer, Resource::Tree, Resource::Bvh],
+    views: TREE_VIEWS,
+    timed_passes: &[
+        "lcull_tree_leaves",
+        "lcull_tree_traverse",
+        "lcull_tree_shade",
+        "lcull_filter",
+    ],
+    story: false,
+    shadow_ray_switch: true,
+    truth_of_vpls: false,
+    validate,
+    invalid_example: Some(invalid_example),
+    ui: ui::settings_ui,
+    tests: TREE_TESTS,
+    sweep: Some(&SWEEP),
+};
+
 /// The error bound eps_max, loose to tight (the paper's 0.0005 among them).
 pub static SWEEP: super::Sweep = super::Sweep {
     name: "epsilon_max",
@@ -178,14 +256,18 @@ fn validate(s: &RenderSettings) -> Result<(), String> {
 
 /// Decades of the list-length scales: 1 .. 10^decades >= cap.
 fn decades(cap: u32) -> u32 {
-    (cap.max(2) as f32).log10().ceil() as u32
+    (cap.max(2) as f32).log10().ceil().min(9.0) as u32
 }
 
 pub struct LightCulling {
     pass: LcullPass,
     buffers: LcullBuffers,
+    /// The tree variant's (allocated by its first frame).
+    tree: Option<TreeCullBuffers>,
     /// Accumulation: (key, method, frames summed).
     state: Option<(u64, MethodId, u32)>,
+    /// The difference view's companion (the other variant) accumulation, alike.
+    companion: Option<(u64, MethodId, u32)>,
     settings: LightCullingSettings,
 }
 
@@ -193,7 +275,9 @@ fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
     Ok(Box::new(LightCulling {
         pass: LcullPass::new(device)?,
         buffers: LcullBuffers::new(device, 1, (1, 1), 1, 1),
+        tree: None,
         state: None,
+        companion: None,
         settings: LightCullingSettings::default(),
     }))
 }
@@ -201,6 +285,10 @@ fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
 impl LightCulling {
     pub fn buffers(&self) -> &LcullBuffers {
         &self.buffers
+    }
+    /// The tree variant's buffers (None before its first frame).
+    pub fn tree_buffers(&self) -> Option<&TreeCullBuffers> {
+        self.tree.as_ref()
     }
     /// The frame's xi seed (a new one per frame unless `sampling.fixed_seed`).
     pub fn seed(s: &RenderSettings, frame_index: u64) -> u32 {
@@ -219,9 +307,102 @@ impl LightCulling {
             n: lc.interleave,
         }
     }
+    /// Whether the last frame ran the tree variant.
+    fn is_tree(&self) -> bool {
+        self.state.is_some_and(|(_, m, _)| m == TREE)
+    }
+    /// Decades of a heat-map view's log scale: the tile list's cap, the tree's VPLs (VPLs in
+    /// range) or its nodes (nodes visited).
+    fn view_decades(&self, view: MethodView) -> u32 {
+        let leaves = self.tree.as_ref().map_or(2, |t| t.leaves);
+        if view == TREE_IN_RANGE {
+            decades(leaves)
+        } else if view == TREE_VISITED {
+            decades(2 * leaves)
+        } else {
+            decades(self.settings.max_lights_per_tile)
+        }
+    }
+    /// Frames in the difference view's companion image when it matches the method's own
+    /// (same key, the other variant); None otherwise.
+    pub fn companion_frames(&self) -> Option<u32> {
+        let (k, m, _) = self.state?;
+        let (ck, cm, n) = self.companion?;
+        (ck == k && cm != m && n > 0).then_some(n)
+    }
     /// Counters of a recent diagnostic frame (non-blocking).
     pub fn poll_stats(&mut self) -> Option<LcullStats> {
         self.pass.stats.poll()
+    }
+}
+
+impl LightCulling {
+    /// The tree variant's frame (section 5): `p` is the tiled frame's parameters.
+    fn record_tree(
+        &mut self,
+        cx: &mut FrameCx<'_>,
+        enc: &mut wgpu::CommandEncoder,
+        p: GpuLcullParams,
+        frames: u32,
+    ) -> f32 {
+        let lc = &self.settings;
+        let leaves = cx.tree.leaves.max(1);
+        let k = lc.reservoir_k;
+        if !self.tree.as_ref().is_some_and(|t| t.matches(cx.size, leaves, k)) {
+            let need = TreeCullBuffers::list_bytes(cx.size, k);
+            let limit = cx.device.limits().max_storage_buffer_binding_size;
+            if need > limit {
+                cx.errors.report(format!(
+                    "light culling (tree): {} x {} pixels x k = {k} list entries need a {} MiB \
+                     buffer; this device binds at most {} MiB (lower \
+                     methods.light-culling.reservoir_k or the resolution)",
+                    cx.size.0,
+                    cx.size.1,
+                    need >> 20,
+                    limit >> 20
+                ));
+                enc.clear_buffer(cx.gi_accum, 0, None);
+                self.state = None;
+                return 1.0;
+            }
+            self.tree = Some(TreeCullBuffers::new(cx.device, cx.size, leaves, k));
+        }
+        let Some(t) = self.tree.as_ref() else {
+            return 0.0;
+        };
+        let tp = GpuLcullParams {
+            n: 1,
+            cap: k,
+            count: leaves,
+            mode: 2,
+            filter_radius: lc.tree_filter_radius,
+            leaves,
+            ..p
+        };
+        let inputs = FrameInputs {
+            scene: cx.scene,
+            gbuffer: &cx.targets.gbuffer,
+            camera: cx.camera,
+            vpls: &cx.vpl_buffers.vpls,
+            accum: cx.gi_accum,
+        };
+        let tree = TreeInputs {
+            nodes: &cx.tree.nodes,
+            sorted_vpls: &cx.tree.sorted_vpls,
+        };
+        self.pass.record_tree(
+            cx.diagnostics,
+            cx.device,
+            cx.queue,
+            enc,
+            cx.timer,
+            tp,
+            &inputs,
+            &tree,
+            &self.buffers,
+            t,
+        );
+        1.0 / frames as f32
     }
 }
 
@@ -231,8 +412,13 @@ impl Method for LightCulling {
         let lc: LightCullingSettings = s.method(ID).unwrap_or_default();
         let grid = Self::grid(&lc, cx.size);
         let (tiles_x, tiles_y) = grid.per_subset();
-        let tiles = grid.count();
-        let cap = lc.max_lights_per_tile;
+        // The tree variant uses no tile lists (one entry, never read).
+        let tree = cx.method == TREE;
+        let (tiles, cap) = if tree {
+            (1, 1)
+        } else {
+            (grid.count(), lc.max_lights_per_tile)
+        };
         let vpl_capacity = cx.vpl_buffers.capacity;
         if !self.buffers.matches(vpl_capacity, cx.size, tiles, cap) {
             let need = LcullBuffers::list_bytes(tiles, cap);
@@ -247,9 +433,11 @@ impl Method for LightCulling {
                 ));
                 enc.clear_buffer(cx.gi_accum, 0, None);
                 self.state = None;
+                self.companion = None;
                 return 1.0;
             }
             self.buffers = LcullBuffers::new(cx.device, vpl_capacity, cx.size, tiles, cap);
+            self.companion = None;
         }
         let frames = match self.state {
             Some((k, m, n)) if s.sampling.accumulate && k == cx.key && m == cx.method => n + 1,
@@ -283,9 +471,50 @@ impl Method for LightCulling {
             filter_normal_cos: lc.filter_normal_cos,
             filter_plane_tolerance: lc.filter_plane_tolerance,
             stride: il.stride,
-            _pad: 0,
+            leaves: 0,
         };
         self.settings = lc;
+        if cx.method == TREE {
+            return self.record_tree(cx, enc, p, frames);
+        }
+        // The difference view's companion: the other variant with the same settings, in
+        // diagnostic frames while the view is drawn, recorded first (the own run then leaves
+        // its lists and counters for the other views).
+        if cx.diagnostics && cx.views.contains(&DIFFERENCE) {
+            self.buffers.ensure_companion(cx.device);
+            let other = if cx.method == CLAMPED { ID } else { CLAMPED };
+            let n = match self.companion {
+                Some((k, m, n)) if s.sampling.accumulate && k == cx.key && m == other => n + 1,
+                _ => 1,
+            };
+            self.companion = Some((cx.key, other, n));
+            let cp = GpuLcullParams {
+                mode: (other == CLAMPED) as u32,
+                accumulate: (n > 1) as u32,
+                ..p
+            };
+            let Some(companion) = self.buffers.companion.as_ref() else {
+                return 0.0;
+            };
+            let inputs = FrameInputs {
+                scene: cx.scene,
+                gbuffer: &cx.targets.gbuffer,
+                camera: cx.camera,
+                vpls: &cx.vpl_buffers.vpls,
+                accum: &companion.accum,
+            };
+            self.pass.record(
+                true,
+                true,
+                cx.device,
+                cx.queue,
+                enc,
+                cx.timer,
+                cp,
+                &inputs,
+                &self.buffers,
+            );
+        }
         let inputs = FrameInputs {
             scene: cx.scene,
             gbuffer: &cx.targets.gbuffer,
@@ -294,6 +523,7 @@ impl Method for LightCulling {
             accum: cx.gi_accum,
         };
         self.pass.record(
+            false,
             cx.diagnostics,
             cx.device,
             cx.queue,
@@ -316,6 +546,7 @@ impl Method for LightCulling {
 
     fn reset(&mut self) {
         self.state = None;
+        self.companion = None;
     }
 
     fn view_size(&self, _view: MethodView, frame: (u32, u32)) -> Option<(u32, u32)> {
@@ -324,20 +555,28 @@ impl Method for LightCulling {
 
     fn record_view(&mut self, view: MethodView, cx: &mut ViewCx<'_>, enc: &mut wgpu::CommandEncoder) {
         let p = GpuLcullViewParams {
-            mode: if view == LIST {
+            mode: if view == LIST || view == TREE_IN_RANGE {
                 0
             } else if view == OVERFLOW {
                 1
             } else if view == PATTERN {
                 2
-            } else {
+            } else if view == IN_RANGE {
                 3
+            } else if view == DIFFERENCE {
+                4
+            } else {
+                5
             },
-            scale_top: 10u32.pow(decades(self.settings.max_lights_per_tile)),
+            scale_top: 10u32.pow(self.view_decades(view)),
             exposure: cx.look.exposure_ev.exp2(),
             tonemap: cx.look.tonemap.gpu_id(),
             n: self.settings.interleave,
             cap: self.settings.max_lights_per_tile,
+            own_scale: self.state.map_or(0.0, |(_, _, n)| 1.0 / n.max(1) as f32),
+            companion_scale: self.companion_frames().map_or(0.0, |n| 1.0 / n as f32),
+            own_is_clamped: self.state.is_some_and(|(_, m, _)| m == CLAMPED) as u32,
+            range: DIFFERENCE_RANGE,
             _pad: [0; 2],
         };
         self.pass.record_view(
@@ -348,15 +587,26 @@ impl Method for LightCulling {
             p,
             &cx.targets.lighting.final_view,
             &cx.targets.gbuffer.position_view,
+            &cx.targets.lighting.gi_accum,
             &self.buffers,
             cx.dst,
         );
     }
 
-    /// Per pixel: tile list length, VPLs in range, VPLs tested, shadow rays.
-    fn read_view(&self, ctx: &GpuContext, _view: MethodView) -> Result<Option<ImageF32>, GpuError> {
+    /// Per pixel: tile list length, VPLs in range, VPLs tested, shadow rays; the difference
+    /// view: (relative difference, clamped luminance, stochastic luminance, 1 where both
+    /// images exist) as last drawn.
+    fn read_view(&self, ctx: &GpuContext, view: MethodView) -> Result<Option<ImageF32>, GpuError> {
         if self.state.is_none() {
             return Ok(None);
+        }
+        if view == DIFFERENCE {
+            return match self.buffers.companion.as_ref() {
+                Some(c) if self.companion_frames().is_some() => {
+                    readback::read_vec4_image(ctx, &c.difference, self.buffers.size)
+                }
+                _ => Ok(None),
+            };
         }
         readback::read_vec4_image(ctx, &self.buffers.diag, self.buffers.size)
     }
@@ -374,14 +624,211 @@ impl Method for LightCulling {
         }
         let d = readback::read_vec4_pixel(ctx, &b.diag, b.size.0, x, y)?;
         Ok(vec![(
-            "light culling (tile list, VPLs in range, VPLs tested, shadow rays)",
+            if self.is_tree() {
+                "tree culling (VPLs in range, listed, nodes visited, shadow rays)"
+            } else {
+                "light culling (tile list, VPLs in range, VPLs tested, shadow rays)"
+            },
             d,
         )])
     }
 
+    /// The range spheres of the pinned pixel's tile list (the tree variant: of its
+    /// reservoir list) in the last frame, those holding the pixel's point first, at most
+    /// [`OVERLAY_SPHERES`]. (Its per-pixel counters are the last diagnostic frame's: the
+    /// pixel-values window.)
+    fn read_overlay(
+        &self,
+        ctx: &GpuContext,
+        pixel: (u32, u32),
+        position: glam::Vec3,
+    ) -> Result<Option<MethodOverlay>, GpuError> {
+        let b = &self.buffers;
+        let (x, y) = pixel;
+        if self.state.is_none() || x >= b.size.0 || y >= b.size.1 {
+            return Ok(None);
+        }
+        let read_spheres =
+            |lights: &wgpu::Buffer, capacity: u32, list: &[u32]| -> Result<Vec<[f32; 4]>, GpuError> {
+                let ranges: Vec<(u64, u64)> = list
+                    .iter()
+                    .filter(|&&i| i < capacity)
+                    .map(|&i| (32 * i as u64, 16))
+                    .collect();
+                Ok(readback::read_buffer_ranges(ctx, lights, &ranges)?
+                    .iter()
+                    .map(|v| bytemuck::pod_read_unaligned::<[f32; 4]>(&v[..16]))
+                    .collect())
+            };
+        let (title, mut rows, spheres) = if self.is_tree() {
+            let Some(t) = self.tree.as_ref().filter(|t| t.size == b.size) else {
+                return Ok(None);
+            };
+            let k = (y * b.size.0 + x) as u64;
+            let mv = readback::read_buffer_range(ctx, &t.m, 8 * k, 8)?;
+            let [m, visited]: [u32; 2] = bytemuck::pod_read_unaligned(&mv[..8]);
+            let listed = m.min(t.k);
+            let list: Vec<u32> = if listed > 0 {
+                bytemuck::pod_collect_to_vec(&readback::read_buffer_range(
+                    ctx,
+                    &t.list,
+                    4 * k * t.k as u64,
+                    4 * listed as u64,
+                )?)
+            } else {
+                Vec::new()
+            };
+            let spheres = read_spheres(&t.lights, t.leaves, &list)?;
+            let rows = vec![
+                (
+                    "VPLs in range (m) / listed (k)".to_string(),
+                    format!(
+                        "{m} / {listed} (k = {}; each kept with probability min(k / m, 1))",
+                        t.k
+                    ),
+                ),
+                ("tree nodes visited".into(), visited.to_string()),
+            ];
+            (
+                "the range spheres of its reservoir list (bounding-sphere tree, section 5)".to_string(),
+                rows,
+                spheres,
+            )
+        } else {
+            let grid = Self::grid(&self.settings, b.size);
+            let t = grid.tile_of(x, y);
+            if t >= b.tiles {
+                return Ok(None);
+            }
+            let count_bytes = readback::read_buffer_range(ctx, &b.tile_count, 4 * t as u64, 4)?;
+            let count = bytemuck::pod_read_unaligned::<u32>(&count_bytes[..4]);
+            let listed = count.min(b.cap);
+            let list: Vec<u32> = if listed > 0 {
+                bytemuck::pod_collect_to_vec(&readback::read_buffer_range(
+                    ctx,
+                    &b.tile_lists,
+                    4 * t as u64 * b.cap as u64,
+                    4 * listed as u64,
+                )?)
+            } else {
+                Vec::new()
+            };
+            let spheres = read_spheres(&b.lights, b.vpl_capacity, &list)?;
+            let subset = x % grid.n + grid.n * (y % grid.n);
+            let rows = vec![
+                (
+                    "tile (interleaving subset)".to_string(),
+                    format!("{t} (subset {subset} of {})", grid.n * grid.n),
+                ),
+                (
+                    "VPLs in the tile's list".into(),
+                    if count > b.cap {
+                        format!(
+                            "{count}: over the cap of {}, the pixel tests its whole subset",
+                            b.cap
+                        )
+                    } else {
+                        count.to_string()
+                    },
+                ),
+            ];
+            let variant = if self.state.is_some_and(|(_, m, _)| m == CLAMPED) {
+                "clamped ranges"
+            } else {
+                "stochastic ranges of the frame's xi"
+            };
+            (
+                format!("the range spheres of its tile's light list ({variant})"),
+                rows,
+                spheres,
+            )
+        };
+        let holds = |s: &[f32; 4]| glam::Vec3::new(s[0], s[1], s[2]).distance(position) < s[3];
+        let mut order: Vec<usize> = (0..spheres.len()).collect();
+        order.sort_by_key(|&k| !holds(&spheres[k]));
+        let inside = spheres.iter().filter(|s| holds(s)).count();
+        let mut prims = Vec::new();
+        for &k in order.iter().take(OVERLAY_SPHERES) {
+            let s = spheres[k];
+            let c = glam::Vec3::new(s[0], s[1], s[2]);
+            let color = if holds(&s) {
+                egui::Color32::from_rgb(90, 230, 110)
+            } else {
+                egui::Color32::from_rgba_unmultiplied(255, 160, 40, 140)
+            };
+            prims.push(Prim::Sphere {
+                center: c,
+                radius: s[3].min(1e6),
+                color,
+            });
+            prims.push(Prim::Point(c, color));
+        }
+        prims.push(Prim::Point(position, egui::Color32::WHITE));
+        rows.push((
+            "range spheres holding the pixel's point".into(),
+            format!("{inside} of {} listed", spheres.len()),
+        ));
+        let (rmin, rmax) = spheres
+            .iter()
+            .fold((f32::INFINITY, 0.0f32), |(a, b), s| (a.min(s[3]), b.max(s[3])));
+        if !spheres.is_empty() {
+            rows.push((
+                "range radii of the list (scene units)".into(),
+                format!("{rmin:.3} .. {rmax:.3}"),
+            ));
+        }
+        rows.push((
+            "spheres drawn".into(),
+            format!("{} of {}", spheres.len().min(OVERLAY_SPHERES), spheres.len()),
+        ));
+        Ok(Some(MethodOverlay {
+            title,
+            rows,
+            key: if self.is_tree() {
+                "green: the listed VPLs (each range sphere holds the pixel's point; one of them \
+                 is shaded, resampled by eq. 8); white: the pixel"
+                    .into()
+            } else {
+                "green: listed VPLs whose range sphere holds the pixel's point (the ones that \
+                 light it); orange: listed for the tile but out of the pixel's range; white: \
+                 the pixel"
+                    .into()
+            },
+            prims,
+        }))
+    }
+
     fn legend(&self, view: MethodView, _tree_levels: u32) -> Option<Legend> {
         let st = self.pass.stats.last();
-        let top = decades(self.settings.max_lights_per_tile) as f32;
+        let top = self.view_decades(view) as f32;
+        if view == TREE_IN_RANGE {
+            return Some(Legend {
+                title: match st {
+                    Some(st) => format!(
+                        "VPLs in range + 1 (mean {:.1}, most {}; {} pixels over k = {})",
+                        st.in_range_per_pixel(),
+                        st.longest_list,
+                        st.overflow_tiles,
+                        self.settings.reservoir_k
+                    ),
+                    None => "VPLs in range + 1".into(),
+                },
+                lo: 0.0,
+                hi: top,
+                log: true,
+            });
+        }
+        if view == TREE_VISITED {
+            return Some(Legend {
+                title: match st {
+                    Some(st) => format!("tree nodes visited + 1 (mean {:.1})", st.visited_per_pixel()),
+                    None => "tree nodes visited + 1".into(),
+                },
+                lo: 0.0,
+                hi: top,
+                log: true,
+            });
+        }
         if view == LIST {
             Some(Legend {
                 title: match st {
@@ -411,13 +858,49 @@ impl Method for LightCulling {
                 hi: 1.0,
                 log: false,
             })
+        } else if view == DIFFERENCE {
+            let own = self.state.map_or(0, |(_, _, n)| n);
+            Some(Legend {
+                title: match self.companion_frames() {
+                    Some(n) => {
+                        let own_clamped = self.state.is_some_and(|(_, m, _)| m == CLAMPED);
+                        let (c, st) = if own_clamped { (own, n) } else { (n, own) };
+                        format!(
+                            "(clamped - stochastic) / mean, over {c} clamped and {st} stochastic \
+                             frames{}",
+                            if own <= 1 {
+                                " (accumulate frames to see the bias, not the noise)"
+                            } else {
+                                ""
+                            }
+                        )
+                    }
+                    None => "(clamped - stochastic) / mean: the other variant runs from the next \
+                             diagnostic frame"
+                        .into(),
+                },
+                lo: -DIFFERENCE_RANGE,
+                hi: DIFFERENCE_RANGE,
+                log: false,
+            })
         } else {
             None
         }
     }
 
     fn stats(&mut self) -> Vec<(&'static str, f64)> {
+        let tree = self.is_tree();
         match self.pass.stats.poll() {
+            Some(st) if tree => vec![
+                ("vpls_in_range_per_pixel", st.in_range_per_pixel()),
+                ("vpls_listed_per_pixel", st.tested_per_pixel()),
+                ("most_vpls_in_range", st.longest_list as f64),
+                ("pixels_over_k", st.overflow_tiles as f64),
+                ("tree_nodes_visited_per_pixel", st.visited_per_pixel()),
+                ("shadow_rays_per_pixel", st.rays_per_pixel()),
+                ("epsilon_max", self.settings.epsilon_max as f64),
+                ("reservoir_k", self.settings.reservoir_k as f64),
+            ],
             Some(st) => vec![
                 ("mean_tile_list", st.mean_list()),
                 ("longest_tile_list", st.longest_list as f64),
@@ -434,6 +917,18 @@ impl Method for LightCulling {
 
     fn status(&mut self) -> Option<String> {
         let st = self.pass.stats.poll()?;
+        if self.is_tree() {
+            return Some(format!(
+                "tree culling {:.1} VPLs in range per pixel (most {}; {} pixels over k = {}) · \
+                 {:.1} nodes visited · {:.2} shadow rays per pixel",
+                st.in_range_per_pixel(),
+                st.longest_list,
+                st.overflow_tiles,
+                self.settings.reservoir_k,
+                st.visited_per_pixel(),
+                st.rays_per_pixel()
+            ));
+        }
         Some(format!(
             "culling {:.1} lights per tile (longest {}, {} over the cap of {}) · {:.1} in range \
              per pixel · {:.1} shadow rays per pixel",

@@ -37,7 +37,7 @@ pub struct GpuLcullParams {
     pub count: u32,
     pub offset: u32,
     pub seed: u32,
-    /// 0 stochastic, 1 clamped.
+    /// 0 stochastic, 1 clamped, 2 the tree variant (stochastic ranges).
     pub mode: u32,
     pub epsilon_max: f32,
     pub exposure: f32,
@@ -50,7 +50,8 @@ pub struct GpuLcullParams {
     pub filter_normal_cos: f32,
     pub filter_plane_tolerance: f32,
     pub stride: u32,
-    pub _pad: u32,
+    /// The tree variant: leaves of the light tree.
+    pub leaves: u32,
 }
 
 /// Twin: `LcullViewParams` in `lcull_views.wgsl`.
@@ -63,6 +64,13 @@ pub struct GpuLcullViewParams {
     pub tonemap: u32,
     pub n: u32,
     pub cap: u32,
+    /// The difference view: 1 / frames of the method's own accumulation and of the
+    /// companion's (0: none yet), and 1 when the method itself is the clamped variant.
+    pub own_scale: f32,
+    pub companion_scale: f32,
+    pub own_is_clamped: u32,
+    /// The difference view's colour scale: relative differences +-range map to its ends.
+    pub range: f32,
     pub _pad: [u32; 2],
 }
 
@@ -82,6 +90,8 @@ pub struct LcullStats {
     /// VPLs in range of their pixel (non-zero fall-off).
     pub in_range: u64,
     pub shadow_rays: u64,
+    /// The tree variant: tree nodes visited by the pixels' traversals.
+    pub nodes_visited: u64,
 }
 
 impl LcullStats {
@@ -96,6 +106,7 @@ impl LcullStats {
             tested: w64(6),
             in_range: w64(8),
             shadow_rays: w64(10),
+            nodes_visited: w64(12),
         }
     }
     fn per_pixel(&self, v: u64) -> f64 {
@@ -109,6 +120,9 @@ impl LcullStats {
     }
     pub fn rays_per_pixel(&self) -> f64 {
         self.per_pixel(self.shadow_rays)
+    }
+    pub fn visited_per_pixel(&self) -> f64 {
+        self.per_pixel(self.nodes_visited)
     }
     pub fn mean_list(&self) -> f64 {
         self.list_entries as f64 / self.tiles_with_geometry.max(1) as f64
@@ -129,6 +143,18 @@ pub struct LcullBuffers {
     pub raw: wgpu::Buffer,
     pub diag: wgpu::Buffer,
     pub stats: wgpu::Buffer,
+    /// The difference view's buffers (allocated when it is first drawn or kept).
+    pub companion: Option<CompanionBuffers>,
+    /// Bound in their place before then (16 bytes each, never touched; two, as one buffer
+    /// may not be both read-only and read-write in a dispatch).
+    pub dummy: [wgpu::Buffer; 2],
+}
+
+/// The clamped-vs-stochastic view's: the other variant's GI accumulation and the view's
+/// linear data as last drawn (`Method::read_view`).
+pub struct CompanionBuffers {
+    pub accum: wgpu::Buffer,
+    pub difference: wgpu::Buffer,
 }
 
 impl LcullBuffers {
@@ -145,6 +171,21 @@ impl LcullBuffers {
             raw: storage_buffer(device, "lcull::raw", 16 * px),
             diag: storage_buffer(device, "lcull::diag", 16 * px),
             stats: storage_buffer(device, "lcull::stats", 4 * STATS_WORDS as u64),
+            companion: None,
+            dummy: [
+                storage_buffer(device, "lcull::dummy_accum", 16),
+                storage_buffer(device, "lcull::dummy_difference", 16),
+            ],
+        }
+    }
+    /// The difference view's buffers, allocated on first use.
+    pub fn ensure_companion(&mut self, device: &wgpu::Device) {
+        if self.companion.is_none() {
+            let px = self.size.0 as u64 * self.size.1 as u64;
+            self.companion = Some(CompanionBuffers {
+                accum: storage_buffer(device, "lcull::companion_accum", 16 * px),
+                difference: storage_buffer(device, "lcull::difference", 16 * px),
+            });
         }
     }
     /// Bytes of the tile lists for this layout (the largest binding).
@@ -156,6 +197,47 @@ impl LcullBuffers {
     }
 }
 
+/// The tree variant's buffers (section 5): per leaf its range, per node the largest range
+/// below it, per pixel its k-entry light list and (m, nodes visited).
+pub struct TreeCullBuffers {
+    pub size: (u32, u32),
+    pub leaves: u32,
+    pub k: u32,
+    /// Two vec4 per leaf: (position, range), (threshold, floor, 0, 0).
+    pub lights: wgpu::Buffer,
+    pub max_range: wgpu::Buffer,
+    pub list: wgpu::Buffer,
+    pub m: wgpu::Buffer,
+}
+
+impl TreeCullBuffers {
+    pub fn new(device: &wgpu::Device, size: (u32, u32), leaves: u32, k: u32) -> Self {
+        let px = size.0 as u64 * size.1 as u64;
+        Self {
+            size,
+            leaves,
+            k,
+            lights: storage_buffer(device, "lcull_tree::lights", 32 * leaves as u64),
+            max_range: storage_buffer(device, "lcull_tree::max_range", 8 * leaves as u64),
+            list: storage_buffer(device, "lcull_tree::list", Self::list_bytes(size, k)),
+            m: storage_buffer(device, "lcull_tree::m", 8 * px),
+        }
+    }
+    /// Bytes of the per-pixel lists (the largest binding).
+    pub fn list_bytes(size: (u32, u32), k: u32) -> u64 {
+        4 * size.0 as u64 * size.1 as u64 * k as u64
+    }
+    pub fn matches(&self, size: (u32, u32), leaves: u32, k: u32) -> bool {
+        self.size == size && self.leaves == leaves && self.k == k
+    }
+}
+
+/// The light tree the tree variant walks (`TreeBuffers`: nodes and VPLs in leaf order).
+pub struct TreeInputs<'a> {
+    pub nodes: &'a wgpu::Buffer,
+    pub sorted_vpls: &'a wgpu::Buffer,
+}
+
 /// Everything a frame of the method binds from the renderer.
 pub struct FrameInputs<'a> {
     pub scene: &'a SceneGpu,
@@ -165,8 +247,19 @@ pub struct FrameInputs<'a> {
     pub accum: &'a wgpu::Buffer,
 }
 
+/// Timer names of a run's passes: the method's own, and the difference view's companion
+/// (diagnostic frames only, so never in a timed frame's GI cost).
+const OWN_PASSES: [&str; 4] = ["lcull_ranges", "lcull_tiles", "lcull_shade", "lcull_filter"];
+const COMPANION_PASSES: [&str; 4] = [
+    "lcull_companion_ranges",
+    "lcull_companion_tiles",
+    "lcull_companion_shade",
+    "lcull_companion_filter",
+];
+
 pub struct LcullPass {
     params: wgpu::Buffer,
+    companion_params: wgpu::Buffer,
     ranges_layout: wgpu::BindGroupLayout,
     ranges: wgpu::ComputePipeline,
     tiles_layout: wgpu::BindGroupLayout,
@@ -176,6 +269,12 @@ pub struct LcullPass {
     shade: wgpu::ComputePipeline,
     shade_timed: wgpu::ComputePipeline,
     filter: wgpu::ComputePipeline,
+    tree_layout: wgpu::BindGroupLayout,
+    tree_leaves: wgpu::ComputePipeline,
+    tree_traverse: wgpu::ComputePipeline,
+    tree_traverse_timed: wgpu::ComputePipeline,
+    tree_shade: wgpu::ComputePipeline,
+    tree_shade_timed: wgpu::ComputePipeline,
     views_layout: wgpu::BindGroupLayout,
     views: wgpu::ComputePipeline,
     view_params: wgpu::Buffer,
@@ -189,6 +288,7 @@ impl LcullPass {
         let tmod = shaders::create_module(device, "methods/light_culling/lcull_tiles.wgsl")?;
         let smod = shaders::create_module(device, "methods/light_culling/lcull_shade.wgsl")?;
         let vmod = shaders::create_module(device, "methods/light_culling/lcull_views.wgsl")?;
+        let trmod = shaders::create_module(device, "methods/light_culling/lcull_tree.wgsl")?;
         let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some(label),
@@ -220,6 +320,14 @@ impl LcullPass {
         se.extend((5..=10).map(|b| storage_entry(b, c, true)));
         se.extend((11..=14).map(|b| storage_entry(b, c, false)));
         let shade_layout = layout("lcull_shade::layout", &se);
+        let mut te = vec![
+            uniform_entry(0, c),
+            float_texture_entry(1),
+            float_texture_entry(2),
+        ];
+        te.extend((3..=6).map(|b| storage_entry(b, c, true)));
+        te.extend((7..=13).map(|b| storage_entry(b, c, false)));
+        let tree_layout = layout("lcull_tree::layout", &te);
         let views_layout = layout(
             "lcull_views::layout",
             &[
@@ -228,6 +336,9 @@ impl LcullPass {
                 float_texture_entry(2),
                 storage_entry(3, c, true),
                 storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm),
+                storage_entry(5, c, true),
+                storage_entry(6, c, true),
+                storage_entry(7, c, false),
             ],
         );
         let pipe =
@@ -239,6 +350,7 @@ impl LcullPass {
         let timed = &[("DIAGNOSTICS", 0.0)];
         Ok(Self {
             params: uniform_buffer::<GpuLcullParams>(device, "lcull::params"),
+            companion_params: uniform_buffer::<GpuLcullParams>(device, "lcull::companion_params"),
             ranges: pipe("lcull_ranges", &ranges_layout, &rmod, "main", &[]),
             ranges_layout,
             tiles: pipe("lcull_tiles", &tiles_layout, &tmod, "main", &[]),
@@ -248,6 +360,24 @@ impl LcullPass {
             shade_timed: pipe("lcull_shade_timed", &shade_layout, &smod, "shade_main", timed),
             filter: pipe("lcull_filter", &shade_layout, &smod, "filter_main", &[]),
             shade_layout,
+            tree_leaves: pipe("lcull_tree_leaves", &tree_layout, &trmod, "leaves_main", &[]),
+            tree_traverse: pipe("lcull_tree_traverse", &tree_layout, &trmod, "traverse_main", &[]),
+            tree_traverse_timed: pipe(
+                "lcull_tree_traverse_timed",
+                &tree_layout,
+                &trmod,
+                "traverse_main",
+                timed,
+            ),
+            tree_shade: pipe("lcull_tree_shade", &tree_layout, &trmod, "shade_main", &[]),
+            tree_shade_timed: pipe(
+                "lcull_tree_shade_timed",
+                &tree_layout,
+                &trmod,
+                "shade_main",
+                timed,
+            ),
+            tree_layout,
             views: pipe("lcull_views", &views_layout, &vmod, "main", &[]),
             views_layout,
             view_params: uniform_buffer::<GpuLcullViewParams>(device, "lcull_views::params"),
@@ -260,10 +390,14 @@ impl LcullPass {
         })
     }
 
-    /// Records the frame's passes (module doc).
+    /// Records the frame's passes (module doc). `companion`: the other variant for the
+    /// difference view, into `f.accum` (its own accumulation), without diagnostics and with
+    /// its own parameters and timer names; recorded before the method's own run, which then
+    /// leaves its lists and counters for the views.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
+        companion: bool,
         diagnostics: bool,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -273,7 +407,13 @@ impl LcullPass {
         f: &FrameInputs<'_>,
         b: &LcullBuffers,
     ) {
-        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let diagnostics = diagnostics && !companion;
+        let (params, names) = if companion {
+            (&self.companion_params, COMPANION_PASSES)
+        } else {
+            (&self.params, OWN_PASSES)
+        };
+        queue.write_buffer(params, 0, bytemuck::bytes_of(&p));
         let tv = wgpu::BindingResource::TextureView;
         let g = f.gbuffer;
         let rbind = bind_group_seq(
@@ -281,13 +421,13 @@ impl LcullPass {
             "lcull_ranges::bind_group",
             &self.ranges_layout,
             &[
-                self.params.as_entire_binding(),
+                params.as_entire_binding(),
                 f.vpls.as_entire_binding(),
                 b.lights.as_entire_binding(),
             ],
         );
         let (gx, gy) = groups_1d_as_2d(p.count.div_ceil(WG_1D).max(1));
-        run_compute(encoder, timer, "lcull_ranges", &self.ranges, &rbind, (gx, gy, 1));
+        run_compute(encoder, timer, names[0], &self.ranges, &rbind, (gx, gy, 1));
 
         if diagnostics {
             encoder.clear_buffer(&b.stats, 0, None);
@@ -297,7 +437,7 @@ impl LcullPass {
             "lcull_tiles::bind_group",
             &self.tiles_layout,
             &[
-                self.params.as_entire_binding(),
+                params.as_entire_binding(),
                 f.camera.as_entire_binding(),
                 tv(&g.position_view),
                 b.lights.as_entire_binding(),
@@ -312,14 +452,14 @@ impl LcullPass {
         } else {
             &self.tiles_timed
         };
-        run_compute(encoder, timer, "lcull_tiles", tiles, &tbind, (tx, ty, 1));
+        run_compute(encoder, timer, names[1], tiles, &tbind, (tx, ty, 1));
 
         let sbind = bind_group_seq(
             device,
             "lcull_shade::bind_group",
             &self.shade_layout,
             &[
-                self.params.as_entire_binding(),
+                params.as_entire_binding(),
                 f.camera.as_entire_binding(),
                 tv(&g.position_view),
                 tv(&g.normal_view),
@@ -342,7 +482,99 @@ impl LcullPass {
             &self.shade_timed
         };
         let groups = groups_image(p.width, p.height);
-        run_compute(encoder, timer, "lcull_shade", shade, &sbind, groups);
+        run_compute(encoder, timer, names[2], shade, &sbind, groups);
+        run_compute(encoder, timer, names[3], &self.filter, &sbind, groups);
+        if diagnostics {
+            let bytes = (STATS_WORDS * 4) as u64;
+            self.stats.record(encoder, &[(&b.stats, 0, 0, bytes)]);
+        }
+    }
+
+    /// Records the tree variant's frame (section 5; `lcull_tree.wgsl`): leaves and node
+    /// bounds, the per-pixel traversal, the one-ray shading, then the shared filter (`p`
+    /// carries the tree's filter radius).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_tree(
+        &mut self,
+        diagnostics: bool,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: GpuLcullParams,
+        f: &FrameInputs<'_>,
+        tree: &TreeInputs<'_>,
+        b: &LcullBuffers,
+        t: &TreeCullBuffers,
+    ) {
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let tv = wgpu::BindingResource::TextureView;
+        let g = f.gbuffer;
+        encoder.clear_buffer(&t.max_range, 0, None);
+        if diagnostics {
+            encoder.clear_buffer(&b.stats, 0, None);
+        }
+        let bind = bind_group_seq(
+            device,
+            "lcull_tree::bind_group",
+            &self.tree_layout,
+            &[
+                self.params.as_entire_binding(),
+                tv(&g.position_view),
+                tv(&g.normal_view),
+                f.scene.bvh_nodes.as_entire_binding(),
+                f.scene.bvh_triangles.as_entire_binding(),
+                tree.sorted_vpls.as_entire_binding(),
+                tree.nodes.as_entire_binding(),
+                t.lights.as_entire_binding(),
+                t.max_range.as_entire_binding(),
+                t.list.as_entire_binding(),
+                t.m.as_entire_binding(),
+                b.raw.as_entire_binding(),
+                b.diag.as_entire_binding(),
+                b.stats.as_entire_binding(),
+            ],
+        );
+        let (gx, gy) = groups_1d_as_2d(p.leaves.div_ceil(WG_1D).max(1));
+        run_compute(
+            encoder,
+            timer,
+            "lcull_tree_leaves",
+            &self.tree_leaves,
+            &bind,
+            (gx, gy, 1),
+        );
+        let groups = groups_image(p.width, p.height);
+        let (traverse, shade) = if diagnostics {
+            (&self.tree_traverse, &self.tree_shade)
+        } else {
+            (&self.tree_traverse_timed, &self.tree_shade_timed)
+        };
+        run_compute(encoder, timer, "lcull_tree_traverse", traverse, &bind, groups);
+        run_compute(encoder, timer, "lcull_tree_shade", shade, &bind, groups);
+        // The shared filter reads `raw` (its bind group's tiled buffers are not read).
+        let sbind = bind_group_seq(
+            device,
+            "lcull_shade::bind_group",
+            &self.shade_layout,
+            &[
+                self.params.as_entire_binding(),
+                f.camera.as_entire_binding(),
+                tv(&g.position_view),
+                tv(&g.normal_view),
+                tv(&g.albedo_view),
+                f.scene.bvh_nodes.as_entire_binding(),
+                f.scene.bvh_triangles.as_entire_binding(),
+                f.vpls.as_entire_binding(),
+                b.lights.as_entire_binding(),
+                b.tile_count.as_entire_binding(),
+                b.tile_lists.as_entire_binding(),
+                b.raw.as_entire_binding(),
+                b.diag.as_entire_binding(),
+                f.accum.as_entire_binding(),
+                b.stats.as_entire_binding(),
+            ],
+        );
         run_compute(encoder, timer, "lcull_filter", &self.filter, &sbind, groups);
         if diagnostics {
             let bytes = (STATS_WORDS * 4) as u64;
@@ -360,6 +592,7 @@ impl LcullPass {
         p: GpuLcullViewParams,
         final_image: &wgpu::TextureView,
         gb_position: &wgpu::TextureView,
+        own_accum: &wgpu::Buffer,
         b: &LcullBuffers,
         dst: &wgpu::TextureView,
     ) {
@@ -370,6 +603,15 @@ impl LcullPass {
             wgpu::BindingResource::TextureView(gb_position),
             b.diag.as_entire_binding(),
             wgpu::BindingResource::TextureView(dst),
+            own_accum.as_entire_binding(),
+            b.companion
+                .as_ref()
+                .map_or(&b.dummy[0], |c| &c.accum)
+                .as_entire_binding(),
+            b.companion
+                .as_ref()
+                .map_or(&b.dummy[1], |c| &c.difference)
+                .as_entire_binding(),
         ];
         let bind = bind_group_seq(device, "lcull_views::bind_group", &self.views_layout, &entries);
         run_compute(

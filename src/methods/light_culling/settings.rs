@@ -10,6 +10,8 @@ pub const MAX_INTERLEAVE: u32 = 16;
 pub const MAX_LIST: u32 = 1 << 16;
 /// Largest filter radius (a (2r + 1)^2 window).
 pub const MAX_FILTER_RADIUS: u32 = 16;
+/// Largest per-pixel light list of the tree variant (its reservoir's k).
+pub const MAX_RESERVOIR: u32 = 256;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -40,6 +42,13 @@ pub struct LightCullingSettings {
     /// ... and whose distance to the pixel's tangent plane is below this fraction of its view
     /// depth.
     pub filter_plane_tolerance: f32,
+    /// The bounding-sphere-tree variant (section 5, `light-culling-tree`): the per-pixel
+    /// light list's k, filled by reservoir sampling during the traversal (5.3.1, Algorithm
+    /// 3). Paper 32.
+    pub reservoir_k: u32,
+    /// The tree variant's geometry-aware filter radius (it has no interleaving to undo;
+    /// the paper's path tracer filters nothing: 0).
+    pub tree_filter_radius: u32,
 }
 
 impl Default for LightCullingSettings {
@@ -52,6 +61,8 @@ impl Default for LightCullingSettings {
             filter_radius: 8,
             filter_normal_cos: 0.9,
             filter_plane_tolerance: 0.02,
+            reservoir_k: 32,
+            tree_filter_radius: 0,
         }
     }
 }
@@ -99,6 +110,20 @@ impl LightCullingSettings {
                 "filter_plane_tolerance",
                 self.filter_plane_tolerance.to_string(),
                 "0..=1",
+            );
+        }
+        if !(1..=MAX_RESERVOIR).contains(&self.reservoir_k) {
+            return f(
+                "reservoir_k",
+                self.reservoir_k.to_string(),
+                &format!("1..={MAX_RESERVOIR}"),
+            );
+        }
+        if self.tree_filter_radius > MAX_FILTER_RADIUS {
+            return f(
+                "tree_filter_radius",
+                self.tree_filter_radius.to_string(),
+                &format!("0..={MAX_FILTER_RADIUS}"),
             );
         }
         Ok(())
@@ -169,6 +194,20 @@ mod tests {
                     ..ok.clone()
                 },
                 "filter_plane_tolerance",
+            ),
+            (
+                LightCullingSettings {
+                    reservoir_k: 0,
+                    ..ok.clone()
+                },
+                "reservoir_k",
+            ),
+            (
+                LightCullingSettings {
+                    tree_filter_radius: 17,
+                    ..ok.clone()
+                },
+                "tree_filter_radius",
             ),
         ];
         for (s, name) in cases {

@@ -1,10 +1,10 @@
 //! Stochastic Light Culling's settings in the GUI (shared by the clamped baseline).
 
-use super::settings::{LightCullingSettings, MAX_FILTER_RADIUS, MAX_INTERLEAVE, MAX_LIST};
+use super::settings::{LightCullingSettings, MAX_FILTER_RADIUS, MAX_INTERLEAVE, MAX_LIST, MAX_RESERVOIR};
 use crate::methods::MethodId;
 use crate::renderer::settings::RenderSettings;
 
-pub fn settings_ui(ui: &mut egui::Ui, _method: MethodId, s: &mut RenderSettings) {
+pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) {
     let id = super::ID;
     let mut lc: LightCullingSettings = match s.method(id) {
         Ok(v) => v,
@@ -14,6 +14,11 @@ pub fn settings_ui(ui: &mut egui::Ui, _method: MethodId, s: &mut RenderSettings)
         }
     };
     let before = lc.clone();
+    ui.checkbox(&mut s.sampling.accumulate, "accumulate frames while static")
+        .on_hover_text(
+            "average the frames' estimates while the view, lights and settings stay (the \
+             clamped-vs-stochastic view then compares converged means)",
+        );
     ui.add(
         egui::Slider::new(&mut lc.epsilon_max, 1e-5..=0.05)
             .logarithmic(true)
@@ -21,8 +26,21 @@ pub fn settings_ui(ui: &mut egui::Ui, _method: MethodId, s: &mut RenderSettings)
     )
     .on_hover_text(
         "largest standard deviation per VPL (stochastic; in the filtered image) or total \
-         darkening (clamped) in exposed display units (paper 0.0005); shared by both variants",
+         darkening (clamped) in exposed display units (paper 0.0005); shared by the variants",
     );
+    if method == super::TREE {
+        ui.add(egui::Slider::new(&mut lc.reservoir_k, 1..=MAX_RESERVOIR).text("light list k"))
+            .on_hover_text(
+                "per-pixel list filled by reservoir sampling during the tree traversal (paper 32); \
+                 one listed VPL is shaded by resampled importance sampling (one shadow ray)",
+            );
+        ui.add(egui::Slider::new(&mut lc.tree_filter_radius, 0..=MAX_FILTER_RADIUS).text("filter radius"))
+            .on_hover_text("geometry-aware filter window (2r+1)^2 (0 = off, as the paper's path tracer)");
+        if lc != before {
+            let _ = s.set_method(id, &lc);
+        }
+        return;
+    }
     ui.add(egui::Slider::new(&mut lc.interleave, 1..=MAX_INTERLEAVE).text("interleave n (n x n)"))
         .on_hover_text("each pixel of an n x n pattern takes 1/n^2 of the VPLs (paper 8; 1 = off)");
     ui.add(egui::Slider::new(&mut lc.filter_radius, 0..=MAX_FILTER_RADIUS).text("filter radius"))
