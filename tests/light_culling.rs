@@ -146,6 +146,36 @@ fn fixed_frame(
     (lc, s, st, vpls)
 }
 
+/// Accumulates the method's frames and checks that the mean converges to `gt` at
+/// 1 / sqrt(frames): 16x the frames (16 -> 256) cut the RMSE 4x (2.5x..6.5x allowed), and
+/// the mean ratio after 256 frames is within `ratio_tol` of 1. Returns the method's stats.
+fn converges(
+    st: &mut Setup,
+    gt: &lightcut::renderer::readback::ImageF32,
+    what: &str,
+    ratio_tol: f64,
+) -> Vec<(&'static str, f64)> {
+    st.set(|s| s.sampling.accumulate = true);
+    let mut errs = Vec::new();
+    for target in [16u32, 256] {
+        while st.r.sampling_frames() < target {
+            st.frame();
+        }
+        let m = metrics::compare(&st.indirect(), gt, 3.0, Tonemap::Aces);
+        errs.push((target, m.rmse, m.mean_ratio));
+    }
+    let stats = st.r.method_stats_blocking();
+    eprintln!("{what} vs unshadowed ground truth (frames, RMSE, mean ratio): {errs:?}; {stats:?}");
+    let ratio = errs[0].1 / errs[1].1;
+    assert!(ratio > 2.5 && ratio < 6.5, "{what}: RMSE ratio {ratio}");
+    assert!(
+        (errs[1].2 - 1.0).abs() < ratio_tol,
+        "{what}: mean ratio after 256 frames {}",
+        errs[1].2
+    );
+    stats
+}
+
 /// The GPU's ranges and fall-offs against the CPU's for `mode`; the finite ranges.
 fn check_ranges(
     s: &RenderSettings,
@@ -461,25 +491,7 @@ fn the_mean_over_frames_converges_to_the_unshadowed_ground_truth_and_clamping_da
     let mut st = Setup::new(&ctx, s, (W, H));
     st.frame();
     let gt = st.ground_truth_of_these_vpls();
-    st.set(|s| s.sampling.accumulate = true);
-    let mut errs = Vec::new();
-    for target in [16u32, 256] {
-        while st.r.sampling_frames() < target {
-            st.frame();
-        }
-        let m = metrics::compare(&st.indirect(), &gt, 3.0, Tonemap::Aces);
-        errs.push((target, m.rmse, m.mean_ratio));
-    }
-    let stats = st.r.method_stats_blocking();
-    eprintln!("stochastic vs unshadowed ground truth (frames, RMSE, mean ratio): {errs:?}; {stats:?}");
-    let ratio = errs[0].1 / errs[1].1;
-    // 16x the frames: the RMSE falls 4x; allow 2.5x..6.5x.
-    assert!(ratio > 2.5 && ratio < 6.5, "RMSE ratio {ratio}");
-    assert!(
-        (errs[1].2 - 1.0).abs() < 0.02,
-        "mean ratio after 256 frames {}",
-        errs[1].2
-    );
+    let stats = converges(&mut st, &gt, "stochastic", 0.02);
     // It culls: fewer VPLs in range per pixel than its subset holds.
     let in_range = stats
         .iter()
@@ -729,24 +741,7 @@ fn the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_trut
     });
     st.frame();
     let gt = st.ground_truth_of_these_vpls();
-    st.set(|s| s.sampling.accumulate = true);
-    let mut errs = Vec::new();
-    for target in [16u32, 256] {
-        while st.r.sampling_frames() < target {
-            st.frame();
-        }
-        let m = metrics::compare(&st.indirect(), &gt, 3.0, Tonemap::Aces);
-        errs.push((target, m.rmse, m.mean_ratio));
-    }
-    let stats = st.r.method_stats_blocking();
-    eprintln!("tree vs unshadowed ground truth (frames, RMSE, mean ratio): {errs:?}; {stats:?}");
-    let ratio = errs[0].1 / errs[1].1;
-    assert!(ratio > 2.5 && ratio < 6.5, "RMSE ratio {ratio}");
-    assert!(
-        (errs[1].2 - 1.0).abs() < 0.03,
-        "mean ratio after 256 frames {}",
-        errs[1].2
-    );
+    let stats = converges(&mut st, &gt, "tree", 0.03);
     let get = |name: &str| stats.iter().find(|(n, _)| *n == name).unwrap().1;
     assert!(get("shadow_rays_per_pixel") == 0.0);
     // The walk skips subtrees: well under the tree's 2 leaves - 1 nodes (0.47 on lavapipe).

@@ -153,7 +153,11 @@ fn blending_picks_cuts_by_their_weights_and_falls_back_to_the_mock_cut() {
         mock_expected > 0,
         "the default view has pixels without a similar cut (blinds)"
     );
-    // Slot 0's choice over many frames (new random numbers each frame).
+    // Slot 0's choice over many frames (new random numbers each frame). It is drawn before any
+    // sample is evaluated, so the frames skip their shadow rays and keep the frozen VPLs and
+    // tree (CI time; the cuts stay the same).
+    st.r.set_freeze_tree(true);
+    st.set(|s| s.gi.shadow_rays = false);
     let frames = 300;
     let mut counts: Vec<std::collections::HashMap<u32, u32>> = vec![Default::default(); watch.len()];
     for _ in 0..frames {
@@ -238,9 +242,10 @@ fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
     // relative RMSE 2.9 / 1.2 / 0.65 after 64 / 1024 / 4096 frames on this view.)
     // Every child probability (the thesis's, RTSLC's MinMax, the defensive mix) has the
     // support of the box term, so each converges.
-    // One ground truth for the three (the VPLs do not change between frames); 8 -> 128 frames.
+    // One ground truth for the three, of VPLs and a tree frozen for all the frames (they would
+    // not change: a fixed VPL seed; CI time); 8 -> 128 frames.
     let mut st = setup(&ctx, settings(RTSLC));
-    let gt = st.ground_truth();
+    let gt = st.ground_truth_of_these_vpls();
     for cp in ChildProbability::ALL {
         st.set(|s| {
             s.gi.method = RTSLC;

@@ -454,7 +454,32 @@ impl LcullPass {
         };
         run_compute(encoder, timer, names[1], tiles, &tbind, (tx, ty, 1));
 
-        let sbind = bind_group_seq(
+        let sbind = self.shade_bind_group(device, params, f, b);
+        let shade = if diagnostics {
+            &self.shade
+        } else {
+            &self.shade_timed
+        };
+        let groups = groups_image(p.width, p.height);
+        run_compute(encoder, timer, names[2], shade, &sbind, groups);
+        run_compute(encoder, timer, names[3], &self.filter, &sbind, groups);
+        if diagnostics {
+            let bytes = (STATS_WORDS * 4) as u64;
+            self.stats.record(encoder, &[(&b.stats, 0, 0, bytes)]);
+        }
+    }
+
+    /// The bind group of `lcull_shade.wgsl` (shading and the filter) with `params`.
+    fn shade_bind_group(
+        &self,
+        device: &wgpu::Device,
+        params: &wgpu::Buffer,
+        f: &FrameInputs<'_>,
+        b: &LcullBuffers,
+    ) -> wgpu::BindGroup {
+        let tv = wgpu::BindingResource::TextureView;
+        let g = f.gbuffer;
+        bind_group_seq(
             device,
             "lcull_shade::bind_group",
             &self.shade_layout,
@@ -475,19 +500,7 @@ impl LcullPass {
                 f.accum.as_entire_binding(),
                 b.stats.as_entire_binding(),
             ],
-        );
-        let shade = if diagnostics {
-            &self.shade
-        } else {
-            &self.shade_timed
-        };
-        let groups = groups_image(p.width, p.height);
-        run_compute(encoder, timer, names[2], shade, &sbind, groups);
-        run_compute(encoder, timer, names[3], &self.filter, &sbind, groups);
-        if diagnostics {
-            let bytes = (STATS_WORDS * 4) as u64;
-            self.stats.record(encoder, &[(&b.stats, 0, 0, bytes)]);
-        }
+        )
     }
 
     /// Records the tree variant's frame (section 5; `lcull_tree.wgsl`): leaves and node
@@ -553,28 +566,7 @@ impl LcullPass {
         run_compute(encoder, timer, "lcull_tree_traverse", traverse, &bind, groups);
         run_compute(encoder, timer, "lcull_tree_shade", shade, &bind, groups);
         // The shared filter reads `raw` (its bind group's tiled buffers are not read).
-        let sbind = bind_group_seq(
-            device,
-            "lcull_shade::bind_group",
-            &self.shade_layout,
-            &[
-                self.params.as_entire_binding(),
-                f.camera.as_entire_binding(),
-                tv(&g.position_view),
-                tv(&g.normal_view),
-                tv(&g.albedo_view),
-                f.scene.bvh_nodes.as_entire_binding(),
-                f.scene.bvh_triangles.as_entire_binding(),
-                f.vpls.as_entire_binding(),
-                b.lights.as_entire_binding(),
-                b.tile_count.as_entire_binding(),
-                b.tile_lists.as_entire_binding(),
-                b.raw.as_entire_binding(),
-                b.diag.as_entire_binding(),
-                f.accum.as_entire_binding(),
-                b.stats.as_entire_binding(),
-            ],
-        );
+        let sbind = self.shade_bind_group(device, &self.params, f, b);
         run_compute(encoder, timer, "lcull_filter", &self.filter, &sbind, groups);
         if diagnostics {
             let bytes = (STATS_WORDS * 4) as u64;
