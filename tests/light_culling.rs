@@ -96,6 +96,27 @@ fn shade_vpls(vpls: &[GpuVpl]) -> Vec<ShadeVpl> {
         .collect()
 }
 
+/// The CPU shadow ray from surface point p (normal nx) to VPL i, both ends offset `off`.
+fn visible<'a>(
+    bvh: &'a Bvh,
+    sv: &'a [ShadeVpl],
+    p: Vec3,
+    nx: Vec3,
+    off: f32,
+) -> impl FnMut(u32) -> bool + 'a {
+    move |i| {
+        let v = sv[i as usize];
+        let o = p + nx * off;
+        let e = v.position + v.normal * off;
+        !bvh.any_hit(&Ray {
+            origin: o,
+            dir: e - o,
+            tmin: 1e-4,
+            tmax: 1.0 - 1e-4,
+        })
+    }
+}
+
 fn flux_max(v: &GpuVpl) -> f32 {
     if v.id == VPL_NONE {
         0.0
@@ -401,17 +422,16 @@ fn gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing()
             surf.push(Some((p, nx)));
             let t = grid.tile_of(x, y) as usize;
             let list = &lists[t * cap..t * cap + count[t] as usize];
-            let cpu = shade(p, nx, list, &sv, &gl, il, s.gi.distance_epsilon, |i| {
-                let v = sv[i as usize];
-                let o = p + nx * off;
-                let e = v.position + v.normal * off;
-                !bvh.any_hit(&Ray {
-                    origin: o,
-                    dir: e - o,
-                    tmin: 1e-4,
-                    tmax: 1.0 - 1e-4,
-                })
-            });
+            let cpu = shade(
+                p,
+                nx,
+                list,
+                &sv,
+                &gl,
+                il,
+                s.gi.distance_epsilon,
+                visible(&bvh, &sv, p, nx, off),
+            );
             let gpu = Vec3::from_slice(&raw[k][..3]);
             if cpu.max_element() > 1e-6 {
                 lit += 1;
@@ -686,17 +706,18 @@ fn the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_trut
             // The shading from the GPU's list, with the same resampling number.
             let nx = Vec3::from_slice(&nrm.pixels[p][..3]).normalize();
             let u = u01(pcg_hash(tree_rng(seed, p as u32, TREE_STREAM_RIS)));
-            let (want, _) = tree_shade(xp, nx, gpu_list, m, k, &sv, &gl, eps, u, |i| {
-                let v = sv[i as usize];
-                let o = xp + nx * off;
-                let e = v.position + v.normal * off;
-                !bvh.any_hit(&Ray {
-                    origin: o,
-                    dir: e - o,
-                    tmin: 1e-4,
-                    tmax: 1.0 - 1e-4,
-                })
-            });
+            let (want, _) = tree_shade(
+                xp,
+                nx,
+                gpu_list,
+                m,
+                k,
+                &sv,
+                &gl,
+                eps,
+                u,
+                visible(&bvh, &sv, xp, nx, off),
+            );
             let got = Vec3::from_slice(&raw[p][..3]);
             if want.max_element() > 1e-6 {
                 lit += 1;
