@@ -13,13 +13,16 @@ use common::Setup;
 use glam::Vec3;
 use lightcut::{
     base::gpu_layout::{GpuVpl, VPL_NONE},
-    methods::light_culling::{self, LightCulling, settings::LightCullingSettings},
+    methods::light_culling::{
+        self, LightCulling,
+        settings::{InterleaveSettings, LightCullingSettings},
+    },
     methods::overlay::Prim,
     metrics,
+    reference::interleave::filter_pixel,
     reference::light_culling::{
         Interleave, LightRange, RangeMode, RangeParams, ShadeVpl, TREE_STREAM_RESERVOIR, TREE_STREAM_RIS,
-        TileCamera, filter_pixel, light_range, shade, tile_lists, tree_max_ranges, tree_rng, tree_shade,
-        tree_traverse,
+        TileCamera, light_range, shade, tile_lists, tree_max_ranges, tree_rng, tree_shade, tree_traverse,
     },
     reference::vpl::{pcg_hash, u01},
     renderer::{
@@ -48,8 +51,7 @@ fn small(epsilon_max: f32) -> LightCullingSettings {
     LightCullingSettings {
         epsilon_max,
         tile_size: 4,
-        interleave: 2,
-        filter_radius: 2,
+        interleave: InterleaveSettings::pattern(2),
         ..Default::default()
     }
 }
@@ -257,7 +259,7 @@ fn gpu_ranges_and_tile_lists_equal_the_cpu_reference() {
     // contained in the CPU's with every range 1e-4 larger (float rounding at the boundary).
     let cam = TileCamera::new(&st.cam, W, H);
     let grid = LightCulling::grid(&lc, (W, H));
-    let il = Interleave::new(lc.interleave, n as u32, LightCulling::seed(&s, 0));
+    let il = Interleave::new(lc.interleave.n, n as u32, LightCulling::seed(&s, 0));
     let pos = positions(&st);
     let inner = tile_lists(&cam, grid, il, &pos, &scaled(&gl, 1.0 - 1e-4));
     let outer = tile_lists(&cam, grid, il, &pos, &scaled(&gl, 1.0 + 1e-4));
@@ -394,7 +396,7 @@ fn gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing()
     let gl = gpu_lights(&st, n);
     let cam = TileCamera::new(&st.cam, W, H);
     let grid = LightCulling::grid(&lc, (W, H));
-    let il = Interleave::new(lc.interleave, n as u32, LightCulling::seed(&s, 0));
+    let il = Interleave::new(lc.interleave.n, n as u32, LightCulling::seed(&s, 0));
     let b = lc_of(&st).buffers();
     let count = gpu_u32(&st, &b.tile_count);
     let lists = gpu_u32(&st, &b.tile_lists);
@@ -455,10 +457,11 @@ fn gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing()
                 y,
                 W,
                 H,
-                lc.filter_radius,
-                lc.filter_normal_cos,
-                lc.filter_plane_tolerance,
-                &cam,
+                lc.interleave.filter_radius,
+                lc.interleave.filter_normal_cos,
+                lc.interleave.filter_plane_tolerance,
+                cam.eye,
+                cam.forward,
                 &surf,
                 &raw3,
             );
@@ -502,10 +505,8 @@ fn the_mean_over_frames_converges_to_the_unshadowed_ground_truth_and_clamping_da
     let Some(ctx) = common::gpu() else { return };
     // No visibility (the paper's figures 1 and 4): the truth is the unshadowed sum over the
     // VPLs. Interleaving on (its per-frame offset keeps the estimate unbiased), no filter.
-    let lc = LightCullingSettings {
-        filter_radius: 0,
-        ..small(0.01)
-    };
+    let mut lc = small(0.01);
+    lc.interleave.filter_radius = 0;
     let mut s = settings(lc);
     s.gi.shadow_rays = false;
     let mut st = Setup::new(&ctx, s, (W, H));
@@ -527,7 +528,7 @@ fn the_mean_over_frames_converges_to_the_unshadowed_ground_truth_and_clamping_da
         s.gi.method = light_culling::CLAMPED;
         s.sampling.accumulate = false;
         let mut l: LightCullingSettings = s.method(light_culling::ID).unwrap();
-        l.interleave = 1;
+        l.interleave.n = 1;
         s.set_method(light_culling::ID, &l).unwrap();
     });
     let mut darkening = Vec::new();

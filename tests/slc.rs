@@ -18,7 +18,7 @@ use lightcut::{
         Buffer, FrameInput,
         context::GpuContext,
         readback::{ImageF32, read_storage_buffer},
-        settings::{ChildProbability, MethodId, RenderSettings, ViewBuffer},
+        settings::{ChildProbability, InterleaveSettings, MethodId, RenderSettings, ViewBuffer},
     },
 };
 
@@ -243,15 +243,25 @@ fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
     // Every child probability (the thesis's, RTSLC's MinMax, the defensive mix) has the
     // support of the box term, so each converges.
     // One ground truth for the three, of VPLs and a tree frozen for all the frames (they would
-    // not change: a fixed VPL seed; CI time); 8 -> 128 frames.
+    // not change: a fixed VPL seed; CI time); 8 -> 128 frames. Then the defensive mix with
+    // 2 x 2 interleaved slots and no filter: each pixel takes a quarter of its cut's slots
+    // (x 4), a random quarter each frame, so it converges too.
     let mut st = setup(&ctx, settings(RTSLC));
     let gt = st.ground_truth_of_these_vpls();
-    for cp in ChildProbability::ALL {
+    let cases = ChildProbability::ALL
+        .map(|cp| (cp, 1))
+        .into_iter()
+        .chain([(ChildProbability::Defensive, 2)]);
+    for (cp, n) in cases {
         st.set(|s| {
             s.gi.method = RTSLC;
             s.sampling.block_size = 1;
             s.sampling.accumulate = true;
             s.sampling.child_probability = cp;
+            s.sampling.interleave = InterleaveSettings {
+                filter_radius: 0,
+                ..InterleaveSettings::pattern(n)
+            };
         });
         // The first frame of the new setting restarts the average.
         st.frame();
@@ -268,7 +278,7 @@ fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
             errs.push((target, m.rmse, block_error(&img, &gt), m.mean_ratio));
         }
         eprintln!(
-            "RTSLC ({cp:?}) vs ground truth (frames, RMSE, block error, mean ratio): {errs:?} ({done} frames)"
+            "RTSLC ({cp:?}, {n} x {n} interleaving) vs ground truth (frames, RMSE, block error, mean ratio): {errs:?} ({done} frames)"
         );
         let (_, r8, b8, _) = errs[0];
         let (_, r128, b128, m128) = errs[2];
@@ -395,6 +405,158 @@ fn the_comparison_ground_truth_equals_the_ground_truth_method() {
     // The sampler's own image is a different (noisy) estimate of the same thing.
     let mm = metrics::compare(&method, &gt, 0.0, lightcut::renderer::settings::Tonemap::Aces);
     assert!(mm.mean_ratio > 0.5 && mm.mean_ratio < 1.5, "{mm:?}");
+    assert!(ctx.errors.take().is_empty());
+}
+
+/// The surfaces (position, unit normal) of a G-buffer's pixels.
+fn surfaces(pos: &ImageF32, nrm: &ImageF32) -> Vec<Option<(Vec3, Vec3)>> {
+    pos.pixels
+        .iter()
+        .zip(&nrm.pixels)
+        .map(|(p, n)| (p[3] > 0.0).then(|| (v3(*p), v3(*n).normalize())))
+        .collect()
+}
+
+/// The largest relative difference between `got` and the CPU filter of `raw` (x `albedo`
+/// where given) over a `size` image.
+fn filter_error(
+    st: &Setup,
+    size: (u32, u32),
+    surf: &[Option<(Vec3, Vec3)>],
+    raw: &[Vec3],
+    albedo: Option<&ImageF32>,
+    got: impl Fn(u32, u32) -> Vec3,
+) -> f32 {
+    use lightcut::reference::{interleave::filter_pixel, light_culling::TileCamera};
+    let cam = TileCamera::new(&st.cam, W, H);
+    let il = &st.r.settings().sampling.interleave;
+    let mut worst = 0.0f32;
+    for y in 0..size.1 {
+        for x in 0..size.0 {
+            let f = filter_pixel(
+                x,
+                y,
+                size.0,
+                size.1,
+                il.filter_radius,
+                il.filter_normal_cos,
+                il.filter_plane_tolerance,
+                cam.eye,
+                cam.forward,
+                surf,
+                raw,
+            );
+            let want = albedo.map_or(f, |a| f * v3(a.get(x, y)));
+            worst = worst.max((got(x, y) - want).abs().max_element() / want.max_element().max(1e-4));
+        }
+    }
+    worst
+}
+
+#[test]
+fn interleaved_sampling_shares_the_cut_slots_out_and_its_filter_equals_the_cpu_reference() {
+    use lightcut::methods::tree_samplers::TreeSamplers;
+    use lightcut::reference::interleave::slot_subset;
+    let Some(ctx) = common::gpu() else { return };
+    let n = 2u32;
+    let read_raw = |st: &Setup| -> Vec<Vec3> {
+        let m = st.r.method_module::<TreeSamplers>().expect("registered");
+        let raw = m.interleaved_raw().expect("interleaving on: a raw estimate");
+        let px: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, raw).unwrap());
+        px.into_iter().map(v3).collect()
+    };
+    // SLC at full resolution, then SST at half resolution (whose samples each estimate the
+    // whole sum: the pixel averages its share; the filter leaves the albedo to the upsampler).
+    for (method, half) in [(SLC, false), (SST, true)] {
+        let mut s = settings(method);
+        s.sampling.fixed_seed = true;
+        s.sampling.half_resolution = half;
+        // Visibility is not what this checks (and without it most samples light the pixel).
+        s.gi.shadow_rays = false;
+        s.sampling.interleave = InterleaveSettings {
+            filter_radius: 1,
+            ..InterleaveSettings::pattern(n)
+        };
+        let cut_size = s.sampling.cut_size;
+        let seed = s.vpl.seed;
+        let mut st = setup(&ctx, s);
+        st.frame();
+        let gi = if half { (W / 2, H / 2) } else { (W, H) };
+        // Two 2 x 2 blocks of the pattern (GI pixels): each pixel's samples are its subset's
+        // slots (the CPU's rule for this frame's offset), the four share the cut's slots out
+        // exactly once, and the pixel's raw estimate is its story's (demodulated).
+        let mut lit = 0;
+        // The two pattern blocks with the most lit pixels (the seed is fixed: the traced
+        // frames repeat this one).
+        let raw0 = read_raw(&st);
+        let lit_in = |(qx, qy): (u32, u32)| {
+            (0..n * n)
+                .filter(|k| raw0[((qy + k / n) * gi.0 + qx + k % n) as usize].max_element() > 0.0)
+                .count()
+        };
+        let mut quads: Vec<(u32, u32)> = (0..gi.1 / n)
+            .flat_map(|by| (0..gi.0 / n).map(move |bx| (bx * n, by * n)))
+            .collect();
+        quads.sort_by_key(|&q| std::cmp::Reverse(lit_in(q)));
+        quads.truncate(2);
+        assert_eq!(quads.len(), 2);
+        for (qx, qy) in quads {
+            let mut seen = vec![0u32; cut_size as usize];
+            for (x, y) in [(qx, qy), (qx + 1, qy), (qx, qy + 1), (qx + 1, qy + 1)] {
+                let scale = if half { 2 } else { 1 };
+                st.r.set_trace_pixel(Some((x * scale, y * scale)));
+                st.frame();
+                let t = st.r.read_pixel_trace().unwrap();
+                let Some(t) = t else {
+                    panic!("{method:?} half {half}: no trace at GI pixel ({x}, {y})");
+                };
+                assert_eq!((t.cells, t.subset), (n * n, x % n + n * (y % n)));
+                let slots: Vec<u32> = t.samples.iter().map(|s| s.cut_slot).collect();
+                assert_eq!(
+                    slots,
+                    slot_subset(n, seed, cut_size, x, y, t.mode == 2),
+                    "{method:?} ({x}, {y})"
+                );
+                assert_eq!(t.taken as usize, slots.len());
+                for i in slots {
+                    seen[i as usize] += 1;
+                }
+                let raw = read_raw(&st)[(y * gi.0 + x) as usize];
+                let want = t.estimate() / std::f32::consts::PI;
+                lit += (want.max_element() > 0.0) as u32;
+                assert!(
+                    (raw - want).abs().max_element() <= 1e-4 * want.max_element().max(1e-6),
+                    "{method:?} ({x}, {y}): raw {raw} vs the story's {want}"
+                );
+            }
+            assert!(
+                seen.iter().all(|&c| c == 1),
+                "{method:?} quad ({qx}, {qy}): {seen:?}"
+            );
+        }
+        assert!(lit >= 6, "{method:?}: {lit} of the 8 traced pixels lit");
+        // The filter of the raw estimates (CPU twin), at every GI pixel: x albedo into the GI,
+        // or demodulated into the half-resolution accumulation.
+        let raw = read_raw(&st);
+        let worst = if half {
+            let (hpos, hnrm, hacc) = st.r.read_half_resolution().unwrap().expect("half resolution on");
+            filter_error(&st, gi, &surfaces(&hpos, &hnrm), &raw, None, |x, y| {
+                v3(hacc[(y * gi.0 + x) as usize])
+            })
+        } else {
+            let pos = st.r.read(Buffer::Position).unwrap();
+            let nrm = st.r.read(Buffer::Normal).unwrap();
+            let alb = st.r.read(Buffer::Albedo).unwrap();
+            let ind = st.indirect();
+            filter_error(&st, gi, &surfaces(&pos, &nrm), &raw, Some(&alb), |x, y| {
+                v3(ind.get(x, y))
+            })
+        };
+        assert!(
+            worst < 1e-4,
+            "{method:?}: filter's worst relative difference {worst}"
+        );
+    }
     assert!(ctx.errors.take().is_empty());
 }
 
@@ -532,7 +694,7 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
             let b = st.r.slc_buffers();
             let cuts: Vec<u32> = bytemuck::cast_slice(&read_storage_buffer(&ctx, &b.cuts).unwrap()).to_vec();
             let (p, n) = (v3(pos.get(x, y)), v3(nrm.get(x, y)).normalize());
-            assert_eq!(trace.cut_size, cut_size);
+            assert_eq!((trace.taken, trace.cells), (cut_size, 1));
             assert_eq!(trace.samples.len(), cut_size as usize);
             if method == SLC && trace.mode == 0 {
                 let cpu = bilinear_blocks(x, y, b.block, b.grid);
@@ -543,6 +705,10 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
             let mut sum = Vec3::ZERO;
             for (i, smp) in trace.samples.iter().enumerate() {
                 sum += smp.contribution;
+                assert_eq!(
+                    smp.cut_slot, i as u32,
+                    "without interleaving, every slot in order"
+                );
                 match method {
                     SST => assert_eq!(smp.start, 1, "SST starts at the root"),
                     _ if trace.mode == 0 => {
@@ -622,6 +788,12 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
             if trace.mode == 2 {
                 want /= cut_size as f32;
             }
+            assert!(
+                (trace.estimate() * a / std::f32::consts::PI - want)
+                    .abs()
+                    .max_element()
+                    <= 1e-6 * want.max_element().max(1e-6)
+            );
             let got = v3(st.indirect().get(x, y));
             assert!(
                 (got - want).abs().max_element() <= 1e-4 * got.max_element().max(1e-6),

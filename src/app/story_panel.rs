@@ -277,18 +277,27 @@ impl StoryPanel {
             }
         }
         ui.separator();
-        let sum: Vec3 = t.samples.iter().map(|s| s.contribution).sum();
-        let mut est = self.albedo / std::f32::consts::PI * sum;
-        if t.mode == 2 {
-            est /= t.cut_size.max(1) as f32;
+        let est = self.albedo / std::f32::consts::PI * t.estimate();
+        if t.cells > 1 {
+            ui.label(format!(
+                "interleaved: subset {} of {} (the cut slots i with (i + the frame's offset) mod {} = {}){}",
+                t.subset,
+                t.cells,
+                t.cells,
+                t.subset,
+                if t.mode == 2 { "" } else { "; each sample x n^2" },
+            ));
+        }
+        if t.filtered {
+            ui.label("the GI buffer holds the geometry-aware filter's mean over the pixel's neighbours on its surface");
         }
         ui.label(format!(
-            "{} samples; their estimate rho/pi x sum = {:.4e} (luminance); the GI buffer holds {:.4e}{}",
+            "{} samples; their estimate = {:.4e} (luminance); the GI buffer holds {:.4e}{}",
             t.samples.len(),
             luminance(est),
             luminance(self.gi),
-            if t.cut_size as usize > t.samples.len() {
-                format!(" (story of the first {} of {})", t.samples.len(), t.cut_size)
+            if t.taken as usize > t.samples.len() {
+                format!(" (story of the first {} of {})", t.samples.len(), t.taken)
             } else {
                 String::new()
             }
@@ -304,7 +313,7 @@ impl StoryPanel {
                     .striped(true)
                     .show(ui, |ui| {
                         for h in [
-                            "#",
+                            "slot",
                             "from",
                             "start (level)",
                             "end (level)",
@@ -319,7 +328,7 @@ impl StoryPanel {
                         ui.end_row();
                         for (i, s) in t.samples.iter().enumerate() {
                             let sel = self.selected == Some(i);
-                            if ui.selectable_label(sel, i.to_string()).clicked() {
+                            if ui.selectable_label(sel, s.cut_slot.to_string()).clicked() {
                                 self.selected = if sel { None } else { Some(i) };
                             }
                             ui.label(match s.slot {
@@ -361,7 +370,7 @@ impl StoryPanel {
             && let Some(s) = t.samples.get(i)
         {
             ui.separator();
-            ui.strong(format!("Sample {i}: path from node {}", s.start));
+            ui.strong(format!("Slot {}: path from node {}", s.cut_slot, s.start));
             if let Some((p, _)) = s.point {
                 ui.label(format!("sampled point ({:.3}, {:.3}, {:.3}) m", p.x, p.y, p.z));
             }

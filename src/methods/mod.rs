@@ -15,6 +15,7 @@
 
 pub mod direct_only;
 pub mod ground_truth;
+pub mod interleave;
 pub mod light_culling;
 pub mod lightcut_interpolation;
 pub mod lightcuts;

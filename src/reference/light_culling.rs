@@ -12,6 +12,7 @@
 
 use glam::{UVec2, Vec3};
 
+pub use super::interleave::{Interleave, filter_pixel};
 use super::vpl::{pcg_hash, u01};
 
 /// Largest range we store (a VPL whose xi is 0 lights everything).
@@ -135,73 +136,6 @@ pub fn light_range(p: &RangeParams, i: u32, position: Vec3, flux_max: f32) -> Li
         position,
         range: falloff.range(p.eps),
         falloff,
-    }
-}
-
-/// Interleaved sampling (section 4.2): an n x n pattern, pixel (x, y) takes subset
-/// (x mod n) + n (y mod n). VPL i belongs to subset ((i / stride) mod n^2 + offset) mod n^2:
-/// runs of `stride` consecutive VPLs share a subset. Our VPLs come in Hammersley order (the
-/// warp's first coordinate i / N, the second the bit-reversed i), so with a stride near
-/// sqrt(N / n^2) (a power of two) each subset is a stratified sample of the whole RSM (of one
-/// light's: with several lights, each light's VPL range need not start on a block boundary
-/// and the stratification weakens; the subsets still partition the VPLs); a stride of 1 would
-/// give each subset one strip of it (the low bits of i fix the top bits of the second
-/// coordinate). `offset` is drawn per frame, so that every pixel sees every VPL with
-/// probability 1 / n^2 over frames.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Interleave {
-    pub n: u32,
-    pub offset: u32,
-    pub stride: u32,
-}
-
-impl Interleave {
-    /// The frame's interleaving for `count` VPLs and seed `seed`.
-    pub fn new(n: u32, count: u32, seed: u32) -> Self {
-        Self {
-            n,
-            offset: Self::offset_of(n, seed),
-            stride: Self::stride_for(count, n),
-        }
-    }
-    pub fn cells(self) -> u32 {
-        self.n * self.n
-    }
-    pub fn pixel_subset(self, x: u32, y: u32) -> u32 {
-        x % self.n + self.n * (y % self.n)
-    }
-    pub fn vpl_subset(self, i: u32) -> u32 {
-        let c = self.cells();
-        ((i / self.stride) % c + self.offset % c) % c
-    }
-    /// The k-th VPL of subset `s` (increasing in k). Twin: `lcull_member`.
-    pub fn member(self, s: u32, k: u32) -> u32 {
-        let c = self.cells();
-        let j = (s + c - self.offset % c) % c;
-        (k / self.stride) * self.stride * c + j * self.stride + k % self.stride
-    }
-    /// How many of `count` VPLs subset `s` holds. Twin: `lcull_members`.
-    pub fn members(self, s: u32, count: u32) -> u32 {
-        let c = self.cells();
-        let j = (s + c - self.offset % c) % c;
-        let block = self.stride * c;
-        let full = count / block;
-        let rem = count - full * block;
-        full * self.stride + rem.saturating_sub(j * self.stride).min(self.stride)
-    }
-    /// The VPLs of subset `s`, in increasing order.
-    pub fn subset(self, s: u32, count: u32) -> impl Iterator<Item = u32> {
-        (0..self.members(s, count)).map(move |k| self.member(s, k))
-    }
-    /// The frame's offset (the uniforms carry it to the kernels).
-    pub fn offset_of(n: u32, seed: u32) -> u32 {
-        pcg_hash(seed ^ 0x2545_f491) % (n * n).max(1)
-    }
-    /// The largest power of two at most sqrt(count / n^2) (at least 1).
-    pub fn stride_for(count: u32, n: u32) -> u32 {
-        let per = (count / (n * n).max(1)).max(1) as f64;
-        let s = per.sqrt().floor().max(1.0) as u32;
-        1 << (31 - s.leading_zeros())
     }
 }
 
@@ -421,45 +355,6 @@ pub fn shade(
         sum += v.flux / pi * (cx * cv * f);
     }
     sum * il.cells() as f32
-}
-
-/// The geometry-aware filter of interleaved sampling (section 4.2; Segovia et al. 2006): the
-/// mean of the demodulated estimates in a (2 radius + 1)^2 window over the pixels on the same
-/// surface: normals within `normal_cos` and the neighbour within `plane_tolerance` x view depth
-/// of the pixel's tangent plane. Twin: `filter_main` in `lcull_shade.wgsl`.
-#[allow(clippy::too_many_arguments)]
-pub fn filter_pixel(
-    x: u32,
-    y: u32,
-    width: u32,
-    height: u32,
-    radius: u32,
-    normal_cos: f32,
-    plane_tolerance: f32,
-    cam: &TileCamera,
-    surf: &[Option<(Vec3, Vec3)>],
-    raw: &[Vec3],
-) -> Vec3 {
-    let k = (y * width + x) as usize;
-    let Some((p, n)) = surf[k] else { return Vec3::ZERO };
-    let tol = plane_tolerance * view_depth(cam, p).max(1e-6);
-    let r = radius as i32;
-    let (mut sum, mut w) = (Vec3::ZERO, 0.0f32);
-    for dy in -r..=r {
-        for dx in -r..=r {
-            let (qx, qy) = (x as i32 + dx, y as i32 + dy);
-            if qx < 0 || qy < 0 || qx >= width as i32 || qy >= height as i32 {
-                continue;
-            }
-            let q = (qy as u32 * width + qx as u32) as usize;
-            let Some((pq, nq)) = surf[q] else { continue };
-            if n.dot(nq) >= normal_cos && (pq - p).dot(n).abs() <= tol {
-                sum += raw[q];
-                w += 1.0;
-            }
-        }
-    }
-    sum / w.max(1.0)
 }
 
 /// The tree variant's random streams (section 5; twin: `tree_rng` in `lcull_tree.wgsl`):

@@ -16,6 +16,7 @@
 pub mod direct;
 pub mod gbuffer;
 pub mod gi;
+pub mod interleave;
 pub mod light_culling;
 pub mod lightcut_interpolation;
 pub mod lightcuts;

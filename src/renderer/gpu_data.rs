@@ -278,7 +278,8 @@ pub struct GpuSlcParams {
     pub ray_offset: f32,
     pub n_min: f32,
     pub d_max: f32,
-    /// 1: the estimate without the albedo (half-resolution GI, upsampled at full resolution).
+    /// 1: the estimate without the albedo (half-resolution GI, upsampled at full resolution;
+    /// interleaving, whose filter applies it).
     pub demodulate: u32,
     /// x | y << 16 of the pixel whose samples are recorded (`methods::tree_samplers::pass::PixelTrace`);
     /// `u32::MAX` = none.
@@ -292,6 +293,11 @@ pub struct GpuSlcParams {
     pub substitute_offset: f32,
     /// 0 mean position (eq. 5.5), 1 min-max box distance, 2 defensive (`ChildProbability`).
     pub child_probability: u32,
+    /// Interleaving pattern edge n (1 = off) and the frame's subset offset
+    /// (`reference::interleave::Interleave::offset_of`).
+    pub interleave: u32,
+    pub interleave_offset: u32,
+    pub _pad: [u32; 2],
 }
 
 /// Twin: `GtParams` in `shaders/methods/ground_truth/ground_truth.wgsl`.
@@ -592,13 +598,27 @@ mod tests {
                         offset_of!(P, eps),
                         offset_of!(P, ray_offset),
                         offset_of!(P, shadow_rays),
-                        offset_of!(P, accumulate),
-                        offset_of!(P, filter_radius),
-                        offset_of!(P, trace_pixel),
-                        offset_of!(P, filter_normal_cos),
-                        offset_of!(P, filter_plane_tolerance),
                         offset_of!(P, stride),
                         offset_of!(P, leaves),
+                        offset_of!(P, _pad),
+                    ]
+                },
+            ),
+            (
+                "interleave_filter.wgsl",
+                "FilterParams",
+                size_of::<crate::renderer::passes::interleave_filter::GpuFilterParams>(),
+                {
+                    use crate::renderer::passes::interleave_filter::GpuFilterParams as P;
+                    vec![
+                        offset_of!(P, width),
+                        offset_of!(P, height),
+                        offset_of!(P, radius),
+                        offset_of!(P, accumulate),
+                        offset_of!(P, normal_cos),
+                        offset_of!(P, plane_tolerance),
+                        offset_of!(P, scale),
+                        offset_of!(P, modulate),
                     ]
                 },
             ),
@@ -668,6 +688,10 @@ mod tests {
                     offset_of!(GpuSlcParams, shadow_rays),
                     offset_of!(GpuSlcParams, substitute_offset),
                     offset_of!(GpuSlcParams, child_probability),
+                    offset_of!(GpuSlcParams, interleave),
+                    offset_of!(GpuSlcParams, interleave_offset),
+                    offset_of!(GpuSlcParams, _pad),
+                    offset_of!(GpuSlcParams, _pad) + 4,
                 ],
             ),
             (

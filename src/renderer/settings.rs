@@ -368,6 +368,105 @@ pub struct TextureSettings {
     pub anisotropy: u16,
 }
 
+/// Interleaved sampling and its geometry-aware filter (Stochastic Light Culling, section 4.2,
+/// after Keller & Heidrich 2001 and Segovia et al. 2006): a method's table holds one
+/// (`[methods.light-culling.interleave]`, `[sampling.interleave]`), the shared pass
+/// `renderer::passes::interleave_filter` undoes the pattern. `D` names the method's default
+/// pattern (light culling 8 x 8, the tree samplers off): a table that sets only some fields
+/// keeps the method's defaults for the others.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields, bound = "")]
+pub struct InterleaveSettings<D: PatternDefault = InterleaveOff> {
+    /// The n x n pattern: each pixel of it takes a disjoint 1 / n^2 of the method's lights
+    /// (light culling: VPLs; the tree samplers: cut slots) scaled by n^2, the subsets shifted
+    /// by a random offset each frame. 1 = off.
+    pub n: u32,
+    /// Radius r of the filter's (2r + 1)^2 window (the paper: 8 x 8 interleaving, 17 x 17
+    /// filter, r = 8); 0 = no filter (each pixel keeps its own subset's estimate: the pattern
+    /// shows).
+    pub filter_radius: u32,
+    /// The filter averages neighbours whose normal is within this cosine of the pixel's ...
+    pub filter_normal_cos: f32,
+    /// ... and whose distance to the pixel's tangent plane is below this fraction of its view
+    /// depth.
+    pub filter_plane_tolerance: f32,
+    #[serde(skip)]
+    pub _default: std::marker::PhantomData<D>,
+}
+
+/// A method's default interleaving pattern edge (a marker type per default: serde cannot
+/// derive for const generics).
+pub trait PatternDefault: Clone + std::fmt::Debug + PartialEq {
+    const N: u32;
+}
+
+/// No interleaving by default (the tree samplers: the thesis).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InterleaveOff;
+impl PatternDefault for InterleaveOff {
+    const N: u32 = 1;
+}
+
+/// 8 x 8 by default (Stochastic Light Culling's real-time results).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interleave8;
+impl PatternDefault for Interleave8 {
+    const N: u32 = 8;
+}
+
+/// Largest filter radius (a (2r + 1)^2 window).
+pub const MAX_FILTER_RADIUS: u32 = 16;
+
+impl<D: PatternDefault> InterleaveSettings<D> {
+    /// The pattern of edge n with the paper's filter (r = n; none for n = 1).
+    pub fn pattern(n: u32) -> Self {
+        Self {
+            n,
+            filter_radius: if n > 1 { n } else { 0 },
+            filter_normal_cos: 0.9,
+            filter_plane_tolerance: 0.02,
+            _default: std::marker::PhantomData,
+        }
+    }
+    /// Whether the filter pass runs: a pattern to undo or a filter asked for.
+    pub fn filters(&self) -> bool {
+        self.n > 1 || self.filter_radius > 0
+    }
+    /// Every field in range (n at most `max_n`), or a message naming it under `table`.
+    pub fn validate(&self, table: &str, max_n: u32) -> Result<(), String> {
+        let f = |name: &str, v: String, range: &str| {
+            Err(format!("{table}.interleave.{name} {v} is out of range ({range})"))
+        };
+        if !(1..=max_n).contains(&self.n) {
+            return f("n", self.n.to_string(), &format!("1..={max_n}"));
+        }
+        if self.filter_radius > MAX_FILTER_RADIUS {
+            return f(
+                "filter_radius",
+                self.filter_radius.to_string(),
+                &format!("0..={MAX_FILTER_RADIUS}"),
+            );
+        }
+        if !(-1.0..=1.0).contains(&self.filter_normal_cos) {
+            return f("filter_normal_cos", self.filter_normal_cos.to_string(), "-1..=1");
+        }
+        if !(0.0..=1.0).contains(&self.filter_plane_tolerance) {
+            return f(
+                "filter_plane_tolerance",
+                self.filter_plane_tolerance.to_string(),
+                "0..=1",
+            );
+        }
+        Ok(())
+    }
+}
+
+impl<D: PatternDefault> Default for InterleaveSettings<D> {
+    fn default() -> Self {
+        Self::pattern(D::N)
+    }
+}
+
 impl Default for TextureSettings {
     fn default() -> Self {
         Self {

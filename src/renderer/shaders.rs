@@ -93,6 +93,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("display.wgsl", include_str!("../../shaders/display.wgsl")),
     ("visualise.wgsl", include_str!("../../shaders/visualise.wgsl")),
     ("bvh_rays.wgsl", include_str!("../../shaders/bvh_rays.wgsl")),
+    (
+        "interleave_filter.wgsl",
+        include_str!("../../shaders/interleave_filter.wgsl"),
+    ),
 ];
 
 /// The shared shaders that are entry points (not include-only files); [`entry_shaders`] adds
@@ -113,6 +117,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "sst_classify.wgsl",
     "sst_overlay.wgsl",
     "compare_views.wgsl",
+    "interleave_filter.wgsl",
 ];
 
 /// Every WGSL file: the shared ones and those the registered GI methods declare.

@@ -20,13 +20,9 @@ struct LcullParams {
     eps: f32,           // gi.distance_epsilon: f(l) = 1 / max(l^2, eps^2)
     ray_offset: f32,
     shadow_rays: u32,
-    accumulate: u32,
-    filter_radius: u32,
-    trace_pixel: u32,   // x | y << 16 or 0xffffffff (unused by the kernels today)
-    filter_normal_cos: f32,
-    filter_plane_tolerance: f32,
     stride: u32,        // runs of `stride` consecutive VPLs share an interleaving subset
     leaves: u32,        // the tree variant: leaves of the light tree (a power of two)
+    _pad: u32,
 };
 
 const LCULL_RANGE_INF: f32 = 1e30;

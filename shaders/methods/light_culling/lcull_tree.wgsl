@@ -20,7 +20,7 @@
 //                  receiver's: with n_i it is 0 wherever the first is positive; no BRDF, as
 //                  the paper); the estimate is its contribution over
 //                  p_i min(k / m, 1) q(i) (eq. 10; p_i is the stochastic fall-off's f / p),
-//                  demodulated into `raw` (lcull_shade's filter_main then x albedo / pi).
+//                  demodulated into `raw` (the shared interleave_filter.wgsl then x albedo / pi).
 // Twins: reference::light_culling::{tree_max_ranges, tree_traverse, tree_shade}.
 #include "common/math.wgsl"
 #include "common/random.wgsl"

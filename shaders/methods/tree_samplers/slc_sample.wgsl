@@ -6,8 +6,10 @@
 // a point drawn from its substitute distribution (Gaussian in the node's frame, clamped to its
 // box; the VPL itself at a leaf) shaded as a VPL of the node's total flux, one shadow ray
 // (a substitute's ending sampling.substitute_offset short of it: slc_substitute_end),
-// divided by the probability of the path. Sum over slots (SST: mean over its samples).
-// Writes the estimate (or adds it), and, in diagnostic frames only (DIAGNOSTICS), the
+// divided by the probability of the path. Sum over slots (SST: mean over its samples); with
+// interleaving (sampling.interleave) over the pixel's subset of the slots, x n^2.
+// Writes the estimate (or adds it; demodulated for the half-resolution upsampler or the
+// interleaving's filter), and, in diagnostic frames only (DIAGNOSTICS), the
 // per-pixel diagnostics, the frame counters and the pixel story: a timed frame compiles this
 // shader with DIAGNOSTICS = false and computes the same estimate without that work.
 // CPU twin: src/reference/slc.rs (cuts, weights, blending); tests check the estimator
@@ -35,8 +37,8 @@
 @group(0) @binding(9) var gb_albedo: texture_2d<f32>;
 @group(0) @binding(10) var<storage, read_write> accum: array<vec4<f32>>;
 // Per pixel: x = traversal steps per traversal, y = 1 if the pixel fell back (no
-// similar cut), z = samples evaluated (not dead), w = 1 + the block whose cut slot 0 used
-// (0: none).
+// similar cut), z = samples evaluated (not dead), w = 1 + the block whose cut its first
+// sample used (0: none).
 @group(0) @binding(11) var<storage, read_write> diag: array<vec4<f32>>;
 // [0] pixels with geometry, [1] fallback pixels, then 64-bit counters as (low, high) word
 // pairs: [2..3] traversal steps, [4..5] traversals, [6..7] dead branches, [8..9] shadow rays
@@ -48,9 +50,11 @@ override DIAGNOSTICS: bool = true;
 
 // The pixel story (`trace_pixel`): what its samples did this frame. Layout (u32 words, f32
 // bitcast) in `methods::tree_samplers::pass::PixelTrace`: a 32-word header, then per sample (the first
-// TRACE_SAMPLES) a 64-word record: slot, start node, end node, steps, stop reason, path
-// probability, sampled point xyz, visible, contribution rgb (flux/pi x G x V / prob), then
-// the path as (child taken, its probability) pairs.
+// TRACE_SAMPLES) a 64-word record: block slot, start node, end node, steps, stop reason,
+// path probability, sampled point xyz, visible, contribution rgb (flux/pi x G x V / prob),
+// the cut slot (word 13), then from word 16 the path as (child taken, its probability)
+// pairs. Header words 16-18 (written after the samples): samples taken, the interleaving's
+// n^2, the pixel's subset.
 @group(0) @binding(13) var<storage, read_write> trace: array<u32>;
 const TRACE_HEADER: u32 = 32u;
 const TRACE_RECORD: u32 = 64u;
@@ -283,7 +287,6 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
             trace[11u + i] = bitcast<u32>(weights[i]);
         }
         trace[15] = bitcast<u32>(wsum);
-        trace[16] = sp.cut_size;
     }
     var own_count = 0u;
     if mode == 3u {
@@ -298,10 +301,27 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
     var first_block = 0u;
     var dead = 0u;
     var rays = 0u;
-    for (var i = 0u; i < sp.cut_size; i++) {
+    // Interleaved sampling over the cut's slots (sampling.interleave; Stochastic Light Culling
+    // section 4.2): subset s of the n x n pattern takes the slots i = first + j n^2 with
+    // first = (s - the frame's offset) mod n^2, each x n^2, so a pattern's pixels share every
+    // slot out exactly once and over frames each pixel takes each slot with probability
+    // 1 / n^2. SST and the root fallback, whose samples each estimate the whole sum, take
+    // their share of the samples (at least one) and average them. n = 1: every slot.
+    // Twin: reference::interleave::slot_subset.
+    let cells = sp.interleave * sp.interleave;
+    let subset = px.x % sp.interleave + sp.interleave * (px.y % sp.interleave);
+    let first = (subset + cells - sp.interleave_offset % cells) % cells;
+    var end = sp.cut_size;
+    if mode == 2u {
+        end = max(end, first + 1u);
+    }
+    var taken = 0u;
+    for (var i = first; i < end; i += cells) {
         var start = 0u;
         var slot = 4u;
-        let tb = select(NO_TRACE, TRACE_HEADER + i * TRACE_RECORD, tracing && i < TRACE_SAMPLES);
+        let tb = select(NO_TRACE, TRACE_HEADER + taken * TRACE_RECORD, tracing && taken < TRACE_SAMPLES);
+        let first_sample = taken == 0u;
+        taken += 1u;
         switch mode {
             case 0u: {
                 var u = rng_next(&rng) * wsum;
@@ -323,7 +343,7 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
                 }
                 start = cuts[blocks[s] * sp.cut_size + i];
                 slot = s;
-                if i == 0u {
+                if first_sample {
                     first_block = blocks[s] + 1u;
                 }
             }
@@ -344,6 +364,7 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
             trace[tb + 1u] = start;
             // Stop reason 3: an empty cut slot (nothing sampled).
             trace[tb + 4u] = 3u;
+            trace[tb + 13u] = i;
         }
         if start == 0u {
             continue;
@@ -383,10 +404,18 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
     }
     if mode == 2u {
         // From the root: every sample estimates the whole sum.
-        sum /= f32(max(sp.cut_size, 1u));
+        sum /= f32(max(taken, 1u));
+    } else {
+        // The subset's slots stand for the whole cut.
+        sum *= f32(cells);
     }
-    // Demodulated (half-resolution GI): without the albedo, which the upsampler applies at
-    // full resolution.
+    if tracing {
+        trace[16] = taken;
+        trace[17] = cells;
+        trace[18] = subset;
+    }
+    // Demodulated (half-resolution GI, interleaving): without the albedo, which the upsampler
+    // or the interleaving's filter applies.
     var radiance = albedo / PI * sum;
     if sp.demodulate != 0u {
         radiance = sum / PI;

@@ -303,9 +303,9 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "Stochastic vs clamped light culling, and the bounding-sphere tree ({}x{}, eps_max {base_eps}, {} x {} interleaving, {} filter radius; tree: k = {}, filter radius {}; {}):\n",
         o.size.0,
         o.size.1,
-        base.interleave,
-        base.interleave,
-        base.filter_radius,
+        base.interleave.n,
+        base.interleave.n,
+        base.interleave.filter_radius,
         base.reservoir_k,
         base.tree_filter_radius,
         b.adapter

@@ -21,6 +21,7 @@ use super::{
     FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
 };
 use crate::reference::light_culling::{Interleave, TileGrid};
+use crate::renderer::passes::interleave_filter::GpuFilterParams;
 use crate::renderer::{
     context::{GpuContext, GpuError},
     readback::{self, ImageF32},
@@ -145,12 +146,10 @@ const VIEWS: &[ViewInfo] = &[
 ];
 
 fn invalid_example(s: &mut RenderSettings) -> &'static str {
-    let lc = LightCullingSettings {
-        interleave: 0,
-        ..Default::default()
-    };
+    let mut lc = LightCullingSettings::default();
+    lc.interleave.n = 0;
     let _ = s.set_method(ID, &lc);
-    "methods.light-culling.interleave"
+    "methods.light-culling.interleave.n"
 }
 
 const TESTS: &[&str] = &[
@@ -304,7 +303,7 @@ impl LightCulling {
             width: size.0,
             height: size.1,
             tile: lc.tile_size,
-            n: lc.interleave,
+            n: lc.interleave.n,
         }
     }
     /// Whether the last frame ran the tree variant.
@@ -343,6 +342,7 @@ impl LightCulling {
         cx: &mut FrameCx<'_>,
         enc: &mut wgpu::CommandEncoder,
         p: GpuLcullParams,
+        fp: GpuFilterParams,
         frames: u32,
     ) -> f32 {
         let lc = &self.settings;
@@ -375,9 +375,12 @@ impl LightCulling {
             cap: k,
             count: leaves,
             mode: 2,
-            filter_radius: lc.tree_filter_radius,
             leaves,
             ..p
+        };
+        let fp = GpuFilterParams {
+            radius: lc.tree_filter_radius,
+            ..fp
         };
         let inputs = FrameInputs {
             scene: cx.scene,
@@ -397,6 +400,7 @@ impl LightCulling {
             enc,
             cx.timer,
             tp,
+            fp,
             &inputs,
             &tree,
             &self.buffers,
@@ -446,12 +450,12 @@ impl Method for LightCulling {
         self.state = Some((cx.key, cx.method, frames));
         let seed = Self::seed(s, cx.frame_index);
         let count = cx.vpl_frame.count.min(vpl_capacity);
-        let il = Interleave::new(lc.interleave, count, seed);
+        let il = Interleave::new(lc.interleave.n, count, seed);
         let p = GpuLcullParams {
             width: cx.size.0,
             height: cx.size.1,
             tile: lc.tile_size,
-            n: lc.interleave,
+            n: lc.interleave.n,
             tiles_x,
             tiles_y,
             tiles,
@@ -465,17 +469,19 @@ impl Method for LightCulling {
             eps: s.gi.distance_epsilon,
             ray_offset: s.gi.ray_offset,
             shadow_rays: s.gi.shadow_rays as u32,
-            accumulate: (frames > 1) as u32,
-            filter_radius: lc.filter_radius,
-            trace_pixel: u32::MAX,
-            filter_normal_cos: lc.filter_normal_cos,
-            filter_plane_tolerance: lc.filter_plane_tolerance,
             stride: il.stride,
             leaves: 0,
+            _pad: 0,
+        };
+        // The filter: raw (before albedo / pi) x albedo / pi into the accumulation.
+        let fp = GpuFilterParams {
+            accumulate: (frames > 1) as u32,
+            scale: std::f32::consts::FRAC_1_PI,
+            ..GpuFilterParams::new(cx.size, &lc.interleave)
         };
         self.settings = lc;
         if cx.method == TREE {
-            return self.record_tree(cx, enc, p, frames);
+            return self.record_tree(cx, enc, p, fp, frames);
         }
         // The difference view's companion: the other variant with the same settings, in
         // diagnostic frames while the view is drawn, recorded first (the own run then leaves
@@ -490,8 +496,11 @@ impl Method for LightCulling {
             self.companion = Some((cx.key, other, n));
             let cp = GpuLcullParams {
                 mode: (other == CLAMPED) as u32,
-                accumulate: (n > 1) as u32,
                 ..p
+            };
+            let cfp = GpuFilterParams {
+                accumulate: (n > 1) as u32,
+                ..fp
             };
             let Some(companion) = self.buffers.companion.as_ref() else {
                 return 0.0;
@@ -511,6 +520,7 @@ impl Method for LightCulling {
                 enc,
                 cx.timer,
                 cp,
+                cfp,
                 &inputs,
                 &self.buffers,
             );
@@ -530,6 +540,7 @@ impl Method for LightCulling {
             enc,
             cx.timer,
             p,
+            fp,
             &inputs,
             &self.buffers,
         );
@@ -571,7 +582,7 @@ impl Method for LightCulling {
             scale_top: 10u32.pow(self.view_decades(view)),
             exposure: cx.look.exposure_ev.exp2(),
             tonemap: cx.look.tonemap.gpu_id(),
-            n: self.settings.interleave,
+            n: self.settings.interleave.n,
             cap: self.settings.max_lights_per_tile,
             own_scale: self.state.map_or(0.0, |(_, _, n)| 1.0 / n.max(1) as f32),
             companion_scale: self.companion_frames().map_or(0.0, |n| 1.0 / n as f32),
@@ -909,7 +920,7 @@ impl Method for LightCulling {
                 ("vpls_in_range_per_pixel", st.in_range_per_pixel()),
                 ("shadow_rays_per_pixel", st.rays_per_pixel()),
                 ("epsilon_max", self.settings.epsilon_max as f64),
-                ("interleave", self.settings.interleave as f64),
+                ("interleave", self.settings.interleave.n as f64),
             ],
             None => Vec::new(),
         }

@@ -1,7 +1,8 @@
 //! Stochastic Light Culling's GPU passes, in frame order (Algorithm 1 of the paper):
 //! `lcull_ranges` (per VPL: fall-off and range), `lcull_tiles` (per tile: depth bounds and the
 //! light list), `lcull_shade` (per pixel: the list's VPLs, demodulated), `lcull_filter` (the
-//! interleaving's geometry-aware filter, x albedo, into the GI accumulation), and the views.
+//! interleaving's geometry-aware filter, x albedo / pi, into the GI accumulation: the shared
+//! `passes::interleave_filter`), and the views.
 //! Reads: the VPLs, G-buffer, camera, BVH. CPU twins: `crate::reference::light_culling`.
 
 use bytemuck::{Pod, Zeroable};
@@ -10,8 +11,9 @@ use crate::methods::lightcut_interpolation::pass::groups_1d_as_2d;
 use crate::renderer::{
     frame::GbufferTargets,
     passes::{
-        WG_1D, bind_group_seq, compute_pipeline_with, float_texture_entry, groups_image, run_compute,
-        storage_buffer, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
+        WG_1D, bind_group_seq, compute_pipeline_with, float_texture_entry, groups_image,
+        interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
+        run_compute, storage_buffer, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
     },
     readback::CounterReadback,
     scene_gpu::SceneGpu,
@@ -44,14 +46,10 @@ pub struct GpuLcullParams {
     pub eps: f32,
     pub ray_offset: f32,
     pub shadow_rays: u32,
-    pub accumulate: u32,
-    pub filter_radius: u32,
-    pub trace_pixel: u32,
-    pub filter_normal_cos: f32,
-    pub filter_plane_tolerance: f32,
     pub stride: u32,
     /// The tree variant: leaves of the light tree.
     pub leaves: u32,
+    pub _pad: u32,
 }
 
 /// Twin: `LcullViewParams` in `lcull_views.wgsl`.
@@ -247,6 +245,18 @@ pub struct FrameInputs<'a> {
     pub accum: &'a wgpu::Buffer,
 }
 
+impl FrameInputs<'_> {
+    /// The filter's: `raw` of `b` into `accum`.
+    fn filter_inputs<'b>(&'b self, b: &'b LcullBuffers) -> FilterInputs<'b> {
+        FilterInputs {
+            gbuffer: self.gbuffer,
+            camera: self.camera,
+            raw: &b.raw,
+            accum: self.accum,
+        }
+    }
+}
+
 /// Timer names of a run's passes: the method's own, and the difference view's companion
 /// (diagnostic frames only, so never in a timed frame's GI cost).
 const OWN_PASSES: [&str; 4] = ["lcull_ranges", "lcull_tiles", "lcull_shade", "lcull_filter"];
@@ -268,7 +278,9 @@ pub struct LcullPass {
     shade_layout: wgpu::BindGroupLayout,
     shade: wgpu::ComputePipeline,
     shade_timed: wgpu::ComputePipeline,
-    filter: wgpu::ComputePipeline,
+    filter: InterleaveFilter,
+    filter_params: FilterUniform,
+    companion_filter_params: FilterUniform,
     tree_layout: wgpu::BindGroupLayout,
     tree_leaves: wgpu::ComputePipeline,
     tree_traverse: wgpu::ComputePipeline,
@@ -315,10 +327,10 @@ impl LcullPass {
                 storage_entry(6, c, false),
             ],
         );
-        let mut se = vec![uniform_entry(0, c), uniform_entry(1, c)];
-        se.extend((2..=4).map(float_texture_entry));
-        se.extend((5..=10).map(|b| storage_entry(b, c, true)));
-        se.extend((11..=14).map(|b| storage_entry(b, c, false)));
+        let mut se = vec![uniform_entry(0, c)];
+        se.extend((1..=2).map(float_texture_entry));
+        se.extend((3..=8).map(|b| storage_entry(b, c, true)));
+        se.extend((9..=11).map(|b| storage_entry(b, c, false)));
         let shade_layout = layout("lcull_shade::layout", &se);
         let mut te = vec![
             uniform_entry(0, c),
@@ -358,7 +370,9 @@ impl LcullPass {
             tiles_layout,
             shade: pipe("lcull_shade", &shade_layout, &smod, "shade_main", &[]),
             shade_timed: pipe("lcull_shade_timed", &shade_layout, &smod, "shade_main", timed),
-            filter: pipe("lcull_filter", &shade_layout, &smod, "filter_main", &[]),
+            filter: InterleaveFilter::new(device)?,
+            filter_params: FilterUniform::new(device, "lcull::filter_params"),
+            companion_filter_params: FilterUniform::new(device, "lcull::companion_filter_params"),
             shade_layout,
             tree_leaves: pipe("lcull_tree_leaves", &tree_layout, &trmod, "leaves_main", &[]),
             tree_traverse: pipe("lcull_tree_traverse", &tree_layout, &trmod, "traverse_main", &[]),
@@ -390,10 +404,10 @@ impl LcullPass {
         })
     }
 
-    /// Records the frame's passes (module doc). `companion`: the other variant for the
-    /// difference view, into `f.accum` (its own accumulation), without diagnostics and with
-    /// its own parameters and timer names; recorded before the method's own run, which then
-    /// leaves its lists and counters for the views.
+    /// Records the frame's passes (module doc); `fp` the filter's parameters. `companion`:
+    /// the other variant for the difference view, into `f.accum` (its own accumulation),
+    /// without diagnostics and with its own parameters and timer names; recorded before the
+    /// method's own run, which then leaves its lists and counters for the views.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
@@ -404,14 +418,19 @@ impl LcullPass {
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
         p: GpuLcullParams,
+        fp: GpuFilterParams,
         f: &FrameInputs<'_>,
         b: &LcullBuffers,
     ) {
         let diagnostics = diagnostics && !companion;
-        let (params, names) = if companion {
-            (&self.companion_params, COMPANION_PASSES)
+        let (params, filter_params, names) = if companion {
+            (
+                &self.companion_params,
+                &self.companion_filter_params,
+                COMPANION_PASSES,
+            )
         } else {
-            (&self.params, OWN_PASSES)
+            (&self.params, &self.filter_params, OWN_PASSES)
         };
         queue.write_buffer(params, 0, bytemuck::bytes_of(&p));
         let tv = wgpu::BindingResource::TextureView;
@@ -462,14 +481,23 @@ impl LcullPass {
         };
         let groups = groups_image(p.width, p.height);
         run_compute(encoder, timer, names[2], shade, &sbind, groups);
-        run_compute(encoder, timer, names[3], &self.filter, &sbind, groups);
+        self.filter.record(
+            device,
+            queue,
+            encoder,
+            timer,
+            names[3],
+            filter_params,
+            fp,
+            &f.filter_inputs(b),
+        );
         if diagnostics {
             let bytes = (STATS_WORDS * 4) as u64;
             self.stats.record(encoder, &[(&b.stats, 0, 0, bytes)]);
         }
     }
 
-    /// The bind group of `lcull_shade.wgsl` (shading and the filter) with `params`.
+    /// The bind group of `lcull_shade.wgsl` with `params`.
     fn shade_bind_group(
         &self,
         device: &wgpu::Device,
@@ -485,10 +513,8 @@ impl LcullPass {
             &self.shade_layout,
             &[
                 params.as_entire_binding(),
-                f.camera.as_entire_binding(),
                 tv(&g.position_view),
                 tv(&g.normal_view),
-                tv(&g.albedo_view),
                 f.scene.bvh_nodes.as_entire_binding(),
                 f.scene.bvh_triangles.as_entire_binding(),
                 f.vpls.as_entire_binding(),
@@ -497,15 +523,14 @@ impl LcullPass {
                 b.tile_lists.as_entire_binding(),
                 b.raw.as_entire_binding(),
                 b.diag.as_entire_binding(),
-                f.accum.as_entire_binding(),
                 b.stats.as_entire_binding(),
             ],
         )
     }
 
     /// Records the tree variant's frame (section 5; `lcull_tree.wgsl`): leaves and node
-    /// bounds, the per-pixel traversal, the one-ray shading, then the shared filter (`p`
-    /// carries the tree's filter radius).
+    /// bounds, the per-pixel traversal, the one-ray shading, then the shared filter (`fp`
+    /// with the tree's filter radius).
     #[allow(clippy::too_many_arguments)]
     pub fn record_tree(
         &mut self,
@@ -515,6 +540,7 @@ impl LcullPass {
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
         p: GpuLcullParams,
+        fp: GpuFilterParams,
         f: &FrameInputs<'_>,
         tree: &TreeInputs<'_>,
         b: &LcullBuffers,
@@ -565,9 +591,16 @@ impl LcullPass {
         };
         run_compute(encoder, timer, "lcull_tree_traverse", traverse, &bind, groups);
         run_compute(encoder, timer, "lcull_tree_shade", shade, &bind, groups);
-        // The shared filter reads `raw` (its bind group's tiled buffers are not read).
-        let sbind = self.shade_bind_group(device, &self.params, f, b);
-        run_compute(encoder, timer, "lcull_filter", &self.filter, &sbind, groups);
+        self.filter.record(
+            device,
+            queue,
+            encoder,
+            timer,
+            "lcull_filter",
+            &self.filter_params,
+            fp,
+            &f.filter_inputs(b),
+        );
         if diagnostics {
             let bytes = (STATS_WORDS * 4) as u64;
             self.stats.record(encoder, &[(&b.stats, 0, 0, bytes)]);

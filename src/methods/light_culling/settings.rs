@@ -4,12 +4,12 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::renderer::settings::{Interleave8, InterleaveSettings, MAX_FILTER_RADIUS};
+
 /// Largest interleaving pattern edge (n x n subsets).
 pub const MAX_INTERLEAVE: u32 = 16;
 /// Largest light list per tile.
 pub const MAX_LIST: u32 = 1 << 16;
-/// Largest filter radius (a (2r + 1)^2 window).
-pub const MAX_FILTER_RADIUS: u32 = 16;
 /// Largest per-pixel light list of the tree variant (its reservoir's k).
 pub const MAX_RESERVOIR: u32 = 256;
 
@@ -31,17 +31,10 @@ pub struct LightCullingSettings {
     /// testing every VPL of its subset: slower, never wrong.
     pub max_lights_per_tile: u32,
     /// Interleaved sampling (section 4.2): an n x n pattern whose pixels each take a
-    /// disjoint 1 / n^2 of the VPLs (scaled by n^2), then the geometry-aware filter. 1 = off.
-    /// Paper 8.
-    pub interleave: u32,
-    /// Radius r of the geometry-aware filter's (2r + 1)^2 window (paper 17 x 17: 8); 0 = no
-    /// filter (each pixel keeps its own subset's estimate).
-    pub filter_radius: u32,
-    /// The filter averages neighbours whose normal is within this cosine of the pixel's.
-    pub filter_normal_cos: f32,
-    /// ... and whose distance to the pixel's tangent plane is below this fraction of its view
-    /// depth.
-    pub filter_plane_tolerance: f32,
+    /// disjoint 1 / n^2 of the VPLs (scaled by n^2), then the geometry-aware filter
+    /// (`[methods.light-culling.interleave]`). Paper: n = 8, a 17 x 17 filter (r = 8). The
+    /// filter's normal and plane tests also serve the tree variant.
+    pub interleave: InterleaveSettings<Interleave8>,
     /// The bounding-sphere-tree variant (section 5, `light-culling-tree`): the per-pixel
     /// light list's k, filled by reservoir sampling during the traversal (5.3.1, Algorithm
     /// 3). Paper 32.
@@ -57,10 +50,7 @@ impl Default for LightCullingSettings {
             epsilon_max: 0.0005,
             tile_size: 16,
             max_lights_per_tile: 1024,
-            interleave: 8,
-            filter_radius: 8,
-            filter_normal_cos: 0.9,
-            filter_plane_tolerance: 0.02,
+            interleave: InterleaveSettings::pattern(8),
             reservoir_k: 32,
             tree_filter_radius: 0,
         }
@@ -88,30 +78,8 @@ impl LightCullingSettings {
                 &format!("1..={MAX_LIST}"),
             );
         }
-        if !(1..=MAX_INTERLEAVE).contains(&self.interleave) {
-            return f(
-                "interleave",
-                self.interleave.to_string(),
-                &format!("1..={MAX_INTERLEAVE}"),
-            );
-        }
-        if self.filter_radius > MAX_FILTER_RADIUS {
-            return f(
-                "filter_radius",
-                self.filter_radius.to_string(),
-                &format!("0..={MAX_FILTER_RADIUS}"),
-            );
-        }
-        if !(-1.0..=1.0).contains(&self.filter_normal_cos) {
-            return f("filter_normal_cos", self.filter_normal_cos.to_string(), "-1..=1");
-        }
-        if !(0.0..=1.0).contains(&self.filter_plane_tolerance) {
-            return f(
-                "filter_plane_tolerance",
-                self.filter_plane_tolerance.to_string(),
-                "0..=1",
-            );
-        }
+        self.interleave
+            .validate("methods.light-culling", MAX_INTERLEAVE)?;
         if !(1..=MAX_RESERVOIR).contains(&self.reservoir_k) {
             return f(
                 "reservoir_k",
@@ -133,6 +101,19 @@ impl LightCullingSettings {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_partial_interleave_table_keeps_the_methods_defaults() {
+        // Light culling interleaves 8 x 8 unless told otherwise; the tree samplers do not.
+        let lc: LightCullingSettings = toml::from_str("[interleave]\nfilter_radius = 4").unwrap();
+        assert_eq!((lc.interleave.n, lc.interleave.filter_radius), (8, 4));
+        let sm: crate::methods::tree_samplers::settings::SamplingSettings =
+            toml::from_str("[interleave]\nfilter_radius = 2").unwrap();
+        assert_eq!((sm.interleave.n, sm.interleave.filter_radius), (1, 2));
+        let sm: crate::methods::tree_samplers::settings::SamplingSettings =
+            toml::from_str("[interleave]\nn = 4").unwrap();
+        assert_eq!((sm.interleave.n, sm.interleave.filter_radius), (4, 0));
+    }
 
     #[test]
     fn out_of_range_fields_are_named() {
@@ -169,28 +150,40 @@ mod tests {
             ),
             (
                 LightCullingSettings {
-                    interleave: 0,
+                    interleave: InterleaveSettings {
+                        n: 0,
+                        ..ok.interleave.clone()
+                    },
                     ..ok.clone()
                 },
-                "interleave",
+                "interleave.n",
             ),
             (
                 LightCullingSettings {
-                    filter_radius: 99,
+                    interleave: InterleaveSettings {
+                        filter_radius: 99,
+                        ..ok.interleave.clone()
+                    },
                     ..ok.clone()
                 },
                 "filter_radius",
             ),
             (
                 LightCullingSettings {
-                    filter_normal_cos: 2.0,
+                    interleave: InterleaveSettings {
+                        filter_normal_cos: 2.0,
+                        ..ok.interleave.clone()
+                    },
                     ..ok.clone()
                 },
                 "filter_normal_cos",
             ),
             (
                 LightCullingSettings {
-                    filter_plane_tolerance: -1.0,
+                    interleave: InterleaveSettings {
+                        filter_plane_tolerance: -1.0,
+                        ..ok.interleave.clone()
+                    },
                     ..ok.clone()
                 },
                 "filter_plane_tolerance",

@@ -41,13 +41,7 @@ pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) 
         }
         return;
     }
-    ui.add(egui::Slider::new(&mut lc.interleave, 1..=MAX_INTERLEAVE).text("interleave n (n x n)"))
-        .on_hover_text("each pixel of an n x n pattern takes 1/n^2 of the VPLs (paper 8; 1 = off)");
-    ui.add(egui::Slider::new(&mut lc.filter_radius, 0..=MAX_FILTER_RADIUS).text("filter radius"))
-        .on_hover_text("geometry-aware filter window (2r+1)^2 (paper 17 x 17: 8; 0 = off)");
-    ui.add(egui::Slider::new(&mut lc.filter_normal_cos, 0.0..=1.0).text("filter normal cos"));
-    ui.add(egui::Slider::new(&mut lc.filter_plane_tolerance, 0.0..=0.2).text("filter plane tolerance"))
-        .on_hover_text("neighbours farther from the pixel's tangent plane than this x depth are skipped");
+    crate::methods::interleave::settings_ui(ui, &mut lc.interleave, MAX_INTERLEAVE, "VPLs", "paper 8 x 8");
     ui.add(egui::Slider::new(&mut lc.tile_size, 4..=32).text("tile size (pixels)"));
     ui.add(
         egui::Slider::new(&mut lc.max_lights_per_tile, 1..=MAX_LIST)

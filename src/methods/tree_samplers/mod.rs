@@ -7,8 +7,9 @@
 //!   to a leaf VPL.
 //!
 //! Passes: optional `gi_downsample` (half-resolution G-buffer), `slc_cuts` (not for SST),
-//! `slc_sample` / `sst_sample` / `rtslc_sample`, optional `gi_upsample`. CPU twins in
-//! `crate::reference::slc`; docs/sampling.md.
+//! `slc_sample` / `sst_sample` / `rtslc_sample`, optional `slc_filter` (interleaved sampling's
+//! geometry-aware filter, `sampling.interleave`), optional `gi_upsample`. CPU twins in
+//! `crate::reference::slc` and `crate::reference::interleave`; docs/sampling.md.
 
 pub mod half;
 pub mod pass;
@@ -18,9 +19,11 @@ mod ui;
 use super::{
     FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
 };
+use crate::reference::interleave::Interleave;
 use crate::renderer::{
     context::{GpuContext, GpuError},
     gpu_data::GpuSlcParams,
+    passes::interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
     readback::{self, ImageF32},
     settings::RenderSettings,
     shaders::ShaderError,
@@ -105,6 +108,7 @@ const TESTS: &[&str] = &[
     "slc::slc_without_usable_inner_nodes_equals_rtslc_and_steps_order_as_the_thesis_says",
     "slc::half_resolution_upsampling_equals_the_cpu_reference",
     "slc::the_pixel_story_matches_the_frame_and_the_tree",
+    "slc::interleaved_sampling_shares_the_cut_slots_out_and_its_filter_equals_the_cpu_reference",
 ];
 
 /// Samples per pixel (the cut size), over `results --spp`.
@@ -132,7 +136,13 @@ pub static SLC_INFO: MethodInfo = MethodInfo {
     module: &MODULE,
     reads: READS,
     views: VIEWS,
-    timed_passes: &["slc_cuts", "slc_sample", "gi_downsample", "gi_upsample"],
+    timed_passes: &[
+        "slc_cuts",
+        "slc_sample",
+        "slc_filter",
+        "gi_downsample",
+        "gi_upsample",
+    ],
     story: true,
     shadow_ray_switch: true,
     truth_of_vpls: false,
@@ -155,7 +165,7 @@ pub static SST_INFO: MethodInfo = MethodInfo {
     module: &MODULE,
     reads: READS,
     views: VIEWS,
-    timed_passes: &["sst_sample", "gi_downsample", "gi_upsample"],
+    timed_passes: &["sst_sample", "slc_filter", "gi_downsample", "gi_upsample"],
     story: true,
     shadow_ray_switch: true,
     truth_of_vpls: false,
@@ -178,7 +188,13 @@ pub static RTSLC_INFO: MethodInfo = MethodInfo {
     module: &MODULE,
     reads: READS,
     views: VIEWS,
-    timed_passes: &["slc_cuts", "rtslc_sample", "gi_downsample", "gi_upsample"],
+    timed_passes: &[
+        "slc_cuts",
+        "rtslc_sample",
+        "slc_filter",
+        "gi_downsample",
+        "gi_upsample",
+    ],
     story: true,
     shadow_ray_switch: true,
     truth_of_vpls: false,
@@ -216,7 +232,7 @@ fn validate(s: &RenderSettings) -> Result<(), String> {
             sm.substitute_offset
         ));
     }
-    Ok(())
+    sm.interleave.validate("sampling", settings::MAX_SLOT_INTERLEAVE)
 }
 
 /// The samplers' GPU state: pipelines, per-frame buffers, accumulation and half-resolution
@@ -226,6 +242,11 @@ pub struct TreeSamplers {
     buffers: SlcBuffers,
     half_pass: HalfPass,
     half: Option<HalfTargets>,
+    /// Interleaved sampling's filter and the sampler's per-frame estimate it reads (at the
+    /// GI resolution; allocated while `sampling.interleave` filters).
+    filter: InterleaveFilter,
+    filter_params: FilterUniform,
+    raw: Option<(wgpu::Buffer, (u32, u32))>,
     /// Accumulation: (key, frames summed).
     state: Option<(u64, u32)>,
     /// Whether the last recorded frame traced a pixel's story.
@@ -239,6 +260,9 @@ fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
         buffers: SlcBuffers::new(device, (1, 1), 1, 1),
         half_pass: HalfPass::new(device)?,
         half: None,
+        filter: InterleaveFilter::new(device)?,
+        filter_params: FilterUniform::new(device, "slc::filter_params"),
+        raw: None,
         state: None,
         traced: false,
     }))
@@ -260,6 +284,11 @@ impl TreeSamplers {
     /// The half-resolution targets of the last frame (None when half resolution is off).
     pub fn half_targets(&self) -> Option<&HalfTargets> {
         self.half.as_ref()
+    }
+    /// The last frame's demodulated estimate before the interleaving's filter, at the GI
+    /// resolution (None while `sampling.interleave` does not filter).
+    pub fn interleaved_raw(&self) -> Option<&wgpu::Buffer> {
+        self.raw.as_ref().map(|(b, _)| b)
     }
     /// The cut of block `b` (node ids in slot order, without empty slots).
     pub fn read_cut(&self, ctx: &GpuContext, b: u32) -> Result<Vec<u32>, GpuError> {
@@ -347,6 +376,24 @@ impl Method for TreeSamplers {
             _ => 1,
         };
         self.state = Some((key, frames));
+        // Interleaved sampling: the sampler writes its frame's demodulated estimate into
+        // `raw`, the filter then averages the pattern into the accumulation.
+        let il = &sm.interleave;
+        let filtered = il.filters();
+        if !filtered {
+            self.raw = None;
+        } else if self.raw.as_ref().is_none_or(|(_, sz)| *sz != gi_size) {
+            let bytes = 16 * gi_size.0 as u64 * gi_size.1 as u64;
+            self.raw = Some((
+                crate::renderer::passes::storage_buffer(device, "slc::interleaved_raw", bytes),
+                gi_size,
+            ));
+        }
+        let seed = if sm.fixed_seed {
+            s.vpl.seed
+        } else {
+            s.vpl.seed ^ (cx.frame_index as u32).wrapping_mul(0x9e37_79b9)
+        };
         let grid = self.buffers.grid;
         let p = GpuSlcParams {
             width: gi_size.0,
@@ -375,17 +422,13 @@ impl Method for TreeSamplers {
                 CutFallback::Recompute => 3,
             },
             cull: sm.cull_behind as u32,
-            seed: if sm.fixed_seed {
-                s.vpl.seed
-            } else {
-                s.vpl.seed ^ (cx.frame_index as u32).wrapping_mul(0x9e37_79b9)
-            },
-            accumulate: (frames > 1) as u32,
+            seed,
+            accumulate: (frames > 1 && !filtered) as u32,
             epsilon: s.gi.distance_epsilon,
             ray_offset: s.gi.ray_offset,
             n_min: s.vpl.n_min,
             d_max,
-            demodulate: half as u32,
+            demodulate: (half || filtered) as u32,
             trace_pixel: match cx.trace_pixel {
                 // In GI pixels (half resolution: the GI pixel covering it).
                 Some((x, y)) if half => (x / 2) | (y / 2) << 16,
@@ -400,6 +443,9 @@ impl Method for TreeSamplers {
                 ChildProbability::MinMax => 1,
                 ChildProbability::Defensive => 2,
             },
+            interleave: il.n,
+            interleave_offset: Interleave::offset_of(il.n, seed),
+            _pad: [0; 2],
         };
         // A timed frame leaves the last diagnostic frame's story (and statistics) in place.
         if cx.diagnostics {
@@ -409,6 +455,7 @@ impl Method for TreeSamplers {
             Some(h) => (&h.gbuffer, &h.accum),
             None => (&cx.targets.gbuffer, cx.gi_accum),
         };
+        let raw = self.raw.as_ref().map(|(b, _)| b);
         self.pass.record(
             cx.diagnostics,
             device,
@@ -419,9 +466,34 @@ impl Method for TreeSamplers {
             cx.tree,
             cx.scene,
             gbuffer,
-            accum,
+            raw.unwrap_or(accum),
             &self.buffers,
         );
+        if let Some(raw) = raw {
+            // The demodulated estimate's mean over the pattern, x albedo (at half resolution
+            // it stays demodulated: the upsampler applies the full-resolution albedo).
+            let fp = GpuFilterParams {
+                accumulate: (frames > 1) as u32,
+                modulate: (!half) as u32,
+                ..GpuFilterParams::new(gi_size, il)
+            };
+            let inputs = FilterInputs {
+                gbuffer,
+                camera: cx.camera,
+                raw,
+                accum,
+            };
+            self.filter.record(
+                device,
+                cx.queue,
+                enc,
+                cx.timer,
+                "slc_filter",
+                &self.filter_params,
+                fp,
+                &inputs,
+            );
+        }
         if let Some(h) = half_targets {
             self.half_pass
                 .record_upsample(device, enc, cx.timer, &cx.targets.gbuffer, size, &h, cx.gi_accum);
@@ -495,7 +567,10 @@ impl Method for TreeSamplers {
         }
         let bytes = readback::read_storage_buffer(ctx, &self.buffers.trace)?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-        Ok(PixelTrace::parse(&words))
+        Ok(PixelTrace::parse(&words).map(|t| PixelTrace {
+            filtered: self.raw.is_some(),
+            ..t
+        }))
     }
 
     fn pixel_rows(

@@ -132,6 +132,8 @@ pub struct TraceSample {
     /// Which of the 4 surrounding blocks' cuts it came from (0-3), or None (mock cut, root,
     /// recomputed cut).
     pub slot: Option<usize>,
+    /// The cut slot it sampled (its index in the cut; SST: the sample's number).
+    pub cut_slot: u32,
     /// The node the traversal started at (0: empty slot).
     pub start: u32,
     /// The node it stopped at (0: dead branch).
@@ -163,7 +165,15 @@ pub struct PixelTrace {
     /// Bilinear x similarity (the blend weights before normalising).
     pub weights: [f32; 4],
     pub weight_sum: f32,
-    pub cut_size: u32,
+    /// Samples the pixel took this frame: the cut size, or with interleaving its subset's
+    /// share of the slots.
+    pub taken: u32,
+    /// The interleaving's n^2 (1: off) and the pixel's subset.
+    pub cells: u32,
+    pub subset: u32,
+    /// Whether the interleaving's geometry-aware filter ran after the samples (the GI buffer
+    /// then holds the filtered value, not this pixel's estimate).
+    pub filtered: bool,
     pub samples: Vec<TraceSample>,
 }
 
@@ -174,8 +184,8 @@ impl PixelTrace {
             return None;
         }
         let f = |i: usize| f32::from_bits(w[i]);
-        let cut_size = w[16];
-        let samples = (0..(cut_size as usize).min(TRACE_SAMPLES))
+        let taken = w[16];
+        let samples = (0..(taken as usize).min(TRACE_SAMPLES))
             .map(|i| {
                 let b = TRACE_HEADER + i * TRACE_RECORD;
                 let stop = match w[b + 4] {
@@ -200,6 +210,7 @@ impl PixelTrace {
                 });
                 TraceSample {
                     slot: (w[b] < 4).then_some(w[b] as usize),
+                    cut_slot: w[b + 13],
                     start: w[b + 1],
                     end,
                     steps,
@@ -218,9 +229,24 @@ impl PixelTrace {
             bilinear: [f(7), f(8), f(9), f(10)],
             weights: [f(11), f(12), f(13), f(14)],
             weight_sum: f(15),
-            cut_size,
+            taken,
+            cells: w[17].max(1),
+            subset: w[18],
+            filtered: false,
             samples,
         })
+    }
+
+    /// The pixel's estimate of the incident sum from its samples (times rho / pi it is the
+    /// radiance; before the interleaving's filter): their sum x n^2, or from the root their
+    /// mean.
+    pub fn estimate(&self) -> glam::Vec3 {
+        let sum: glam::Vec3 = self.samples.iter().map(|s| s.contribution).sum();
+        if self.mode == 2 {
+            sum / self.taken.max(1) as f32
+        } else {
+            sum * self.cells as f32
+        }
     }
 
     pub fn mode_name(&self) -> &'static str {

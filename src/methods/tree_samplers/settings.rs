@@ -55,6 +55,11 @@ impl CutFallback {
 }
 
 pub use crate::base::sampling::ChildProbability;
+pub use crate::renderer::settings::InterleaveSettings;
+
+/// Largest interleaving pattern of the tree samplers: 8 x 8 = 64 subsets of at most 64 cut
+/// slots.
+pub const MAX_SLOT_INTERLEAVE: u32 = 8;
 
 /// Sampling the tree (stages 11-16, thesis chapter 5): used by the SLC, SST and RTSLC methods.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -64,7 +69,7 @@ pub struct SamplingSettings {
     /// blocks cost less and blur the cut choice across edges (blending hides the seams).
     pub block_size: u32,
     /// Nodes per cut = cluster evaluations (shadow rays) per pixel; SST takes this many
-    /// traversals from the root.
+    /// traversals from the root. With n x n interleaving a pixel takes 1 / n^2 of them.
     pub cut_size: u32,
     /// Leave out of the cuts children whose box lies wholly behind the block centre's
     /// surface (thesis 5.1). Pixels of a block that face differently can then miss light
@@ -96,6 +101,14 @@ pub struct SamplingSettings {
     pub accumulate: bool,
     /// Render GI at half resolution and upsample it with a joint bilateral filter using S.
     pub half_resolution: bool,
+    /// Interleaved sampling over the cut's slots (`[sampling.interleave]`; ours, after
+    /// Stochastic Light Culling section 4.2 and RTSLC's code, which interleaves 2 x 2 or
+    /// 4 x 4): pixel subset s of the n x n pattern evaluates only the slots i with
+    /// (i + the frame's offset) mod n^2 = s, each x n^2 (SST and the root fallback: its share
+    /// of the samples, averaged), then the geometry-aware filter averages the pattern back
+    /// (at the GI resolution, before the upsampling). n^2 fewer shadow rays per pixel for a
+    /// blur within surfaces. Default off (n = 1, the thesis).
+    pub interleave: InterleaveSettings,
     /// The samplers' random numbers are the same every frame (debugging: a pixel's story
     /// repeats); off, the seed changes per frame (needed to accumulate).
     pub fixed_seed: bool,
@@ -120,6 +133,7 @@ impl Default for SamplingSettings {
             fallback: CutFallback::MockCut,
             accumulate: false,
             half_resolution: false,
+            interleave: InterleaveSettings::pattern(1),
             fixed_seed: false,
         }
     }

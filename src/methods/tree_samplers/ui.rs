@@ -71,5 +71,13 @@ pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) 
         &mut sm.half_resolution,
         "half-resolution GI (bilateral upsampling)",
     );
+    let lights = if method == SST { "samples" } else { "cut slots" };
+    crate::methods::interleave::settings_ui(
+        ui,
+        &mut sm.interleave,
+        super::settings::MAX_SLOT_INTERLEAVE,
+        lights,
+        "RTSLC's code 2 x 2 or 4 x 4",
+    );
     ui.checkbox(&mut sm.accumulate, "accumulate frames while static");
 }

@@ -7,6 +7,7 @@ pub mod composite;
 pub mod direct;
 pub mod display;
 pub mod gbuffer;
+pub mod interleave_filter;
 pub mod rsm;
 pub mod sst_build;
 pub mod sst_overlay;

@@ -1,0 +1,138 @@
+//! The geometry-aware filter of interleaved sampling (`shaders/interleave_filter.wgsl`;
+//! Stochastic Light Culling section 4.2): one pass shared by the methods that interleave
+//! (light culling, the tree samplers). Reads: a method's per-pixel estimate (`raw`), the
+//! G-buffer it was computed on, the camera. Writes: an accumulation buffer. Settings:
+//! `settings::InterleaveSettings`. Twin: `reference::interleave::filter_pixel`.
+
+use bytemuck::{Pod, Zeroable};
+
+use super::{
+    bind_group_seq, compute_pipeline, float_texture_entry, groups_image, run_compute, storage_entry,
+    uniform_buffer, uniform_entry,
+};
+use crate::renderer::{
+    frame::GbufferTargets,
+    settings::{InterleaveSettings, PatternDefault},
+    shaders,
+    timing::GpuTimer,
+};
+
+/// Twin: `FilterParams` in `shaders/interleave_filter.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuFilterParams {
+    pub width: u32,
+    pub height: u32,
+    pub radius: u32,
+    /// 0: write, 1: add to the accumulation.
+    pub accumulate: u32,
+    pub normal_cos: f32,
+    pub plane_tolerance: f32,
+    /// Applied to the window's mean (light culling: 1 / pi; the tree samplers: 1).
+    pub scale: f32,
+    /// 1: times the pixel's albedo (0: the output stays demodulated).
+    pub modulate: u32,
+}
+
+impl GpuFilterParams {
+    /// The filter of `il` on a `size` image, written (not added) and x albedo.
+    pub fn new<D: PatternDefault>(size: (u32, u32), il: &InterleaveSettings<D>) -> Self {
+        Self {
+            width: size.0,
+            height: size.1,
+            radius: il.filter_radius,
+            accumulate: 0,
+            normal_cos: il.filter_normal_cos,
+            plane_tolerance: il.filter_plane_tolerance,
+            scale: 1.0,
+            modulate: 1,
+        }
+    }
+}
+
+/// The filter's uniforms: one per use in a frame (a method filtering twice in one encoder,
+/// as light culling's companion run does, needs two: the queue writes them before the
+/// frame runs).
+pub struct FilterUniform(wgpu::Buffer);
+
+impl FilterUniform {
+    pub fn new(device: &wgpu::Device, label: &str) -> Self {
+        Self(uniform_buffer::<GpuFilterParams>(device, label))
+    }
+}
+
+/// What one filter dispatch reads and writes.
+pub struct FilterInputs<'a> {
+    pub gbuffer: &'a GbufferTargets,
+    pub camera: &'a wgpu::Buffer,
+    pub raw: &'a wgpu::Buffer,
+    pub accum: &'a wgpu::Buffer,
+}
+
+pub struct InterleaveFilter {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl InterleaveFilter {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let module = shaders::create_module(device, "interleave_filter.wgsl")?;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("interleave_filter::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                uniform_entry(1, c),
+                float_texture_entry(2),
+                float_texture_entry(3),
+                float_texture_entry(4),
+                storage_entry(5, c, true),
+                storage_entry(6, c, false),
+            ],
+        });
+        Ok(Self {
+            pipeline: compute_pipeline(device, "interleave_filter", &[Some(&layout)], &module, "main"),
+            layout,
+        })
+    }
+
+    /// Records the filter under the timer name `name` (the method's: it is part of its GI
+    /// cost).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        name: &'static str,
+        uniform: &FilterUniform,
+        p: GpuFilterParams,
+        f: &FilterInputs<'_>,
+    ) {
+        queue.write_buffer(&uniform.0, 0, bytemuck::bytes_of(&p));
+        let tv = wgpu::BindingResource::TextureView;
+        let bind = bind_group_seq(
+            device,
+            "interleave_filter::bind_group",
+            &self.layout,
+            &[
+                uniform.0.as_entire_binding(),
+                f.camera.as_entire_binding(),
+                tv(&f.gbuffer.position_view),
+                tv(&f.gbuffer.normal_view),
+                tv(&f.gbuffer.albedo_view),
+                f.raw.as_entire_binding(),
+                f.accum.as_entire_binding(),
+            ],
+        );
+        run_compute(
+            encoder,
+            timer,
+            name,
+            &self.pipeline,
+            &bind,
+            groups_image(p.width, p.height),
+        );
+    }
+}
