@@ -17,6 +17,7 @@ pub mod direct;
 pub mod gbuffer;
 pub mod gi;
 pub mod interleave;
+pub mod ism;
 pub mod light_culling;
 pub mod lightcut_interpolation;
 pub mod lightcuts;

@@ -467,6 +467,70 @@ impl<D: PatternDefault> Default for InterleaveSettings<D> {
     }
 }
 
+/// Imperfect shadow maps (`renderer::passes::ism`; the VAL paper's section 5, Ritschel et al.
+/// 2008): a visibility component for methods with many oriented point lights.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IsmSettings {
+    /// Points sampled once on the scene's triangles (area-uniform); map i receives every
+    /// N-th of them (N lights). More points: fewer holes, a slower splat.
+    pub points: u32,
+    /// Atlas edge in texels (the paper: 4096).
+    pub atlas: u32,
+    /// One map's edge (the paper: 128; the atlas holds (atlas / tile)^2 maps: 1024).
+    pub tile: u32,
+    /// Pull-push levels (the paper: 2 iterations): holes up to about 2^levels texels wide
+    /// are filled.
+    pub pull_push_levels: u32,
+    /// Relative depth bias of the lookup: a point is lit when its distance x (1 - bias) is
+    /// at most the map's (the receiver's own points are in the map).
+    pub bias: f32,
+}
+
+impl Default for IsmSettings {
+    fn default() -> Self {
+        Self {
+            points: 1 << 18,
+            atlas: 4096,
+            tile: 128,
+            pull_push_levels: 2,
+            // Measured (tests/ism.rs, a plane occluder over a floor, 128^2 maps): 0.03 shadows
+            // 3% of the lit floor (a texel keeps the nearest of its points, on a floor seen at
+            // a grazing angle several centimetres nearer), 0.05 none.
+            bias: 0.05,
+        }
+    }
+}
+
+impl IsmSettings {
+    /// The pull-push levels that fit the map.
+    pub fn levels(&self) -> u32 {
+        self.pull_push_levels.min(self.tile.max(1).ilog2())
+    }
+    /// Every field in range, or a message naming it under `table`.
+    pub fn validate(&self, table: &str) -> Result<(), String> {
+        let f = |name: &str, v: String, range: &str| {
+            Err(format!("{table}.ism.{name} {v} is out of range ({range})"))
+        };
+        if !(1..=1 << 24).contains(&self.points) {
+            return f("points", self.points.to_string(), "1..=16777216");
+        }
+        if !(self.tile.is_power_of_two() && (8..=1024).contains(&self.tile)) {
+            return f("tile", self.tile.to_string(), "a power of two in 8..=1024");
+        }
+        if !(self.atlas.is_power_of_two() && (self.tile..=8192).contains(&self.atlas)) {
+            return f("atlas", self.atlas.to_string(), "a power of two in tile..=8192");
+        }
+        if self.pull_push_levels > 8 {
+            return f("pull_push_levels", self.pull_push_levels.to_string(), "0..=8");
+        }
+        if !(0.0..0.5).contains(&self.bias) {
+            return f("bias", self.bias.to_string(), "0..0.5");
+        }
+        Ok(())
+    }
+}
+
 impl Default for TextureSettings {
     fn default() -> Self {
         Self {

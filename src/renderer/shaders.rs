@@ -97,6 +97,8 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         "interleave_filter.wgsl",
         include_str!("../../shaders/interleave_filter.wgsl"),
     ),
+    ("ism.wgsl", include_str!("../../shaders/ism.wgsl")),
+    ("common/ism.wgsl", include_str!("../../shaders/common/ism.wgsl")),
 ];
 
 /// The shared shaders that are entry points (not include-only files); [`entry_shaders`] adds
@@ -118,6 +120,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "sst_overlay.wgsl",
     "compare_views.wgsl",
     "interleave_filter.wgsl",
+    "ism.wgsl",
 ];
 
 /// Every WGSL file: the shared ones and those the registered GI methods declare.

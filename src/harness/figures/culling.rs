@@ -62,6 +62,8 @@ fn stat(m: &Measured, k: &str) -> f64 {
 pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let base: LightCullingSettings = b.base.method(lcull::ID).map_err(|e| anyhow::anyhow!(e))?;
     let base_eps = base.epsilon_max as f64;
+    // For labels: the f32 setting as written (0.0005, not its f64 widening).
+    let eps_label = base.epsilon_max;
     let mut eps_values = o.sweep_values(lcull::ID, 0);
     if !eps_values.iter().any(|e| (e - base_eps).abs() < 1e-12) {
         eps_values.push(base_eps);
@@ -258,7 +260,10 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let at_base_n = |r: &Row| r.vpls == b.base.vpl.count;
     plot::lines(
         &dir.join("culling_time_vpls.png"),
-        &format!("{}: GI GPU time over the VPL count (eps_max {base_eps})", b.scene),
+        &format!(
+            "{}: GI GPU time over the VPL count (eps_max {eps_label})",
+            b.scene
+        ),
         "VPLs",
         "ms (GPU timestamps of the culling passes)",
         &series(&|r| at_base_eps(r).then_some((r.vpls as f64, r.gi_ms))),
@@ -300,7 +305,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     )?;
 
     let mut table = format!(
-        "Stochastic vs clamped light culling, and the bounding-sphere tree ({}x{}, eps_max {base_eps}, {} x {} interleaving, {} filter radius; tree: k = {}, filter radius {}; {}):\n",
+        "Stochastic vs clamped light culling, and the bounding-sphere tree ({}x{}, eps_max {eps_label}, {} x {} interleaving, {} filter radius; tree: k = {}, filter radius {}; {}):\n",
         o.size.0,
         o.size.1,
         base.interleave.n,

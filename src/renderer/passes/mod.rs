@@ -8,6 +8,7 @@ pub mod direct;
 pub mod display;
 pub mod gbuffer;
 pub mod interleave_filter;
+pub mod ism;
 pub mod rsm;
 pub mod sst_build;
 pub mod sst_overlay;

@@ -1,0 +1,109 @@
+// Imperfect shadow maps, built each frame for a set of oriented point lights (the VAL
+// paper's section 5, after Ritschel et al. 2008):
+//   splat_main: point k of the scene's point cloud into map k mod lights, one texel, the
+//     nearest distance kept (atomicMax of ~bits: positive floats order as their bits);
+//   resolve_main: the keys into distances (ISM_EMPTY where no point landed);
+//   pull_main: level l of each map = the mean of the filled texels of its 2 x 2 block below;
+//   push_main: level l's empty texels from level l + 1, coarsest first.
+// Twins: reference::ism::{splat, pull_push}.
+#include "common/ism.wgsl"
+
+@group(0) @binding(0) var<uniform> ism: IsmParams;
+@group(0) @binding(1) var<storage, read> points: array<vec4<f32>>;
+// Per light: position (xyz), then unit normal (xyz).
+@group(0) @binding(2) var<storage, read> lights: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> keys: array<atomic<u32>>;
+@group(0) @binding(4) var<storage, read_write> ism_depth: array<f32>;
+// Levels 1.. of every map in use, map-major (level_base + m s^2 + y s + x).
+@group(0) @binding(5) var<storage, read_write> pyramid: array<f32>;
+
+@compute @workgroup_size(64, 1, 1)
+fn splat_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
+    let k = gid.x + gid.y * nw.x * 64u;
+    if k >= ism.points || ism.lights == 0u {
+        return;
+    }
+    let m = k % ism.lights;
+    let p = ism_project(lights[2u * m].xyz, lights[2u * m + 1u].xyz, points[k].xyz);
+    if p.z < 0.0 {
+        return;
+    }
+    atomicMax(&keys[ism_texel(m, p.xy)], 0xffffffffu - bitcast<u32>(p.z));
+}
+
+// The texel (x, y) of map m at level l (0: the atlas).
+fn level_index(m: u32, x: u32, y: u32, l: u32, base: u32) -> u32 {
+    if l == 0u {
+        let mx = m % ism.per_row;
+        let my = m / ism.per_row;
+        return (my * ism.tile + y) * ism.atlas + mx * ism.tile + x;
+    }
+    let s = ism.tile >> l;
+    return base + m * s * s + y * s + x;
+}
+
+fn read_level(m: u32, x: u32, y: u32, l: u32, base: u32) -> f32 {
+    if l == 0u {
+        return ism_depth[level_index(m, x, y, 0u, 0u)];
+    }
+    return pyramid[level_index(m, x, y, l, base)];
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn resolve_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    // One map per workgroup row of the dispatch's z.
+    let m = gid.z;
+    if gid.x >= ism.tile || gid.y >= ism.tile || m >= ism.lights {
+        return;
+    }
+    let i = level_index(m, gid.x, gid.y, 0u, 0u);
+    let key = atomicLoad(&keys[i]);
+    ism_depth[i] = select(bitcast<f32>(0xffffffffu - key), ISM_EMPTY, key == 0u);
+}
+
+// ism.level = l >= 1; ism.level_base: l's offset; the level below at `below_base` =
+// level_base - lights x (2s)^2 (level 1's below is the atlas).
+@compute @workgroup_size(8, 8, 1)
+fn pull_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let l = ism.level;
+    let s = ism.tile >> l;
+    let m = gid.z;
+    if gid.x >= s || gid.y >= s || m >= ism.lights {
+        return;
+    }
+    let below_base = ism.level_base - select(ism.lights * 4u * s * s, 0u, l == 1u);
+    var sum = 0.0;
+    var w = 0.0;
+    for (var j = 0u; j < 4u; j++) {
+        let v = read_level(m, 2u * gid.x + (j & 1u), 2u * gid.y + (j >> 1u), l - 1u, below_base);
+        if v < ISM_EMPTY {
+            sum += v;
+            w += 1.0;
+        }
+    }
+    pyramid[level_index(m, gid.x, gid.y, l, ism.level_base)] = select(ISM_EMPTY, sum / w, w > 0.0);
+}
+
+// ism.level = l >= 0 (the level filled); ism.level_base: level l + 1's offset.
+@compute @workgroup_size(8, 8, 1)
+fn push_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let l = ism.level;
+    let s = ism.tile >> l;
+    let m = gid.z;
+    if gid.x >= s || gid.y >= s || m >= ism.lights {
+        return;
+    }
+    let above = pyramid[level_index(m, gid.x / 2u, gid.y / 2u, l + 1u, ism.level_base)];
+    if l == 0u {
+        let i = level_index(m, gid.x, gid.y, 0u, 0u);
+        if ism_depth[i] >= ISM_EMPTY {
+            ism_depth[i] = above;
+        }
+    } else {
+        let below_base = ism.level_base - ism.lights * s * s;
+        let i = level_index(m, gid.x, gid.y, l, below_base);
+        if pyramid[i] >= ISM_EMPTY {
+            pyramid[i] = above;
+        }
+    }
+}
