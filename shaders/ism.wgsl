@@ -1,7 +1,9 @@
 // Imperfect shadow maps, built each frame for a set of oriented point lights (the VAL
 // paper's section 5, after Ritschel et al. 2008):
-//   splat_main: point k of the scene's point cloud into map k mod lights, one texel, the
-//     nearest distance kept (atomicMax of ~bits: positive floats order as their bits);
+//   splat_main: each light's points (point k into map k mod lights; or, with per_light,
+//     per_light points spread over the cloud: Stochastic Light Culling's adaptive ISMs), those
+//     within the light's range, one texel each, the nearest distance kept (atomicMax of
+//     ~bits: positive floats order as their bits);
 //   resolve_main: the keys into distances (ISM_EMPTY where no point landed);
 //   pull_main: level l of each map = the mean of the filled texels of its 2 x 2 block below;
 //   push_main: level l's empty texels from level l + 1, coarsest first.
@@ -10,7 +12,7 @@
 
 @group(0) @binding(0) var<uniform> ism: IsmParams;
 @group(0) @binding(1) var<storage, read> points: array<vec4<f32>>;
-// Per light: position (xyz), then unit normal (xyz).
+// Per light: position (xyz) and squared range (w; 1e30: none), then unit normal (xyz).
 @group(0) @binding(2) var<storage, read> lights: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> keys: array<atomic<u32>>;
 @group(0) @binding(4) var<storage, read_write> ism_depth: array<f32>;
@@ -20,11 +22,24 @@
 @compute @workgroup_size(64, 1, 1)
 fn splat_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
     let k = gid.x + gid.y * nw.x * 64u;
-    if k >= ism.points || ism.lights == 0u {
+    if k >= ism.threads || ism.lights == 0u {
         return;
     }
-    let m = k % ism.lights;
-    let p = ism_project(lights[2u * m].xyz, lights[2u * m + 1u].xyz, points[k].xyz);
+    // Map m's j-th point: m + j x max(cloud / per_light, 1), wrapping (round-robin: k).
+    var m = k % ism.lights;
+    var idx = k;
+    if ism.per_light != 0u {
+        m = k / ism.per_light;
+        let j = k % ism.per_light;
+        idx = (m + j * max(ism.points / ism.per_light, 1u)) % ism.points;
+    }
+    let c = lights[2u * m];
+    let x = points[idx].xyz;
+    let d = x - c.xyz;
+    if dot(d, d) >= c.w {
+        return;
+    }
+    let p = ism_project(c.xyz, lights[2u * m + 1u].xyz, x);
     if p.z < 0.0 {
         return;
     }

@@ -5,7 +5,7 @@
 mod common;
 
 use glam::Vec3;
-use lightcut::reference::ism::{self, EMPTY, IsmLayout};
+use lightcut::reference::ism::{self, EMPTY, IsmLayout, IsmLight};
 use lightcut::renderer::{
     context::GpuContext,
     passes::ism::{IsmPass, IsmPoints, IsmTargets},
@@ -15,7 +15,7 @@ use lightcut::renderer::{
 };
 
 /// The GPU's resolved atlas after one build.
-fn build(ctx: &GpuContext, s: &IsmSettings, points: &[Vec3], lights: &[(Vec3, Vec3)]) -> Vec<f32> {
+fn build(ctx: &GpuContext, s: &IsmSettings, points: &[Vec3], lights: &[IsmLight]) -> Vec<f32> {
     let mut pass = IsmPass::new(&ctx.device).unwrap();
     let t = IsmTargets::new(&ctx.device, s);
     let pts = IsmPoints::new(&ctx.device, &ctx.queue, points, (points.len() as u32, 0));
@@ -48,26 +48,38 @@ fn layout(s: &IsmSettings) -> IsmLayout {
 fn gpu_maps_equal_the_cpu_reference() {
     let Some(ctx) = common::gpu() else { return };
     let scene = lightcut::scene::default_scene::build();
-    let s = IsmSettings {
-        points: 40_000,
-        atlas: 128,
-        tile: 32,
-        ..Default::default()
-    };
+    // The VAL paper's sharing (the cloud round-robin), then Stochastic Light Culling's
+    // adaptive maps (3000 points per light, half the lights with a range).
+    for per_light in [0, 3000] {
+        let s = IsmSettings {
+            points: 40_000,
+            points_per_light: per_light,
+            atlas: 128,
+            tile: 32,
+            ..Default::default()
+        };
+        maps_equal(&ctx, &scene, &s);
+    }
+}
+
+fn maps_equal(ctx: &GpuContext, scene: &lightcut::scene::Scene, s: &IsmSettings) {
     let points = ism::sample_points(&scene.positions, &scene.indices, s.points, 1);
     // 12 lights inside the room, facing every way.
     let (lo, hi) = (scene.bounds.min, scene.bounds.max);
-    let lights: Vec<(Vec3, Vec3)> = (0..12u32)
+    let lights: Vec<IsmLight> = (0..12u32)
         .map(|i| {
             let r = |k: u32| lightcut::reference::vpl::u01(lightcut::reference::vpl::pcg_hash(i * 7 + k));
             let c = lo + (hi - lo) * Vec3::new(0.2 + 0.6 * r(0), 0.2 + 0.6 * r(1), 0.2 + 0.6 * r(2));
             let n = Vec3::new(r(3) - 0.5, r(4) - 0.5, r(5) - 0.5).normalize();
-            (c, n)
+            IsmLight {
+                range: if i % 2 == 0 { EMPTY } else { 1.0 + 2.0 * r(6) },
+                ..IsmLight::new(c, n)
+            }
         })
         .collect();
-    let gpu = build(&ctx, &s, &points, &lights);
-    let l = layout(&s);
-    let mut cpu = ism::splat(l, &lights, &points);
+    let gpu = build(ctx, s, &points, &lights);
+    let l = layout(s);
+    let mut cpu = ism::splat(l, &lights, &points, s.points_per_light);
     let splatted = cpu.iter().filter(|&&d| d < EMPTY).count();
     ism::pull_push(l, &mut cpu, lights.len() as u32, s.levels());
     let (mut texels, mut equal, mut filled) = (0, 0, 0);
@@ -82,7 +94,10 @@ fn gpu_maps_equal_the_cpu_reference() {
             }
         }
     }
-    eprintln!("{equal} of {texels} texels equal the CPU's ({filled} filled)");
+    eprintln!(
+        "{} points per light: {equal} of {texels} texels equal the CPU's ({filled} filled)",
+        s.points_per_light
+    );
     // A point on a texel boundary may land on either side in the two float paths.
     assert!(equal * 1000 >= texels * 995, "{equal} of {texels}");
     assert!(
@@ -125,12 +140,13 @@ fn the_lookup_agrees_with_exact_shadow_tests_for_a_plane_occluder() {
     };
     let points = ism::sample_points(&pos, &idx, s.points, 3);
     let lights = vec![
-        (Vec3::new(0.0, 2.0, 0.0), Vec3::NEG_Y),
-        (Vec3::new(0.6, 2.5, -0.3), Vec3::new(-0.2, -1.0, 0.1).normalize()),
+        IsmLight::new(Vec3::new(0.0, 2.0, 0.0), Vec3::NEG_Y),
+        IsmLight::new(Vec3::new(0.6, 2.5, -0.3), Vec3::new(-0.2, -1.0, 0.1).normalize()),
     ];
     let atlas = build(&ctx, &s, &points, &lights);
     let l = layout(&s);
-    for (m, &(c, n)) in lights.iter().enumerate() {
+    for (m, light) in lights.iter().enumerate() {
+        let (c, n) = (light.position, light.normal);
         let (mut tested, mut agree, mut shadowed, mut false_shadow) = (0, 0, 0, 0);
         for j in 0..101 {
             for i in 0..101 {

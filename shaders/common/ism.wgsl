@@ -13,6 +13,10 @@ struct IsmParams {
     level: u32,      // the pull / push pass's level
     bias: f32,       // relative depth bias of the lookup
     level_base: u32, // offset of `level` in the pyramid buffer (pull / push)
+    per_light: u32,  // 0: point k to map k mod lights; else map m takes per_light points spread over the cloud
+    threads: u32,    // splat threads: points, or lights x per_light
+    _pad0: u32,
+    _pad1: u32,
 };
 
 const ISM_EMPTY: f32 = 1e30;

@@ -10,6 +10,39 @@ use glam::{Vec2, Vec3};
 
 use super::vpl::{pcg_hash, u01};
 
+/// An oriented point light with a range beyond which its map keeps no point (`EMPTY`: none).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IsmLight {
+    pub position: Vec3,
+    pub normal: Vec3,
+    pub range: f32,
+}
+
+impl IsmLight {
+    /// A light without a range.
+    pub fn new(position: Vec3, normal: Vec3) -> Self {
+        Self {
+            position,
+            normal,
+            range: EMPTY,
+        }
+    }
+}
+
+/// The points of light `m`'s map: with `per_light` 0 every N-th point of the cloud from
+/// point m (the VAL paper: round-robin), otherwise `per_light` points spread over the whole
+/// cloud, every (cloud / per_light)-th from point m, wrapping (Stochastic Light Culling's
+/// adaptive ISMs, section 4.3: 8192 points per VPL; the cloud is in area order, so a
+/// consecutive run would cover a few triangles). Twin: the index arithmetic of `splat_main`.
+pub fn light_points(m: u32, lights: u32, per_light: u32, cloud: u32) -> impl Iterator<Item = u32> {
+    let n = lights.max(1);
+    let (start, step, count) = match cloud.checked_div(per_light) {
+        None => (m, n, (cloud + n - 1 - m.min(cloud)) / n),
+        Some(stride) => (m, stride.max(1), per_light),
+    };
+    (0..count).map(move |j| ((start as u64 + j as u64 * step as u64) % cloud.max(1) as u64) as u32)
+}
+
 /// An empty texel (no point landed there, nothing filled it): lookups see no occluder.
 /// Twin: `ISM_EMPTY`.
 pub const EMPTY: f32 = 1e30;
@@ -108,21 +141,23 @@ pub fn texel_of(uv: Vec2, tile: u32) -> (u32, u32) {
     (f(uv.x), f(uv.y))
 }
 
-/// Splats every point into the atlas: point k into map k mod lights, the nearest distance per
-/// texel. Twin: `splat_main` in `ism.wgsl`.
-pub fn splat(layout: IsmLayout, lights: &[(Vec3, Vec3)], points: &[Vec3]) -> Vec<f32> {
+/// Splats each light's points (`light_points`) into its map, those within its range, the
+/// nearest distance per texel. Twin: `splat_main` in `ism.wgsl`.
+pub fn splat(layout: IsmLayout, lights: &[IsmLight], points: &[Vec3], per_light: u32) -> Vec<f32> {
     let mut atlas = vec![EMPTY; (layout.atlas * layout.atlas) as usize];
     let n = (lights.len() as u32).min(layout.capacity());
-    if n == 0 {
-        return atlas;
-    }
-    for (k, &p) in points.iter().enumerate() {
-        let m = k as u32 % n;
-        let (c, nrm) = lights[m as usize];
-        if let Some((uv, dist)) = project(c, nrm, p) {
-            let (u, v) = texel_of(uv, layout.tile);
-            let i = layout.texel(m, u, v);
-            atlas[i] = atlas[i].min(dist);
+    for m in 0..n {
+        let l = lights[m as usize];
+        for k in light_points(m, n, per_light, points.len() as u32) {
+            let p = points[k as usize];
+            if (p - l.position).length_squared() >= l.range * l.range {
+                continue;
+            }
+            if let Some((uv, dist)) = project(l.position, l.normal, p) {
+                let (u, v) = texel_of(uv, layout.tile);
+                let i = layout.texel(m, u, v);
+                atlas[i] = atlas[i].min(dist);
+            }
         }
     }
     atlas
@@ -215,6 +250,56 @@ mod tests {
             assert!(((uv - Vec2::splat(0.5)).length() - 0.5).abs() < 1e-3);
             assert!(project(Vec3::ONE, n, Vec3::ONE - n).is_none());
         }
+    }
+
+    #[test]
+    fn each_light_takes_its_share_of_the_points() {
+        // Round-robin: the lights partition the cloud.
+        let mut seen = vec![0; 103];
+        for m in 0..7 {
+            for k in light_points(m, 7, 0, 103) {
+                seen[k as usize] += 1;
+                assert_eq!(k % 7, m);
+            }
+        }
+        assert!(seen.iter().all(|&c| c == 1));
+        // Per light: every (cloud / per_light)-th point from m, wrapping; distinct points.
+        let v: Vec<u32> = light_points(3, 7, 40, 103).collect();
+        assert_eq!(v.len(), 40);
+        assert_eq!((v[0], v[1], v[39]), (3, 5, 81));
+        let w: Vec<u32> = light_points(2, 7, 200, 103).collect();
+        assert_eq!((w[0], w[101], w[102], w[103]), (2, 0, 1, 2));
+        let mut u = v.clone();
+        u.dedup();
+        assert_eq!(u.len(), 40);
+    }
+
+    #[test]
+    fn a_range_keeps_farther_points_out_of_the_map() {
+        // A light 1 m over a 2 x 2 m floor with a range of 1.2 m: its map (pull-push
+        // included) holds no depth of 1.2 or more; without a range it does.
+        let pos = vec![
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(-1.0, 0.0, 1.0),
+        ];
+        let pts = sample_points(&pos, &[0, 1, 2, 0, 2, 3], 20_000, 5);
+        let layout = IsmLayout { atlas: 32, tile: 32 };
+        let mut light = IsmLight::new(Vec3::Y, Vec3::NEG_Y);
+        let far = |a: &[f32]| a.iter().filter(|&&d| (1.2..EMPTY).contains(&d)).count();
+        assert!(far(&splat(layout, &[light], &pts, 0)) > 50);
+        light.range = 1.2;
+        let mut a = splat(layout, &[light], &pts, 0);
+        // The disc within range (radius 0.66 m, 34 degrees off the normal) covers about 70
+        // texels of the map; pull-push then spreads its depths a few texels outwards, never a
+        // farther one.
+        let filled = |a: &[f32]| a.iter().filter(|&&d| d < EMPTY).count();
+        let splatted = filled(&a);
+        assert!((40..120).contains(&splatted), "{splatted}");
+        pull_push(layout, &mut a, 1, 2);
+        assert_eq!(far(&a), 0);
+        assert!(filled(&a) > splatted);
     }
 
     #[test]

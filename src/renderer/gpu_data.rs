@@ -605,6 +605,28 @@ mod tests {
                 },
             ),
             (
+                "ism.wgsl",
+                "IsmParams",
+                size_of::<crate::renderer::passes::ism::GpuIsmParams>(),
+                {
+                    use crate::renderer::passes::ism::GpuIsmParams as P;
+                    vec![
+                        offset_of!(P, atlas),
+                        offset_of!(P, tile),
+                        offset_of!(P, per_row),
+                        offset_of!(P, lights),
+                        offset_of!(P, points),
+                        offset_of!(P, level),
+                        offset_of!(P, bias),
+                        offset_of!(P, level_base),
+                        offset_of!(P, per_light),
+                        offset_of!(P, threads),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                    ]
+                },
+            ),
+            (
                 "interleave_filter.wgsl",
                 "FilterParams",
                 size_of::<crate::renderer::passes::interleave_filter::GpuFilterParams>(),

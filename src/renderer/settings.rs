@@ -473,8 +473,13 @@ impl<D: PatternDefault> Default for InterleaveSettings<D> {
 #[serde(default, deny_unknown_fields)]
 pub struct IsmSettings {
     /// Points sampled once on the scene's triangles (area-uniform); map i receives every
-    /// N-th of them (N lights). More points: fewer holes, a slower splat.
+    /// N-th of them (N lights) unless `points_per_light` says otherwise. More points: fewer
+    /// holes, a slower splat.
     pub points: u32,
+    /// 0: the lights share the cloud out round-robin (the VAL paper). Otherwise each map takes
+    /// this many points spread over the cloud, those within its light's range
+    /// (Stochastic Light Culling's adaptive ISMs, section 4.3: 8192 per VPL on 32^2 maps).
+    pub points_per_light: u32,
     /// Atlas edge in texels (the paper: 4096).
     pub atlas: u32,
     /// One map's edge (the paper: 128; the atlas holds (atlas / tile)^2 maps: 1024).
@@ -491,6 +496,7 @@ impl Default for IsmSettings {
     fn default() -> Self {
         Self {
             points: 1 << 18,
+            points_per_light: 0,
             atlas: 4096,
             tile: 128,
             pull_push_levels: 2,
@@ -514,6 +520,9 @@ impl IsmSettings {
         };
         if !(1..=1 << 24).contains(&self.points) {
             return f("points", self.points.to_string(), "1..=16777216");
+        }
+        if self.points_per_light > 1 << 16 {
+            return f("points_per_light", self.points_per_light.to_string(), "0..=65536");
         }
         if !(self.tile.is_power_of_two() && (8..=1024).contains(&self.tile)) {
             return f("tile", self.tile.to_string(), "a power of two in 8..=1024");

@@ -13,7 +13,7 @@ use super::{
     StridedUniforms, WG_1D, WG_2D, bind_group_seq, compute_pipeline, dynamic_uniform_entry, storage_buffer,
     storage_entry,
 };
-use crate::reference::ism::IsmLayout;
+use crate::reference::ism::{IsmLayout, IsmLight};
 use crate::renderer::{settings::IsmSettings, shaders, timing::GpuTimer};
 
 /// Twin: `IsmParams` in `shaders/common/ism.wgsl`.
@@ -28,6 +28,12 @@ pub struct GpuIsmParams {
     pub level: u32,
     pub bias: f32,
     pub level_base: u32,
+    /// 0: point k to map k mod lights; else map m takes per_light points spread over the cloud
+    /// (`reference::ism::light_points`).
+    pub per_light: u32,
+    /// Splat threads: the cloud's points, or lights x per_light.
+    pub threads: u32,
+    pub _pad: [u32; 2],
 }
 
 /// The scene's point cloud on the GPU (vec4 per point), built once per scene and settings.
@@ -132,8 +138,9 @@ impl IsmPass {
         })
     }
 
-    /// Builds the maps of `lights` (position, unit normal; at most the atlas's capacity) from
-    /// `points`, timed as `name`: clear, splat, resolve, pull-push over `t`'s levels.
+    /// Builds the maps of `lights` (at most the atlas's capacity) from `points` (shared out as
+    /// `s.points_per_light` says), timed as `name`: clear, splat, resolve, pull-push over
+    /// `t`'s levels.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
@@ -144,13 +151,16 @@ impl IsmPass {
         name: &str,
         s: &IsmSettings,
         points: &IsmPoints,
-        lights: &[(Vec3, Vec3)],
+        lights: &[IsmLight],
         t: &IsmTargets,
     ) {
         let n = (lights.len() as u32).min(t.capacity);
         let data: Vec<[f32; 4]> = lights[..n as usize]
             .iter()
-            .flat_map(|(c, nrm)| [[c.x, c.y, c.z, 1.0], [nrm.x, nrm.y, nrm.z, 0.0]])
+            .flat_map(|l| {
+                let (c, nrm) = (l.position, l.normal);
+                [[c.x, c.y, c.z, l.range * l.range], [nrm.x, nrm.y, nrm.z, 0.0]]
+            })
             .collect();
         if !data.is_empty() {
             queue.write_buffer(&t.lights, 0, bytemuck::cast_slice(&data));
@@ -164,6 +174,13 @@ impl IsmPass {
             level: 0,
             bias: s.bias,
             level_base: 0,
+            per_light: s.points_per_light,
+            threads: if s.points_per_light == 0 {
+                points.count
+            } else {
+                n.saturating_mul(s.points_per_light)
+            },
+            _pad: [0; 2],
         };
         // Uniforms: 0 splat / resolve, then pull levels 1..=L, then push levels L-1..=0.
         let level_base = |l: u32| IsmTargets::pyramid_len(t.layout.tile, n, l.saturating_sub(1)) as u32;
@@ -206,7 +223,7 @@ impl IsmPass {
             let off = StridedUniforms::<GpuIsmParams>::offset;
             if n > 0 {
                 // Workgroups as (x, y) when one row would pass the 65535 limit.
-                let groups = points.count.div_ceil(WG_1D).max(1);
+                let groups = base.threads.div_ceil(WG_1D).max(1);
                 let gx = groups.min(65535);
                 let gy = groups.div_ceil(gx);
                 pass.set_pipeline(&self.splat);
