@@ -12,7 +12,7 @@
 
 @group(0) @binding(0) var<uniform> ism: IsmParams;
 @group(0) @binding(1) var<storage, read> points: array<vec4<f32>>;
-// Per light: position (xyz) and squared range (w; 1e30: none), then unit normal (xyz).
+// Per light: position (xyz) and squared range (w; +inf: none), then unit normal (xyz).
 @group(0) @binding(2) var<storage, read> lights: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> keys: array<atomic<u32>>;
 @group(0) @binding(4) var<storage, read_write> ism_depth: array<f32>;

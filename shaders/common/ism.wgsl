@@ -8,7 +8,7 @@ struct IsmParams {
     atlas: u32,      // atlas edge (texels)
     tile: u32,       // one map's edge
     per_row: u32,    // maps per atlas row
-    lights: u32,     // maps in use (point k goes to map k mod lights)
+    lights: u32,     // maps in use
     points: u32,
     level: u32,      // the pull / push pass's level
     bias: f32,       // relative depth bias of the lookup

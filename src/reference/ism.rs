@@ -1,7 +1,8 @@
 //! CPU twin of imperfect shadow maps (Ritschel et al. 2008, as the VAL paper uses them:
 //! Weinzierl-Heigl, section 5): a point cloud sampled once from the scene's triangles
 //! (area-uniform), the points shared out round-robin between the lights (point k to light
-//! k mod N), each splatted as one texel into its light's paraboloid map (Brabec et al. 2002:
+//! k mod N) or a share per light (Stochastic Light Culling's adaptive ISMs, its section 4.3),
+//! those within the light's range each splatted as one texel into its light's paraboloid map (Brabec et al. 2002:
 //! the hemisphere around the light's normal) in one atlas, keeping the nearest distance; holes
 //! filled by pull-push over a few coarser levels; a lookup compares a point's distance to the
 //! map's. Twin of `shaders/ism.wgsl` and `shaders/common/ism.wgsl`.
@@ -107,7 +108,8 @@ pub fn sample_points(positions: &[Vec3], indices: &[u32], count: u32, seed: u32)
 
 /// An orthonormal frame (t, b) around unit `n` (Duff et al. 2017). Twin: `ism_basis`.
 pub fn basis(n: Vec3) -> (Vec3, Vec3) {
-    let sign = 1.0f32.copysign(n.z);
+    // As the GPU's select(-1, 1, n.z >= 0): -0.0 counts as positive.
+    let sign = if n.z >= 0.0 { 1.0f32 } else { -1.0 };
     let a = -1.0 / (sign + n.z);
     let b = n.x * n.y * a;
     (
@@ -146,6 +148,9 @@ pub fn texel_of(uv: Vec2, tile: u32) -> (u32, u32) {
 pub fn splat(layout: IsmLayout, lights: &[IsmLight], points: &[Vec3], per_light: u32) -> Vec<f32> {
     let mut atlas = vec![EMPTY; (layout.atlas * layout.atlas) as usize];
     let n = (lights.len() as u32).min(layout.capacity());
+    if points.is_empty() {
+        return atlas;
+    }
     for m in 0..n {
         let l = lights[m as usize];
         for k in light_points(m, n, per_light, points.len() as u32) {
@@ -269,9 +274,8 @@ mod tests {
         assert_eq!((v[0], v[1], v[39]), (3, 5, 81));
         let w: Vec<u32> = light_points(2, 7, 200, 103).collect();
         assert_eq!((w[0], w[101], w[102], w[103]), (2, 0, 1, 2));
-        let mut u = v.clone();
-        u.dedup();
-        assert_eq!(u.len(), 40);
+        let distinct: std::collections::HashSet<u32> = v.iter().copied().collect();
+        assert_eq!(distinct.len(), 40);
     }
 
     #[test]

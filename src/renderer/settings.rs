@@ -530,6 +530,16 @@ impl IsmSettings {
         if !(self.atlas.is_power_of_two() && (self.tile..=8192).contains(&self.atlas)) {
             return f("atlas", self.atlas.to_string(), "a power of two in tile..=8192");
         }
+        // The build dispatches one workgroup layer per map (at most 65535), and its splat
+        // threads (maps x points_per_light) stay within u32.
+        let maps = (self.atlas / self.tile).pow(2);
+        if maps > 65535 {
+            return f(
+                "atlas",
+                self.atlas.to_string(),
+                &format!("at most 65535 maps of tile {}: atlas / tile <= 255", self.tile),
+            );
+        }
         if self.pull_push_levels > 8 {
             return f("pull_push_levels", self.pull_push_levels.to_string(), "0..=8");
         }
@@ -859,6 +869,63 @@ mod tests {
         let text = toml::to_string(&s).unwrap();
         let back: RenderSettings = toml::from_str(&text).unwrap();
         assert_eq!(s, back);
+    }
+
+    #[test]
+    fn ism_settings_refuse_what_the_build_cannot_dispatch() {
+        let ok = IsmSettings::default();
+        assert!(ok.validate("t").is_ok());
+        // Stochastic Light Culling's 16384 maps of 32^2 fit; 65536 maps would not.
+        assert!(
+            IsmSettings {
+                tile: 32,
+                ..ok.clone()
+            }
+            .validate("t")
+            .is_ok()
+        );
+        let cases = [
+            (
+                IsmSettings {
+                    atlas: 8192,
+                    tile: 32,
+                    ..ok.clone()
+                },
+                "t.ism.atlas",
+            ),
+            (
+                IsmSettings {
+                    tile: 100,
+                    ..ok.clone()
+                },
+                "t.ism.tile",
+            ),
+            (
+                IsmSettings {
+                    points: 0,
+                    ..ok.clone()
+                },
+                "t.ism.points",
+            ),
+            (
+                IsmSettings {
+                    points_per_light: 1 << 17,
+                    ..ok.clone()
+                },
+                "t.ism.points_per_light",
+            ),
+            (
+                IsmSettings {
+                    bias: 0.5,
+                    ..ok.clone()
+                },
+                "t.ism.bias",
+            ),
+        ];
+        for (s, name) in cases {
+            let e = s.validate("t").unwrap_err();
+            assert!(e.starts_with(name), "{e}");
+        }
     }
 
     #[test]

@@ -221,7 +221,7 @@ impl IsmPass {
                 timestamp_writes: timer.compute_pass(name),
             });
             let off = StridedUniforms::<GpuIsmParams>::offset;
-            if n > 0 {
+            if n > 0 && points.count > 0 {
                 // Workgroups as (x, y) when one row would pass the 65535 limit.
                 let groups = base.threads.div_ceil(WG_1D).max(1);
                 let gx = groups.min(65535);
