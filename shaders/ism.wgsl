@@ -2,7 +2,7 @@
 // paper's section 5, after Ritschel et al. 2008):
 //   splat_main: each light's points (point k into map k mod lights; or, with per_light,
 //     per_light points spread over the cloud: Stochastic Light Culling's adaptive ISMs), those
-//     within the light's range, one texel each, the nearest distance kept (atomicMax of
+//     within the light's range (and, with front_cull, facing away from it), one texel each, the nearest distance kept (atomicMax of
 //     ~bits: positive floats order as their bits);
 //   resolve_main: the keys into distances (ISM_EMPTY where no point landed);
 //   pull_main: level l of each map = the mean of the filled texels of its 2 x 2 block below;
@@ -11,6 +11,7 @@
 #include "common/ism.wgsl"
 
 @group(0) @binding(0) var<uniform> ism: IsmParams;
+// Per point: position, then its surface normal (zero: never culled).
 @group(0) @binding(1) var<storage, read> points: array<vec4<f32>>;
 // Per light: position (xyz) and squared range (w; +inf: none), then unit normal (xyz).
 @group(0) @binding(2) var<storage, read> lights: array<vec4<f32>>;
@@ -34,9 +35,13 @@ fn splat_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         idx = (m + j * max(ism.points / ism.per_light, 1u)) % ism.points;
     }
     let c = lights[2u * m];
-    let x = points[idx].xyz;
+    let x = points[2u * idx].xyz;
     let d = x - c.xyz;
     if dot(d, d) >= c.w {
+        return;
+    }
+    // Front-face culling (Stochastic Light Culling's Program 1).
+    if ism.front_cull != 0u && dot(points[2u * idx + 1u].xyz, d) < 0.0 {
         return;
     }
     let p = ism_project(c.xyz, lights[2u * m + 1u].xyz, x);

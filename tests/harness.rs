@@ -256,7 +256,9 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         3,
     );
     // Stochastic vs clamped culling and the sphere tree: 2 VPL counts x 2 visibilities x 3
-    // variants, then the second bound at the base count (1024 = 2^10) x 2 x 3.
+    // variants, then the second bound at the base count (1024 = 2^10) x 2 x 3; the stochastic
+    // ranges with imperfect shadow maps, with and without their range culling, at both counts
+    // (+ 4), and with them at the second bound (+ 1).
     check_csv(
         &d,
         "culling.csv",
@@ -268,8 +270,9 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "mean_ratio",
             "rmse_vs_true_ground_truth",
             "shade_ms",
+            "ism_ms",
         ],
-        18,
+        23,
     );
     let (_, rows) = read_csv(&d.join("culling.csv"));
     assert!(
@@ -284,7 +287,15 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     for r in &rows {
         let rays: f64 = r["shadow_rays_per_pixel"].parse().unwrap();
         assert_eq!(rays == 0.0, r["visibility"] == "none", "{r:?}");
+        let ism: f64 = r["ism_ms"].parse().unwrap();
+        assert_eq!(ism > 0.0, r["visibility"].starts_with("ism"), "{r:?}");
     }
+    assert_eq!(
+        rows.iter()
+            .filter(|r| r["visibility"] == "ism-unculled" && r["ranges"] == "stochastic")
+            .count(),
+        2
+    );
     check_csv(
         &d,
         "culling_table1.csv",

@@ -3,8 +3,9 @@
 //! pixel's tile, the shading and the geometry-aware filter against the CPU, overflowing tiles
 //! counted and shaded the same, and the estimator's unbiasedness over frames (the clamped
 //! baseline's darkening beside it, and the clamped-vs-stochastic difference view's data); the
-//! bounding-sphere-tree variant (section 5) against the CPU and its unbiasedness. Tiny sizes:
-//! 250 VPLs, 48 x 32 pixels.
+//! bounding-sphere-tree variant (section 5) against the CPU and its unbiasedness; ISM
+//! visibility (4.3-4.4): the maps and the shading against the CPU, their agreement with
+//! shadow rays. Tiny sizes: 250 VPLs, 48 x 32 pixels.
 
 mod common;
 
@@ -15,11 +16,12 @@ use lightcut::{
     base::gpu_layout::{GpuVpl, VPL_NONE},
     methods::light_culling::{
         self, LightCulling,
-        settings::{InterleaveSettings, LightCullingSettings},
+        settings::{CullingVisibility, InterleaveSettings, IsmSettings, LightCullingSettings},
     },
     methods::overlay::Prim,
     metrics,
     reference::interleave::filter_pixel,
+    reference::ism::{self, EMPTY, IsmLayout, IsmLight},
     reference::light_culling::{
         Interleave, LightRange, RangeMode, RangeParams, ShadeVpl, TREE_STREAM_RESERVOIR, TREE_STREAM_RIS,
         TileCamera, light_range, shade, tile_lists, tree_max_ranges, tree_rng, tree_shade, tree_traverse,
@@ -27,6 +29,7 @@ use lightcut::{
     reference::vpl::{pcg_hash, u01},
     renderer::{
         Buffer, FrameInput,
+        passes::ism::cloud_of_bvh,
         readback::read_storage_buffer,
         settings::{RenderSettings, Tonemap, ViewBuffer},
     },
@@ -772,4 +775,216 @@ fn the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_trut
         "the tree culls: {stats:?}"
     );
     assert!(ctx.errors.take().is_empty());
+}
+
+/// ISM visibility (`visibility = "ism"`, section 4.4's adaptive maps with 4.3's range culling)
+/// on the fixed frame: 250 VPLs, 256 maps of 16^2 texels, 2048 points each.
+fn ism_small() -> LightCullingSettings {
+    LightCullingSettings {
+        visibility: CullingVisibility::Ism,
+        ism: IsmSettings {
+            points: 1 << 18,
+            points_per_light: 8192,
+            atlas: 512,
+            tile: 32,
+            ..Default::default()
+        },
+        ..small(0.002)
+    }
+}
+
+#[test]
+fn ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays() {
+    let Some(ctx) = common::gpu() else { return };
+    let lc = ism_small();
+    let mut s = settings(lc.clone());
+    s.sampling.fixed_seed = true;
+    let mut st = Setup::new(&ctx, s.clone(), (W, H));
+    st.frame();
+    assert!(ctx.errors.take().is_empty());
+    let vpls = st.r.read_vpls().unwrap();
+    let n = vpls.len();
+    let gl = gpu_lights(&st, n);
+    let sv = shade_vpls(&vpls);
+    let layout = IsmLayout {
+        atlas: lc.ism.atlas,
+        tile: lc.ism.tile,
+    };
+
+    // The maps: the CPU twin's splat of the same cloud (one map per VPL, each its points
+    // within the VPL's range) and pull-push, against the GPU's atlas.
+    let (targets, maps) = lc_of(&st).ism_targets().expect("maps built");
+    assert_eq!(maps as usize, n);
+    let gpu_atlas: Vec<f32> =
+        bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &targets.depth).unwrap());
+    let cloud = cloud_of_bvh(
+        &st.r.scene_gpu().bvh,
+        lc.ism.points,
+        light_culling::ISM_CLOUD_SEED,
+    );
+    let lights: Vec<IsmLight> = (0..n)
+        .map(|i| IsmLight {
+            range: gl[i].range,
+            ..IsmLight::new(gl[i].position, sv[i].normal)
+        })
+        .collect();
+    let (points, normals): (Vec<Vec3>, Vec<Vec3>) = cloud.into_iter().unzip();
+    assert!(lc.ism.front_face_culling, "the paper's culling is on by default");
+    let mut cpu_atlas = ism::splat_culled(layout, &lights, &points, Some(&normals), lc.ism.points_per_light);
+    let filled_before = cpu_atlas.iter().filter(|&&d| d < EMPTY).count();
+    ism::pull_push(layout, &mut cpu_atlas, n as u32, lc.ism.levels());
+    let texels = n * (lc.ism.tile * lc.ism.tile) as usize;
+    let same = (0..n as u32)
+        .flat_map(|m| (0..lc.ism.tile).flat_map(move |v| (0..lc.ism.tile).map(move |u| (m, u, v))))
+        .filter(|&(m, u, v)| {
+            let k = layout.texel(m, u, v);
+            let (a, b) = (gpu_atlas[k], cpu_atlas[k]);
+            a == b || (a - b).abs() <= 1e-5 * b.abs()
+        })
+        .count();
+    eprintln!("ISM: {same} of {texels} texels equal the CPU's ({filled_before} filled by the splat)");
+    assert!(filled_before > texels / 20, "the maps hold points");
+    assert!(same * 1000 >= texels * 995, "{same} of {texels}");
+
+    // Shading: the CPU's sum with the CPU lookup in the GPU's atlas as visibility.
+    let grid = LightCulling::grid(&lc, (W, H));
+    let il = Interleave::new(lc.interleave.n, n as u32, LightCulling::seed(&s, 0));
+    let b = lc_of(&st).buffers();
+    let count = gpu_u32(&st, &b.tile_count);
+    let lists = gpu_u32(&st, &b.tile_lists);
+    let raw: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &b.raw).unwrap());
+    let cap = lc.max_lights_per_tile as usize;
+    let bvh = Bvh::build(&st.scene.positions, &st.scene.indices);
+    let pos = st.r.read(Buffer::Position).unwrap();
+    let nrm = st.r.read(Buffer::Normal).unwrap();
+    let (mut lit, mut close, mut pairs, mut agree, mut false_shadow, mut ray_lit) = (0, 0, 0, 0, 0, 0usize);
+    for y in 0..H {
+        for x in 0..W {
+            let k = (y * W + x) as usize;
+            let g = pos.pixels[k];
+            if g[3] == 0.0 {
+                continue;
+            }
+            let p = Vec3::new(g[0], g[1], g[2]);
+            let nx = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
+            let t = grid.tile_of(x, y) as usize;
+            let list = &lists[t * cap..t * cap + count[t] as usize];
+            let ism_visible = |i: u32| {
+                ism::visible(
+                    layout,
+                    &gpu_atlas,
+                    i,
+                    sv[i as usize].position,
+                    sv[i as usize].normal,
+                    p,
+                    lc.ism.bias,
+                )
+            };
+            let cpu = shade(p, nx, list, &sv, &gl, il, s.gi.distance_epsilon, ism_visible);
+            let gpu = Vec3::from_slice(&raw[k][..3]);
+            if cpu.max_element() > 1e-6 {
+                lit += 1;
+                if (gpu - cpu).abs().max_element() <= 1e-3 * cpu.max_element() {
+                    close += 1;
+                }
+            }
+            // How often the map's answer is the shadow ray's, over the VPLs in range that
+            // face the pixel.
+            let mut ray = visible(&bvh, &sv, p, nx, s.gi.ray_offset);
+            for &i in list {
+                let v = sv[i as usize];
+                let d = v.position - p;
+                let w = d.normalize_or_zero();
+                if gl[i as usize]
+                    .falloff
+                    .eval(d.length_squared(), s.gi.distance_epsilon)
+                    <= 0.0
+                    || nx.dot(w) <= 0.0
+                    || -v.normal.dot(w) <= 0.0
+                {
+                    continue;
+                }
+                pairs += 1;
+                let (a, r) = (ism_visible(i), ray(i));
+                ray_lit += r as usize;
+                if a == r {
+                    agree += 1;
+                } else if r {
+                    false_shadow += 1;
+                }
+            }
+        }
+    }
+    let agreement = agree as f64 / pairs.max(1) as f64;
+    eprintln!(
+        "ISM shading: {close} of {lit} lit pixels within 1e-3 of the CPU; the maps agree with \
+         shadow rays on {agree} of {pairs} VPL-pixel pairs ({:.1}%; of the others {false_shadow} \
+         shadowed by the map, lit by the ray; {ray_lit} lit by the ray)",
+        100.0 * agreement
+    );
+    assert!(lit > 200 && close >= lit * 98 / 100, "{close} of {lit}");
+    // The maps add what a ray sees: they agree with the rays more often than "all lit" does
+    // (lit by the ray: the agreement of no visibility).
+    let base = ray_lit as f64 / pairs.max(1) as f64;
+    assert!(
+        pairs > 1000 && agreement > base + 0.02,
+        "agreement {agreement}, all lit {base}"
+    );
+
+    // The images: with the same seed the variants shade the same VPLs whatever the visibility
+    // (the tree variant: a map per leaf, its VPL resampled as with rays), so the maps' image
+    // is nearer the rays' than the unshadowed one is.
+    let image = |st: &mut Setup, method, vis: Option<bool>| {
+        st.set(|s| {
+            s.gi.method = method;
+            s.gi.shadow_rays = vis.is_some();
+            light_culling::set_visibility(s, vis == Some(true));
+        });
+        st.frame();
+        st.indirect()
+    };
+    for method in [light_culling::ID, light_culling::TREE] {
+        let with_ism = image(&mut st, method, Some(true));
+        let maps = lc_of(&st).ism_targets().map(|(_, m)| m);
+        let with_rays = image(&mut st, method, Some(false));
+        let unshadowed = image(&mut st, method, None);
+        let e_ism = metrics::compare(&with_ism, &with_rays, 3.0, Tonemap::Aces);
+        let e_none = metrics::compare(&unshadowed, &with_rays, 3.0, Tonemap::Aces);
+        eprintln!(
+            "{method}: vs shadow rays, maps RMSE {:.3e} (mean ratio {:.3}), unshadowed RMSE {:.3e} \
+             (mean ratio {:.3}); {maps:?} maps",
+            e_ism.rmse, e_ism.mean_ratio, e_none.rmse, e_none.mean_ratio
+        );
+        assert_eq!(
+            maps,
+            Some(if method == light_culling::TREE {
+                256
+            } else {
+                n as u32
+            })
+        );
+        // Closer per pixel, and at least half the light the rays remove removed.
+        assert!(
+            e_ism.rmse < e_none.rmse
+                && (e_ism.mean_ratio - 1.0).abs() < 0.5 * (e_none.mean_ratio - 1.0).abs(),
+            "{method}: {e_ism:?} vs {e_none:?}"
+        );
+    }
+    assert!(ctx.errors.take().is_empty());
+
+    // More VPLs than maps: refused with a message naming the atlas, nothing drawn.
+    st.set(|s| {
+        s.gi.method = light_culling::ID;
+        s.gi.shadow_rays = true;
+        light_culling::set_visibility(s, true);
+        s.vpl.count = 300;
+    });
+    st.frame();
+    let errors = ctx.errors.take();
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.contains("methods.light-culling.ism.atlas")),
+        "{errors:?}"
+    );
 }

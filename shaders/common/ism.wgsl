@@ -15,8 +15,8 @@ struct IsmParams {
     level_base: u32, // offset of `level` in the pyramid buffer (pull / push)
     per_light: u32,  // 0: point k to map k mod lights; else map m takes per_light points spread over the cloud
     threads: u32,    // splat threads: points, or lights x per_light
+    front_cull: u32, // 1: points whose normal faces the light are left out
     _pad0: u32,
-    _pad1: u32,
 };
 
 const ISM_EMPTY: f32 = 1e30;

@@ -59,6 +59,8 @@ pub enum VisibilityArg {
     None,
     /// A BVH shadow ray per evaluated VPL or sample.
     Rays,
+    /// Imperfect shadow maps, one per VPL (the light-culling methods; others refuse it).
+    Ism,
 }
 
 /// Settings of the tree samplers (override `--settings`).
@@ -91,9 +93,10 @@ pub struct SamplingArgs {
     /// No shadow rays for the ground truth and the tree samplers (every VPL / sample visible).
     #[arg(long)]
     pub no_shadow_rays: bool,
-    /// Visibility of the VPL methods and their ground truth: `rays` (BVH shadow rays) or
+    /// Visibility of the VPL methods and their ground truth: `rays` (BVH shadow rays),
     /// `none` (every VPL visible: the unshadowed estimate, as Stochastic Light Culling's
-    /// figures 1 and 4); the same switch as `--no-shadow-rays`.
+    /// figures 1 and 4; the same switch as `--no-shadow-rays`) or `ism` (the light-culling
+    /// methods look each VPL up in its imperfect shadow map; the ground truth traces rays).
     #[arg(long, value_enum)]
     pub visibility: Option<VisibilityArg>,
     /// GI at half resolution, joint-bilateral upsampled with the similarity S.
@@ -163,7 +166,10 @@ impl SamplingArgs {
             s.gi.shadow_rays = false;
         }
         if let Some(v) = self.visibility {
-            s.gi.shadow_rays = v == VisibilityArg::Rays;
+            s.gi.shadow_rays = v != VisibilityArg::None;
+            if v != VisibilityArg::None {
+                crate::methods::light_culling::set_visibility(s, v == VisibilityArg::Ism);
+            }
         }
         if self.half_res {
             s.sampling.half_resolution = true;
@@ -383,6 +389,15 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     let method = settings.gi.method;
     args.sampling.apply(&mut settings);
+    if args.sampling.visibility == Some(VisibilityArg::Ism) && !crate::methods::light_culling::has_ism(method)
+    {
+        return Err(anyhow!(
+            "--visibility ism: {method} traces shadow rays; imperfect shadow maps serve {}",
+            crate::methods::light_culling::ISM_METHODS
+                .map(|m| m.to_string())
+                .join(", ")
+        ));
+    }
     if args.sampling.frames == 0 {
         return Err(anyhow!("--frames must be at least 1"));
     }

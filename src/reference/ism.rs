@@ -74,6 +74,20 @@ impl IsmLayout {
 /// `count` points on the triangles, uniform in area: stratified over the cumulative area
 /// (point i at (i + xi) / count), then uniform in its triangle. Deterministic in `seed`.
 pub fn sample_points(positions: &[Vec3], indices: &[u32], count: u32, seed: u32) -> Vec<Vec3> {
+    sample_oriented_points(positions, indices, count, seed)
+        .into_iter()
+        .map(|(p, _)| p)
+        .collect()
+}
+
+/// [`sample_points`] with each point's triangle normal ((b - a) x (c - a), normalised; zero
+/// for a degenerate triangle): the orientation front-face culling tests.
+pub fn sample_oriented_points(
+    positions: &[Vec3],
+    indices: &[u32],
+    count: u32,
+    seed: u32,
+) -> Vec<(Vec3, Vec3)> {
     let tri = |t: usize| {
         let i = &indices[3 * t..3 * t + 3];
         [
@@ -101,7 +115,10 @@ pub fn sample_points(positions: &[Vec3], indices: &[u32], count: u32, seed: u32)
             let [a, b, c] = tri(t);
             let (r1, r2) = (u01(pcg_hash(h ^ 0x68e3_1da4)), u01(pcg_hash(h ^ 0x2545_f491)));
             let s = r1.sqrt();
-            a * (1.0 - s) + b * (s * (1.0 - r2)) + c * (s * r2)
+            (
+                a * (1.0 - s) + b * (s * (1.0 - r2)) + c * (s * r2),
+                (b - a).cross(c - a).normalize_or_zero(),
+            )
         })
         .collect()
 }
@@ -146,6 +163,20 @@ pub fn texel_of(uv: Vec2, tile: u32) -> (u32, u32) {
 /// Splats each light's points (`light_points`) into its map, those within its range, the
 /// nearest distance per texel. Twin: `splat_main` in `ism.wgsl`.
 pub fn splat(layout: IsmLayout, lights: &[IsmLight], points: &[Vec3], per_light: u32) -> Vec<f32> {
+    splat_culled(layout, lights, points, None, per_light)
+}
+
+/// [`splat`], and with `normals` front-face culling (Stochastic Light Culling's Program 1,
+/// after Tokuyoshi 2014): a point whose normal faces the light (n . (p - c) < 0) is left
+/// out (a zero normal never is). A lit receiver faces its light, so its own surface's points never shadow it; the
+/// back faces of closed objects still do (a one-sided occluder facing the light does not).
+pub fn splat_culled(
+    layout: IsmLayout,
+    lights: &[IsmLight],
+    points: &[Vec3],
+    normals: Option<&[Vec3]>,
+    per_light: u32,
+) -> Vec<f32> {
     let mut atlas = vec![EMPTY; (layout.atlas * layout.atlas) as usize];
     let n = (lights.len() as u32).min(layout.capacity());
     if points.is_empty() {
@@ -156,6 +187,9 @@ pub fn splat(layout: IsmLayout, lights: &[IsmLight], points: &[Vec3], per_light:
         for k in light_points(m, n, per_light, points.len() as u32) {
             let p = points[k as usize];
             if (p - l.position).length_squared() >= l.range * l.range {
+                continue;
+            }
+            if normals.is_some_and(|n| n[k as usize].dot(p - l.position) < 0.0) {
                 continue;
             }
             if let Some((uv, dist)) = project(l.position, l.normal, p) {

@@ -600,7 +600,7 @@ mod tests {
                         offset_of!(P, shadow_rays),
                         offset_of!(P, stride),
                         offset_of!(P, leaves),
-                        offset_of!(P, _pad),
+                        offset_of!(P, ism_flags),
                     ]
                 },
             ),
@@ -621,8 +621,26 @@ mod tests {
                         offset_of!(P, level_base),
                         offset_of!(P, per_light),
                         offset_of!(P, threads),
+                        offset_of!(P, front_cull),
                         offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
+                    ]
+                },
+            ),
+            (
+                "ism_view.wgsl",
+                "IsmViewParams",
+                size_of::<crate::renderer::passes::ism::GpuIsmViewParams>(),
+                {
+                    use crate::renderer::passes::ism::GpuIsmViewParams as P;
+                    vec![
+                        offset_of!(P, atlas),
+                        offset_of!(P, tile),
+                        offset_of!(P, per_row),
+                        offset_of!(P, maps),
+                        offset_of!(P, lo),
+                        offset_of!(P, hi),
+                        offset_of!(P, scale),
+                        offset_of!(P, cols),
                     ]
                 },
             ),

@@ -23,7 +23,12 @@ pub struct SceneGpu {
     pub bounds: Aabb,
     pub triangle_count: usize,
     pub bvh: Bvh,
+    /// Unique per scene upload: what a method derived from the scene (a point cloud) is
+    /// rebuilt when it changes.
+    pub generation: u64,
 }
+
+static GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
 
 /// Builds the GPU vertex list: one material id per vertex, duplicating a vertex where
 /// triangles of different materials share it.
@@ -300,6 +305,7 @@ impl SceneGpu {
             bounds: scene.bounds,
             triangle_count: scene.triangle_count(),
             bvh,
+            generation: GENERATION.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
     }
 }

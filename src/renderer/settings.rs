@@ -468,10 +468,14 @@ impl<D: PatternDefault> Default for InterleaveSettings<D> {
 }
 
 /// Imperfect shadow maps (`renderer::passes::ism`; the VAL paper's section 5, Ritschel et al.
-/// 2008): a visibility component for methods with many oriented point lights.
+/// 2008): a visibility component for methods with many oriented point lights. A method's
+/// table holds one (`[methods.light-culling.ism]`); `D` names its defaults (the VAL paper's
+/// 128^2 maps sharing the cloud round-robin, or Stochastic Light Culling's adaptive 32^2 maps
+/// of 8192 points each), so that a table setting only some fields keeps the method's
+/// defaults for the others.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct IsmSettings {
+#[serde(default, deny_unknown_fields, bound = "")]
+pub struct IsmSettings<D: IsmDefault = IsmVal> {
     /// Points sampled once on the scene's triangles (area-uniform); map i receives every
     /// N-th of them (N lights) unless `points_per_light` says otherwise. More points: fewer
     /// holes, a slower splat.
@@ -490,25 +494,64 @@ pub struct IsmSettings {
     /// Relative depth bias of the lookup: a point is lit when its distance x (1 - bias) is
     /// at most the map's (the receiver's own points are in the map).
     pub bias: f32,
+    /// Front-face culling (Stochastic Light Culling's Program 1): a map leaves out the points
+    /// whose surface faces its light, so that lit surfaces do not shadow themselves; one-sided
+    /// occluders facing the light then cast no shadow. The VAL paper: off; light culling: on.
+    pub front_face_culling: bool,
+    #[serde(skip)]
+    pub _default: std::marker::PhantomData<D>,
 }
 
-impl Default for IsmSettings {
+/// A method's default map size and sharing (a marker type per default, as
+/// [`PatternDefault`]).
+pub trait IsmDefault: Clone + std::fmt::Debug + PartialEq {
+    const TILE: u32;
+    const POINTS_PER_LIGHT: u32;
+    const FRONT_FACE_CULLING: bool;
+}
+
+/// The VAL paper's: 128^2 maps (1024 in a 4096^2 atlas), the cloud shared round-robin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IsmVal;
+impl IsmDefault for IsmVal {
+    const TILE: u32 = 128;
+    const POINTS_PER_LIGHT: u32 = 0;
+    const FRONT_FACE_CULLING: bool = false;
+}
+
+/// Stochastic Light Culling's adaptive ISMs (section 4.4): 32^2 maps (16384 in a 4096^2
+/// atlas) of 8192 points each.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IsmAdaptive;
+impl IsmDefault for IsmAdaptive {
+    const TILE: u32 = 32;
+    const POINTS_PER_LIGHT: u32 = 8192;
+    const FRONT_FACE_CULLING: bool = true;
+}
+
+impl<D: IsmDefault> Default for IsmSettings<D> {
     fn default() -> Self {
         Self {
             points: 1 << 18,
-            points_per_light: 0,
+            points_per_light: D::POINTS_PER_LIGHT,
             atlas: 4096,
-            tile: 128,
+            tile: D::TILE,
             pull_push_levels: 2,
             // Measured (tests/ism.rs, a plane occluder over a floor, 128^2 maps): 0.03 shadows
             // 3% of the lit floor (a texel keeps the nearest of its points, on a floor seen at
             // a grazing angle several centimetres nearer), 0.05 none.
             bias: 0.05,
+            front_face_culling: D::FRONT_FACE_CULLING,
+            _default: std::marker::PhantomData,
         }
     }
 }
 
-impl IsmSettings {
+impl<D: IsmDefault> IsmSettings<D> {
+    /// Maps the atlas holds.
+    pub fn capacity(&self) -> u32 {
+        (self.atlas / self.tile.max(1)).pow(2)
+    }
     /// The pull-push levels that fit the map.
     pub fn levels(&self) -> u32 {
         self.pull_push_levels.min(self.tile.max(1).ilog2())
@@ -873,7 +916,7 @@ mod tests {
 
     #[test]
     fn ism_settings_refuse_what_the_build_cannot_dispatch() {
-        let ok = IsmSettings::default();
+        let ok: IsmSettings = IsmSettings::default();
         assert!(ok.validate("t").is_ok());
         // Stochastic Light Culling's 16384 maps of 32^2 fit; 65536 maps would not.
         assert!(

@@ -99,6 +99,7 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ),
     ("ism.wgsl", include_str!("../../shaders/ism.wgsl")),
     ("common/ism.wgsl", include_str!("../../shaders/common/ism.wgsl")),
+    ("ism_view.wgsl", include_str!("../../shaders/ism_view.wgsl")),
 ];
 
 /// The shared shaders that are entry points (not include-only files); [`entry_shaders`] adds
@@ -121,6 +122,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "compare_views.wgsl",
     "interleave_filter.wgsl",
     "ism.wgsl",
+    "ism_view.wgsl",
 ];
 
 /// Every WGSL file: the shared ones and those the registered GI methods declare.

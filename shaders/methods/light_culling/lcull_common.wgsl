@@ -19,10 +19,10 @@ struct LcullParams {
     exposure: f32,      // E = 2^display.exposure_ev
     eps: f32,           // gi.distance_epsilon: f(l) = 1 / max(l^2, eps^2)
     ray_offset: f32,
-    shadow_rays: u32,
+    shadow_rays: u32,   // visibility: 0 none, 1 BVH shadow rays, 2 imperfect shadow maps
     stride: u32,        // runs of `stride` consecutive VPLs share an interleaving subset
     leaves: u32,        // the tree variant: leaves of the light tree (a power of two)
-    _pad: u32,
+    ism_flags: u32,     // bit 0: write the VPLs' ISM lights; bit 1: section 4.3's range culling
 };
 
 const LCULL_RANGE_INF: f32 = 1e30;
@@ -72,4 +72,15 @@ fn lcull_members(p: LcullParams, s: u32) -> u32 {
         last = min(rem - j * p.stride, p.stride);
     }
     return full * p.stride + last;
+}
+
+// The VPL's light for its imperfect shadow map (ism_flags bit 0; `renderer::passes::ism`'s
+// layout: (position, squared range: the splat's cut-off; +inf without section 4.3's range
+// culling), (normal, 0)).
+fn lcull_ism_light(p: LcullParams, position: vec3<f32>, normal: vec3<f32>, range: f32) -> array<vec4<f32>, 2> {
+    var r2 = 3.0e38;
+    if (p.ism_flags & 2u) != 0u && range < LCULL_RANGE_INF {
+        r2 = range * range;
+    }
+    return array<vec4<f32>, 2>(vec4<f32>(position, r2), vec4<f32>(normal, 0.0));
 }

@@ -1,6 +1,6 @@
 // Algorithm 1, step 3: per pixel, the VPLs of its tile's list (every VPL of its interleaving
 // subset when the tile is over its cap), each with the stochastic (eq. 2) or clamped fall-off
-// and, with shadow rays on, a BVH shadow ray; the sum x n^2 (the subset is 1 / n^2 of the
+// and, with visibility on, a BVH shadow ray or a lookup in its imperfect shadow map; the sum x n^2 (the subset is 1 / n^2 of the
 // VPLs), demodulated (before albedo / pi), into `raw`. The shared geometry-aware filter
 // (`interleave_filter.wgsl`, section 4.2) then undoes the interleaving into the GI
 // accumulation. Twin: reference::light_culling::shade.
@@ -8,6 +8,7 @@
 #include "common/vpl.wgsl"
 #include "common/vpl_visibility.wgsl"
 #include "methods/light_culling/lcull_common.wgsl"
+#include "common/ism.wgsl"
 
 @group(0) @binding(0) var<uniform> params: LcullParams;
 @group(0) @binding(1) var gb_position: texture_2d<f32>;
@@ -21,6 +22,9 @@
 @group(0) @binding(9) var<storage, read_write> raw: array<vec4<f32>>;
 @group(0) @binding(10) var<storage, read_write> diag: array<vec4<f32>>;
 @group(0) @binding(11) var<storage, read_write> stats: array<atomic<u32>>;
+// The VPLs' imperfect shadow maps (shadow_rays == 2; a dummy otherwise).
+@group(0) @binding(12) var<uniform> ism: IsmParams;
+@group(0) @binding(13) var<storage, read> ism_depth: array<f32>;
 
 #include "common/stats64.wgsl"
 

@@ -1,7 +1,9 @@
 // One VPL's demodulated contribution (without albedo / pi) with its stochastic or clamped
-// fall-off and, with shadow rays on, a BVH shadow ray. Textual include: the including shader
-// declares `params` (LcullParams), `lights` (two vec4 per VPL, lcull_light.wgsl), `vpls`
-// and the BVH. Twin: the body of reference::light_culling::shade.
+// fall-off and, with visibility on, a BVH shadow ray (shadow_rays 1) or a lookup in the VPL's
+// imperfect shadow map (2: map i, common/ism.wgsl). Textual include: the including shader
+// declares `params` (LcullParams), `lights` (two vec4 per VPL, lcull_light.wgsl), `vpls`,
+// the BVH and `ism` / `ism_depth`. Twin: the body of reference::light_culling::shade with
+// its `visible` (a ray, or reference::ism::visible).
 
 struct Term {
     value: vec3<f32>,
@@ -28,7 +30,12 @@ fn term(i: u32, x: vec3<f32>, nx: vec3<f32>) -> Term {
     if cx <= 0.0 || cv <= 0.0 {
         return t;
     }
-    if params.shadow_rays != 0u {
+    if params.shadow_rays == 2u {
+        t.ray = 1u;
+        if !ism_visible(i, v.position.xyz, v.normal, x) {
+            return t;
+        }
+    } else if params.shadow_rays != 0u {
         t.ray = 1u;
         if !vpl_visible(v.position.xyz, v.normal, x, nx, params.ray_offset) {
             return t;

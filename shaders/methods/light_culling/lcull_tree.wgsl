@@ -29,6 +29,7 @@
 #include "common/vpl_visibility.wgsl"
 #include "methods/light_culling/lcull_common.wgsl"
 #include "methods/light_culling/lcull_light.wgsl"
+#include "common/ism.wgsl"
 
 @group(0) @binding(0) var<uniform> params: LcullParams;
 @group(0) @binding(1) var gb_position: texture_2d<f32>;
@@ -48,6 +49,10 @@
 @group(0) @binding(11) var<storage, read_write> raw: array<vec4<f32>>;
 @group(0) @binding(12) var<storage, read_write> diag: array<vec4<f32>>;
 @group(0) @binding(13) var<storage, read_write> stats: array<atomic<u32>>;
+// The leaves' imperfect shadow maps (shadow_rays == 2: map j for leaf j; dummies otherwise).
+@group(0) @binding(14) var<uniform> ism: IsmParams;
+@group(0) @binding(15) var<storage, read> ism_depth: array<f32>;
+@group(0) @binding(16) var<storage, read_write> ism_lights: array<vec4<f32>>;
 
 #include "common/stats64.wgsl"
 #include "methods/light_culling/lcull_term.wgsl"
@@ -68,6 +73,11 @@ fn leaves_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let l = lcull_light(params, vpls[j], j);
     lights[2u * j] = l.position_range;
     lights[2u * j + 1u] = l.falloff;
+    if (params.ism_flags & 1u) != 0u && 2u * j + 1u < arrayLength(&ism_lights) {
+        let m = lcull_ism_light(params, l.position_range.xyz, vpls[j].normal, l.position_range.w);
+        ism_lights[2u * j] = m[0];
+        ism_lights[2u * j + 1u] = m[1];
+    }
     let r = l.position_range.w;
     if r > 0.0 {
         // Up the ancestors while this range is the largest seen there: a thread that finds

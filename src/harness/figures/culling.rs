@@ -5,10 +5,15 @@
 //! per pixel, error, bias and noise; the clamped ranges at the stochastic ones' GPU time
 //! (figure 4's comparison) interpolated from the eps_max sweep; the paper's Table 1 beside our
 //! pass times. Section 5's bounding-sphere-tree variant runs beside them on the same VPLs and
-//! bounds (per-pixel culling, k-entry reservoir lists, one shadow ray).
+//! bounds (per-pixel culling, k-entry reservoir lists, one shadow ray). The stochastic ranges
+//! also run with imperfect shadow maps (sections 4.3-4.4, against the true ground truth), and
+//! with the maps' range culling off (figure 7: the maps' build time with and without it).
 
 use super::*;
-use crate::methods::light_culling::{self as lcull, settings::LightCullingSettings};
+use crate::methods::light_culling::{
+    self as lcull,
+    settings::{CullingVisibility, LightCullingSettings},
+};
 use crate::metrics;
 
 /// The paper's Table 1 (AMD R9 290X, 1920 x 1152, 65,536 VPLs, no shadows), ms:
@@ -27,9 +32,33 @@ pub const PAPER_TABLE_1: [(&[&str], &str, f64); 3] = [
     (&["lcull_filter"], "geometry-aware filtering", 1.00),
 ];
 
+/// A row's visibility: none, shadow rays, or imperfect shadow maps (with or without section
+/// 4.3's range culling).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Vis {
+    None,
+    Rays,
+    Ism,
+    IsmUnculled,
+}
+
+impl Vis {
+    fn label(self) -> &'static str {
+        match self {
+            Vis::None => "none",
+            Vis::Rays => "rays",
+            Vis::Ism => "ism",
+            Vis::IsmUnculled => "ism-unculled",
+        }
+    }
+    fn shadows(self) -> bool {
+        self != Vis::None
+    }
+}
+
 struct Row {
     mode: &'static str,
-    shadows: bool,
+    vis: Vis,
     vpls: u32,
     eps: f64,
     gi_ms: f64,
@@ -42,6 +71,8 @@ struct Row {
     mean_ratio: f64,
     rmse_true: f64,
     passes: Vec<(&'static str, f64)>,
+    /// The maps' build (`lcull_ism`; 0 without maps).
+    ism_ms: f64,
     /// The frame's light-tree build (sst_keys, sst_sort, sst_build, sst_classify): every
     /// method's frame runs it, the tree variant needs it (the other variants do not).
     tree_build_ms: f64,
@@ -65,7 +96,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     // For labels: the f32 setting as written (0.0005, not its f64 widening).
     let eps_label = base.epsilon_max;
     let mut eps_values = o.sweep_values(lcull::ID, 0);
-    if !eps_values.iter().any(|e| (e - base_eps).abs() < 1e-12) {
+    if !eps_values.iter().any(|&e| same_eps(e, base_eps)) {
         eps_values.push(base_eps);
     }
     eps_values.sort_by(f64::total_cmp);
@@ -89,7 +120,8 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     };
     let img = images(dir)?;
     let mut rows: Vec<Row> = Vec::new();
-    let run = |b: &mut Bench, mode: usize, shadows: bool, vpls: u32, eps: f64| -> anyhow::Result<Row> {
+    let run = |b: &mut Bench, mode: usize, vis: Vis, vpls: u32, eps: f64| -> anyhow::Result<Row> {
+        let shadows = vis.shadows();
         let s = with(b, |s| {
             s.gi.method = modes[mode].0;
             s.gi.shadow_rays = shadows;
@@ -98,6 +130,12 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 lcull::ID,
                 &LightCullingSettings {
                     epsilon_max: eps as f32,
+                    visibility: if matches!(vis, Vis::Ism | Vis::IsmUnculled) {
+                        CullingVisibility::Ism
+                    } else {
+                        CullingVisibility::Rays
+                    },
+                    ism_range_culling: vis != Vis::IsmUnculled,
                     ..base.clone()
                 },
             );
@@ -116,15 +154,15 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         });
         let (gi_ms, gi_std) = m.gi_ms();
         eprintln!(
-            "[{}] {} {} VPLs eps {eps}{}: GI {gi_ms:.3} ms GPU, RMSE {:.4e}",
+            "[{}] {} {} VPLs eps {eps}, visibility {}: GI {gi_ms:.3} ms GPU, RMSE {:.4e}",
             b.scene,
             modes[mode].1,
             vpls,
-            if shadows { " shadow rays" } else { "" },
+            vis.label(),
             m.rmse().0
         );
         if vpls == b.base.vpl.count
-            && (eps - base_eps).abs() < 1e-12
+            && same_eps(eps, base_eps)
             && !shadows
             && let Some(x) = &m.indirect
         {
@@ -135,7 +173,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         }
         Ok(Row {
             mode: modes[mode].1,
-            shadows,
+            vis,
             vpls,
             eps,
             gi_ms,
@@ -151,26 +189,38 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 .into_iter()
                 .map(|p| (p, m.pass_ms(&[p]).0))
                 .collect(),
+            ism_ms: if matches!(vis, Vis::Ism | Vis::IsmUnculled) {
+                m.pass_ms(&["lcull_ism"]).0
+            } else {
+                0.0
+            },
             tree_build_ms: m.pass_ms(&TREE_BUILD).0,
         })
     };
-    // Over the VPL count at the base bound, then over the bound at the base count.
+    // Over the VPL count at the base bound, then over the bound at the base count; the maps
+    // with the stochastic ranges (with and without their range culling over the count).
+    // More VPLs than the atlas holds maps: no ISM row (the count is named in the table).
+    let maps = base.ism.capacity();
     for &e in &o.vpl_exponents {
-        for shadows in [false, true] {
+        for vis in [Vis::None, Vis::Rays, Vis::Ism, Vis::IsmUnculled] {
             for mode in 0..modes.len() {
-                rows.push(run(b, mode, shadows, 1 << e, base_eps)?);
+                if matches!(vis, Vis::Ism | Vis::IsmUnculled) && (mode != 0 || 1 << e > maps) {
+                    continue;
+                }
+                rows.push(run(b, mode, vis, 1 << e, base_eps)?);
             }
         }
     }
     for &eps in &eps_values {
-        for shadows in [false, true] {
+        for vis in [Vis::None, Vis::Rays, Vis::Ism] {
             for mode in 0..modes.len() {
-                if (eps - base_eps).abs() < 1e-12
-                    && o.vpl_exponents.iter().any(|&e| 1 << e == b.base.vpl.count)
-                {
+                if same_eps(eps, base_eps) && o.vpl_exponents.iter().any(|&e| 1 << e == b.base.vpl.count) {
                     continue; // measured above
                 }
-                rows.push(run(b, mode, shadows, b.base.vpl.count, eps)?);
+                if vis == Vis::Ism && (mode != 0 || b.base.vpl.count > maps) {
+                    continue;
+                }
+                rows.push(run(b, mode, vis, b.base.vpl.count, eps)?);
             }
         }
     }
@@ -198,12 +248,14 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "filter_ms",
         // The frame's light-tree build (the tree variant needs it; in no variant's GI time).
         "tree_build_ms",
+        // The imperfect shadow maps' build (lcull_ism, in the GI time; 0 without maps).
+        "ism_ms",
     ]);
     for r in &rows {
         let mut cells = vec![
             b.scene.clone(),
             r.mode.to_string(),
-            if r.shadows { "rays" } else { "none" }.to_string(),
+            r.vis.label().to_string(),
             r.vpls.to_string(),
             num(r.eps),
             num(r.gi_ms),
@@ -218,26 +270,28 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         ];
         cells.extend(r.passes.iter().map(|p| num(p.1)));
         cells.push(num(r.tree_build_ms));
+        cells.push(num(r.ism_ms));
         csv.row(cells);
     }
     csv.write(&dir.join("culling.csv"))?;
 
     let series = |pick: &dyn Fn(&Row) -> Option<(f64, f64)>| -> Vec<plot::Series> {
         let mut v = Vec::new();
-        for (c, (mode, shadows)) in [
-            ("stochastic", false),
-            ("clamped", false),
-            ("tree", false),
-            ("stochastic", true),
-            ("clamped", true),
-            ("tree", true),
+        for (c, (mode, vis)) in [
+            ("stochastic", Vis::None),
+            ("clamped", Vis::None),
+            ("tree", Vis::None),
+            ("stochastic", Vis::Rays),
+            ("clamped", Vis::Rays),
+            ("tree", Vis::Rays),
+            ("stochastic", Vis::Ism),
         ]
         .into_iter()
         .enumerate()
         {
             let mut points: Vec<(f64, f64)> = rows
                 .iter()
-                .filter(|r| r.mode == mode && r.shadows == shadows)
+                .filter(|r| r.mode == mode && r.vis == vis)
                 .filter_map(pick)
                 .filter(|p| p.0.is_finite() && p.1.is_finite() && p.0 > 0.0 && p.1 > 0.0)
                 .collect();
@@ -247,7 +301,11 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 v.push(plot::Series {
                     name: format!(
                         "{mode}, {}",
-                        if shadows { "shadow rays" } else { "no visibility" }
+                        match vis {
+                            Vis::None => "no visibility",
+                            Vis::Rays => "shadow rays",
+                            _ => "ISMs",
+                        }
                     ),
                     color: c,
                     points,
@@ -256,7 +314,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         }
         v
     };
-    let at_base_eps = |r: &Row| (r.eps - base_eps).abs() < 1e-12;
+    let at_base_eps = |r: &Row| same_eps(r.eps, base_eps);
     let at_base_n = |r: &Row| r.vpls == b.base.vpl.count;
     plot::lines(
         &dir.join("culling_time_vpls.png"),
@@ -317,13 +375,15 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     );
     for r in rows.iter().filter(|r| at_base_eps(r)) {
         table.push_str(&format!(
-            "  {:<10} {:<5} {:>6} VPLs: GI {:>9.3} ms GPU{}, {:>6.1} VPLs in range/pixel, RMSE {:.4e} (bias {:.2e}), mean ratio {:.3}, RMSE vs true GT {:.4e}\n",
+            "  {:<10} {:<12} {:>6} VPLs: GI {:>9.3} ms GPU{}, {:>6.1} VPLs in range/pixel, RMSE {:.4e} (bias {:.2e}), mean ratio {:.3}, RMSE vs true GT {:.4e}\n",
             r.mode,
-            if r.shadows { "rays" } else { "none" },
+            r.vis.label(),
             r.vpls,
             r.gi_ms,
             if r.mode == "tree" {
                 format!(" (+ {:.3} ms light-tree build)", r.tree_build_ms)
+            } else if r.ism_ms > 0.0 {
+                format!(" (of which {:.3} ms the maps)", r.ism_ms)
             } else {
                 String::new()
             },
@@ -337,13 +397,13 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     // The paper's Table 1 beside our passes, at the largest VPL count without visibility.
     let mut checks = Vec::new();
     let top = o.vpl_exponents.iter().max().map(|&e| 1u32 << e);
-    let find = |mode: &str, shadows: bool, n: u32| {
+    let find = |mode: &str, vis: Vis, n: u32| {
         rows.iter()
-            .find(|r| r.mode == mode && r.shadows == shadows && r.vpls == n && at_base_eps(r))
+            .find(|r| r.mode == mode && r.vis == vis && r.vpls == n && at_base_eps(r))
     };
     let mut t1 = Csv::new(&["scene", "vpls", "paper_pass", "our_passes", "our_ms", "paper_ms"]);
     if let Some(n) = top
-        && let Some(r) = find("stochastic", false, n)
+        && let Some(r) = find("stochastic", Vis::None, n)
     {
         table.push_str(&format!(
             "  Table 1 ({n} VPLs, no visibility; paper: R9 290X, 1920x1152, 65,536 VPLs):\n"
@@ -365,7 +425,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 num(pms),
             ]);
         }
-        if let Some(c) = find("clamped", false, n) {
+        if let Some(c) = find("clamped", Vis::None, n) {
             checks.push(check(
                 b,
                 "stochastic / clamped GI time, most VPLs",
@@ -380,15 +440,58 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         }
     }
     t1.write(&dir.join("culling_table1.csv"))?;
+    // Figure 7: the maps' build with and without the range culling, at the largest count
+    // with maps; the paper's 16,384 AISMs in about 22 ms (R9 290X) beside it.
+    let top_ism = o
+        .vpl_exponents
+        .iter()
+        .map(|&e| 1u32 << e)
+        .filter(|&n| n <= maps)
+        .max();
+    if let Some(n) = top_ism
+        && let (Some(c), Some(u)) = (
+            find("stochastic", Vis::Ism, n),
+            find("stochastic", Vis::IsmUnculled, n),
+        )
+    {
+        table.push_str(&format!(
+            "  Figure 7 ({n} VPLs, {}^2 maps of {} points, front-face culling {}): the maps' build {:.3} ms with range culling, {:.3} ms without (paper: 16,384 AISMs in about 22 ms with it, R9 290X); with the maps RMSE vs the true GT {:.4e}, with shadow rays {:.4e}\n",
+            base.ism.tile,
+            base.ism.points_per_light,
+            if base.ism.front_face_culling { "on" } else { "off" },
+            c.ism_ms,
+            u.ism_ms,
+            c.rmse_true,
+            find("stochastic", Vis::Rays, n).map_or(f64::NAN, |r| r.rmse_true),
+        ));
+        checks.push(check(
+            b,
+            "ISM build with / without range culling, most VPLs",
+            c.ism_ms / u.ism_ms,
+            1.0,
+            false,
+            format!(
+                "GPU timestamps of lcull_ism, median of {} timed frames, {n} VPLs (the paper's fig. 7)",
+                o.timing_frames
+            ),
+        ));
+    }
+    if o.vpl_exponents.iter().any(|&e| 1u32 << e > maps) {
+        table.push_str(&format!(
+            "  (no ISM rows above {maps} VPLs: the atlas holds {maps} maps of {}^2; raise methods.light-culling.ism.atlas)\n",
+            base.ism.tile
+        ));
+    }
     // Figure 4: the clamped ranges at the stochastic ones' time (log-log interpolation over
     // the eps_max sweep), error against the unshadowed truth.
     for shadows in [false, true] {
+        let vis = if shadows { Vis::Rays } else { Vis::None };
         let st = rows
             .iter()
-            .find(|r| r.mode == "stochastic" && r.shadows == shadows && at_base_n(r) && at_base_eps(r));
+            .find(|r| r.mode == "stochastic" && r.vis == vis && at_base_n(r) && at_base_eps(r));
         let mut cl: Vec<(f64, f64, f64)> = rows
             .iter()
-            .filter(|r| r.mode == "clamped" && r.shadows == shadows && at_base_n(r))
+            .filter(|r| r.mode == "clamped" && r.vis == vis && at_base_n(r))
             .map(|r| (r.gi_ms, r.rmse, r.mean_ratio))
             .collect();
         cl.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -405,6 +508,12 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         }
     }
     Ok(Report { table, checks })
+}
+
+/// Whether two error bounds are the same setting (the base bound is an f32 widened to f64, a
+/// sweep value an f64 as typed: 0.0005 is both).
+fn same_eps(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-6 * a.abs().max(b.abs())
 }
 
 /// (rmse, mean ratio) at time `t` on the curve `pts` (time, rmse, ratio; sorted by time),
@@ -434,5 +543,11 @@ mod tests {
         let (r, m) = super::interpolate_at(&pts, 2.0).unwrap();
         assert!((r - 0.5).abs() < 1e-12 && (m - 0.95).abs() < 1e-12);
         assert!(super::interpolate_at(&pts, 8.0).is_none());
+    }
+
+    #[test]
+    fn a_typed_bound_is_the_same_as_its_f32_setting() {
+        assert!(super::same_eps(0.0005, 0.0005f32 as f64));
+        assert!(!super::same_eps(0.0005, 0.0004));
     }
 }

@@ -8,7 +8,9 @@
 //! (de-)interleaved image (section 4.2) collect the VPLs whose range spheres touch them;
 //! pixels sum their tile's list; the geometry-aware filter undoes the interleaving. The
 //! clamped baseline uses deterministic ranges from the same bound (appendix A): it darkens.
-//! Visibility: `gi.shadow_rays` (BVH shadow rays, or none as the paper's figures 1 and 4).
+//! Visibility: `gi.shadow_rays` (none, as the paper's figures 1 and 4), then
+//! `visibility`: BVH shadow rays, or one imperfect shadow map per VPL built each frame with
+//! the points beyond its range culled (section 4.3, the shared `passes::ism`).
 //!
 //! Passes: `pass.rs`; CPU twins: `crate::reference::light_culling`; docs/light-culling.md.
 
@@ -22,6 +24,7 @@ use super::{
 };
 use crate::reference::light_culling::{Interleave, TileGrid};
 use crate::renderer::passes::interleave_filter::GpuFilterParams;
+use crate::renderer::passes::ism::{IsmPoints, IsmTargets};
 use crate::renderer::{
     context::{GpuContext, GpuError},
     readback::{self, ImageF32},
@@ -29,10 +32,10 @@ use crate::renderer::{
     shaders::ShaderError,
 };
 use pass::{
-    FrameInputs, GpuLcullParams, GpuLcullViewParams, LcullBuffers, LcullPass, LcullStats, TreeCullBuffers,
-    TreeInputs,
+    FrameInputs, GpuLcullParams, GpuLcullViewParams, IsmFrame, LcullBuffers, LcullPass, LcullStats,
+    TreeCullBuffers, TreeInputs, VISIBILITY_ISM,
 };
-use settings::LightCullingSettings;
+use settings::{IsmAdaptive, IsmSettings, LightCullingSettings};
 
 /// The paper's stochastic light culling.
 pub const ID: MethodId = MethodId::new("light-culling");
@@ -84,6 +87,21 @@ pub const IN_RANGE: MethodView = MethodView::new("culling list share in range");
 pub const DIFFERENCE: MethodView = MethodView::new("culling clamped vs stochastic");
 /// The difference view's colour scale: relative differences of +-this map to its ends.
 pub const DIFFERENCE_RANGE: f32 = 0.5;
+/// The VPLs' imperfect shadow maps (the atlas; built while drawn even with rays).
+pub const ISM_ATLAS: MethodView = MethodView::new("culling ISM atlas");
+/// Seed of the scene's point cloud for the maps.
+pub const ISM_CLOUD_SEED: u32 = 0x15a1;
+
+const ISM_VIEW: ViewInfo = ViewInfo {
+    name: ISM_ATLAS.name(),
+    file: "culling_ism_atlas",
+    about: "the VPLs' imperfect shadow maps (one 32^2 paraboloid map per VPL, section 4.4's \
+            AISMs, points beyond the VPL's range culled): distance on a log scale, texels \
+            pull-push filled at half brightness, holes black; built each frame with ISM \
+            visibility, or while this view is shown",
+    passes: &["lcull_ism"],
+};
+
 /// The tree variant: VPLs in range of the pixel (log heat map).
 pub const TREE_IN_RANGE: MethodView = MethodView::new("culling tree VPLs in range");
 /// The tree variant: nodes its traversal visited (log heat map).
@@ -103,6 +121,7 @@ const TREE_VIEWS: &[ViewInfo] = &[
         about: "bounding-sphere-tree nodes the pixel's traversal visited, log scale",
         passes: &["lcull_tree_traverse"],
     },
+    ISM_VIEW,
 ];
 
 /// Range spheres drawn for the pinned pixel's tile at most (those holding the pixel first).
@@ -143,6 +162,7 @@ const VIEWS: &[ViewInfo] = &[
                 image; while shown, diagnostic frames also run the other variant",
         passes: &["lcull_companion_shade"],
     },
+    ISM_VIEW,
 ];
 
 fn invalid_example(s: &mut RenderSettings) -> &'static str {
@@ -156,10 +176,13 @@ const TESTS: &[&str] = &[
     "light_culling::gpu_ranges_and_tile_lists_equal_the_cpu_reference",
     "light_culling::gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing",
     "light_culling::the_mean_over_frames_converges_to_the_unshadowed_ground_truth_and_clamping_darkens",
+    "light_culling::ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays",
 ];
 
-const TREE_TESTS: &[&str] =
-    &["light_culling::the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_truth"];
+const TREE_TESTS: &[&str] = &[
+    "light_culling::the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_truth",
+    "light_culling::ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays",
+];
 
 pub static INFO: MethodInfo = MethodInfo {
     id: ID,
@@ -173,7 +196,13 @@ pub static INFO: MethodInfo = MethodInfo {
     module: &MODULE,
     reads: &[Resource::Gbuffer, Resource::Vpls, Resource::Bvh],
     views: VIEWS,
-    timed_passes: &["lcull_ranges", "lcull_tiles", "lcull_shade", "lcull_filter"],
+    timed_passes: &[
+        "lcull_ranges",
+        "lcull_ism",
+        "lcull_tiles",
+        "lcull_shade",
+        "lcull_filter",
+    ],
     story: false,
     shadow_ray_switch: true,
     truth_of_vpls: false,
@@ -196,7 +225,13 @@ pub static CLAMPED_INFO: MethodInfo = MethodInfo {
     module: &MODULE,
     reads: &[Resource::Gbuffer, Resource::Vpls, Resource::Bvh],
     views: VIEWS,
-    timed_passes: &["lcull_ranges", "lcull_tiles", "lcull_shade", "lcull_filter"],
+    timed_passes: &[
+        "lcull_ranges",
+        "lcull_ism",
+        "lcull_tiles",
+        "lcull_shade",
+        "lcull_filter",
+    ],
     story: false,
     shadow_ray_switch: true,
     truth_of_vpls: false,
@@ -223,6 +258,7 @@ pub static TREE_INFO: MethodInfo = MethodInfo {
     views: TREE_VIEWS,
     timed_passes: &[
         "lcull_tree_leaves",
+        "lcull_ism",
         "lcull_tree_traverse",
         "lcull_tree_shade",
         "lcull_filter",
@@ -249,6 +285,29 @@ pub static SWEEP: super::Sweep = super::Sweep {
     integer: false,
 };
 
+/// The methods that can look VPLs up in imperfect shadow maps (`render --visibility ism`).
+pub const ISM_METHODS: [MethodId; 3] = [ID, CLAMPED, TREE];
+
+/// Whether `m` can use ISM visibility.
+pub fn has_ism(m: MethodId) -> bool {
+    ISM_METHODS.contains(&m)
+}
+
+/// Sets light culling's visibility (while `gi.shadow_rays` is on): maps or rays.
+pub fn set_visibility(s: &mut RenderSettings, ism: bool) {
+    // A malformed table is left for validation to name.
+    let Ok(mut lc) = s.method::<LightCullingSettings>(ID) else {
+        return;
+    };
+    lc.visibility = if ism {
+        settings::CullingVisibility::Ism
+    } else {
+        settings::CullingVisibility::Rays
+    };
+    // Cannot fail: the struct serialises to a table.
+    let _ = s.set_method(ID, &lc);
+}
+
 fn validate(s: &RenderSettings) -> Result<(), String> {
     s.method::<LightCullingSettings>(ID)?.validate()
 }
@@ -268,6 +327,16 @@ pub struct LightCulling {
     /// The difference view's companion (the other variant) accumulation, alike.
     companion: Option<(u64, MethodId, u32)>,
     settings: LightCullingSettings,
+    /// The scene's point cloud for the maps and the scene upload it was sampled from.
+    ism_points: Option<(u64, IsmPoints)>,
+    ism_targets: Option<IsmTargets>,
+    /// Maps built by the last frame (0: none).
+    ism_maps: u32,
+    /// Whether the last frame looked its VPLs up in the maps (else rays or none).
+    ism_on: bool,
+    /// The atlas view's linear data (its size, the buffer).
+    ism_view_data: Option<((u32, u32), wgpu::Buffer)>,
+    scene_radius: f32,
 }
 
 fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
@@ -278,7 +347,32 @@ fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
         state: None,
         companion: None,
         settings: LightCullingSettings::default(),
+        ism_points: None,
+        ism_targets: None,
+        ism_maps: 0,
+        ism_on: false,
+        ism_view_data: None,
+        scene_radius: 1.0,
     }))
+}
+
+/// The frame's maps to build, borrowing the method's ISM state.
+fn ism_frame<'a>(
+    settings: &'a IsmSettings<IsmAdaptive>,
+    points: &'a Option<(u64, IsmPoints)>,
+    targets: &'a Option<IsmTargets>,
+    maps: u32,
+    build: bool,
+) -> Option<IsmFrame<'a>> {
+    let (Some((_, points)), Some(targets)) = (points.as_ref(), targets.as_ref()) else {
+        return None;
+    };
+    build.then_some(IsmFrame {
+        settings,
+        points,
+        targets,
+        maps: maps.min(targets.capacity),
+    })
 }
 
 impl LightCulling {
@@ -332,6 +426,67 @@ impl LightCulling {
     /// Counters of a recent diagnostic frame (non-blocking).
     pub fn poll_stats(&mut self) -> Option<LcullStats> {
         self.pass.stats.poll()
+    }
+    /// The imperfect shadow maps of the last frame that built them (None before), and how
+    /// many maps it built.
+    pub fn ism_targets(&self) -> Option<(&IsmTargets, u32)> {
+        self.ism_targets.as_ref().map(|t| (t, self.ism_maps))
+    }
+    /// The scene's point cloud and the (points, seed) it was sampled with.
+    pub fn ism_points(&self) -> Option<&IsmPoints> {
+        self.ism_points.as_ref().map(|(_, p)| p)
+    }
+
+    /// The point cloud and the atlas for `s` on the frame's scene (rebuilt when either
+    /// changed).
+    fn ensure_ism(&mut self, cx: &FrameCx<'_>, s: &IsmSettings<IsmAdaptive>) {
+        let key = (s.points, ISM_CLOUD_SEED);
+        let generation = cx.scene.generation;
+        if !matches!(&self.ism_points, Some((g, p)) if *g == generation && p.key == key) {
+            let points =
+                IsmPoints::from_bvh(cx.device, cx.queue, &cx.scene.bvh, s.points, ISM_CLOUD_SEED, key);
+            self.ism_points = Some((generation, points));
+        }
+        if !self.ism_targets.as_ref().is_some_and(|t| t.matches(s)) {
+            self.ism_targets = Some(IsmTargets::new(cx.device, s));
+        }
+    }
+
+    /// The frame's visibility and maps: (GpuLcullParams::shadow_rays, ism_flags, maps to
+    /// build); None (reported) when ISM visibility needs more maps than the atlas holds.
+    fn plan_ism(
+        &mut self,
+        cx: &FrameCx<'_>,
+        lc: &LightCullingSettings,
+        maps: u32,
+    ) -> Option<(u32, u32, u32)> {
+        let on = lc.uses_ism(cx.settings.gi.shadow_rays);
+        let shown = cx.diagnostics && cx.views.contains(&ISM_ATLAS);
+        let rays = if on {
+            VISIBILITY_ISM
+        } else {
+            cx.settings.gi.shadow_rays as u32
+        };
+        if on && maps > lc.ism.capacity() {
+            cx.errors.report(format!(
+                "light culling: ISM visibility needs a map per VPL ({maps}), but an atlas of {} \
+                 with {} x {} maps holds {} (raise methods.light-culling.ism.atlas, lower \
+                 ism.tile or the VPL count)",
+                lc.ism.atlas,
+                lc.ism.tile,
+                lc.ism.tile,
+                lc.ism.capacity()
+            ));
+            return None;
+        }
+        self.ism_on = on;
+        if !(on || shown) {
+            self.ism_maps = 0;
+            return Some((rays, 0, 0));
+        }
+        self.ensure_ism(cx, &lc.ism);
+        self.ism_maps = maps.min(lc.ism.capacity());
+        Some((rays, 1 | (lc.ism_range_culling as u32) << 1, self.ism_maps))
     }
 }
 
@@ -393,6 +548,13 @@ impl LightCulling {
             nodes: &cx.tree.nodes,
             sorted_vpls: &cx.tree.sorted_vpls,
         };
+        let ism = ism_frame(
+            &self.settings.ism,
+            &self.ism_points,
+            &self.ism_targets,
+            self.ism_maps,
+            tp.ism_flags & 1 != 0,
+        );
         self.pass.record_tree(
             cx.diagnostics,
             cx.device,
@@ -405,6 +567,7 @@ impl LightCulling {
             &tree,
             &self.buffers,
             t,
+            ism.as_ref(),
         );
         1.0 / frames as f32
     }
@@ -447,9 +610,17 @@ impl Method for LightCulling {
             Some((k, m, n)) if s.sampling.accumulate && k == cx.key && m == cx.method => n + 1,
             _ => 1,
         };
-        self.state = Some((cx.key, cx.method, frames));
         let seed = Self::seed(s, cx.frame_index);
         let count = cx.vpl_frame.count.min(vpl_capacity);
+        self.scene_radius = cx.scene_radius;
+        let maps = if tree { cx.tree.leaves.max(1) } else { count };
+        let Some((visibility, ism_flags, _)) = self.plan_ism(cx, &lc, maps) else {
+            enc.clear_buffer(cx.gi_accum, 0, None);
+            self.state = None;
+            self.companion = None;
+            return 1.0;
+        };
+        self.state = Some((cx.key, cx.method, frames));
         let il = Interleave::new(lc.interleave.n, count, seed);
         let p = GpuLcullParams {
             width: cx.size.0,
@@ -468,10 +639,10 @@ impl Method for LightCulling {
             exposure: s.display.exposure_ev.exp2(),
             eps: s.gi.distance_epsilon,
             ray_offset: s.gi.ray_offset,
-            shadow_rays: s.gi.shadow_rays as u32,
+            shadow_rays: visibility,
             stride: il.stride,
             leaves: 0,
-            _pad: 0,
+            ism_flags,
         };
         // The filter: raw (before albedo / pi) x albedo / pi into the accumulation.
         let fp = GpuFilterParams {
@@ -512,6 +683,13 @@ impl Method for LightCulling {
                 vpls: &cx.vpl_buffers.vpls,
                 accum: &companion.accum,
             };
+            let ism = ism_frame(
+                &self.settings.ism,
+                &self.ism_points,
+                &self.ism_targets,
+                self.ism_maps,
+                ism_flags & 1 != 0,
+            );
             self.pass.record(
                 true,
                 true,
@@ -523,6 +701,7 @@ impl Method for LightCulling {
                 cfp,
                 &inputs,
                 &self.buffers,
+                ism.as_ref(),
             );
         }
         let inputs = FrameInputs {
@@ -532,6 +711,13 @@ impl Method for LightCulling {
             vpls: &cx.vpl_buffers.vpls,
             accum: cx.gi_accum,
         };
+        let ism = ism_frame(
+            &self.settings.ism,
+            &self.ism_points,
+            &self.ism_targets,
+            self.ism_maps,
+            ism_flags & 1 != 0,
+        );
         self.pass.record(
             false,
             cx.diagnostics,
@@ -543,6 +729,7 @@ impl Method for LightCulling {
             fp,
             &inputs,
             &self.buffers,
+            ism.as_ref(),
         );
         1.0 / frames as f32
     }
@@ -560,11 +747,43 @@ impl Method for LightCulling {
         self.companion = None;
     }
 
-    fn view_size(&self, _view: MethodView, frame: (u32, u32)) -> Option<(u32, u32)> {
+    fn view_size(&self, view: MethodView, frame: (u32, u32)) -> Option<(u32, u32)> {
+        if view == ISM_ATLAS && (self.ism_maps == 0 || self.ism_targets.is_none()) {
+            return None;
+        }
         (self.buffers.size == frame && self.state.is_some()).then_some(frame)
     }
 
     fn record_view(&mut self, view: MethodView, cx: &mut ViewCx<'_>, enc: &mut wgpu::CommandEncoder) {
+        if view == ISM_ATLAS {
+            let size = self.buffers.size;
+            if self.ism_view_data.as_ref().is_none_or(|(s, _)| *s != size) {
+                let bytes = 16 * size.0 as u64 * size.1 as u64;
+                let data = cx.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("lcull::ism_view_data"),
+                    size: bytes.max(16),
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                });
+                self.ism_view_data = Some((size, data));
+            }
+            if let (Some(t), Some((_, data))) = (self.ism_targets.as_ref(), self.ism_view_data.as_ref()) {
+                let r = self.scene_radius;
+                self.pass.ism.record_view(
+                    cx.device,
+                    cx.queue,
+                    enc,
+                    cx.timer,
+                    t,
+                    self.ism_maps,
+                    (0.005 * r, 2.0 * r),
+                    size,
+                    cx.dst,
+                    data,
+                );
+            }
+            return;
+        }
         let p = GpuLcullViewParams {
             mode: if view == LIST || view == TREE_IN_RANGE {
                 0
@@ -611,6 +830,12 @@ impl Method for LightCulling {
         if self.state.is_none() {
             return Ok(None);
         }
+        if view == ISM_ATLAS {
+            return match self.ism_view_data.as_ref() {
+                Some((size, data)) if self.ism_maps > 0 => readback::read_vec4_image(ctx, data, *size),
+                _ => Ok(None),
+            };
+        }
         if view == DIFFERENCE {
             return match self.buffers.companion.as_ref() {
                 Some(c) if self.companion_frames().is_some() => {
@@ -636,9 +861,9 @@ impl Method for LightCulling {
         let d = readback::read_vec4_pixel(ctx, &b.diag, b.size.0, x, y)?;
         Ok(vec![(
             if self.is_tree() {
-                "tree culling (VPLs in range, listed, nodes visited, shadow rays)"
+                "tree culling (VPLs in range, listed, nodes visited, shadow rays or ISM lookups)"
             } else {
-                "light culling (tile list, VPLs in range, VPLs tested, shadow rays)"
+                "light culling (tile list, VPLs in range, VPLs tested, shadow rays or ISM lookups)"
             },
             d,
         )])
@@ -810,6 +1035,20 @@ impl Method for LightCulling {
     }
 
     fn legend(&self, view: MethodView, _tree_levels: u32) -> Option<Legend> {
+        if view == ISM_ATLAS {
+            let r = self.scene_radius;
+            let tile = self.ism_targets.as_ref().map_or(0, |t| t.layout.tile);
+            return Some(Legend {
+                title: format!(
+                    "distance from the VPL ({} maps of {tile}^2; dim: filled by pull-push; black: \
+                     hole)",
+                    self.ism_maps
+                ),
+                lo: (0.005 * r).log10(),
+                hi: (2.0 * r).log10(),
+                log: true,
+            });
+        }
         let st = self.pass.stats.last();
         let top = self.view_decades(view) as f32;
         if view == TREE_IN_RANGE {
@@ -911,6 +1150,7 @@ impl Method for LightCulling {
                 ("shadow_rays_per_pixel", st.rays_per_pixel()),
                 ("epsilon_max", self.settings.epsilon_max as f64),
                 ("reservoir_k", self.settings.reservoir_k as f64),
+                ("ism_maps", if self.ism_on { self.ism_maps as f64 } else { 0.0 }),
             ],
             Some(st) => vec![
                 ("mean_tile_list", st.mean_list()),
@@ -921,6 +1161,7 @@ impl Method for LightCulling {
                 ("shadow_rays_per_pixel", st.rays_per_pixel()),
                 ("epsilon_max", self.settings.epsilon_max as f64),
                 ("interleave", self.settings.interleave.n as f64),
+                ("ism_maps", if self.ism_on { self.ism_maps as f64 } else { 0.0 }),
             ],
             None => Vec::new(),
         }
@@ -928,10 +1169,15 @@ impl Method for LightCulling {
 
     fn status(&mut self) -> Option<String> {
         let st = self.pass.stats.poll()?;
+        let vis = if self.ism_on {
+            format!("ISM lookups per pixel ({} maps)", self.ism_maps)
+        } else {
+            "shadow rays per pixel".to_string()
+        };
         if self.is_tree() {
             return Some(format!(
                 "tree culling {:.1} VPLs in range per pixel (most {}; {} pixels over k = {}) · \
-                 {:.1} nodes visited · {:.2} shadow rays per pixel",
+                 {:.1} nodes visited · {:.2} {vis}",
                 st.in_range_per_pixel(),
                 st.longest_list,
                 st.overflow_tiles,
@@ -942,7 +1188,7 @@ impl Method for LightCulling {
         }
         Some(format!(
             "culling {:.1} lights per tile (longest {}, {} over the cap of {}) · {:.1} in range \
-             per pixel · {:.1} shadow rays per pixel",
+             per pixel · {:.1} {vis}",
             st.mean_list(),
             st.longest_list,
             st.overflow_tiles,

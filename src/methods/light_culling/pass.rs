@@ -1,18 +1,21 @@
 //! Stochastic Light Culling's GPU passes, in frame order (Algorithm 1 of the paper):
-//! `lcull_ranges` (per VPL: fall-off and range), `lcull_tiles` (per tile: depth bounds and the
-//! light list), `lcull_shade` (per pixel: the list's VPLs, demodulated), `lcull_filter` (the
+//! `lcull_ranges` (per VPL: fall-off and range; with ISM visibility also its map's light),
+//! `lcull_ism` (with ISM visibility: the VPLs' imperfect shadow maps, the shared
+//! `passes::ism`), `lcull_tiles` (per tile: depth bounds and the light list), `lcull_shade` (per pixel: the list's VPLs, demodulated), `lcull_filter` (the
 //! interleaving's geometry-aware filter, x albedo / pi, into the GI accumulation: the shared
 //! `passes::interleave_filter`), and the views.
 //! Reads: the VPLs, G-buffer, camera, BVH. CPU twins: `crate::reference::light_culling`.
 
 use bytemuck::{Pod, Zeroable};
 
+use super::settings::{IsmAdaptive, IsmSettings};
 use crate::methods::lightcut_interpolation::pass::groups_1d_as_2d;
 use crate::renderer::{
     frame::GbufferTargets,
     passes::{
         WG_1D, bind_group_seq, compute_pipeline_with, float_texture_entry, groups_image,
         interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
+        ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
         run_compute, storage_buffer, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
     },
     readback::CounterReadback,
@@ -45,12 +48,19 @@ pub struct GpuLcullParams {
     pub exposure: f32,
     pub eps: f32,
     pub ray_offset: f32,
+    /// Visibility: 0 none, 1 BVH shadow rays, 2 imperfect shadow maps.
     pub shadow_rays: u32,
     pub stride: u32,
     /// The tree variant: leaves of the light tree.
     pub leaves: u32,
-    pub _pad: u32,
+    /// Bit 0: the ranges pass writes the VPLs' ISM lights (the maps are built: ISM
+    /// visibility, or the atlas view); bit 1: a map leaves out the points beyond its VPL's
+    /// range (section 4.3).
+    pub ism_flags: u32,
 }
+
+/// `GpuLcullParams::shadow_rays` of ISM visibility.
+pub const VISIBILITY_ISM: u32 = 2;
 
 /// Twin: `LcullViewParams` in `lcull_views.wgsl`.
 #[repr(C)]
@@ -257,14 +267,31 @@ impl FrameInputs<'_> {
     }
 }
 
+/// The frame's imperfect shadow maps (ISM visibility, or drawn by the atlas view): built
+/// after the ranges from the lights they wrote, one map per VPL (the tree: per leaf).
+pub struct IsmFrame<'a> {
+    pub settings: &'a IsmSettings<IsmAdaptive>,
+    pub points: &'a IsmPoints,
+    pub targets: &'a IsmTargets,
+    /// Maps to build (the frame's VPLs or leaves; at most the atlas's capacity).
+    pub maps: u32,
+}
+
 /// Timer names of a run's passes: the method's own, and the difference view's companion
 /// (diagnostic frames only, so never in a timed frame's GI cost).
-const OWN_PASSES: [&str; 4] = ["lcull_ranges", "lcull_tiles", "lcull_shade", "lcull_filter"];
-const COMPANION_PASSES: [&str; 4] = [
+const OWN_PASSES: [&str; 5] = [
+    "lcull_ranges",
+    "lcull_tiles",
+    "lcull_shade",
+    "lcull_filter",
+    "lcull_ism",
+];
+const COMPANION_PASSES: [&str; 5] = [
     "lcull_companion_ranges",
     "lcull_companion_tiles",
     "lcull_companion_shade",
     "lcull_companion_filter",
+    "lcull_companion_ism",
 ];
 
 pub struct LcullPass {
@@ -291,6 +318,12 @@ pub struct LcullPass {
     views: wgpu::ComputePipeline,
     view_params: wgpu::Buffer,
     pub stats: CounterReadback<LcullStats>,
+    /// The imperfect shadow maps' build (and the atlas view).
+    pub ism: IsmPass,
+    /// The lookups' parameters (`GpuIsmParams`, level 0).
+    ism_params: wgpu::Buffer,
+    /// Bound in the maps' place without ISM visibility: depth (read) and lights (written).
+    ism_dummy: [wgpu::Buffer; 2],
 }
 
 impl LcullPass {
@@ -313,6 +346,7 @@ impl LcullPass {
                 uniform_entry(0, c),
                 storage_entry(1, c, true),
                 storage_entry(2, c, false),
+                storage_entry(3, c, false),
             ],
         );
         let tiles_layout = layout(
@@ -331,6 +365,7 @@ impl LcullPass {
         se.extend((1..=2).map(float_texture_entry));
         se.extend((3..=8).map(|b| storage_entry(b, c, true)));
         se.extend((9..=11).map(|b| storage_entry(b, c, false)));
+        se.extend([uniform_entry(12, c), storage_entry(13, c, true)]);
         let shade_layout = layout("lcull_shade::layout", &se);
         let mut te = vec![
             uniform_entry(0, c),
@@ -339,6 +374,11 @@ impl LcullPass {
         ];
         te.extend((3..=6).map(|b| storage_entry(b, c, true)));
         te.extend((7..=13).map(|b| storage_entry(b, c, false)));
+        te.extend([
+            uniform_entry(14, c),
+            storage_entry(15, c, true),
+            storage_entry(16, c, false),
+        ]);
         let tree_layout = layout("lcull_tree::layout", &te);
         let views_layout = layout(
             "lcull_views::layout",
@@ -401,7 +441,30 @@ impl LcullPass {
                 (STATS_WORDS * 4) as u64,
                 LcullStats::from_words,
             ),
+            ism: IsmPass::new(device)?,
+            ism_params: uniform_buffer::<GpuIsmParams>(device, "lcull::ism_params"),
+            ism_dummy: [
+                storage_buffer(device, "lcull::ism_dummy_depth", 16),
+                storage_buffer(device, "lcull::ism_dummy_lights", 32),
+            ],
         })
+    }
+
+    /// The maps' depth and lights buffers to bind (dummies without maps); writes the lookups'
+    /// parameters.
+    fn ism_bindings<'b>(
+        &'b self,
+        queue: &wgpu::Queue,
+        ism: Option<&'b IsmFrame<'b>>,
+    ) -> (&'b wgpu::Buffer, &'b wgpu::Buffer) {
+        match ism {
+            Some(m) => {
+                let p = GpuIsmParams::new(m.targets, m.settings, m.maps, m.points.count);
+                queue.write_buffer(&self.ism_params, 0, bytemuck::bytes_of(&p));
+                (&m.targets.depth, &m.targets.lights)
+            }
+            None => (&self.ism_dummy[0], &self.ism_dummy[1]),
+        }
     }
 
     /// Records the frame's passes (module doc); `fp` the filter's parameters. `companion`:
@@ -421,6 +484,7 @@ impl LcullPass {
         fp: GpuFilterParams,
         f: &FrameInputs<'_>,
         b: &LcullBuffers,
+        ism: Option<&IsmFrame<'_>>,
     ) {
         let diagnostics = diagnostics && !companion;
         let (params, filter_params, names) = if companion {
@@ -435,6 +499,7 @@ impl LcullPass {
         queue.write_buffer(params, 0, bytemuck::bytes_of(&p));
         let tv = wgpu::BindingResource::TextureView;
         let g = f.gbuffer;
+        let (ism_depth, ism_lights) = self.ism_bindings(queue, ism);
         let rbind = bind_group_seq(
             device,
             "lcull_ranges::bind_group",
@@ -443,10 +508,17 @@ impl LcullPass {
                 params.as_entire_binding(),
                 f.vpls.as_entire_binding(),
                 b.lights.as_entire_binding(),
+                ism_lights.as_entire_binding(),
             ],
         );
         let (gx, gy) = groups_1d_as_2d(p.count.div_ceil(WG_1D).max(1));
         run_compute(encoder, timer, names[0], &self.ranges, &rbind, (gx, gy, 1));
+        let sbind = self.shade_bind_group(device, params, f, b, ism_depth);
+        if let Some(m) = ism {
+            let (ms, mp, mt) = (m.settings, m.points, m.targets);
+            self.ism
+                .record_maps(device, queue, encoder, timer, names[4], ms, mp, m.maps, mt);
+        }
 
         if diagnostics {
             encoder.clear_buffer(&b.stats, 0, None);
@@ -473,7 +545,6 @@ impl LcullPass {
         };
         run_compute(encoder, timer, names[1], tiles, &tbind, (tx, ty, 1));
 
-        let sbind = self.shade_bind_group(device, params, f, b);
         let shade = if diagnostics {
             &self.shade
         } else {
@@ -504,6 +575,7 @@ impl LcullPass {
         params: &wgpu::Buffer,
         f: &FrameInputs<'_>,
         b: &LcullBuffers,
+        ism_depth: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
         let tv = wgpu::BindingResource::TextureView;
         let g = f.gbuffer;
@@ -524,6 +596,8 @@ impl LcullPass {
                 b.raw.as_entire_binding(),
                 b.diag.as_entire_binding(),
                 b.stats.as_entire_binding(),
+                self.ism_params.as_entire_binding(),
+                ism_depth.as_entire_binding(),
             ],
         )
     }
@@ -545,8 +619,10 @@ impl LcullPass {
         tree: &TreeInputs<'_>,
         b: &LcullBuffers,
         t: &TreeCullBuffers,
+        ism: Option<&IsmFrame<'_>>,
     ) {
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let (ism_depth, ism_lights) = self.ism_bindings(queue, ism);
         let tv = wgpu::BindingResource::TextureView;
         let g = f.gbuffer;
         encoder.clear_buffer(&t.max_range, 0, None);
@@ -572,6 +648,9 @@ impl LcullPass {
                 b.raw.as_entire_binding(),
                 b.diag.as_entire_binding(),
                 b.stats.as_entire_binding(),
+                self.ism_params.as_entire_binding(),
+                ism_depth.as_entire_binding(),
+                ism_lights.as_entire_binding(),
             ],
         );
         let (gx, gy) = groups_1d_as_2d(p.leaves.div_ceil(WG_1D).max(1));
@@ -583,6 +662,11 @@ impl LcullPass {
             &bind,
             (gx, gy, 1),
         );
+        if let Some(m) = ism {
+            let (ms, mp, mt) = (m.settings, m.points, m.targets);
+            self.ism
+                .record_maps(device, queue, encoder, timer, "lcull_ism", ms, mp, m.maps, mt);
+        }
         let groups = groups_image(p.width, p.height);
         let (traverse, shade) = if diagnostics {
             (&self.tree_traverse, &self.tree_shade)

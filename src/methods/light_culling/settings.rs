@@ -4,7 +4,9 @@
 
 use serde::{Deserialize, Serialize};
 
-pub use crate::renderer::settings::{Interleave8, InterleaveSettings, MAX_FILTER_RADIUS};
+pub use crate::renderer::settings::{
+    Interleave8, InterleaveSettings, IsmAdaptive, IsmSettings, MAX_FILTER_RADIUS,
+};
 
 /// Largest interleaving pattern edge (n x n subsets).
 pub const MAX_INTERLEAVE: u32 = 16;
@@ -12,6 +14,19 @@ pub const MAX_INTERLEAVE: u32 = 16;
 pub const MAX_LIST: u32 = 1 << 16;
 /// Largest per-pixel light list of the tree variant (its reservoir's k).
 pub const MAX_RESERVOIR: u32 = 256;
+
+/// How a VPL's visibility is tested while `gi.shadow_rays` is on (`render --visibility
+/// rays|ism`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CullingVisibility {
+    /// A BVH shadow ray per VPL in range (exact).
+    #[default]
+    Rays,
+    /// A lookup in the VPL's imperfect shadow map (section 4.4's AISMs, built each frame
+    /// from the scene's point cloud with section 4.3's culling by the VPL's range; `ism`).
+    Ism,
+}
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -42,6 +57,18 @@ pub struct LightCullingSettings {
     /// The tree variant's geometry-aware filter radius (it has no interleaving to undo;
     /// the paper's path tracer filters nothing: 0).
     pub tree_filter_radius: u32,
+    /// Visibility while `gi.shadow_rays` is on: BVH shadow rays, or imperfect shadow maps
+    /// (one per VPL, `ism`). The ground truth always traces rays, so the comparison shows
+    /// the maps' error.
+    pub visibility: CullingVisibility,
+    /// The imperfect shadow maps of `visibility = "ism"` (`[methods.light-culling.ism]`):
+    /// the paper's adaptive ISMs, 8192 points per VPL on 32^2 maps (section 4.4), one map
+    /// per VPL (the tree variant: per leaf), so the atlas must hold the frame's VPLs.
+    pub ism: IsmSettings<IsmAdaptive>,
+    /// Section 4.3's point-cloud culling: a VPL's map leaves out the points beyond its
+    /// stochastic (or clamped) range, where its fall-off is 0 anyway. Off splats every point
+    /// of the map's share (the paper's figure 7 compares the two).
+    pub ism_range_culling: bool,
 }
 
 impl Default for LightCullingSettings {
@@ -53,6 +80,9 @@ impl Default for LightCullingSettings {
             interleave: InterleaveSettings::pattern(8),
             reservoir_k: 32,
             tree_filter_radius: 0,
+            visibility: CullingVisibility::Rays,
+            ism: IsmSettings::default(),
+            ism_range_culling: true,
         }
     }
 }
@@ -94,7 +124,12 @@ impl LightCullingSettings {
                 &format!("0..={MAX_FILTER_RADIUS}"),
             );
         }
-        Ok(())
+        self.ism.validate("methods.light-culling")
+    }
+
+    /// Whether the frame looks VPLs up in imperfect shadow maps (`shadow_rays`: `gi.shadow_rays`).
+    pub fn uses_ism(&self, shadow_rays: bool) -> bool {
+        shadow_rays && self.visibility == CullingVisibility::Ism
     }
 }
 
@@ -113,6 +148,23 @@ mod tests {
         let sm: crate::methods::tree_samplers::settings::SamplingSettings =
             toml::from_str("[interleave]\nn = 4").unwrap();
         assert_eq!((sm.interleave.n, sm.interleave.filter_radius), (4, 0));
+    }
+
+    #[test]
+    fn a_partial_ism_table_keeps_the_adaptive_maps_defaults() {
+        // Light culling's maps are the paper's AISMs (32^2, 8192 points each), whatever
+        // fields a table leaves out; the VAL defaults are 128^2 maps sharing the cloud.
+        let lc: LightCullingSettings = toml::from_str("visibility = \"ism\"\n[ism]\nbias = 0.03").unwrap();
+        assert_eq!(lc.visibility, CullingVisibility::Ism);
+        assert_eq!(
+            (lc.ism.tile, lc.ism.points_per_light, lc.ism.bias),
+            (32, 8192, 0.03)
+        );
+        let val: IsmSettings = IsmSettings::default();
+        assert_eq!((val.tile, val.points_per_light), (128, 0));
+        assert!(lc.uses_ism(true) && !lc.uses_ism(false));
+        let back: LightCullingSettings = toml::from_str(&toml::to_string(&lc).unwrap()).unwrap();
+        assert_eq!(back, lc);
     }
 
     #[test]
@@ -201,6 +253,16 @@ mod tests {
                     ..ok.clone()
                 },
                 "tree_filter_radius",
+            ),
+            (
+                LightCullingSettings {
+                    ism: IsmSettings {
+                        tile: 48,
+                        ..ok.ism.clone()
+                    },
+                    ..ok.clone()
+                },
+                "methods.light-culling.ism.tile",
             ),
         ];
         for (s, name) in cases {

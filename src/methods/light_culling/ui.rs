@@ -1,6 +1,8 @@
 //! Stochastic Light Culling's settings in the GUI (shared by the clamped baseline).
 
-use super::settings::{LightCullingSettings, MAX_FILTER_RADIUS, MAX_INTERLEAVE, MAX_LIST, MAX_RESERVOIR};
+use super::settings::{
+    CullingVisibility, LightCullingSettings, MAX_FILTER_RADIUS, MAX_INTERLEAVE, MAX_LIST, MAX_RESERVOIR,
+};
 use crate::methods::MethodId;
 use crate::renderer::settings::RenderSettings;
 
@@ -36,6 +38,7 @@ pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) 
             );
         ui.add(egui::Slider::new(&mut lc.tree_filter_radius, 0..=MAX_FILTER_RADIUS).text("filter radius"))
             .on_hover_text("geometry-aware filter window (2r+1)^2 (0 = off, as the paper's path tracer)");
+        visibility_ui(ui, &mut lc, s.gi.shadow_rays);
         if lc != before {
             let _ = s.set_method(id, &lc);
         }
@@ -49,8 +52,67 @@ pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) 
             .text("max lights per tile"),
     )
     .on_hover_text("an overflowing tile is shaded by testing all its subset's VPLs (counted, shown)");
+    visibility_ui(ui, &mut lc, s.gi.shadow_rays);
     if lc != before {
         // Cannot fail: the struct serialises to a table.
         let _ = s.set_method(id, &lc);
     }
+}
+
+/// Visibility (rays or imperfect shadow maps, while shadow rays are on) and the maps' settings.
+fn visibility_ui(ui: &mut egui::Ui, lc: &mut LightCullingSettings, shadow_rays: bool) {
+    ui.add_enabled_ui(shadow_rays, |ui| {
+        ui.horizontal(|ui| {
+            ui.label("visibility");
+            ui.radio_value(&mut lc.visibility, CullingVisibility::Rays, "shadow rays")
+                .on_hover_text("a BVH shadow ray per VPL in range (exact)");
+            ui.radio_value(&mut lc.visibility, CullingVisibility::Ism, "ISM")
+                .on_hover_text(
+                    "a lookup in the VPL's imperfect shadow map (the paper's AISMs, section 4.4; \
+                     the ground truth still traces rays, so the comparison shows their error)",
+                );
+        });
+    })
+    .response
+    .on_disabled_hover_text("turn shadow rays on to pick how VPLs are shadowed");
+    if !(shadow_rays && lc.visibility == CullingVisibility::Ism) {
+        return;
+    }
+    let m = &mut lc.ism;
+    ui.indent("ism", |ui| {
+        ui.add(
+            egui::Slider::new(&mut m.points_per_light, 0..=65536)
+                .logarithmic(true)
+                .text("points per map"),
+        )
+        .on_hover_text("points splatted into each VPL's map (paper 8192; 0 = the cloud shared round-robin)");
+        ui.add(
+            egui::Slider::new(&mut m.points, 1024..=1 << 22)
+                .logarithmic(true)
+                .text("cloud points"),
+        )
+        .on_hover_text("points sampled once on the scene's triangles, uniform in area");
+        let mut tile_log = m.tile.max(8).ilog2();
+        if ui
+            .add(egui::Slider::new(&mut tile_log, 3..=7).text("map size (log2)"))
+            .on_hover_text("one paraboloid map's edge: 2^k texels (paper 32^2)")
+            .changed()
+        {
+            m.tile = 1 << tile_log;
+        }
+        let mut atlas_log = m.atlas.max(m.tile).ilog2();
+        if ui
+            .add(egui::Slider::new(&mut atlas_log, m.tile.ilog2()..=13).text("atlas size (log2)"))
+            .on_hover_text("the atlas holds (atlas / map)^2 maps: one per VPL")
+            .changed()
+        {
+            m.atlas = 1 << atlas_log;
+        }
+        ui.label(format!("{} maps", m.capacity()));
+        ui.add(egui::Slider::new(&mut m.pull_push_levels, 0..=4).text("pull-push levels"))
+            .on_hover_text("hole filling (paper 2)");
+        ui.add(egui::Slider::new(&mut m.bias, 0.0..=0.3).text("relative depth bias"));
+        ui.checkbox(&mut lc.ism_range_culling, "cull points by range (section 4.3)")
+            .on_hover_text("a VPL's map leaves out points beyond its range, where it adds nothing");
+    });
 }

@@ -3,18 +3,24 @@
 //! area-uniform: `reference::ism::sample_points`) splatted each frame into one paraboloid map
 //! per oriented point light in an atlas, then pull-push hole filling; methods look maps up
 //! with `common/ism.wgsl`'s `ism_visible`. Reads: the point cloud, the lights (position,
-//! normal). Writes: [`IsmTargets`]. Settings: `settings::IsmSettings`. Twin:
-//! `reference::ism`.
+//! range, normal: uploaded from the CPU by [`IsmPass::record`], or written on the GPU by the
+//! caller before [`IsmPass::record_maps`]). Writes: [`IsmTargets`]. Settings:
+//! `settings::IsmSettings`. Twin: `reference::ism`. `ism_view.wgsl` draws the atlas as a view
+//! ([`IsmPass::record_view`]).
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
 use super::{
-    StridedUniforms, WG_1D, WG_2D, bind_group_seq, compute_pipeline, dynamic_uniform_entry, storage_buffer,
-    storage_entry,
+    StridedUniforms, WG_1D, WG_2D, bind_group_seq, compute_pipeline, dynamic_uniform_entry, groups_image,
+    run_compute, storage_buffer, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
 };
-use crate::reference::ism::{IsmLayout, IsmLight};
-use crate::renderer::{settings::IsmSettings, shaders, timing::GpuTimer};
+use crate::reference::ism::{IsmLayout, IsmLight, sample_oriented_points};
+use crate::renderer::{
+    settings::{IsmDefault, IsmSettings},
+    shaders,
+    timing::GpuTimer,
+};
 
 /// Twin: `IsmParams` in `shaders/common/ism.wgsl`.
 #[repr(C)]
@@ -33,10 +39,55 @@ pub struct GpuIsmParams {
     pub per_light: u32,
     /// Splat threads: the cloud's points, or lights x per_light.
     pub threads: u32,
-    pub _pad: [u32; 2],
+    /// 1: front-face culling (points facing the light left out).
+    pub front_cull: u32,
+    pub _pad: u32,
 }
 
-/// The scene's point cloud on the GPU (vec4 per point), built once per scene and settings.
+impl GpuIsmParams {
+    /// The parameters of `lights` maps in `t` built from `points` points under `s` (level 0:
+    /// the splat and the lookups).
+    pub fn new<D: IsmDefault>(t: &IsmTargets, s: &IsmSettings<D>, lights: u32, points: u32) -> Self {
+        Self {
+            atlas: t.layout.atlas,
+            tile: t.layout.tile,
+            per_row: t.layout.per_row(),
+            lights,
+            points,
+            level: 0,
+            bias: s.bias,
+            level_base: 0,
+            per_light: s.points_per_light,
+            threads: if s.points_per_light == 0 {
+                points
+            } else {
+                lights.saturating_mul(s.points_per_light)
+            },
+            front_cull: s.front_face_culling as u32,
+            _pad: 0,
+        }
+    }
+}
+
+/// Twin: `IsmViewParams` in `shaders/ism_view.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuIsmViewParams {
+    pub atlas: u32,
+    pub tile: u32,
+    pub per_row: u32,
+    pub maps: u32,
+    /// The false colour's log scale (metres).
+    pub lo: f32,
+    pub hi: f32,
+    /// Map texels per view pixel.
+    pub scale: f32,
+    /// Columns of the view's grid of maps.
+    pub cols: u32,
+}
+
+/// The scene's point cloud on the GPU (per point two vec4: position, normal), built once per
+/// scene and settings.
 pub struct IsmPoints {
     pub buffer: wgpu::Buffer,
     pub count: u32,
@@ -45,8 +96,23 @@ pub struct IsmPoints {
 }
 
 impl IsmPoints {
+    /// Points without normals (front-face culling then culls nothing: a zero normal).
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, points: &[Vec3], key: (u32, u32)) -> Self {
-        let data: Vec<[f32; 4]> = points.iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
+        let oriented: Vec<(Vec3, Vec3)> = points.iter().map(|&p| (p, Vec3::ZERO)).collect();
+        Self::oriented(device, queue, &oriented, key)
+    }
+
+    /// Points with their surface normals.
+    pub fn oriented(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        points: &[(Vec3, Vec3)],
+        key: (u32, u32),
+    ) -> Self {
+        let data: Vec<[f32; 4]> = points
+            .iter()
+            .flat_map(|(p, n)| [[p.x, p.y, p.z, 1.0], [n.x, n.y, n.z, 0.0]])
+            .collect();
         let buffer = storage_buffer(device, "ism::points", (data.len() * 16) as u64);
         queue.write_buffer(&buffer, 0, bytemuck::cast_slice(&data));
         Self {
@@ -55,6 +121,27 @@ impl IsmPoints {
             key,
         }
     }
+
+    /// `count` points uniform in area over the triangles of a scene's BVH (its CPU copy),
+    /// deterministic in `seed` (`reference::ism::sample_points` over the BVH's triangle
+    /// order); `key` identifies the scene and settings it was built for.
+    pub fn from_bvh(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        bvh: &crate::scene::bvh::Bvh,
+        count: u32,
+        seed: u32,
+        key: (u32, u32),
+    ) -> Self {
+        Self::oriented(device, queue, &cloud_of_bvh(bvh, count, seed), key)
+    }
+}
+
+/// The point cloud [`IsmPoints::from_bvh`] uploads, with normals (its CPU twin, for tests).
+pub fn cloud_of_bvh(bvh: &crate::scene::bvh::Bvh, count: u32, seed: u32) -> Vec<(Vec3, Vec3)> {
+    let positions: Vec<Vec3> = bvh.triangles.iter().flat_map(|t| t.vertices()).collect();
+    let indices: Vec<u32> = (0..positions.len() as u32).collect();
+    sample_oriented_points(&positions, &indices, count, seed)
 }
 
 /// The atlas (resolved distances), its splat keys, the pull-push pyramid and the lights.
@@ -62,7 +149,8 @@ pub struct IsmTargets {
     pub layout: IsmLayout,
     /// Distances per atlas texel (`reference::ism::EMPTY` where nothing landed or filled).
     pub depth: wgpu::Buffer,
-    keys: wgpu::Buffer,
+    /// The splat's keys (0 where no point landed: the holes before pull-push).
+    pub keys: wgpu::Buffer,
     pyramid: wgpu::Buffer,
     /// Per light: position, then normal (vec4 each).
     pub lights: wgpu::Buffer,
@@ -79,7 +167,7 @@ impl IsmTargets {
             .sum()
     }
 
-    pub fn new(device: &wgpu::Device, s: &IsmSettings) -> Self {
+    pub fn new<D: IsmDefault>(device: &wgpu::Device, s: &IsmSettings<D>) -> Self {
         let layout = IsmLayout {
             atlas: s.atlas,
             tile: s.tile,
@@ -98,7 +186,7 @@ impl IsmTargets {
         }
     }
 
-    pub fn matches(&self, s: &IsmSettings) -> bool {
+    pub fn matches<D: IsmDefault>(&self, s: &IsmSettings<D>) -> bool {
         self.layout.atlas == s.atlas && self.layout.tile == s.tile && self.levels == s.levels()
     }
 }
@@ -110,6 +198,9 @@ pub struct IsmPass {
     pull: wgpu::ComputePipeline,
     push: wgpu::ComputePipeline,
     params: StridedUniforms<GpuIsmParams>,
+    view_layout: wgpu::BindGroupLayout,
+    view: wgpu::ComputePipeline,
+    view_params: wgpu::Buffer,
 }
 
 impl IsmPass {
@@ -128,7 +219,21 @@ impl IsmPass {
             ],
         });
         let pipe = |entry: &str| compute_pipeline(device, entry, &[Some(&layout)], &module, entry);
+        let view_module = shaders::create_module(device, "ism_view.wgsl")?;
+        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("ism_view::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                storage_entry(1, c, true),
+                storage_entry(2, c, true),
+                storage_texture_entry(3, wgpu::TextureFormat::Rgba8Unorm),
+                storage_entry(4, c, false),
+            ],
+        });
         Ok(Self {
+            view: compute_pipeline(device, "ism_view", &[Some(&view_layout)], &view_module, "main"),
+            view_layout,
+            view_params: uniform_buffer::<GpuIsmViewParams>(device, "ism_view::params"),
             splat: pipe("splat_main"),
             resolve: pipe("resolve_main"),
             pull: pipe("pull_main"),
@@ -139,17 +244,17 @@ impl IsmPass {
     }
 
     /// Builds the maps of `lights` (at most the atlas's capacity) from `points` (shared out as
-    /// `s.points_per_light` says), timed as `name`: clear, splat, resolve, pull-push over
-    /// `t`'s levels.
+    /// `s.points_per_light` says), timed as `name`: uploads the lights, then
+    /// [`Self::record_maps`].
     #[allow(clippy::too_many_arguments)]
-    pub fn record(
+    pub fn record<D: IsmDefault>(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
         name: &str,
-        s: &IsmSettings,
+        s: &IsmSettings<D>,
         points: &IsmPoints,
         lights: &[IsmLight],
         t: &IsmTargets,
@@ -165,23 +270,27 @@ impl IsmPass {
         if !data.is_empty() {
             queue.write_buffer(&t.lights, 0, bytemuck::cast_slice(&data));
         }
-        let base = GpuIsmParams {
-            atlas: t.layout.atlas,
-            tile: t.layout.tile,
-            per_row: t.layout.per_row(),
-            lights: n,
-            points: points.count,
-            level: 0,
-            bias: s.bias,
-            level_base: 0,
-            per_light: s.points_per_light,
-            threads: if s.points_per_light == 0 {
-                points.count
-            } else {
-                n.saturating_mul(s.points_per_light)
-            },
-            _pad: [0; 2],
-        };
+        self.record_maps(device, queue, encoder, timer, name, s, points, n, t);
+    }
+
+    /// Builds the maps of the first `n` lights of `t.lights` (written by the caller: per
+    /// light (position, squared range), (normal, 0)), timed as `name`: clear, splat, resolve,
+    /// pull-push over `t`'s levels.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_maps<D: IsmDefault>(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        name: &str,
+        s: &IsmSettings<D>,
+        points: &IsmPoints,
+        n: u32,
+        t: &IsmTargets,
+    ) {
+        let n = n.min(t.capacity);
+        let base = GpuIsmParams::new(t, s, n, points.count);
         // Uniforms: 0 splat / resolve, then pull levels 1..=L, then push levels L-1..=0.
         let level_base = |l: u32| IsmTargets::pyramid_len(t.layout.tile, n, l.saturating_sub(1)) as u32;
         let mut items = vec![base];
@@ -213,7 +322,12 @@ impl IsmPass {
                 t.pyramid.as_entire_binding(),
             ],
         );
-        encoder.clear_buffer(&t.keys, 0, None);
+        // Only the atlas rows of the maps in use (their keys; the rest is never read).
+        let rows = n.div_ceil(t.layout.per_row()) as u64 * t.layout.tile as u64;
+        let bytes = (rows * t.layout.atlas as u64 * 4).min(t.keys.size());
+        if bytes > 0 {
+            encoder.clear_buffer(&t.keys, 0, Some(bytes));
+        }
         encoder.push_debug_group(name);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -247,5 +361,61 @@ impl IsmPass {
             }
         }
         encoder.pop_debug_group();
+    }
+
+    /// Draws `t`'s first `maps` maps into `dst` (`ism_view.wgsl`: a grid shaped like the view,
+    /// fitted, distances on a log scale lo .. hi metres) and its linear data into `data`
+    /// (vec4 per view pixel; at least `dst`'s size).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_view(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        t: &IsmTargets,
+        maps: u32,
+        (lo, hi): (f32, f32),
+        size: (u32, u32),
+        dst: &wgpu::TextureView,
+        data: &wgpu::Buffer,
+    ) {
+        let l = t.layout;
+        let maps = maps.min(t.capacity).max(1);
+        let (w, h) = (size.0.max(1) as f32, size.1.max(1) as f32);
+        let cols = ((maps as f32 * w / h).sqrt().ceil() as u32).clamp(1, maps);
+        let rows = maps.div_ceil(cols);
+        let scale = ((cols * l.tile) as f32 / w).max((rows * l.tile) as f32 / h);
+        let p = GpuIsmViewParams {
+            atlas: l.atlas,
+            tile: l.tile,
+            per_row: l.per_row(),
+            maps,
+            lo,
+            hi: hi.max(lo * 2.0),
+            scale,
+            cols,
+        };
+        queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
+        let bind = bind_group_seq(
+            device,
+            "ism_view::bind_group",
+            &self.view_layout,
+            &[
+                self.view_params.as_entire_binding(),
+                t.depth.as_entire_binding(),
+                t.keys.as_entire_binding(),
+                wgpu::BindingResource::TextureView(dst),
+                data.as_entire_binding(),
+            ],
+        );
+        run_compute(
+            encoder,
+            timer,
+            "ism_view",
+            &self.view,
+            &bind,
+            groups_image(size.0, size.1),
+        );
     }
 }
