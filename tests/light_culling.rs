@@ -777,8 +777,67 @@ fn the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_trut
     assert!(ctx.errors.take().is_empty());
 }
 
+/// The GPU's atlas after the last frame against the CPU twin's from the same lights (`gl`:
+/// positions and ranges, `sv`: normals), with (`range_culling`) or without the ranges; at most
+/// 0.5% of the texels may differ (a point on a texel boundary may land on either side).
+/// Returns the GPU's atlas.
+fn atlas_matches(
+    st: &Setup,
+    lc: &LightCullingSettings,
+    gl: &[LightRange],
+    sv: &[ShadeVpl],
+    range_culling: bool,
+) -> Vec<f32> {
+    let layout = IsmLayout {
+        atlas: lc.ism.atlas,
+        tile: lc.ism.tile,
+    };
+    let (targets, maps) = lc_of(st).ism_targets().expect("maps built");
+    let n = maps as usize;
+    assert_eq!(n, gl.len(), "a map per light");
+    let gpu: Vec<f32> =
+        bytemuck::pod_collect_to_vec(&read_storage_buffer(&st.r.ctx, &targets.depth).unwrap());
+    let cloud = cloud_of_bvh(
+        &st.r.scene_gpu().bvh,
+        lc.ism.points,
+        light_culling::ISM_CLOUD_SEED,
+    );
+    let (points, normals): (Vec<Vec3>, Vec<Vec3>) = cloud.into_iter().unzip();
+    let lights: Vec<IsmLight> = (0..n)
+        .map(|i| IsmLight {
+            // Without range culling a VPL of range 0 (it lights nothing) still splats nothing.
+            range: if range_culling || gl[i].range <= 0.0 {
+                gl[i].range
+            } else {
+                EMPTY
+            },
+            ..IsmLight::new(gl[i].position, sv[i].normal)
+        })
+        .collect();
+    let mut cpu = ism::splat_culled(layout, &lights, &points, Some(&normals), lc.ism.points_per_light);
+    let filled = cpu.iter().filter(|&&d| d < EMPTY).count();
+    ism::pull_push(layout, &mut cpu, n as u32, lc.ism.levels());
+    let texels = n * (lc.ism.tile * lc.ism.tile) as usize;
+    let same = (0..n as u32)
+        .flat_map(|m| (0..lc.ism.tile).flat_map(move |v| (0..lc.ism.tile).map(move |u| (m, u, v))))
+        .filter(|&(m, u, v)| {
+            let k = layout.texel(m, u, v);
+            let (a, b) = (gpu[k], cpu[k]);
+            a == b || (a - b).abs() <= 1e-5 * b.abs()
+        })
+        .count();
+    eprintln!(
+        "ISM (range culling {range_culling}): {same} of {texels} texels equal the CPU's ({filled} \
+         filled by the splat)"
+    );
+    assert!(filled > texels / 20, "the maps hold points");
+    assert!(same * 1000 >= texels * 995, "{same} of {texels}");
+    gpu
+}
+
 /// ISM visibility (`visibility = "ism"`, section 4.4's adaptive maps with 4.3's range culling)
-/// on the fixed frame: 250 VPLs, 256 maps of 16^2 texels, 2048 points each.
+/// on the fixed frame: 250 VPLs, 256 maps of 32^2 texels (a 512^2 atlas), 8192 points each
+/// from a cloud of 2^18.
 fn ism_small() -> LightCullingSettings {
     LightCullingSettings {
         visibility: CullingVisibility::Ism,
@@ -812,40 +871,9 @@ fn ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays() {
     };
 
     // The maps: the CPU twin's splat of the same cloud (one map per VPL, each its points
-    // within the VPL's range) and pull-push, against the GPU's atlas.
-    let (targets, maps) = lc_of(&st).ism_targets().expect("maps built");
-    assert_eq!(maps as usize, n);
-    let gpu_atlas: Vec<f32> =
-        bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &targets.depth).unwrap());
-    let cloud = cloud_of_bvh(
-        &st.r.scene_gpu().bvh,
-        lc.ism.points,
-        light_culling::ISM_CLOUD_SEED,
-    );
-    let lights: Vec<IsmLight> = (0..n)
-        .map(|i| IsmLight {
-            range: gl[i].range,
-            ..IsmLight::new(gl[i].position, sv[i].normal)
-        })
-        .collect();
-    let (points, normals): (Vec<Vec3>, Vec<Vec3>) = cloud.into_iter().unzip();
+    // within the VPL's range and facing away from it) and pull-push, against the GPU's atlas.
     assert!(lc.ism.front_face_culling, "the paper's culling is on by default");
-    let mut cpu_atlas = ism::splat_culled(layout, &lights, &points, Some(&normals), lc.ism.points_per_light);
-    let filled_before = cpu_atlas.iter().filter(|&&d| d < EMPTY).count();
-    ism::pull_push(layout, &mut cpu_atlas, n as u32, lc.ism.levels());
-    let texels = n * (lc.ism.tile * lc.ism.tile) as usize;
-    let same = (0..n as u32)
-        .flat_map(|m| (0..lc.ism.tile).flat_map(move |v| (0..lc.ism.tile).map(move |u| (m, u, v))))
-        .filter(|&(m, u, v)| {
-            let k = layout.texel(m, u, v);
-            let (a, b) = (gpu_atlas[k], cpu_atlas[k]);
-            a == b || (a - b).abs() <= 1e-5 * b.abs()
-        })
-        .count();
-    eprintln!("ISM: {same} of {texels} texels equal the CPU's ({filled_before} filled by the splat)");
-    assert!(filled_before > texels / 20, "the maps hold points");
-    assert!(same * 1000 >= texels * 995, "{same} of {texels}");
-
+    let gpu_atlas = atlas_matches(&st, &lc, &gl, &sv, true);
     // Shading: the CPU's sum with the CPU lookup in the GPU's atlas as visibility.
     let grid = LightCulling::grid(&lc, (W, H));
     let il = Interleave::new(lc.interleave.n, n as u32, LightCulling::seed(&s, 0));
@@ -946,6 +974,9 @@ fn ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays() {
     for method in [light_culling::ID, light_culling::TREE] {
         let with_ism = image(&mut st, method, Some(true));
         let maps = lc_of(&st).ism_targets().map(|(_, m)| m);
+        if method == light_culling::TREE {
+            tree_shading_with_maps_matches(&st, &lc, &s);
+        }
         let with_rays = image(&mut st, method, Some(false));
         let unshadowed = image(&mut st, method, None);
         let e_ism = metrics::compare(&with_ism, &with_rays, 3.0, Tonemap::Aces);
@@ -972,6 +1003,20 @@ fn ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays() {
     }
     assert!(ctx.errors.take().is_empty());
 
+    // Without the range culling (figure 7's comparison) the maps hold every point of their
+    // share that faces away from their VPL: still the CPU twin's.
+    st.set(|s| {
+        s.gi.method = light_culling::ID;
+        s.gi.shadow_rays = true;
+        let mut l: LightCullingSettings = s.method(light_culling::ID).unwrap();
+        l.visibility = CullingVisibility::Ism;
+        l.ism_range_culling = false;
+        s.set_method(light_culling::ID, &l).unwrap();
+    });
+    st.frame();
+    atlas_matches(&st, &lc, &gpu_lights(&st, n), &sv, false);
+    assert!(ctx.errors.take().is_empty());
+
     // More VPLs than maps: refused with a message naming the atlas, nothing drawn.
     st.set(|s| {
         s.gi.method = light_culling::ID;
@@ -987,4 +1032,78 @@ fn ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays() {
             .any(|e| e.contains("methods.light-culling.ism.atlas")),
         "{errors:?}"
     );
+    assert_eq!(
+        lc_of(&st).ism_targets().map(|(_, m)| m),
+        Some(0),
+        "no maps counted"
+    );
+}
+
+/// The tree variant's one-ray shading with its leaves' maps against the CPU's (the GPU's list
+/// and atlas, the same resampling number, `reference::ism::visible` as visibility).
+fn tree_shading_with_maps_matches(st: &Setup, lc: &LightCullingSettings, s: &RenderSettings) {
+    let ctx = &st.r.ctx;
+    let (_, tb) = st.r.tree_buffers();
+    let leaves = tb.leaves;
+    let sorted: Vec<GpuVpl> =
+        bytemuck::pod_collect_to_vec(&read_storage_buffer(ctx, &tb.sorted_vpls).unwrap());
+    let t = lc_of(st).tree_buffers().expect("the tree variant's buffers");
+    let gl = lights_of(st, &t.lights, leaves as usize);
+    let sv = shade_vpls(&sorted[..leaves as usize]);
+    // The maps of the leaves, as the tiled variant's of the VPLs.
+    let atlas = atlas_matches(st, lc, &gl, &sv, true);
+    let layout = IsmLayout {
+        atlas: lc.ism.atlas,
+        tile: lc.ism.tile,
+    };
+    let list = gpu_u32(st, &t.list);
+    let mv = gpu_u32(st, &t.m);
+    let raw: Vec<[f32; 4]> =
+        bytemuck::pod_collect_to_vec(&read_storage_buffer(ctx, &lc_of(st).buffers().raw).unwrap());
+    let pos = st.r.read(Buffer::Position).unwrap();
+    let nrm = st.r.read(Buffer::Normal).unwrap();
+    let seed = LightCulling::seed(s, 0);
+    let k = lc.reservoir_k as usize;
+    let (mut lit, mut close) = (0, 0);
+    for p in 0..(W * H) as usize {
+        let g = pos.pixels[p];
+        if g[3] == 0.0 {
+            continue;
+        }
+        let xp = Vec3::new(g[0], g[1], g[2]);
+        let nx = Vec3::from_slice(&nrm.pixels[p][..3]).normalize();
+        let m = mv[2 * p];
+        let u = u01(pcg_hash(tree_rng(seed, p as u32, TREE_STREAM_RIS)));
+        let (want, _) = tree_shade(
+            xp,
+            nx,
+            &list[p * k..p * k + (m as usize).min(k)],
+            m,
+            k as u32,
+            &sv,
+            &gl,
+            s.gi.distance_epsilon,
+            u,
+            |i| {
+                ism::visible(
+                    layout,
+                    &atlas,
+                    i,
+                    sv[i as usize].position,
+                    sv[i as usize].normal,
+                    xp,
+                    lc.ism.bias,
+                )
+            },
+        );
+        let got = Vec3::from_slice(&raw[p][..3]);
+        if want.max_element() > 1e-6 {
+            lit += 1;
+            if (got - want).abs().max_element() <= 1e-3 * want.max_element() {
+                close += 1;
+            }
+        }
+    }
+    eprintln!("tree with maps: {close} of {lit} lit pixels' shading within 1e-3 of the CPU");
+    assert!(lit > 100 && close >= lit * 98 / 100, "{close} of {lit}");
 }

@@ -124,6 +124,21 @@ pub struct SamplingArgs {
 }
 
 impl SamplingArgs {
+    /// `--visibility ism` with a method that has no imperfect shadow maps is refused (it
+    /// would trace rays without saying so).
+    pub fn check_visibility(&self, methods: &[crate::methods::MethodId]) -> anyhow::Result<()> {
+        use crate::methods::light_culling::{ISM_METHODS, has_ism};
+        if self.visibility == Some(VisibilityArg::Ism)
+            && let Some(m) = methods.iter().find(|&&m| !has_ism(m))
+        {
+            return Err(anyhow!(
+                "--visibility ism: {m} traces shadow rays; imperfect shadow maps serve {}",
+                ISM_METHODS.map(|m| m.to_string()).join(", ")
+            ));
+        }
+        Ok(())
+    }
+
     pub fn apply(&self, s: &mut crate::renderer::settings::RenderSettings) {
         use crate::renderer::settings::{ChildProbability, CutBlending, CutFallback};
         if let Some(v) = self.block {

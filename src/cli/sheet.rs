@@ -72,6 +72,7 @@ pub fn run(args: &SheetArgs) -> anyhow::Result<()> {
             }
         })
         .collect::<anyhow::Result<_>>()?;
+    args.sampling.check_visibility(&methods)?;
     let cam_name = args.camera.clone().or(opened.camera_name.clone());
     let camera = opened
         .scene

@@ -78,8 +78,9 @@ fn lcull_members(p: LcullParams, s: u32) -> u32 {
 // layout: (position, squared range: the splat's cut-off; +inf without section 4.3's range
 // culling), (normal, 0)).
 fn lcull_ism_light(p: LcullParams, position: vec3<f32>, normal: vec3<f32>, range: f32) -> array<vec4<f32>, 2> {
+    // A VPL without range (0: it lights nothing) splats nothing either way.
     var r2 = 3.0e38;
-    if (p.ism_flags & 2u) != 0u && range < LCULL_RANGE_INF {
+    if range <= 0.0 || ((p.ism_flags & 2u) != 0u && range < LCULL_RANGE_INF) {
         r2 = range * range;
     }
     return array<vec4<f32>, 2>(vec4<f32>(position, r2), vec4<f32>(normal, 0.0));

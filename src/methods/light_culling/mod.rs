@@ -95,10 +95,11 @@ pub const ISM_CLOUD_SEED: u32 = 0x15a1;
 const ISM_VIEW: ViewInfo = ViewInfo {
     name: ISM_ATLAS.name(),
     file: "culling_ism_atlas",
-    about: "the VPLs' imperfect shadow maps (one 32^2 paraboloid map per VPL, section 4.4's \
-            AISMs, points beyond the VPL's range culled): distance on a log scale, texels \
-            pull-push filled at half brightness, holes black; built each frame with ISM \
-            visibility, or while this view is shown",
+    about: "the VPLs' imperfect shadow maps (one paraboloid map per VPL, the tree variant per \
+            leaf; section 4.4's AISMs, culled as `methods.light-culling.ism` and \
+            `ism_range_culling` say): distance on a log scale, texels pull-push filled at half \
+            brightness, holes black; built each frame with ISM visibility, or while this view \
+            is shown",
     passes: &["lcull_ism"],
 };
 
@@ -467,15 +468,39 @@ impl LightCulling {
         } else {
             cx.settings.gi.shadow_rays as u32
         };
+        // Failures leave no maps behind (the view and the counters say none).
+        self.ism_on = false;
+        self.ism_maps = 0;
+        let tree = cx.method == TREE;
         if on && maps > lc.ism.capacity() {
+            let what = if tree {
+                format!(
+                    "a map per leaf of the light tree ({} VPLs in {maps} leaves)",
+                    cx.vpl_frame.count
+                )
+            } else {
+                format!("a map per VPL ({maps})")
+            };
             cx.errors.report(format!(
-                "light culling: ISM visibility needs a map per VPL ({maps}), but an atlas of {} \
-                 with {} x {} maps holds {} (raise methods.light-culling.ism.atlas, lower \
-                 ism.tile or the VPL count)",
+                "light culling: ISM visibility needs {what}, but an atlas of {} with {} x {} \
+                 maps holds {} (raise methods.light-culling.ism.atlas, lower ism.tile or the VPL \
+                 count)",
                 lc.ism.atlas,
                 lc.ism.tile,
                 lc.ism.tile,
                 lc.ism.capacity()
+            ));
+            return None;
+        }
+        let need = 4 * (lc.ism.atlas as u64).pow(2);
+        let limit = cx.device.limits().max_storage_buffer_binding_size;
+        if (on || shown) && need > limit {
+            cx.errors.report(format!(
+                "light culling: an ISM atlas of {0} x {0} needs a {1} MiB buffer; this device \
+                 binds at most {2} MiB (lower methods.light-culling.ism.atlas)",
+                lc.ism.atlas,
+                need >> 20,
+                limit >> 20
             ));
             return None;
         }

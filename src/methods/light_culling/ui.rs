@@ -99,10 +99,16 @@ fn visibility_ui(ui: &mut egui::Ui, lc: &mut LightCullingSettings, shadow_rays: 
             .changed()
         {
             m.tile = 1 << tile_log;
+            m.atlas = m.atlas.clamp(m.tile, m.tile << 7);
         }
-        let mut atlas_log = m.atlas.max(m.tile).ilog2();
+        // At most 128 x 128 maps (the build's 65535 workgroup layers) and an 8192 atlas.
+        let tile_log = m.tile.ilog2();
+        let mut atlas_log = m.atlas.max(m.tile).ilog2().min(tile_log + 7);
         if ui
-            .add(egui::Slider::new(&mut atlas_log, m.tile.ilog2()..=13).text("atlas size (log2)"))
+            .add(
+                egui::Slider::new(&mut atlas_log, tile_log..=(tile_log + 7).min(13))
+                    .text("atlas size (log2)"),
+            )
             .on_hover_text("the atlas holds (atlas / map)^2 maps: one per VPL")
             .changed()
         {
@@ -112,6 +118,10 @@ fn visibility_ui(ui: &mut egui::Ui, lc: &mut LightCullingSettings, shadow_rays: 
         ui.add(egui::Slider::new(&mut m.pull_push_levels, 0..=4).text("pull-push levels"))
             .on_hover_text("hole filling (paper 2)");
         ui.add(egui::Slider::new(&mut m.bias, 0.0..=0.3).text("relative depth bias"));
+        ui.checkbox(&mut m.front_face_culling, "cull front faces (Program 1)")
+            .on_hover_text(
+                "a map leaves out points whose surface faces its VPL (no self-shadowing of lit surfaces)",
+            );
         ui.checkbox(&mut lc.ism_range_culling, "cull points by range (section 4.3)")
             .on_hover_text("a VPL's map leaves out points beyond its range, where it adds nothing");
     });
