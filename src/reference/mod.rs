@@ -24,4 +24,5 @@ pub mod lightcuts;
 pub mod slc;
 pub mod sst;
 pub mod sst_tree;
+pub mod val;
 pub mod vpl;
