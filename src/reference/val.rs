@@ -22,7 +22,7 @@
 //!   keeps the energy), its area the sum of its texels' surface areas (the RSM texel area
 //!   perpendicular to the light over the cosine to the light).
 
-use glam::{UVec2, Vec3};
+use glam::{Mat4, UVec2, Vec3};
 
 /// Most clusters (the key keeps 10 bits of the index; the paper's atlas holds 1024 maps).
 pub const MAX_CLUSTERS: u32 = 1024;
@@ -50,6 +50,8 @@ pub struct Rsm {
     pub texel_area: f32,
     /// Unit direction the light travels.
     pub light_dir: Vec3,
+    /// World -> the light's clip space (orthographic; the RSM's raster).
+    pub view_proj: Mat4,
 }
 
 impl Rsm {
@@ -66,6 +68,17 @@ impl Rsm {
     pub fn surface_area(&self, i: usize) -> f32 {
         let c = self.texels[i].normal.dot(-self.light_dir).max(0.05);
         self.texel_area / c
+    }
+    /// The texel a world point projects into (the raster's convention: texel (i, j) covers
+    /// NDC x in [2i / res - 1, 2(i + 1) / res - 1] and y from 1 - 2j / res down); None outside.
+    /// Twin: `val_texel_of` in `val_cluster.wgsl`.
+    pub fn texel_of(&self, p: Vec3) -> Option<UVec2> {
+        let c = self.view_proj * p.extend(1.0);
+        let (x, y) = (c.x / c.w, c.y / c.w);
+        let u = ((x * 0.5 + 0.5) * self.res as f32).floor();
+        let v = ((0.5 - y * 0.5) * self.res as f32).floor();
+        let inside = (0.0..self.res as f32).contains(&u) && (0.0..self.res as f32).contains(&v);
+        inside.then(|| UVec2::new(u as u32, v as u32))
     }
     /// The RSM's total reflected flux over the lit texels.
     pub fn total_flux(&self) -> Vec3 {
@@ -104,8 +117,9 @@ pub struct Val {
     pub pixels: u32,
     /// Sum of its texels' surface areas (m^2).
     pub area: f32,
-    /// Its centre in the RSM (the rounded mean texel coordinate): the splat's centre and the
-    /// texel whose flux eq. 1 compares with.
+    /// Its centre in the RSM (the texel its mean position projects into, kept from the last
+    /// step where that texel has no flux): the splat's centre and the texel whose flux eq. 1
+    /// compares with (the paper's "position as texture coordinate").
     pub texel: UVec2,
 }
 
@@ -130,12 +144,8 @@ pub fn metric(p: &ClusterParams, extent: f32, x: &RsmTexel, c: &Val, centre_flux
     let w = p.weights;
     let dp = (x.position - c.position).length() / extent.max(1e-12);
     let dn = ((1.0 - x.normal.dot(c.normal)) * 0.5).clamp(0.0, 1.0);
-    let sum = x.flux.x.abs()
-        + x.flux.y.abs()
-        + x.flux.z.abs()
-        + centre_flux.x.abs()
-        + centre_flux.y.abs()
-        + centre_flux.z.abs();
+    let s = x.flux.abs() + centre_flux.abs();
+    let sum = s.x + s.y + s.z;
     let df = if sum > 0.0 {
         let d = x.flux - centre_flux;
         (d.x.abs() + d.y.abs() + d.z.abs()) / sum
@@ -220,7 +230,6 @@ pub fn average(rsm: &Rsm, assignment: &[u32], vals: &[Val]) -> Vec<Val> {
         position: Vec3,
         normal: Vec3,
         flux: Vec3,
-        texel: [f64; 2],
         area: f32,
         pixels: u32,
     }
@@ -234,35 +243,24 @@ pub fn average(rsm: &Rsm, assignment: &[u32], vals: &[Val]) -> Vec<Val> {
         a.position += t.position;
         a.normal += t.normal;
         a.flux += t.flux;
-        a.texel[0] += (i as u32 % rsm.res) as f64;
-        a.texel[1] += (i as u32 / rsm.res) as f64;
         a.area += rsm.surface_area(i);
         a.pixels += 1;
     }
     acc.iter()
         .zip(vals)
-        .enumerate()
-        .map(|(ci, (a, old))| {
+        .map(|(a, old)| {
             if a.pixels == 0 {
                 return Val { pixels: 0, ..*old };
             }
-            let n = a.pixels as f32;
-            let mean_texel = |s: f64| ((s / a.pixels as f64).round() as u32).min(rsm.res - 1);
-            let mut texel = UVec2::new(mean_texel(a.texel[0]), mean_texel(a.texel[1]));
-            // The mean of a non-convex cluster may fall on a texel without flux; its centre
-            // texel is then the cluster's texel nearest to the mean (in RSM coordinates).
-            if !rsm.lit((texel.y * rsm.res + texel.x) as usize) {
-                let target = texel.as_ivec2();
-                texel = assignment
-                    .iter()
-                    .enumerate()
-                    .filter(|&(_, &c)| c as usize == ci)
-                    .map(|(i, _)| UVec2::new(i as u32 % rsm.res, i as u32 / rsm.res))
-                    .min_by_key(|t| (t.as_ivec2() - target).length_squared())
-                    .unwrap_or(texel);
-            }
+            let position = a.position / a.pixels as f32;
+            // The centre: where the mean position lands in the RSM, if that texel has flux (a
+            // non-convex cluster's mean may fall outside it); else the last centre.
+            let texel = rsm
+                .texel_of(position)
+                .filter(|t| rsm.lit((t.y * rsm.res + t.x) as usize))
+                .unwrap_or(old.texel);
             Val {
-                position: a.position / n,
+                position,
                 normal: a.normal.normalize_or(old.normal),
                 flux: a.flux,
                 pixels: a.pixels,
@@ -345,12 +343,31 @@ mod tests {
                 }
             })
             .collect();
+        // Top-down orthographic: texel (x, y) covers world x in 0.1 (x -+ 1/2), z alike.
+        let a = 2.0 / (0.1 * res as f32);
+        let view_proj = Mat4::from_cols(
+            glam::Vec4::new(a, 0.0, 0.0, 0.0),
+            glam::Vec4::ZERO,
+            glam::Vec4::new(0.0, -a, 0.0, 0.0),
+            glam::Vec4::new(a * 0.05 - 1.0, 1.0 - a * 0.05, 0.5, 1.0),
+        );
         Rsm {
             res,
             texels,
             texel_area: 0.01,
             light_dir: -Vec3::Y,
+            view_proj,
         }
+    }
+
+    #[test]
+    fn a_texel_centre_projects_into_its_texel() {
+        let rsm = floor(16);
+        for (i, t) in rsm.texels.iter().enumerate() {
+            let want = UVec2::new(i as u32 % 16, i as u32 / 16);
+            assert_eq!(rsm.texel_of(t.position), Some(want));
+        }
+        assert_eq!(rsm.texel_of(Vec3::new(-1.0, 0.0, 0.0)), None);
     }
 
     fn params(splat: u32) -> ClusterParams {

@@ -627,6 +627,43 @@ mod tests {
                 },
             ),
             (
+                "val_cluster.wgsl",
+                "ValParams",
+                size_of::<crate::renderer::passes::val_cluster::GpuValParams>(),
+                {
+                    use crate::renderer::passes::val_cluster::GpuValParams as P;
+                    vec![
+                        offset_of!(P, view_proj),
+                        offset_of!(P, light_dir),
+                        offset_of!(P, texel_area),
+                        offset_of!(P, res),
+                        offset_of!(P, clusters),
+                        offset_of!(P, splat),
+                        offset_of!(P, layer),
+                        offset_of!(P, w_p),
+                        offset_of!(P, w_n),
+                        offset_of!(P, w_f),
+                        offset_of!(P, extent),
+                    ]
+                },
+            ),
+            (
+                "val_cluster.wgsl",
+                "Val",
+                size_of::<crate::renderer::passes::val_cluster::GpuVal>(),
+                {
+                    use crate::renderer::passes::val_cluster::GpuVal as P;
+                    vec![
+                        offset_of!(P, position),
+                        offset_of!(P, area),
+                        offset_of!(P, normal),
+                        offset_of!(P, pixels),
+                        offset_of!(P, flux),
+                        offset_of!(P, texel),
+                    ]
+                },
+            ),
+            (
                 "ism_view.wgsl",
                 "IsmViewParams",
                 size_of::<crate::renderer::passes::ism::GpuIsmViewParams>(),

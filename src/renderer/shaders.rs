@@ -100,6 +100,7 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("ism.wgsl", include_str!("../../shaders/ism.wgsl")),
     ("common/ism.wgsl", include_str!("../../shaders/common/ism.wgsl")),
     ("ism_view.wgsl", include_str!("../../shaders/ism_view.wgsl")),
+    ("val_cluster.wgsl", include_str!("../../shaders/val_cluster.wgsl")),
 ];
 
 /// The shared shaders that are entry points (not include-only files); [`entry_shaders`] adds
@@ -123,6 +124,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "interleave_filter.wgsl",
     "ism.wgsl",
     "ism_view.wgsl",
+    "val_cluster.wgsl",
 ];
 
 /// Every WGSL file: the shared ones and those the registered GI methods declare.

@@ -1,0 +1,259 @@
+//! Virtual Area Lights' clustering of a reflective shadow map (`shaders/val_cluster.wgsl`; the
+//! VAL paper's section 4, after Prutkin et al. 2012): clusters seeded at given RSM texels, then
+//! k steps of mapping (splat windows with eq. 1's metric, a fallback for texels no splat
+//! reaches) and averaging (mean position and normal, summed flux and surface area, the new
+//! centre texel), empty clusters re-seeded. Reads: one layer of the RSM (position, normal,
+//! flux), the seeds. Writes: [`ValTargets`] (the clusters, each texel's key). Twin:
+//! `reference::val` (docs/val.md).
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, UVec2, Vec3};
+
+use super::{
+    WG_1D, WG_2D, bind_group_seq, compute_pipeline, float_array_texture_entry, storage_buffer, storage_entry,
+    uniform_buffer, uniform_entry,
+};
+use crate::reference::val::{MAX_CLUSTERS, NONE, Val};
+use crate::renderer::{shaders, timing::GpuTimer};
+
+/// Twin: `ValParams` in `val_cluster.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuValParams {
+    pub view_proj: [[f32; 4]; 4],
+    pub light_dir: [f32; 3],
+    pub texel_area: f32,
+    pub res: u32,
+    pub clusters: u32,
+    pub splat: u32,
+    pub layer: u32,
+    pub w_p: f32,
+    pub w_n: f32,
+    pub w_f: f32,
+    /// d_p's unit: splat texels x texel edge (`reference::val::extent`).
+    pub extent: f32,
+}
+
+impl GpuValParams {
+    /// The parameters of `clusters` clusters on layer `layer` of a `res`^2 RSM whose raster is
+    /// `view_proj`, texels of `texel` metres perpendicular to a light travelling along
+    /// `light_dir`.
+    pub fn new(
+        view_proj: Mat4,
+        light_dir: Vec3,
+        texel: f32,
+        res: u32,
+        layer: u32,
+        clusters: u32,
+        p: &crate::reference::val::ClusterParams,
+    ) -> Self {
+        Self {
+            view_proj: view_proj.to_cols_array_2d(),
+            light_dir: light_dir.to_array(),
+            texel_area: texel * texel,
+            res,
+            clusters,
+            splat: p.splat,
+            layer,
+            w_p: p.weights.position,
+            w_n: p.weights.normal,
+            w_f: p.weights.flux,
+            extent: p.splat as f32 * texel,
+        }
+    }
+}
+
+/// Twin: `Val` in `val_cluster.wgsl` (`reference::val::Val`; the texel packed x | y << 16).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuVal {
+    pub position: [f32; 3],
+    pub area: f32,
+    pub normal: [f32; 3],
+    pub pixels: u32,
+    pub flux: [f32; 3],
+    pub texel: u32,
+}
+
+impl GpuVal {
+    pub fn to_val(self) -> Val {
+        Val {
+            position: Vec3::from_array(self.position),
+            normal: Vec3::from_array(self.normal),
+            flux: Vec3::from_array(self.flux),
+            pixels: self.pixels,
+            area: self.area,
+            texel: UVec2::new(self.texel & 0xffff, self.texel >> 16),
+        }
+    }
+}
+
+/// The cluster of a texel's stored (inverted) key; `NONE` where no cluster took it.
+pub fn key_cluster(stored: u32) -> u32 {
+    if stored == 0 {
+        NONE
+    } else {
+        (!stored) & (MAX_CLUSTERS - 1)
+    }
+}
+
+/// The clusters (two buffers: a step reads one and writes the other), the texels' keys, the
+/// fallback list and the seeds.
+pub struct ValTargets {
+    pub clusters: u32,
+    pub res: u32,
+    vals: [wgpu::Buffer; 2],
+    /// Per RSM texel the inverted least key of the last step ([`key_cluster`]).
+    pub keys: wgpu::Buffer,
+    fallback: wgpu::Buffer,
+    seeds: wgpu::Buffer,
+    /// Which of `vals` the last run left its clusters in.
+    last: usize,
+}
+
+impl ValTargets {
+    pub fn new(device: &wgpu::Device, clusters: u32, res: u32) -> Self {
+        let n = clusters.clamp(1, MAX_CLUSTERS) as u64;
+        let texels = res as u64 * res as u64;
+        let vals = |label| storage_buffer(device, label, n * std::mem::size_of::<GpuVal>() as u64);
+        Self {
+            clusters: n as u32,
+            res,
+            vals: [vals("val::clusters_a"), vals("val::clusters_b")],
+            keys: storage_buffer(device, "val::keys", 4 * texels),
+            fallback: storage_buffer(device, "val::fallback", 4 * (texels + 1)),
+            seeds: storage_buffer(device, "val::seeds", 4 * n),
+            last: 0,
+        }
+    }
+    pub fn matches(&self, clusters: u32, res: u32) -> bool {
+        self.clusters == clusters && self.res == res
+    }
+    /// The buffer holding the clusters after the last run.
+    pub fn vals(&self) -> &wgpu::Buffer {
+        &self.vals[self.last]
+    }
+}
+
+pub struct ValClusterPass {
+    layout: wgpu::BindGroupLayout,
+    clear: wgpu::ComputePipeline,
+    seed: wgpu::ComputePipeline,
+    map: wgpu::ComputePipeline,
+    fallback: wgpu::ComputePipeline,
+    average: wgpu::ComputePipeline,
+    reseed: wgpu::ComputePipeline,
+    params: wgpu::Buffer,
+}
+
+impl ValClusterPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let module = shaders::create_module(device, "val_cluster.wgsl")?;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("val_cluster::layout"),
+            entries: &[
+                uniform_entry(0, c),
+                float_array_texture_entry(1),
+                float_array_texture_entry(2),
+                float_array_texture_entry(3),
+                storage_entry(4, c, true),
+                storage_entry(5, c, false),
+                storage_entry(6, c, false),
+                storage_entry(7, c, false),
+                storage_entry(8, c, true),
+            ],
+        });
+        let pipe = |entry: &str| compute_pipeline(device, entry, &[Some(&layout)], &module, entry);
+        Ok(Self {
+            clear: pipe("clear_main"),
+            seed: pipe("seed_main"),
+            map: pipe("map_main"),
+            fallback: pipe("fallback_main"),
+            average: pipe("average_main"),
+            reseed: pipe("reseed_main"),
+            params: uniform_buffer::<GpuValParams>(device, "val_cluster::params"),
+            layout,
+        })
+    }
+
+    /// Clusters seeded at `seeds` (at most the targets' clusters), then `iterations` steps, in
+    /// one compute pass timed as `name`. `rsm`: the position, normal and flux array views.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        name: &str,
+        rsm: [&wgpu::TextureView; 3],
+        p: GpuValParams,
+        seeds: &[UVec2],
+        iterations: u32,
+        t: &mut ValTargets,
+    ) {
+        let n = (seeds.len() as u32).min(t.clusters);
+        let p = GpuValParams { clusters: n, ..p };
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let packed: Vec<u32> = seeds[..n as usize].iter().map(|s| s.x | s.y << 16).collect();
+        if !packed.is_empty() {
+            queue.write_buffer(&t.seeds, 0, bytemuck::cast_slice(&packed));
+        }
+        // (in, out): 0 -> 1 and 1 -> 0.
+        let bind = |i: usize| {
+            bind_group_seq(
+                device,
+                "val_cluster::bind_group",
+                &self.layout,
+                &[
+                    self.params.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(rsm[0]),
+                    wgpu::BindingResource::TextureView(rsm[1]),
+                    wgpu::BindingResource::TextureView(rsm[2]),
+                    t.vals[i].as_entire_binding(),
+                    t.vals[1 - i].as_entire_binding(),
+                    t.keys.as_entire_binding(),
+                    t.fallback.as_entire_binding(),
+                    t.seeds.as_entire_binding(),
+                ],
+            )
+        };
+        let groups = [bind(0), bind(1)];
+        encoder.push_debug_group(name);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(name),
+                timestamp_writes: timer.compute_pass(name),
+            });
+            if n > 0 {
+                let per_cluster = n.div_ceil(WG_1D);
+                let texel_groups = (p.res * p.res).div_ceil(WG_1D);
+                let (cx, cy) = (texel_groups.min(65535), texel_groups.div_ceil(65535));
+                let splat = p.splat.div_ceil(WG_2D);
+                let image = p.res.div_ceil(WG_2D);
+                // Seed into vals[0] (the bind group whose output is 0).
+                pass.set_bind_group(0, &groups[1], &[]);
+                pass.set_pipeline(&self.seed);
+                pass.dispatch_workgroups(per_cluster, 1, 1);
+                let mut cur = 0;
+                for _ in 0..iterations.max(1) {
+                    pass.set_bind_group(0, &groups[cur], &[]);
+                    pass.set_pipeline(&self.clear);
+                    pass.dispatch_workgroups(cx, cy, 1);
+                    pass.set_pipeline(&self.map);
+                    pass.dispatch_workgroups(splat, splat, n);
+                    pass.set_pipeline(&self.fallback);
+                    pass.dispatch_workgroups(image, image, 1);
+                    pass.set_pipeline(&self.average);
+                    pass.dispatch_workgroups(n, 1, 1);
+                    pass.set_pipeline(&self.reseed);
+                    pass.dispatch_workgroups(per_cluster, 1, 1);
+                    cur = 1 - cur;
+                }
+                t.last = cur;
+            }
+        }
+        encoder.pop_debug_group();
+    }
+}
