@@ -1064,11 +1064,17 @@ impl Method for LightCulling {
             let r = self.scene_radius;
             let tile = self.ism_targets.as_ref().map_or(0, |t| t.layout.tile);
             return Some(Legend {
-                title: format!(
-                    "distance from the VPL ({} maps of {tile}^2; dim: filled by pull-push; black: \
-                     hole)",
-                    self.ism_maps
-                ),
+                title: if self.ism_maps == 0 {
+                    "no maps this frame (ISM visibility off and the view not drawn yet, or \
+                     refused: see the problems window)"
+                        .to_string()
+                } else {
+                    format!(
+                        "distance from the VPL ({} maps of {tile}^2; dim: filled by pull-push; \
+                         black: hole)",
+                        self.ism_maps
+                    )
+                },
                 lo: (0.005 * r).log10(),
                 hi: (2.0 * r).log10(),
                 log: true,
