@@ -11,7 +11,8 @@
 //                  summed flux and surface area, pixel count; its new centre is the texel its
 //                  mean position projects into when that one is lit (else the old centre);
 //                  a cluster left empty keeps its centre with 0 pixels;
-//   seed_main / reseed_main: clusters from their seed texels (all; those left empty);
+//   seed_main / reseed_main: clusters from their seed texels (all, before the first step;
+//                  those the last step left empty, before the next one);
 //   clear_main:    the keys and the fallback list before a step.
 // Twin: reference::val::{map, average}.
 
@@ -168,7 +169,8 @@ fn seed_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-// After a step: a cluster left without texels is re-seeded (the paper re-initialises it).
+// Before a step after the first: a cluster left without texels is re-seeded (the paper
+// re-initialises it); the caller binds the step's input as vals_out.
 @compute @workgroup_size(64, 1, 1)
 fn reseed_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if gid.x < vp.clusters && vals_out[gid.x].pixels == 0u {

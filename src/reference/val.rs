@@ -14,7 +14,8 @@
 //!   samples the RSM there);
 //! - the depth-buffer assignment ("lowest mu wins") is a minimum over a packed key
 //!   (mu's f32 bits with the low 10 mantissa bits replaced by the cluster index, so ties and
-//!   near-ties go to the lower index): one atomicMin per texel and cluster on the GPU;
+//!   near-ties go to the lower index): on the GPU one atomicMax of the inverted key per texel
+//!   and cluster (a cleared 0 means none);
 //! - texels no splat reaches take the cluster of least mu among all clusters (the paper leaves
 //!   them unassigned, losing their flux): every texel with flux belongs to one cluster and the
 //!   clusters' flux sums to the RSM's;
@@ -271,20 +272,25 @@ pub fn average(rsm: &Rsm, assignment: &[u32], vals: &[Val]) -> Vec<Val> {
         .collect()
 }
 
-/// k iterations of mapping and averaging from clusters seeded at `seeds` (a cluster that
-/// loses its texels is re-seeded at its seed, as the paper re-initialises empty clusters).
-/// Returns the clusters and the last assignment.
+/// k iterations of mapping and averaging from clusters seeded at `seeds`. A cluster left
+/// without texels by a step is re-seeded at its seed before the next one (as the paper
+/// re-initialises empty clusters); after the last step it stays empty (`pixels` 0: no light,
+/// its other fields stale), so the clusters with pixels hold every lit texel and the RSM's
+/// flux exactly once (a duplicate seed's cluster is one such empty cluster). Returns the
+/// clusters and the last assignment. Twin: `ValClusterPass::record`.
 pub fn cluster(rsm: &Rsm, p: &ClusterParams, seeds: &[UVec2], iterations: u32) -> (Vec<Val>, Vec<u32>) {
     let mut vals: Vec<Val> = seeds.iter().map(|&t| seed(rsm, t)).collect();
     let mut assignment = vec![NONE; rsm.texels.len()];
-    for _ in 0..iterations.max(1) {
-        assignment = map(rsm, p, &vals).0;
-        vals = average(rsm, &assignment, &vals);
-        for (v, &s) in vals.iter_mut().zip(seeds) {
-            if v.pixels == 0 {
-                *v = seed(rsm, s);
+    for step in 0..iterations.max(1) {
+        if step > 0 {
+            for (v, &s) in vals.iter_mut().zip(seeds) {
+                if v.pixels == 0 {
+                    *v = seed(rsm, s);
+                }
             }
         }
+        assignment = map(rsm, p, &vals).0;
+        vals = average(rsm, &assignment, &vals);
     }
     (vals, assignment)
 }
@@ -313,9 +319,9 @@ mod tests {
     use super::*;
     use crate::reference::vpl::{pcg_hash, u01};
 
-    /// A flat floor (y = 0) seen from above, `res`^2 texels of 0.1 m: four quadrants with
-    /// their own colour, the right half tilted up (normal leaning +x), texels of the last row
-    /// without geometry.
+    /// A floor seen from above, `res`^2 texels of 0.1 m: the right half's normal leans 56
+    /// degrees towards -x; the top quadrants share a colour, the bottom ones have their own;
+    /// texels of the last row without geometry.
     fn floor(res: u32) -> Rsm {
         let texels = (0..res * res)
             .map(|i| {
@@ -329,13 +335,14 @@ mod tests {
                         y as f32 * 0.1,
                     ),
                     normal: if right {
-                        Vec3::new(-0.2, 1.0, 0.0).normalize()
+                        Vec3::new(-1.5, 1.0, 0.0).normalize()
                     } else {
                         Vec3::Y
                     },
+                    // The top quadrants share a colour: only their normals tell them apart.
                     flux: match (right, bottom) {
                         (false, false) => Vec3::new(1.0, 0.2, 0.2),
-                        (true, false) => Vec3::new(0.2, 1.0, 0.2),
+                        (true, false) => Vec3::new(1.0, 0.2, 0.2),
                         (false, true) => Vec3::new(0.2, 0.2, 1.0),
                         (true, true) => Vec3::new(0.6, 0.6, 0.6),
                     } * 0.01,
@@ -395,39 +402,48 @@ mod tests {
         let rsm = floor(64);
         for (n, splat, iterations) in [(16, 16, 1), (16, 8, 3), (40, 32, 4)] {
             let p = params(splat);
-            let (vals, assignment) = cluster(&rsm, &p, &random_seeds(64, n), iterations);
+            // Every fourth seed repeats an earlier one (VPL seeds drawn with replacement do).
+            let mut s = random_seeds(64, n);
+            for k in (3..s.len()).step_by(4) {
+                s[k] = s[k - 3];
+            }
+            let (vals, assignment) = cluster(&rsm, &p, &s, iterations);
             let lit = (0..rsm.texels.len()).filter(|&i| rsm.lit(i)).count();
             // One cluster per lit texel, none for the rest.
             for (i, &c) in assignment.iter().enumerate() {
                 assert_eq!(c != NONE, rsm.lit(i), "texel {i}");
                 assert!(c == NONE || c < n);
             }
-            // Each cluster's counts agree with the assignment (a cluster left empty is
-            // re-seeded: one pixel, its seed's); together they hold every lit texel and the
-            // RSM's flux (sums in another order: float rounding).
-            let (mut pixels, mut sum) = (0, Vec3::ZERO);
+            // Each cluster's count is its texels'; the non-empty ones hold every lit texel
+            // and the RSM's flux exactly once (sums in another order: float rounding).
+            let (mut pixels, mut sum, mut empty) = (0, Vec3::ZERO, 0);
             for (c, v) in vals.iter().enumerate() {
                 let mine = assignment.iter().filter(|&&a| a == c as u32).count();
-                assert!(
-                    v.pixels as usize == mine || (mine == 0 && v.pixels == 1),
-                    "cluster {c}"
-                );
-                if mine > 0 {
+                assert_eq!(v.pixels as usize, mine, "cluster {c}");
+                if v.pixels > 0 {
                     pixels += mine;
                     sum += v.flux;
+                } else {
+                    empty += 1;
                 }
             }
             assert_eq!(pixels, lit, "{n} clusters, splat {splat}");
-            // Small splats leave gaps that the fallback closes (it is exercised here).
-            let (_, fallback) = map(&rsm, &p, &vals);
+            // After one step the duplicates' clusters are empty (the lower index wins the
+            // tie); later steps re-seed them where the original has moved away.
             assert!(
-                splat != 8 || fallback > 0,
-                "{fallback} texels by fallback at splat {splat}"
+                iterations > 1 || empty >= n / 4,
+                "the duplicate seeds' clusters are empty: {empty}"
             );
             let total = rsm.total_flux();
             assert!(
                 (sum - total).abs().max_element() <= 1e-4 * total.max_element(),
                 "{sum} vs {total}"
+            );
+            // Small splats leave gaps that the fallback closes (it is exercised here).
+            let (_, fallback) = map(&rsm, &p, &vals);
+            assert!(
+                splat != 8 || fallback > 0,
+                "{fallback} texels by fallback at splat {splat}"
             );
         }
     }

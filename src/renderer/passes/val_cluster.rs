@@ -2,7 +2,7 @@
 //! VAL paper's section 4, after Prutkin et al. 2012): clusters seeded at given RSM texels, then
 //! k steps of mapping (splat windows with eq. 1's metric, a fallback for texels no splat
 //! reaches) and averaging (mean position and normal, summed flux and surface area, the new
-//! centre texel), empty clusters re-seeded. Reads: one layer of the RSM (position, normal,
+//! centre texel), empty clusters re-seeded before the next step. Reads: one layer of the RSM (position, normal,
 //! flux), the seeds. Writes: [`ValTargets`] (the clusters, each texel's key). Twin:
 //! `reference::val` (docs/val.md).
 
@@ -35,24 +35,23 @@ pub struct GpuValParams {
 }
 
 impl GpuValParams {
-    /// The parameters of `clusters` clusters on layer `layer` of a `res`^2 RSM whose raster is
-    /// `view_proj`, texels of `texel` metres perpendicular to a light travelling along
-    /// `light_dir`.
+    /// The parameters for layer `layer` of a `res`^2 RSM whose raster is `view_proj`, texels of
+    /// `texel` metres perpendicular to a light travelling along `light_dir` (the cluster count
+    /// is the seeds', set by [`ValClusterPass::record`]).
     pub fn new(
         view_proj: Mat4,
         light_dir: Vec3,
         texel: f32,
         res: u32,
         layer: u32,
-        clusters: u32,
         p: &crate::reference::val::ClusterParams,
     ) -> Self {
         Self {
             view_proj: view_proj.to_cols_array_2d(),
-            light_dir: light_dir.to_array(),
+            light_dir: light_dir.normalize_or(Vec3::NEG_Y).to_array(),
             texel_area: texel * texel,
             res,
-            clusters,
+            clusters: 0,
             splat: p.splat,
             layer,
             w_p: p.weights.position,
@@ -177,8 +176,12 @@ impl ValClusterPass {
         })
     }
 
-    /// Clusters seeded at `seeds` (at most the targets' clusters), then `iterations` steps, in
-    /// one compute pass timed as `name`. `rsm`: the position, normal and flux array views.
+    /// Clusters seeded at `seeds` (one per cluster, at most the targets' clusters), then
+    /// `iterations` steps, in one compute pass timed as `name`: a cluster left empty by a step
+    /// is re-seeded before the next; after the last step it stays empty (`pixels` 0). `rsm`:
+    /// the position, normal and flux array views. The parameters and seeds live in the pass
+    /// and the targets: one `record` per submission. Refused (nothing recorded) when the
+    /// targets were made for another resolution or fewer clusters, or without seeds.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -192,8 +195,21 @@ impl ValClusterPass {
         seeds: &[UVec2],
         iterations: u32,
         t: &mut ValTargets,
-    ) {
-        let n = (seeds.len() as u32).min(t.clusters);
+    ) -> Result<(), String> {
+        if p.res != t.res {
+            return Err(format!(
+                "VAL clustering: a {0}^2 RSM in targets made for {1}^2",
+                p.res, t.res
+            ));
+        }
+        if seeds.is_empty() || seeds.len() as u32 > t.clusters {
+            return Err(format!(
+                "VAL clustering: {} seeds for targets of {} clusters",
+                seeds.len(),
+                t.clusters
+            ));
+        }
+        let n = seeds.len() as u32;
         let p = GpuValParams { clusters: n, ..p };
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         let packed: Vec<u32> = seeds[..n as usize].iter().map(|s| s.x | s.y << 16).collect();
@@ -226,7 +242,7 @@ impl ValClusterPass {
                 label: Some(name),
                 timestamp_writes: timer.compute_pass(name),
             });
-            if n > 0 {
+            {
                 let per_cluster = n.div_ceil(WG_1D);
                 let texel_groups = (p.res * p.res).div_ceil(WG_1D);
                 let (cx, cy) = (texel_groups.min(65535), texel_groups.div_ceil(65535));
@@ -237,7 +253,14 @@ impl ValClusterPass {
                 pass.set_pipeline(&self.seed);
                 pass.dispatch_workgroups(per_cluster, 1, 1);
                 let mut cur = 0;
-                for _ in 0..iterations.max(1) {
+                for step in 0..iterations.max(1) {
+                    if step > 0 {
+                        // Re-seed the empty clusters of the step's input (the bind group
+                        // whose output is vals[cur]).
+                        pass.set_bind_group(0, &groups[1 - cur], &[]);
+                        pass.set_pipeline(&self.reseed);
+                        pass.dispatch_workgroups(per_cluster, 1, 1);
+                    }
                     pass.set_bind_group(0, &groups[cur], &[]);
                     pass.set_pipeline(&self.clear);
                     pass.dispatch_workgroups(cx, cy, 1);
@@ -247,13 +270,12 @@ impl ValClusterPass {
                     pass.dispatch_workgroups(image, image, 1);
                     pass.set_pipeline(&self.average);
                     pass.dispatch_workgroups(n, 1, 1);
-                    pass.set_pipeline(&self.reseed);
-                    pass.dispatch_workgroups(per_cluster, 1, 1);
                     cur = 1 - cur;
                 }
                 t.last = cur;
             }
         }
         encoder.pop_debug_group();
+        Ok(())
     }
 }
