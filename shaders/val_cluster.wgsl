@@ -218,10 +218,18 @@ fn average_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_
     var area = 0.0;
     var pixels = 0u;
     if ci < vp.clusters && old.pixels > 0u {
+        // Its window's texels, then the fallback's (any cluster may have some; no window
+        // reaches them), as one index range.
         let centre = unpack_texel(old.texel);
         let lo = vec2<u32>(window_lo(centre.x), window_lo(centre.y));
-        for (var k = li; k < vp.splat * vp.splat; k += AVG_WG) {
-            let t = lo + vec2<u32>(k % vp.splat, k / vp.splat);
+        let window = vp.splat * vp.splat;
+        let total = window + atomicLoad(&fallback[0]);
+        for (var k = li; k < total; k += AVG_WG) {
+            var t = lo + vec2<u32>(k % vp.splat, k / vp.splat);
+            if k >= window {
+                let i = atomicLoad(&fallback[1u + k - window]);
+                t = vec2<u32>(i % vp.res, i / vp.res);
+            }
             if t.x >= vp.res || t.y >= vp.res {
                 continue;
             }
@@ -230,24 +238,6 @@ fn average_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_
                 continue;
             }
             let x = load(t);
-            position += x.position;
-            normal += x.normal;
-            flux += x.flux;
-            area += surface_area(x.normal);
-            pixels += 1u;
-        }
-    }
-    // The fallback's texels (any cluster with pixels may have some; those windows never
-    // reach them).
-    if ci < vp.clusters && old.pixels > 0u {
-        let n = atomicLoad(&fallback[0]);
-        for (var k = li; k < n; k += AVG_WG) {
-            let i = atomicLoad(&fallback[1u + k]);
-            let key = atomicLoad(&keys[i]);
-            if ((~key) & ((1u << INDEX_BITS) - 1u)) != ci {
-                continue;
-            }
-            let x = load(vec2<u32>(i % vp.res, i / vp.res));
             position += x.position;
             normal += x.normal;
             flux += x.flux;

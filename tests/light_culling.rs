@@ -101,6 +101,14 @@ fn shade_vpls(vpls: &[GpuVpl]) -> Vec<ShadeVpl> {
         .collect()
 }
 
+/// Counts a lit pixel (the CPU's value above 1e-6) and whether the GPU's is within 1e-3 of it.
+fn tally(lit: &mut usize, close: &mut usize, gpu: Vec3, cpu: Vec3) {
+    if cpu.max_element() > 1e-6 {
+        *lit += 1;
+        *close += ((gpu - cpu).abs().max_element() <= 1e-3 * cpu.max_element()) as usize;
+    }
+}
+
 /// The CPU shadow ray from surface point p (normal nx) to VPL i, both ends offset `off`.
 fn visible<'a>(
     bvh: &'a Bvh,
@@ -438,13 +446,8 @@ fn gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing()
                 visible(&bvh, &sv, p, nx, off),
             );
             let gpu = Vec3::from_slice(&raw[k][..3]);
-            if cpu.max_element() > 1e-6 {
-                lit += 1;
-                // A shadow ray grazing an edge may differ between the BVH traversals.
-                if (gpu - cpu).abs().max_element() <= 1e-3 * cpu.max_element() {
-                    close += 1;
-                }
-            }
+            // A shadow ray grazing an edge may differ between the BVH traversals.
+            tally(&mut lit, &mut close, gpu, cpu);
         }
     }
     eprintln!("shading: {close} of {lit} lit pixels within 1e-3 of the CPU");
@@ -723,12 +726,7 @@ fn the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_trut
                 visible(&bvh, &sv, xp, nx, off),
             );
             let got = Vec3::from_slice(&raw[p][..3]);
-            if want.max_element() > 1e-6 {
-                lit += 1;
-                if (got - want).abs().max_element() <= 1e-3 * want.max_element() {
-                    close += 1;
-                }
-            }
+            tally(&mut lit, &mut close, got, want);
         }
     }
     eprintln!(
@@ -910,12 +908,7 @@ fn ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays() {
             };
             let cpu = shade(p, nx, list, &sv, &gl, il, s.gi.distance_epsilon, ism_visible);
             let gpu = Vec3::from_slice(&raw[k][..3]);
-            if cpu.max_element() > 1e-6 {
-                lit += 1;
-                if (gpu - cpu).abs().max_element() <= 1e-3 * cpu.max_element() {
-                    close += 1;
-                }
-            }
+            tally(&mut lit, &mut close, gpu, cpu);
             // How often the map's answer is the shadow ray's, over the VPLs in range that
             // face the pixel.
             let mut ray = visible(&bvh, &sv, p, nx, s.gi.ray_offset);
@@ -1097,12 +1090,7 @@ fn tree_shading_with_maps_matches(st: &Setup, lc: &LightCullingSettings, s: &Ren
             },
         );
         let got = Vec3::from_slice(&raw[p][..3]);
-        if want.max_element() > 1e-6 {
-            lit += 1;
-            if (got - want).abs().max_element() <= 1e-3 * want.max_element() {
-                close += 1;
-            }
-        }
+        tally(&mut lit, &mut close, got, want);
     }
     eprintln!("tree with maps: {close} of {lit} lit pixels' shading within 1e-3 of the CPU");
     assert!(lit > 100 && close >= lit * 98 / 100, "{close} of {lit}");

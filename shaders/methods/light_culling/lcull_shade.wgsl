@@ -1,7 +1,7 @@
 // Algorithm 1, step 3: per pixel, the VPLs of its tile's list (every VPL of its interleaving
 // subset when the tile is over its cap), each with the stochastic (eq. 2) or clamped fall-off
-// and, with visibility on, a BVH shadow ray or a lookup in its imperfect shadow map; the sum x n^2 (the subset is 1 / n^2 of the
-// VPLs), demodulated (before albedo / pi), into `raw`. The shared geometry-aware filter
+// and, with visibility on, a BVH shadow ray or a lookup in its imperfect shadow map; the
+// sum x n^2 (the subset is 1 / n^2 of the VPLs), demodulated (before albedo / pi), into `raw`. The shared geometry-aware filter
 // (`interleave_filter.wgsl`, section 4.2) then undoes the interleaving into the GI
 // accumulation. Twin: reference::light_culling::shade.
 #include "common/math.wgsl"

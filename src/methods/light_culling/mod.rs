@@ -433,10 +433,6 @@ impl LightCulling {
     pub fn ism_targets(&self) -> Option<(&IsmTargets, u32)> {
         self.ism_targets.as_ref().map(|t| (t, self.ism_maps))
     }
-    /// The scene's point cloud and the (points, seed) it was sampled with.
-    pub fn ism_points(&self) -> Option<&IsmPoints> {
-        self.ism_points.as_ref().map(|(_, p)| p)
-    }
 
     /// The point cloud and the atlas for `s` on the frame's scene (rebuilt when either
     /// changed).

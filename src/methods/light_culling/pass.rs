@@ -1,7 +1,8 @@
 //! Stochastic Light Culling's GPU passes, in frame order (Algorithm 1 of the paper):
 //! `lcull_ranges` (per VPL: fall-off and range; with ISM visibility also its map's light),
 //! `lcull_ism` (with ISM visibility: the VPLs' imperfect shadow maps, the shared
-//! `passes::ism`), `lcull_tiles` (per tile: depth bounds and the light list), `lcull_shade` (per pixel: the list's VPLs, demodulated), `lcull_filter` (the
+//! `passes::ism`), `lcull_tiles` (per tile: depth bounds and the light list), `lcull_shade`
+//! (per pixel: the list's VPLs, demodulated), `lcull_filter` (the
 //! interleaving's geometry-aware filter, x albedo / pi, into the GI accumulation: the shared
 //! `passes::interleave_filter`), and the views.
 //! Reads: the VPLs, G-buffer, camera, BVH. CPU twins: `crate::reference::light_culling`.
