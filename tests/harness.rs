@@ -303,6 +303,36 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         &["our_ms", "paper_ms"],
         3,
     );
+    // The VAL paper's Table 1: 64 and 512 VALs with rays, PCSS and simple lookups, and the
+    // VPL-shading mode with rays.
+    check_csv(
+        &d,
+        "val.csv",
+        &["method", "vals", "visibility"],
+        &[
+            "clustering_ms",
+            "indirect_ms",
+            "ism_ms",
+            "gi_gpu_ms",
+            "rmse_vs_ground_truth",
+            "rmse_vs_exact_visibility",
+        ],
+        8,
+    );
+    let (_, rows) = read_csv(&d.join("val.csv"));
+    for r in &rows {
+        let ism: f64 = r["ism_ms"].parse().unwrap();
+        assert_eq!(ism > 0.0, r["visibility"] != "rays", "{r:?}");
+        let exact: f64 = r["rmse_vs_exact_visibility"].parse().unwrap();
+        assert_eq!(exact == 0.0, r["visibility"] == "rays", "{r:?}");
+    }
+    check_csv(
+        &d,
+        "val_table1.csv",
+        &["row"],
+        &["ours_64_pcss_ms", "ours_512_simple_ms", "paper_64_pcss_ms"],
+        4,
+    );
     let (_, rows) = read_csv(&d.join("interpolation.csv"));
     let names: Vec<&str> = rows.iter().map(|r| r["method"].as_str()).collect();
     assert_eq!(names, ["Lightcuts", "LI full vis.", "LI interp. vis."]);

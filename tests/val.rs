@@ -9,17 +9,23 @@ mod common;
 use common::Setup;
 
 use glam::{UVec2, Vec3};
+use lightcut::methods::val::{
+    self as val_method, Vals,
+    settings::{InterleaveSettings, IsmSettings, ValSettings, ValVisibility},
+};
+use lightcut::reference::ism::{self, IsmLayout};
 use lightcut::reference::val::{self, ClusterParams, MetricWeights, NONE, Rsm, RsmTexel};
 use lightcut::reference::vpl::{pcg_hash, u01};
 use lightcut::renderer::{
     Buffer,
     context::GpuContext,
     gpu_data::light_frustum,
-    passes::val_cluster::{GpuVal, GpuValParams, ValClusterPass, ValTargets, key_cluster},
+    passes::val_cluster::{GpuVal, GpuValParams, ValClusterPass, ValSeeds, ValTargets, key_cluster},
     readback::read_storage_buffer,
     settings::RenderSettings,
     timing::GpuTimer,
 };
+use lightcut::scene::bvh::{Bvh, Ray};
 
 const RES: u32 = 128;
 
@@ -143,7 +149,7 @@ fn gpu_cluster(
         "val_cluster",
         [&views[0], &views[1], &views[2]],
         params,
-        seeds,
+        ValSeeds::Cpu(seeds),
         iterations,
         &mut t,
     )
@@ -285,7 +291,7 @@ fn a_mismatched_clustering_is_refused() {
             "val_cluster",
             [&views[0], &views[1], &views[2]],
             p,
-            seeds,
+            ValSeeds::Cpu(seeds),
             1,
             &mut t,
         )
@@ -294,4 +300,365 @@ fn a_mismatched_clustering_is_refused() {
     assert!(run(64, &[UVec2::ZERO; 5]).unwrap_err().contains("5 seeds"));
     assert!(run(64, &[]).is_err());
     assert!(run(64, &[UVec2::ZERO; 4]).is_ok());
+}
+
+// ---- The VAL method (`methods::val`): seeds, shading, visibility, accumulation ----
+
+const W: u32 = 48;
+const H: u32 = 32;
+const METHOD_RES: u32 = 128;
+
+/// Tiny VAL settings: 24 VALs, 2 steps, a 2 x 2 pattern, 64^2 maps in a 512^2 atlas.
+fn small() -> ValSettings {
+    ValSettings {
+        clusters: 24,
+        iterations: 2,
+        interleave: InterleaveSettings::pattern(2),
+        ism: IsmSettings {
+            atlas: 512,
+            tile: 64,
+            points: 1 << 15,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+fn method_settings(vs: &ValSettings, method: lightcut::methods::MethodId) -> RenderSettings {
+    let mut s = RenderSettings::default();
+    s.gi.method = method;
+    s.vpl.count = 250;
+    s.shadow.resolution = METHOD_RES;
+    s.sampling.fixed_seed = true;
+    s.set_method(val_method::ID, vs).unwrap();
+    s
+}
+
+fn vals_of(st: &Setup) -> &Vals {
+    st.r.method_module::<Vals>()
+        .expect("the VAL module is registered")
+}
+
+fn read_vals(st: &Setup) -> Vec<val::Val> {
+    let t = vals_of(st).targets().expect("a VAL frame ran");
+    let bytes = read_storage_buffer(&st.r.ctx, t.vals()).unwrap();
+    let g: &[GpuVal] = bytemuck::cast_slice(&bytes);
+    g[..t.clusters as usize].iter().map(|v| v.to_val()).collect()
+}
+
+/// Counts a lit pixel (the CPU's value above 1e-6) and whether the GPU's is within 1e-3 of it.
+fn tally(lit: &mut usize, close: &mut usize, gpu: Vec3, cpu: Vec3) {
+    if cpu.max_element() > 1e-6 {
+        *lit += 1;
+        *close += ((gpu - cpu).abs().max_element() <= 1e-3 * cpu.max_element()) as usize;
+    }
+}
+
+/// The CPU's demodulated raw estimate of every pixel (n^2 x its subset's VALs, each with
+/// `vis`) with the frame's interleaving offset.
+fn cpu_raw(
+    st: &Setup,
+    vals: &[val::Val],
+    n: u32,
+    offset: u32,
+    as_point: bool,
+    mut vis: impl FnMut(u32, &val::Val, Vec3, Vec3) -> f32,
+) -> Vec<Option<Vec3>> {
+    let pos = st.r.read(Buffer::Position).unwrap();
+    let nrm = st.r.read(Buffer::Normal).unwrap();
+    let eps = st.r.settings().gi.distance_epsilon;
+    (0..W * H)
+        .map(|k| {
+            let g = pos.pixels[k as usize];
+            if g[3] == 0.0 {
+                return None;
+            }
+            let (x, y) = (k % W, k / W);
+            let p = Vec3::new(g[0], g[1], g[2]);
+            let nx = Vec3::from_slice(&nrm.pixels[k as usize][..3]).normalize();
+            let s = x % n + n * (y % n);
+            let sum: Vec3 = val::subset(vals.len() as u32, n, offset, s)
+                .map(|i| {
+                    let v = &vals[i as usize];
+                    let t = val::term(v, as_point, eps, p, nx);
+                    if t == Vec3::ZERO { t } else { t * vis(i, v, p, nx) }
+                })
+                .sum();
+            Some(sum * (n * n) as f32)
+        })
+        .collect()
+}
+
+fn gpu_raw(st: &Setup) -> Vec<Vec3> {
+    let b = vals_of(st).buffers();
+    let raw: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&st.r.ctx, &b.raw).unwrap());
+    raw.iter().map(|r| Vec3::from_slice(&r[..3])).collect()
+}
+
+/// (lit pixels, pixels within 1e-3 of the CPU).
+fn compare(gpu: &[Vec3], cpu: &[Option<Vec3>]) -> (usize, usize) {
+    let (mut lit, mut close) = (0, 0);
+    for (g, c) in gpu.iter().zip(cpu) {
+        if let Some(c) = c {
+            tally(&mut lit, &mut close, *g, *c);
+        }
+    }
+    (lit, close)
+}
+
+#[test]
+fn seeds_shading_and_pcss_equal_the_cpu_reference() {
+    let Some(ctx) = common::gpu() else { return };
+    let vs = small();
+    let s = method_settings(&vs, val_method::ID);
+    let mut st = Setup::new(&ctx, s.clone(), (W, H));
+    st.frame();
+    assert!(ctx.errors.take().is_empty());
+
+    // Seeds: the GPU's from the frame's VPLs are the CPU twin's.
+    let vpls = st.r.read_vpls().unwrap();
+    let ids: Vec<u32> = vpls.iter().map(|v| v.id).collect();
+    let want = val::seeds_from_vpls(&ids, vs.clusters, 0, METHOD_RES);
+    let t = vals_of(&st).targets().unwrap();
+    let got: Vec<u32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &t.seeds).unwrap());
+    assert_eq!(&got[..vs.clusters as usize], &want[..], "seed texels");
+
+    // The clusters partition the RSM's lit texels and keep its flux.
+    let flux = st.r.read(Buffer::RsmFlux(0)).unwrap();
+    let pos = st.r.read(Buffer::RsmPosition(0)).unwrap();
+    let (mut lit_texels, mut total) = (0u32, Vec3::ZERO);
+    for (f, p) in flux.pixels.iter().zip(&pos.pixels) {
+        let f = Vec3::from_slice(&f[..3]);
+        if p[3] > 0.0 && f.max_element() > 0.0 {
+            lit_texels += 1;
+            total += f;
+        }
+    }
+    let vals = read_vals(&st);
+    assert_eq!(vals.iter().map(|v| v.pixels).sum::<u32>(), lit_texels);
+    let vf: Vec3 = vals.iter().filter(|v| v.pixels > 0).map(|v| v.flux).sum();
+    assert!(
+        (vf - total).abs().max_element() <= 1e-3 * total.max_element(),
+        "{vf} vs {total}"
+    );
+    assert!(
+        vals.iter().filter(|v| v.pixels > 0).count() >= 12,
+        "most VALs lit"
+    );
+
+    // The maps' lights are the VALs.
+    let (it, maps) = vals_of(&st).ism().expect("PCSS builds the maps");
+    assert_eq!(maps, vs.clusters);
+    let lights: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &it.lights).unwrap());
+    for (i, v) in vals.iter().enumerate() {
+        assert_eq!(Vec3::from_slice(&lights[2 * i][..3]), v.position);
+        assert_eq!(lights[2 * i][3] > 0.0, v.pixels > 0);
+    }
+
+    // PCSS shading (the default) against the CPU's lookups in the GPU's atlas.
+    let layout = IsmLayout {
+        atlas: vs.ism.atlas,
+        tile: vs.ism.tile,
+    };
+    let atlas: Vec<f32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &it.depth).unwrap());
+    let n = vs.interleave.n;
+    let offset = Vals::offset(&s, n, 0);
+    let (mut blocked, mut lookups) = (0, 0);
+    let bvh = Bvh::build(&st.scene.positions, &st.scene.indices);
+    let off = s.gi.ray_offset;
+    let ray = |v: &val::Val, p: Vec3, nx: Vec3| {
+        let o = p + nx * off;
+        let e = v.position + v.normal * off;
+        !bvh.any_hit(&Ray {
+            origin: o,
+            dir: e - o,
+            tmin: 1e-4,
+            tmax: 1.0 - 1e-4,
+        })
+    };
+    let (mut vis_pcss, mut vis_simple, mut vis_ray) = (0.0f64, 0.0f64, 0.0f64);
+    let cpu = cpu_raw(&st, &vals, n, offset, false, |i, v, p, nx| {
+        let q = val::pcss(
+            layout,
+            &atlas,
+            i,
+            v.position,
+            v.normal,
+            v.area,
+            p,
+            vs.ism.bias,
+            &vs.pcss,
+        );
+        lookups += 1;
+        blocked += q.blocked as usize;
+        vis_pcss += q.visibility as f64;
+        vis_simple += ism::visible(layout, &atlas, i, v.position, v.normal, p, vs.ism.bias) as u32 as f64;
+        vis_ray += ray(v, p, nx) as u32 as f64;
+        q.visibility
+    });
+    println!(
+        "mean visibility: pcss {:.3}, simple {:.3}, rays {:.3}",
+        vis_pcss / lookups as f64,
+        vis_simple / lookups as f64,
+        vis_ray / lookups as f64
+    );
+    let (lit, close) = compare(&gpu_raw(&st), &cpu);
+    println!(
+        "PCSS: {close} of {lit} lit pixels equal the CPU's; {blocked} of {lookups} lookups found blockers"
+    );
+    assert!(lit > 200 && close as f64 >= 0.99 * lit as f64, "{close} / {lit}");
+    assert!(
+        blocked > lookups / 20 && blocked < lookups,
+        "the search finds some blockers"
+    );
+
+    // The simple lookup, and the VPL mode with shadow rays.
+    st.set(|s| val_method::set_visibility(s, ValVisibility::Ism));
+    st.frame();
+    let vals = read_vals(&st);
+    let (it, _) = vals_of(&st).ism().unwrap();
+    let atlas: Vec<f32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &it.depth).unwrap());
+    let cpu = cpu_raw(&st, &vals, n, offset, false, |i, v, p, _| {
+        ism::visible(layout, &atlas, i, v.position, v.normal, p, vs.ism.bias) as u32 as f32
+    });
+    let (lit, close) = compare(&gpu_raw(&st), &cpu);
+    println!("ISM: {close} of {lit} lit pixels equal the CPU's");
+    assert!(lit > 200 && close as f64 >= 0.99 * lit as f64, "{close} / {lit}");
+
+    st.set(|s| {
+        s.gi.method = val_method::VPL;
+        val_method::set_visibility(s, ValVisibility::Rays);
+    });
+    st.frame();
+    assert!(ctx.errors.take().is_empty());
+    assert!(vals_of(&st).ism().is_none(), "rays build no maps");
+    let vals = read_vals(&st);
+    let cpu = cpu_raw(&st, &vals, n, offset, true, |_, v, p, nx| {
+        let o = p + nx * off;
+        let e = v.position + v.normal * off;
+        let hit = bvh.any_hit(&Ray {
+            origin: o,
+            dir: e - o,
+            tmin: 1e-4,
+            tmax: 1.0 - 1e-4,
+        });
+        if hit { 0.0 } else { 1.0 }
+    });
+    let (lit, close) = compare(&gpu_raw(&st), &cpu);
+    println!("VPL mode with rays: {close} of {lit} lit pixels equal the CPU's");
+    assert!(lit > 200 && close as f64 >= 0.99 * lit as f64, "{close} / {lit}");
+}
+
+#[test]
+fn the_method_converges_to_its_own_sum_and_its_maps_agree_with_rays() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut vs = small();
+    vs.visibility = ValVisibility::Rays;
+    vs.interleave.filter_radius = 0;
+    let mut s = method_settings(&vs, val_method::ID);
+    s.sampling.fixed_seed = false;
+    s.sampling.accumulate = true;
+    let mut st = Setup::new(&ctx, s.clone(), (W, H));
+    let f0 = st.r.frame_index();
+    let frames = 12u64;
+    for _ in 0..frames {
+        st.frame();
+    }
+    assert!(ctx.errors.take().is_empty());
+    assert_eq!(st.r.frames_averaged(), Some(frames as u32));
+    let vals = read_vals(&st);
+    let n = vs.interleave.n;
+    let bvh = Bvh::build(&st.scene.positions, &st.scene.indices);
+    let off = s.gi.ray_offset;
+    let ray = |v: &val::Val, p: Vec3, nx: Vec3| {
+        let o = p + nx * off;
+        let e = v.position + v.normal * off;
+        !bvh.any_hit(&Ray {
+            origin: o,
+            dir: e - o,
+            tmin: 1e-4,
+            tmax: 1.0 - 1e-4,
+        })
+    };
+    // Every offset's estimate; their mean over the pattern is the sum over all VALs.
+    let per_offset: Vec<Vec<Option<Vec3>>> = (0..n * n)
+        .map(|o| cpu_raw(&st, &vals, n, o, false, |_, v, p, nx| ray(v, p, nx) as u32 as f32))
+        .collect();
+    let full = |k: usize| -> Option<Vec3> {
+        per_offset[0][k]
+            .map(|_| per_offset.iter().map(|e| e[k].unwrap_or_default()).sum::<Vec3>() / (n * n) as f32)
+    };
+    // The frames' mean (GPU, x albedo / pi) against the CPU's mean over the same offsets.
+    let albedo = st.r.read(Buffer::Albedo).unwrap();
+    let gpu = st.indirect();
+    let (mut lit, mut close, mut err_mean, mut err_one, mut norm) = (0, 0, 0.0f64, 0.0f64, 0.0f64);
+    for k in 0..(W * H) as usize {
+        let Some(truth) = full(k) else { continue };
+        let a = Vec3::from_slice(&albedo.pixels[k][..3]) / std::f32::consts::PI;
+        let mean: Vec3 = (0..frames)
+            .map(|i| per_offset[Vals::offset(&s, n, f0 + i) as usize][k].unwrap_or_default())
+            .sum::<Vec3>()
+            / frames as f32;
+        tally(
+            &mut lit,
+            &mut close,
+            Vec3::from_slice(&gpu.pixels[k][..3]),
+            mean * a,
+        );
+        let one = per_offset[Vals::offset(&s, n, f0) as usize][k].unwrap_or_default();
+        err_mean += (mean - truth).length_squared() as f64;
+        err_one += (one - truth).length_squared() as f64;
+        norm += truth.length_squared() as f64;
+    }
+    println!(
+        "accumulated {frames} frames: {close} of {lit} pixels equal the CPU's mean; relative error vs \
+         the sum over all VALs {:.4} (one frame {:.4})",
+        (err_mean / norm).sqrt(),
+        (err_one / norm).sqrt()
+    );
+    assert!(lit > 200 && close as f64 >= 0.99 * lit as f64, "{close} / {lit}");
+    assert!(
+        err_mean < 0.5 * err_one,
+        "the mean of the frames is nearer the sum over all VALs"
+    );
+
+    // The maps against rays over the (pixel, VAL) pairs that light each other.
+    st.set(|s| val_method::set_visibility(s, ValVisibility::Ism));
+    st.frame();
+    let vals = read_vals(&st);
+    let (it, _) = vals_of(&st).ism().unwrap();
+    let layout = IsmLayout {
+        atlas: vs.ism.atlas,
+        tile: vs.ism.tile,
+    };
+    let atlas: Vec<f32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &it.depth).unwrap());
+    let (mut pairs, mut agree, mut ray_lit) = (0usize, 0usize, 0usize);
+    let eps = s.gi.distance_epsilon;
+    let pos = st.r.read(Buffer::Position).unwrap();
+    let nrm = st.r.read(Buffer::Normal).unwrap();
+    for k in 0..(W * H) as usize {
+        let g = pos.pixels[k];
+        if g[3] == 0.0 {
+            continue;
+        }
+        let p = Vec3::new(g[0], g[1], g[2]);
+        let nx = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
+        for (i, v) in vals.iter().enumerate() {
+            if val::term(v, false, eps, p, nx) == Vec3::ZERO {
+                continue;
+            }
+            pairs += 1;
+            let r = ray(v, p, nx);
+            ray_lit += r as usize;
+            agree +=
+                (ism::visible(layout, &atlas, i as u32, v.position, v.normal, p, vs.ism.bias) == r) as usize;
+        }
+    }
+    let (agree, all_lit) = (agree as f64 / pairs as f64, ray_lit as f64 / pairs as f64);
+    println!(
+        "maps agree with rays on {:.1}% of {pairs} pairs (all lit: {:.1}%)",
+        100.0 * agree,
+        100.0 * all_lit
+    );
+    assert!(pairs > 1000 && agree > all_lit, "the maps see shadows");
 }

@@ -63,6 +63,17 @@ pub enum VisibilityArg {
     Ism,
 }
 
+/// The VALs' visibility for `--val-visibility`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ValVisibilityArg {
+    /// One lookup in the VAL's imperfect shadow map (the paper's simple lookup).
+    Ism,
+    /// The PCSS-style lookup in its map (section 6; the default).
+    Pcss,
+    /// A BVH shadow ray to the VAL's centre (the same VALs without the maps' error).
+    Rays,
+}
+
 /// Settings of the tree samplers (override `--settings`).
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct SamplingArgs {
@@ -99,6 +110,11 @@ pub struct SamplingArgs {
     /// methods look each VPL up in its imperfect shadow map; the ground truth traces rays).
     #[arg(long, value_enum)]
     pub visibility: Option<VisibilityArg>,
+    /// How the VAL methods (`val`, `val-vpl`) shadow their VALs while shadow rays are on:
+    /// `ism` (a simple lookup in each VAL's imperfect shadow map), `pcss` (the PCSS-style
+    /// lookup) or `rays` (a BVH ray to each VAL's centre). Other methods refuse it.
+    #[arg(long, value_enum)]
+    pub val_visibility: Option<ValVisibilityArg>,
     /// GI at half resolution, joint-bilateral upsampled with the similarity S.
     #[arg(long)]
     pub half_res: bool,
@@ -129,11 +145,27 @@ impl SamplingArgs {
     pub fn check_visibility(&self, methods: &[crate::methods::MethodId]) -> anyhow::Result<()> {
         use crate::methods::light_culling::{ISM_METHODS, has_ism};
         if self.visibility == Some(VisibilityArg::Ism)
+            && let Some(m) = methods.iter().find(|&&m| crate::methods::val::is_val(m))
+        {
+            return Err(anyhow!(
+                "--visibility ism: {m} picks its maps with --val-visibility ism|pcss (--visibility \
+                 rays / none switch its shadows on / off)"
+            ));
+        }
+        if self.visibility == Some(VisibilityArg::Ism)
             && let Some(m) = methods.iter().find(|&&m| !has_ism(m))
         {
             return Err(anyhow!(
                 "--visibility ism: {m} traces shadow rays; imperfect shadow maps serve {}",
                 ISM_METHODS.map(|m| m.to_string()).join(", ")
+            ));
+        }
+        if self.val_visibility.is_some()
+            && let Some(m) = methods.iter().find(|&&m| !crate::methods::val::is_val(m))
+        {
+            return Err(anyhow!(
+                "--val-visibility: {m} has no virtual area lights; it serves {}",
+                crate::methods::val::METHODS.map(|m| m.to_string()).join(", ")
             ));
         }
         Ok(())
@@ -185,6 +217,17 @@ impl SamplingArgs {
             if v != VisibilityArg::None {
                 crate::methods::light_culling::set_visibility(s, v == VisibilityArg::Ism);
             }
+        }
+        if let Some(v) = self.val_visibility {
+            use crate::methods::val::settings::ValVisibility;
+            crate::methods::val::set_visibility(
+                s,
+                match v {
+                    ValVisibilityArg::Ism => ValVisibility::Ism,
+                    ValVisibilityArg::Pcss => ValVisibility::Pcss,
+                    ValVisibilityArg::Rays => ValVisibility::Rays,
+                },
+            );
         }
         if self.half_res {
             s.sampling.half_resolution = true;
@@ -404,15 +447,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     let method = settings.gi.method;
     args.sampling.apply(&mut settings);
-    if args.sampling.visibility == Some(VisibilityArg::Ism) && !crate::methods::light_culling::has_ism(method)
-    {
-        return Err(anyhow!(
-            "--visibility ism: {method} traces shadow rays; imperfect shadow maps serve {}",
-            crate::methods::light_culling::ISM_METHODS
-                .map(|m| m.to_string())
-                .join(", ")
-        ));
-    }
+    args.sampling.check_visibility(&[method])?;
     if args.sampling.frames == 0 {
         return Err(anyhow!("--frames must be at least 1"));
     }

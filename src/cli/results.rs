@@ -45,14 +45,19 @@ pub enum Figure {
     /// over the VPL count (--vpl-exponents) and eps_max (--sweep light-culling=..), with and
     /// without visibility, GPU time and error.
     Culling,
+    /// The VAL paper's Table 1: 64 PCSS VALs vs 512 simple VALs, GPU time of clustering,
+    /// indirect illumination and maps, error against the ground truth and against the same
+    /// VALs with exact visibility; the VPL-shading mode beside them.
+    Val,
 }
 
-const ORDER: [Figure; 9] = [
+const ORDER: [Figure; 10] = [
     Figure::Timings,
     Figure::Steps,
     Figure::EqualTime,
     Figure::Interpolation,
     Figure::Culling,
+    Figure::Val,
     Figure::Blocks,
     Figure::Blending,
     Figure::Upsampling,
@@ -263,6 +268,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
                 Figure::Timings => figures::timings(&mut b, &o, &dir)?,
                 Figure::EqualTime => figures::equal_time(&mut b, &o, &dir)?,
                 Figure::Culling => figures::culling(&mut b, &o, &dir)?,
+                Figure::Val => figures::val(&mut b, &o, &dir)?,
                 Figure::Steps => figures::steps(&mut b, &o, &dir)?,
                 Figure::Blocks => figures::blocks(&mut b, &o, &dir)?,
                 Figure::Blending => figures::blending(&mut b, &o, &dir)?,

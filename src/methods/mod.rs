@@ -16,12 +16,14 @@
 pub mod direct_only;
 pub mod ground_truth;
 pub mod interleave;
+pub mod ism_ui;
 pub mod light_culling;
 pub mod lightcut_interpolation;
 pub mod lightcuts;
 pub mod overlay;
 pub mod reference;
 pub mod tree_samplers;
+pub mod val;
 
 use std::any::Any;
 use std::fmt;
@@ -54,6 +56,8 @@ pub static REGISTRY: &[&MethodInfo] = &[
     &light_culling::INFO,
     &light_culling::CLAMPED_INFO,
     &light_culling::TREE_INFO,
+    &val::INFO,
+    &val::VPL_INFO,
     &ground_truth::INFO,
     &reference::INFO,
     &direct_only::INFO,
@@ -457,6 +461,9 @@ pub struct FrameCx<'a> {
     /// The method views drawn for this frame (or kept for drawing after it): a view whose
     /// data needs work in the frame checks for itself here.
     pub views: &'a [MethodView],
+    /// Light 0's reflective shadow map raster (None without lights): the VAL clustering
+    /// reads layer 0 of `targets.shadow` through it.
+    pub rsm: Option<crate::renderer::gpu_data::RsmRaster>,
 }
 
 /// What a method's view drawing may use.
@@ -467,6 +474,8 @@ pub struct ViewCx<'a> {
     pub look: &'a ViewLook,
     pub targets: &'a FrameTargets,
     pub tree: &'a TreeBuffers,
+    /// The scene (its BVH: views that trace rays).
+    pub scene: &'a SceneGpu,
     /// Destination (`Rgba8Unorm` storage view) of the size [`Method::view_size`] gave.
     pub dst: &'a wgpu::TextureView,
     /// Block outlined in the cut views (set by the UI).

@@ -90,12 +90,24 @@ impl Rsm {
     }
 }
 
-/// Eq. 1's convex weights (w_p + w_n + w_f = 1 is the paper's; any non-negative weights work).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Eq. 1's convex weights (w_p + w_n + w_f = 1 is the paper's; any non-negative weights work;
+/// the paper gives no values, ours default to 0.4 / 0.3 / 0.3).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct MetricWeights {
     pub position: f32,
     pub normal: f32,
     pub flux: f32,
+}
+
+impl Default for MetricWeights {
+    fn default() -> Self {
+        Self {
+            position: 0.4,
+            normal: 0.3,
+            flux: 0.3,
+        }
+    }
 }
 
 /// The clustering's parameters.
@@ -312,6 +324,186 @@ pub fn disk_irradiance(flux: f32, c: Vec3, nc: Vec3, area: f32, x: Vec3, nx: Vec
         return 0.0;
     }
     flux * cx * cc / (std::f32::consts::PI * d2 + area)
+}
+
+/// The seed texel (packed x | y << 16) of each of `clusters` clusters from the frame's VPL ids
+/// (`layer << 24 | texel index` of a `res`^2 RSM, `NONE` for an empty VPL): cluster j starts
+/// at VPL j x count / clusters and takes the first VPL of `layer` from there (wrapping); 0
+/// when there is none (that cluster ends empty). The VPLs are importance-sampled RSM texels
+/// (thesis 4.1's BRSM warping of a Hammersley set), our form of the paper's "Halton sequence
+/// warped by an importance map". Twin: `seeds_main` in `methods/val/val_shade.wgsl`.
+pub fn seeds_from_vpls(ids: &[u32], clusters: u32, layer: u32, res: u32) -> Vec<u32> {
+    let count = ids.len() as u64;
+    (0..clusters as u64)
+        .map(|j| {
+            if count == 0 {
+                return 0;
+            }
+            let i0 = j * count / clusters.max(1) as u64;
+            (0..count)
+                .map(|t| ids[((i0 + t) % count) as usize])
+                .find(|&id| id != NONE && id >> 24 == layer)
+                .map_or(0, |id| {
+                    let i = id & 0x00ff_ffff;
+                    (i % res) | (i / res) << 16
+                })
+        })
+        .collect()
+}
+
+/// The VALs of interleaving subset `s` of an `n` x `n` pattern shifted by `offset` (section
+/// 6: VAL v shades the tile (v + offset) mod n^2; pixel (x, y) is in subset x mod n + n (y
+/// mod n)). Twin: `val_member` / `val_members` in `val_common.wgsl`.
+pub fn subset(clusters: u32, n: u32, offset: u32, s: u32) -> impl Iterator<Item = u32> {
+    let c = (n * n).max(1);
+    let j = (s + c - offset % c) % c;
+    (j..clusters).step_by(c as usize)
+}
+
+/// VAL `v`'s light at `x` (normal `nx`) without the receiver's albedo / pi: its flux / pi x
+/// eq. 2's form factor, i.e. Phi / pi x cos_x cos_c / (|x - c|^2 + A / pi) (`disk_irradiance`
+/// / pi); with `as_point` the VPL term of the same light, Phi / pi x cos cos / max(d^2, eps^2)
+/// (the VPL-shading mode, the paper's figure 7). Twin: `val_term` in `val_common.wgsl`.
+pub fn term(v: &Val, as_point: bool, eps: f32, x: Vec3, nx: Vec3) -> Vec3 {
+    let d = v.position - x;
+    let d2 = d.length_squared();
+    if v.pixels == 0 || d2 <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let w = d / d2.sqrt();
+    let (cx, cc) = (nx.dot(w), -v.normal.dot(w));
+    if cx <= 0.0 || cc <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let denom = if as_point {
+        d2.max(eps * eps)
+    } else {
+        d2 + v.area / std::f32::consts::PI
+    };
+    v.flux / std::f32::consts::PI * (cx * cc / denom)
+}
+
+/// 16 Poisson-disk offsets in the unit disk (the PCSS sample's, after Bavoil 2008) for the
+/// blocker search and the filter. Twin: `VAL_POISSON` in `val_common.wgsl`.
+pub const POISSON: [[f32; 2]; 16] = [
+    [-0.942_016_24, -0.399_062_16],
+    [0.945_586_1, -0.768_907_25],
+    [-0.094_184_1, -0.929_388_7],
+    [0.344_959_38, 0.293_877_6],
+    [-0.915_885_8, 0.457_714_32],
+    [-0.815_442_3, -0.879_124_64],
+    [-0.382_775_43, 0.276_768_45],
+    [0.974_843_98, 0.756_483_8],
+    [0.443_233_25, -0.975_115_54],
+    [0.537_429_8, -0.473_734_2],
+    [-0.264_969_11, -0.418_930_23],
+    [0.791_975_14, 0.190_901_88],
+    [-0.241_888_4, 0.997_065_07],
+    [-0.814_099_55, 0.914_375_9],
+    [0.199_841_26, 0.786_413_67],
+    [0.143_831_61, -0.141_007_9],
+];
+
+/// The PCSS lookup's parameters (section 6; the paper gives no sample counts).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Pcss {
+    /// Poisson samples of the blocker search (1 ..= 16).
+    pub blocker_samples: u32,
+    /// Poisson samples of the filter (1 ..= 16).
+    pub pcf_samples: u32,
+    /// The filter's largest radius in map texels.
+    pub max_radius: f32,
+}
+
+impl Default for Pcss {
+    fn default() -> Self {
+        Self {
+            blocker_samples: 16,
+            pcf_samples: 16,
+            max_radius: 8.0,
+        }
+    }
+}
+
+/// A PCSS lookup's outcome.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PcssLookup {
+    /// The lit fraction of the filter's samples (1 without blockers).
+    pub visibility: f32,
+    /// Blockers found by the search.
+    pub blocked: bool,
+    /// Eq. 3's penumbra width on the receiver: 2 r_L (z_r - z_b) / z_b metres (r_L the VAL
+    /// disk's radius sqrt(A / pi)); 0 without blockers.
+    pub penumbra: f32,
+}
+
+/// The PCSS-style lookup of `x` in map `m` of a VAL at `c` (normal `n`, area `area`), section
+/// 6, in the paraboloid map (map coordinates per radian near a direction at cos theta = z to
+/// the normal: 0.5 / (1 + z)):
+/// - blocker search: the Poisson samples over a disk of angular radius r_L / z_r around x's
+///   texel (the light's disk seen from the receiver, at least one texel); depths nearer than
+///   x's (with the lookup's bias) are averaged into z_b;
+/// - penumbra (eq. 3): r = (z_r - z_b) / z_b; on the receiver the penumbra's half-width is
+///   r_L r, seen from the light an angle r_L r / z_r;
+/// - filter: the fraction of the Poisson samples over that disk (1 texel .. `max_radius`)
+///   that see x.
+///
+/// Twin: `val_pcss` in `val_shade.wgsl`.
+#[allow(clippy::too_many_arguments)]
+pub fn pcss(
+    layout: crate::reference::ism::IsmLayout,
+    atlas: &[f32],
+    m: u32,
+    c: Vec3,
+    n: Vec3,
+    area: f32,
+    x: Vec3,
+    bias: f32,
+    p: &Pcss,
+) -> PcssLookup {
+    use crate::reference::ism::{project, texel_of};
+    let unseen = PcssLookup {
+        visibility: 1.0,
+        ..Default::default()
+    };
+    let Some((uv, zr)) = project(c, n, x) else {
+        return unseen;
+    };
+    let z = ((x - c) / zr).dot(n);
+    let per_radian = 0.5 / (1.0 + z);
+    let texel = 1.0 / layout.tile as f32;
+    let rl = (area.max(0.0) / std::f32::consts::PI).sqrt();
+    let depth = |o: [f32; 2], r: f32| {
+        let (u, v) = texel_of(uv + glam::Vec2::from_array(o) * r, layout.tile);
+        atlas[layout.texel(m, u, v)]
+    };
+    let cmp = zr * (1.0 - bias);
+    let search = (per_radian * rl / zr).max(texel);
+    let (mut sum, mut nb) = (0.0f32, 0u32);
+    for o in POISSON.iter().take(p.blocker_samples as usize) {
+        let d = depth(*o, search);
+        if d < cmp {
+            sum += d;
+            nb += 1;
+        }
+    }
+    if nb == 0 {
+        return unseen;
+    }
+    let zb = sum / nb as f32;
+    let ratio = (zr - zb) / zb.max(1e-6);
+    let radius = (per_radian * rl * ratio / zr).clamp(texel, p.max_radius * texel);
+    let lit = POISSON
+        .iter()
+        .take(p.pcf_samples as usize)
+        .filter(|o| cmp <= depth(**o, radius))
+        .count();
+    PcssLookup {
+        visibility: lit as f32 / p.pcf_samples.max(1) as f32,
+        blocked: true,
+        penumbra: 2.0 * rl * ratio,
+    }
 }
 
 #[cfg(test)]

@@ -33,6 +33,7 @@ macro_rules! frame_cx {
             trace_pixel: $trace,
             diagnostics: $diag,
             views: &$r.frame_views,
+            rsm: $r.rsm_raster,
         }
     };
 }
@@ -89,6 +90,20 @@ impl Renderer {
             .map(|l| l.irradiance.dot(Vec3::new(0.2126, 0.7152, 0.0722)))
             .unwrap_or(1.0);
         self.lights_texel = gpu_lights.lights[0].shadow[0];
+        self.rsm_raster = lights.first().map(|l| {
+            let (view_proj, texel, _) = crate::renderer::gpu_data::light_frustum(
+                l.direction,
+                &self.scene.bounds,
+                s.shadow.resolution,
+            );
+            crate::renderer::gpu_data::RsmRaster {
+                view_proj,
+                direction: l.direction.normalize_or(glam::Vec3::NEG_Y),
+                texel,
+                res: s.shadow.resolution,
+                lights: lights.len() as u32,
+            }
+        });
 
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("frame::encoder"),

@@ -113,6 +113,18 @@ pub fn light_frustum(direction: Vec3, bounds: &Aabb, resolution: u32) -> (Mat4, 
     (proj * view, 2.0 * half / resolution as f32, far - near)
 }
 
+/// Light 0's reflective shadow map raster, as the frame drew it (the VAL clustering reads it):
+/// its `view_proj`, the direction its light travels, the texel edge in metres perpendicular
+/// to it, the RSM resolution and the frame's light count (RSM layers).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RsmRaster {
+    pub view_proj: Mat4,
+    pub direction: Vec3,
+    pub texel: f32,
+    pub res: u32,
+    pub lights: u32,
+}
+
 impl GpuLights {
     pub fn new(
         lights: &[DirectionalLight],

@@ -193,6 +193,11 @@ impl Renderer {
 
     /// The GPU instance of the method module whose type is `T` (tests and tools that read a
     /// method's own buffers, e.g. `methods::lightcuts::Lightcuts`).
+    /// The index the next frame records with (`FrameCx::frame_index`: frames rendered so far).
+    pub fn frame_index(&self) -> u64 {
+        self.frames
+    }
+
     pub fn method_module<T: Method>(&self) -> Option<&T> {
         self.methods
             .iter()

@@ -162,6 +162,8 @@ pub struct Renderer {
     /// Luminance of light 0's irradiance and its shadow texel size, last frame (RSM flux view).
     light0_lum: f32,
     lights_texel: f32,
+    /// Light 0's RSM raster this frame (None without lights).
+    rsm_raster: Option<gpu_data::RsmRaster>,
     /// The RSMs' total reflected flux (flux-pyramid tops), read back without blocking.
     flux_readback: readback::AsyncReadback,
     flux_total: Option<f32>,
@@ -276,6 +278,7 @@ impl Renderer {
             vpl_frame: VplFrame::default(),
             light0_lum: 0.0,
             lights_texel: 0.0,
+            rsm_raster: None,
             flux_readback: readback::AsyncReadback::new(
                 device,
                 "vpl::flux_total_readback",

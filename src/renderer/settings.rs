@@ -414,6 +414,14 @@ impl PatternDefault for Interleave8 {
     const N: u32 = 8;
 }
 
+/// 4 x 4 by default (the VAL method: the paper's split G-buffer of n x m tiles leaves n open;
+/// 64 VALs then give each pixel 4).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interleave4;
+impl PatternDefault for Interleave4 {
+    const N: u32 = 4;
+}
+
 /// Largest filter radius (a (2r + 1)^2 window).
 pub const MAX_FILTER_RADIUS: u32 = 16;
 

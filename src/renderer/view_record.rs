@@ -154,6 +154,7 @@ impl Renderer {
                 return;
             }
             let mut cx = ViewCx {
+                scene: &self.scene,
                 device: &device,
                 queue: &queue,
                 timer: &mut self.timer,

@@ -6,11 +6,13 @@ mod culling;
 mod interpolation;
 mod resolution;
 mod sampling;
+mod val;
 
 pub use culling::culling;
 pub use interpolation::interpolation;
 pub use resolution::{scaling, upsampling};
 pub use sampling::{blending, blocks, steps};
+pub use val::val;
 
 use std::path::Path;
 

@@ -78,50 +78,8 @@ fn visibility_ui(ui: &mut egui::Ui, lc: &mut LightCullingSettings, shadow_rays: 
     if !(shadow_rays && lc.visibility == CullingVisibility::Ism) {
         return;
     }
-    let m = &mut lc.ism;
     ui.indent("ism", |ui| {
-        ui.add(
-            egui::Slider::new(&mut m.points_per_light, 0..=65536)
-                .logarithmic(true)
-                .text("points per map"),
-        )
-        .on_hover_text("points splatted into each VPL's map (paper 8192; 0 = the cloud shared round-robin)");
-        ui.add(
-            egui::Slider::new(&mut m.points, 1024..=1 << 22)
-                .logarithmic(true)
-                .text("cloud points"),
-        )
-        .on_hover_text("points sampled once on the scene's triangles, uniform in area");
-        let mut tile_log = m.tile.max(8).ilog2();
-        if ui
-            .add(egui::Slider::new(&mut tile_log, 3..=7).text("map size (log2)"))
-            .on_hover_text("one paraboloid map's edge: 2^k texels (paper 32^2)")
-            .changed()
-        {
-            m.tile = 1 << tile_log;
-            m.atlas = m.atlas.clamp(m.tile, m.tile << 7);
-        }
-        // At most 128 x 128 maps (the build's 65535 workgroup layers) and an 8192 atlas.
-        let tile_log = m.tile.ilog2();
-        let mut atlas_log = m.atlas.max(m.tile).ilog2().min(tile_log + 7);
-        if ui
-            .add(
-                egui::Slider::new(&mut atlas_log, tile_log..=(tile_log + 7).min(13))
-                    .text("atlas size (log2)"),
-            )
-            .on_hover_text("the atlas holds (atlas / map)^2 maps: one per VPL")
-            .changed()
-        {
-            m.atlas = 1 << atlas_log;
-        }
-        ui.label(format!("{} maps", m.capacity()));
-        ui.add(egui::Slider::new(&mut m.pull_push_levels, 0..=4).text("pull-push levels"))
-            .on_hover_text("hole filling (paper 2)");
-        ui.add(egui::Slider::new(&mut m.bias, 0.0..=0.3).text("relative depth bias"));
-        ui.checkbox(&mut m.front_face_culling, "cull front faces (Program 1)")
-            .on_hover_text(
-                "a map leaves out points whose surface faces its VPL (no self-shadowing of lit surfaces)",
-            );
+        crate::methods::ism_ui::settings_ui(ui, &mut lc.ism, "VPL", "32^2", "8192");
         ui.checkbox(&mut lc.ism_range_culling, "cull points by range (section 4.3)")
             .on_hover_text("a VPL's map leaves out points beyond its range, where it adds nothing");
     });

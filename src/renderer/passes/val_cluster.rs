@@ -105,7 +105,9 @@ pub struct ValTargets {
     /// Per RSM texel the inverted least key of the last step ([`key_cluster`]).
     pub keys: wgpu::Buffer,
     fallback: wgpu::Buffer,
-    seeds: wgpu::Buffer,
+    /// Per cluster its seed texel (packed x | y << 16): written by [`ValClusterPass::record`]
+    /// from CPU seeds, or by the caller's kernel ([`ValSeeds::Written`]).
+    pub seeds: wgpu::Buffer,
     /// Which of `vals` the last run left its clusters in.
     last: usize,
 }
@@ -131,6 +133,25 @@ impl ValTargets {
     /// The buffer holding the clusters after the last run.
     pub fn vals(&self) -> &wgpu::Buffer {
         &self.vals[self.last]
+    }
+}
+
+/// Where a clustering run's seeds come from.
+#[derive(Clone, Copy, Debug)]
+pub enum ValSeeds<'a> {
+    /// Texels given by the CPU (uploaded into the targets' seeds).
+    Cpu(&'a [UVec2]),
+    /// This many seeds already written into `ValTargets::seeds` on the GPU earlier in the
+    /// same submission (the VAL method's seeds from the frame's VPLs).
+    Written(u32),
+}
+
+impl ValSeeds<'_> {
+    pub fn count(&self) -> usize {
+        match self {
+            ValSeeds::Cpu(s) => s.len(),
+            ValSeeds::Written(n) => *n as usize,
+        }
     }
 }
 
@@ -176,7 +197,8 @@ impl ValClusterPass {
         })
     }
 
-    /// Clusters seeded at `seeds` (one per cluster, at most the targets' clusters), then
+    /// Clusters seeded at `seeds` (one per cluster, at most the targets' clusters; a seed on a
+    /// texel without flux gives a cluster that ends empty), then
     /// `iterations` steps, in one compute pass timed as `name`: a cluster left empty by a step
     /// is re-seeded before the next; after the last step it stays empty (`pixels` 0). `rsm`:
     /// the position, normal and flux array views. The parameters and seeds live in the pass
@@ -192,7 +214,7 @@ impl ValClusterPass {
         name: &str,
         rsm: [&wgpu::TextureView; 3],
         p: GpuValParams,
-        seeds: &[UVec2],
+        seeds: ValSeeds<'_>,
         iterations: u32,
         t: &mut ValTargets,
     ) -> Result<(), String> {
@@ -202,18 +224,18 @@ impl ValClusterPass {
                 p.res, t.res
             ));
         }
-        if seeds.is_empty() || seeds.len() as u32 > t.clusters {
+        if seeds.count() == 0 || seeds.count() as u32 > t.clusters {
             return Err(format!(
                 "VAL clustering: {} seeds for targets of {} clusters",
-                seeds.len(),
+                seeds.count(),
                 t.clusters
             ));
         }
-        let n = seeds.len() as u32;
+        let n = seeds.count() as u32;
         let p = GpuValParams { clusters: n, ..p };
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        let packed: Vec<u32> = seeds[..n as usize].iter().map(|s| s.x | s.y << 16).collect();
-        if !packed.is_empty() {
+        if let ValSeeds::Cpu(seeds) = seeds {
+            let packed: Vec<u32> = seeds.iter().map(|s| s.x | s.y << 16).collect();
             queue.write_buffer(&t.seeds, 0, bytemuck::cast_slice(&packed));
         }
         // (in, out): 0 -> 1 and 1 -> 0.

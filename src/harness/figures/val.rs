@@ -1,0 +1,264 @@
+//! The VAL paper's Table 1 on our scenes (Weinzierl-Heigl, section 7.2): 64 VALs with the
+//! PCSS lookup against 512 VALs with the simple lookup, GPU time of clustering, indirect
+//! illumination, ISM generation and the whole frame, and the error of each against the ground
+//! truth of the frame's VPLs with shadow rays and against the same VALs with exact visibility
+//! (a ray to each VAL's centre: the maps' error alone, apart from the clustering's). Every
+//! count also runs with the other lookup, and the VPL-shading mode (`val-vpl`, figure 7's
+//! comparison) with rays. Fixed seeds: every run of a count shades the same interleaving
+//! subsets, so two of them differ only in visibility.
+
+use super::*;
+use crate::harness::median;
+use crate::methods::val::{
+    self as val_method,
+    settings::{ValSettings, ValVisibility},
+};
+use crate::metrics;
+use crate::renderer::readback::ImageF32;
+
+/// The paper's Table 1 (Radeon HD 6850, 1280 x 720, Cornell box), ms: (row, our passes, 64
+/// PCSS VALs, 512 simple VALs). Its "complete" is the whole frame.
+pub const PAPER_TABLE_1: [(&str, &[&str], f64, f64); 3] = [
+    ("clustering", &["val_seeds", "val_cluster"], 5.0, 5.0),
+    ("indirect illumination", &["val_shade", "val_filter"], 11.0, 30.0),
+    ("ISM generation", &["val_ism_lights", "val_ism"], 10.0, 17.0),
+];
+/// The paper's complete frame times (64 PCSS, 512 simple).
+pub const PAPER_COMPLETE: (f64, f64) = (26.0, 52.0);
+
+struct Row {
+    method: MethodId,
+    vals: u32,
+    vis: ValVisibility,
+    groups: Vec<f64>,
+    gi_ms: f64,
+    frame_gpu_ms: f64,
+    rmse_gt: f64,
+    rmse_exact: f64,
+    lit: f64,
+    radius: f64,
+}
+
+fn stat(m: &Measured, k: &str) -> f64 {
+    m.method_stats
+        .iter()
+        .find(|(n, _)| *n == k)
+        .map_or(f64::NAN, |(_, v)| *v)
+}
+
+pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
+    let base: ValSettings = b.base.method(val_method::ID).map_err(|e| anyhow::anyhow!(e))?;
+    let img = images(dir)?;
+    let settings = |b: &Bench, method: MethodId, vals: u32, vis: ValVisibility| {
+        with(b, |s| {
+            s.gi.method = method;
+            s.gi.shadow_rays = true;
+            s.sampling.fixed_seed = true;
+            s.sampling.accumulate = false;
+            let _ = s.set_method(
+                val_method::ID,
+                &ValSettings {
+                    clusters: vals,
+                    visibility: vis,
+                    ..base.clone()
+                },
+            );
+        })
+    };
+    let mut rows: Vec<Row> = Vec::new();
+    let configs = [
+        (val_method::ID, 64, ValVisibility::Rays),
+        (val_method::ID, 64, ValVisibility::Pcss),
+        (val_method::ID, 64, ValVisibility::Ism),
+        (val_method::ID, 512, ValVisibility::Rays),
+        (val_method::ID, 512, ValVisibility::Ism),
+        (val_method::ID, 512, ValVisibility::Pcss),
+        (val_method::VPL, 64, ValVisibility::Rays),
+        (val_method::VPL, 512, ValVisibility::Rays),
+    ];
+    let mut exact: Vec<(MethodId, u32, ImageF32)> = Vec::new();
+    for (method, vals, vis) in configs {
+        let s = settings(b, method, vals, vis);
+        let m = b.measure(&s, o.size, o.per_config(), true)?;
+        let Some(x) = m.indirect.clone() else {
+            anyhow::bail!("{method} with {vals} VALs produced no image");
+        };
+        if vis == ValVisibility::Rays {
+            exact.push((method, vals, x.clone()));
+        }
+        let rmse_exact = exact
+            .iter()
+            .find(|(em, ev, _)| *em == method && *ev == vals)
+            .map_or(f64::NAN, |(_, _, e)| {
+                metrics::compare_without_flip(&x, e, b.gi_exposure, b.base.display.tonemap).rmse
+            });
+        let groups: Vec<f64> = PAPER_TABLE_1.iter().map(|(_, p, _, _)| m.pass_ms(p).0).collect();
+        let all = m.pass_ms_per_frame(None);
+        let row = Row {
+            method,
+            vals,
+            vis,
+            groups,
+            gi_ms: m.gi_ms().0,
+            frame_gpu_ms: median(&all),
+            rmse_gt: m.rmse().0,
+            rmse_exact,
+            lit: stat(&m, "vals_lit"),
+            radius: stat(&m, "val_mean_radius_m"),
+        };
+        eprintln!(
+            "[{}] {method} {vals} VALs, {}: GI {:.3} ms GPU, RMSE vs GT {:.4e}, vs exact visibility {:.4e}",
+            b.scene,
+            vis.name(),
+            row.gi_ms,
+            row.rmse_gt,
+            row.rmse_exact
+        );
+        if method == val_method::ID {
+            let stem = format!("val_{vals}_{}", vis.name());
+            b.write_gi_png(&img.join(format!("{stem}.png")), &x)?;
+            let gt = b.ground_truth(&s, o.size)?;
+            b.write_error_png(&img.join(format!("{stem}_error.png")), &x, &gt)?;
+        }
+        rows.push(row);
+    }
+
+    let mut csv = Csv::new(&[
+        "scene",
+        "method",
+        "vals",
+        "visibility",
+        "clustering_ms",
+        "indirect_ms",
+        "ism_ms",
+        "gi_gpu_ms",
+        "frame_gpu_ms",
+        "rmse_vs_ground_truth",
+        "rmse_vs_exact_visibility",
+        "vals_lit",
+        "mean_disk_radius_m",
+    ]);
+    for r in &rows {
+        let mut cells = vec![
+            b.scene.clone(),
+            r.method.to_string(),
+            r.vals.to_string(),
+            r.vis.name().to_string(),
+        ];
+        cells.extend(r.groups.iter().map(|&v| num(v)));
+        cells.extend([
+            num(r.gi_ms),
+            num(r.frame_gpu_ms),
+            num(r.rmse_gt),
+            num(r.rmse_exact),
+            num(r.lit),
+            num(r.radius),
+        ]);
+        csv.row(cells);
+    }
+    csv.write(&dir.join("val.csv"))?;
+
+    let find = |m: MethodId, n: u32, v: ValVisibility| {
+        rows.iter().find(|r| r.method == m && r.vals == n && r.vis == v)
+    };
+    let mut table = format!(
+        "Virtual Area Lights ({}x{}, {} VPLs as seeds, splat {}, {} steps, {} x {} interleaving, {}^2 maps of {} cloud points, {}):\n",
+        o.size.0,
+        o.size.1,
+        b.base.vpl.count,
+        base.splat,
+        base.iterations,
+        base.interleave.n,
+        base.interleave.n,
+        base.ism.tile,
+        base.ism.points,
+        b.adapter
+    );
+    for r in &rows {
+        table.push_str(&format!(
+            "  {:<8} {:>4} VALs {:<5}: GI {:>8.3} ms GPU (clustering {:.3}, indirect {:.3}, ISMs {:.3}), frame {:.3} ms GPU, RMSE vs GT {:.4e}, vs exact visibility {:.4e}, {:.0} VALs lit\n",
+            r.method.to_string(),
+            r.vals,
+            r.vis.name(),
+            r.gi_ms,
+            r.groups[0],
+            r.groups[1],
+            r.groups[2],
+            r.frame_gpu_ms,
+            r.rmse_gt,
+            r.rmse_exact,
+            r.lit
+        ));
+    }
+    let mut checks = Vec::new();
+    let mut t1 = Csv::new(&[
+        "scene",
+        "row",
+        "our_passes",
+        "ours_64_pcss_ms",
+        "ours_512_simple_ms",
+        "paper_64_pcss_ms",
+        "paper_512_simple_ms",
+    ]);
+    if let (Some(a), Some(c)) = (
+        find(val_method::ID, 64, ValVisibility::Pcss),
+        find(val_method::ID, 512, ValVisibility::Ism),
+    ) {
+        table.push_str("  Table 1 (paper: Radeon HD 6850, 1280x720, Cornell box):\n");
+        for (i, (name, passes, p64, p512)) in PAPER_TABLE_1.iter().enumerate() {
+            table.push_str(&format!(
+                "    {name:<22} 64 PCSS {:>8.3} ms (paper {p64} ms), 512 simple {:>8.3} ms (paper {p512} ms)\n",
+                a.groups[i], c.groups[i]
+            ));
+            t1.row(vec![
+                b.scene.clone(),
+                name.to_string(),
+                passes.join("+"),
+                num(a.groups[i]),
+                num(c.groups[i]),
+                num(*p64),
+                num(*p512),
+            ]);
+        }
+        table.push_str(&format!(
+            "    {:<22} 64 PCSS {:>8.3} ms, 512 simple {:>8.3} ms (the VAL passes); whole frame {:.3} / {:.3} ms GPU (paper {} / {} ms)\n",
+            "complete",
+            a.gi_ms,
+            c.gi_ms,
+            a.frame_gpu_ms,
+            c.frame_gpu_ms,
+            PAPER_COMPLETE.0,
+            PAPER_COMPLETE.1
+        ));
+        t1.row(vec![
+            b.scene.clone(),
+            "complete (VAL passes)".into(),
+            "all".into(),
+            num(a.gi_ms),
+            num(c.gi_ms),
+            num(PAPER_COMPLETE.0),
+            num(PAPER_COMPLETE.1),
+        ]);
+        checks.push(check(
+            b,
+            "VAL GI time, 64 PCSS / 512 simple",
+            a.gi_ms / c.gi_ms,
+            1.0,
+            false,
+            format!(
+                "GPU timestamps of the VAL passes (val_seeds .. val_filter), median of {} timed frames (the paper: 26 / 52 ms whole frames)",
+                o.timing_frames
+            ),
+        ));
+        checks.push(check(
+            b,
+            "VAL RMSE vs GT, 64 PCSS / 512 simple",
+            a.rmse_gt / c.rmse_gt,
+            1.25,
+            false,
+            "RMSE of the GI against the ground truth of the frame's VPLs with shadow rays (the paper: perceptually equivalent, fig. 8)".into(),
+        ));
+    }
+    t1.write(&dir.join("val_table1.csv"))?;
+    Ok(Report { table, checks })
+}

@@ -1,0 +1,748 @@
+//! Virtual Area Lights (Weinzierl-Heigl, "Efficient VAL-based Real-Time Global Illumination",
+//! `../shared/papers/val-based-gi-ism-pcss.txt`; after Prutkin et al. 2012 and Ritschel et al.
+//! 2008) on the frame's RSM and VPLs.
+//!
+//! Each frame: clusters seeded at the frame's VPLs (BRSM importance-sampled RSM texels, our
+//! form of the paper's warped Halton seeds), k steps of section 4's clustering of light 0's
+//! RSM into VALs (eq. 1's metric, splats, averaging), each VAL's imperfect shadow map
+//! (section 5: the scene's point cloud shared round-robin, paraboloid maps, pull-push), then
+//! per pixel the VALs of its interleaving subset (section 6) with the point-to-disk form
+//! factor (eq. 2) and a simple or PCSS-style lookup (blocker search, eq. 3's penumbra,
+//! Poisson PCF), the geometry-aware filter after. `val-vpl` shades the same VALs as point
+//! lights (the paper's figure 7); `rays` visibility traces one BVH ray to each VAL's centre,
+//! which separates the maps' error from the clustering's (Table 1's RMSE columns).
+//!
+//! Passes: `pass.rs`; CPU twins: `crate::reference::val`, `crate::reference::ism`;
+//! docs/val.md.
+
+pub mod pass;
+pub mod settings;
+mod ui;
+
+use std::collections::HashMap;
+
+use super::{
+    FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
+};
+use crate::reference::val::MAX_CLUSTERS;
+use crate::reference::vpl::pcg_hash;
+use crate::renderer::passes::interleave_filter::GpuFilterParams;
+use crate::renderer::passes::ism::{IsmPoints, IsmTargets};
+use crate::renderer::passes::val_cluster::{GpuVal, GpuValParams, ValTargets};
+use crate::renderer::{
+    context::{GpuContext, GpuError},
+    readback::{self, CounterReadback, ImageF32},
+    settings::RenderSettings,
+    shaders::ShaderError,
+};
+use pass::{
+    GpuValShadeParams, GpuValViewParams, VIS_ISM, VIS_NONE, VIS_PCSS, VIS_RAYS, ValBuffers, ValFrame, ValIsm,
+    ValPass,
+};
+use settings::{ValSettings, ValVisibility};
+
+/// VALs with the form factor (eq. 2).
+pub const ID: MethodId = MethodId::new("val");
+/// The same VALs shaded as point lights (the paper's VPL-shading comparison, figure 7).
+pub const VPL: MethodId = MethodId::new("val-vpl");
+
+macro_rules! shader {
+    ($name:literal) => {
+        (
+            concat!("methods/val/", $name),
+            include_str!(concat!("../../../shaders/methods/val/", $name)),
+        )
+    };
+}
+
+pub static MODULE: Module = Module {
+    name: "val",
+    create,
+    shaders: &[
+        shader!("val_common.wgsl"),
+        shader!("val_shade.wgsl"),
+        shader!("val_views.wgsl"),
+    ],
+    entry_shaders: &["methods/val/val_shade.wgsl", "methods/val/val_views.wgsl"],
+};
+
+/// The clusters over light 0's RSM.
+pub const CLUSTERS: MethodView = MethodView::new("VAL clusters");
+/// The VALs as disks in the camera view.
+pub const DISKS: MethodView = MethodView::new("VAL disks");
+/// The VALs' imperfect shadow maps.
+pub const ISM_ATLAS: MethodView = MethodView::new("VAL ISM atlas");
+/// One VAL's map beside its true paraboloid depth map.
+pub const ISM_TRUE: MethodView = MethodView::new("VAL ISM vs true map");
+/// The PCSS penumbra width per pixel.
+pub const PENUMBRA: MethodView = MethodView::new("VAL penumbra width");
+/// Seed of the scene's point cloud for the maps.
+pub const ISM_CLOUD_SEED: u32 = 0x7a1;
+/// Texels between the two maps of the ISM-vs-true view.
+const GAP: u32 = 4;
+
+const VIEWS: &[ViewInfo] = &[
+    ViewInfo {
+        name: CLUSTERS.name(),
+        file: "val_clusters",
+        about: "light 0's reflective shadow map, each texel with flux in its VAL's colour (the \
+                last clustering step's assignment, section 4), the VALs' centre texels white",
+        passes: &["val_cluster"],
+    },
+    ViewInfo {
+        name: DISKS.name(),
+        file: "val_disks",
+        about: "the VALs as the disks they shade with (radius sqrt(area / pi) at the cluster's \
+                mean position, in its mean normal's plane) over the grey final, in the cluster \
+                colours of the clusters view",
+        passes: &["val_cluster"],
+    },
+    ViewInfo {
+        name: ISM_ATLAS.name(),
+        file: "val_ism_atlas",
+        about: "the VALs' imperfect shadow maps (section 5: one paraboloid map per VAL, the \
+                point cloud shared round-robin): distance on a log scale, texels pull-push \
+                filled at half brightness, holes black; built each frame with ISM or PCSS \
+                visibility, or while this view is shown",
+        passes: &["val_ism"],
+    },
+    ViewInfo {
+        name: ISM_TRUE.name(),
+        file: "val_ism_vs_true",
+        about: "one VAL's imperfect shadow map (left; methods.val.inspect picks it) beside the \
+                true paraboloid depth map traced through the BVH from the same point (right): \
+                what the points and pull-push miss",
+        passes: &["val_ism"],
+    },
+    ViewInfo {
+        name: PENUMBRA.name(),
+        file: "val_penumbra_width",
+        about: "the PCSS lookup's penumbra width on the receiver (eq. 3: 2 r_L (z_r - z_b) / \
+                z_b metres, averaged over the pixel's lookups that found blockers; dark blue: \
+                none did), log scale",
+        passes: &["val_shade"],
+    },
+];
+
+const TIMED: &[&str] = &[
+    "val_seeds",
+    "val_cluster",
+    "val_ism_lights",
+    "val_ism",
+    "val_shade",
+    "val_filter",
+];
+
+const TESTS: &[&str] = &[
+    "val::seeds_shading_and_pcss_equal_the_cpu_reference",
+    "val::one_clustering_step_equals_the_cpu_reference",
+    "val::the_method_converges_to_its_own_sum_and_its_maps_agree_with_rays",
+];
+
+fn invalid_example(s: &mut RenderSettings) -> &'static str {
+    let v = ValSettings {
+        clusters: 0,
+        ..Default::default()
+    };
+    let _ = s.set_method(ID, &v);
+    "methods.val.clusters"
+}
+
+pub static INFO: MethodInfo = MethodInfo {
+    id: ID,
+    aliases: &["virtual-area-lights", "vals"],
+    label: "Virtual Area Lights",
+    short: "VAL",
+    about: "Weinzierl-Heigl: the RSM clustered into virtual area lights each frame, shaded with \
+            the point-to-disk form factor, interleaved, shadowed by imperfect shadow maps with \
+            a simple or PCSS lookup.",
+    progress_unit: "",
+    kind: Kind::PerFrame,
+    module: &MODULE,
+    reads: &[
+        Resource::Gbuffer,
+        Resource::ShadowMaps,
+        Resource::Vpls,
+        Resource::Bvh,
+    ],
+    views: VIEWS,
+    timed_passes: TIMED,
+    story: false,
+    shadow_ray_switch: true,
+    truth_of_vpls: false,
+    validate,
+    invalid_example: Some(invalid_example),
+    ui: ui::settings_ui,
+    tests: TESTS,
+    sweep: Some(&SWEEP),
+};
+
+pub static VPL_INFO: MethodInfo = MethodInfo {
+    id: VPL,
+    aliases: &["val-as-vpls"],
+    label: "VALs shaded as VPLs",
+    short: "VAL as VPL",
+    about: "The VAL pipeline with every cluster shaded as a point light (the VAL paper's \
+            figure 7 comparison): same clusters, maps and lookups.",
+    progress_unit: "",
+    kind: Kind::PerFrame,
+    module: &MODULE,
+    reads: &[
+        Resource::Gbuffer,
+        Resource::ShadowMaps,
+        Resource::Vpls,
+        Resource::Bvh,
+    ],
+    views: VIEWS,
+    timed_passes: TIMED,
+    story: false,
+    shadow_ray_switch: true,
+    truth_of_vpls: false,
+    validate,
+    invalid_example: Some(invalid_example),
+    ui: ui::settings_ui,
+    tests: TESTS,
+    sweep: Some(&SWEEP),
+};
+
+/// The VAL count (the paper's Table 1 compares 64 and 512).
+pub static SWEEP: super::Sweep = super::Sweep {
+    name: "clusters",
+    values: &[16.0, 64.0, 256.0, 1024.0],
+    apply: |s, v| {
+        let mut vs: ValSettings = s.method(ID).unwrap_or_default();
+        vs.clusters = (v.round() as u32).clamp(1, MAX_CLUSTERS);
+        let _ = s.set_method(ID, &vs);
+    },
+    integer: true,
+};
+
+/// The VAL methods (`render --val-visibility`).
+pub const METHODS: [MethodId; 2] = [ID, VPL];
+
+/// Whether `m` is a VAL method.
+pub fn is_val(m: MethodId) -> bool {
+    METHODS.contains(&m)
+}
+
+/// Sets the VALs' visibility (used while `gi.shadow_rays` is on).
+pub fn set_visibility(s: &mut RenderSettings, v: ValVisibility) {
+    let Ok(mut vs) = s.method::<ValSettings>(ID) else {
+        return;
+    };
+    vs.visibility = v;
+    let _ = s.set_method(ID, &vs);
+}
+
+fn validate(s: &RenderSettings) -> Result<(), String> {
+    s.method::<ValSettings>(ID)?.validate()
+}
+
+/// The last diagnostic frame's clusters.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ValStats {
+    pub clusters: u32,
+    /// Clusters with texels.
+    pub lit: u32,
+    pub pixels: u64,
+    /// Sum of the clusters' flux, luminance (W).
+    pub flux: f64,
+    /// Mean disk radius of the lit clusters (m).
+    pub mean_radius: f64,
+}
+
+impl ValStats {
+    fn from_words(w: &[u32]) -> Self {
+        let vals: &[GpuVal] = bytemuck::cast_slice(&w[..w.len() / 12 * 12]);
+        let mut st = ValStats {
+            clusters: vals.len() as u32,
+            ..Default::default()
+        };
+        for v in vals.iter().filter(|v| v.pixels > 0) {
+            st.lit += 1;
+            st.pixels += v.pixels as u64;
+            st.flux += (0.2126 * v.flux[0] + 0.7152 * v.flux[1] + 0.0722 * v.flux[2]) as f64;
+            st.mean_radius += (v.area.max(0.0) as f64 / std::f64::consts::PI).sqrt();
+        }
+        st.mean_radius /= st.lit.max(1) as f64;
+        st
+    }
+}
+
+pub struct Vals {
+    pass: ValPass,
+    buffers: ValBuffers,
+    targets: Option<ValTargets>,
+    stats: Option<CounterReadback<ValStats>>,
+    /// Accumulation: (key, method, frames summed).
+    state: Option<(u64, MethodId, u32)>,
+    settings: ValSettings,
+    /// The scene's point cloud (and the scene upload it was sampled from) and the atlas.
+    ism_points: Option<(u64, IsmPoints)>,
+    ism_targets: Option<IsmTargets>,
+    /// Maps built by the last frame (0: none).
+    ism_maps: u32,
+    /// The last frame's visibility (`pass::VIS_*`).
+    visibility: u32,
+    /// Per view its linear data (size, buffer).
+    view_data: HashMap<&'static str, ((u32, u32), wgpu::Buffer)>,
+    scene_radius: f32,
+    ray_offset: f32,
+}
+
+fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
+    Ok(Box::new(Vals {
+        pass: ValPass::new(device)?,
+        buffers: ValBuffers::new(device, (1, 1)),
+        targets: None,
+        stats: None,
+        state: None,
+        settings: ValSettings::default(),
+        ism_points: None,
+        ism_targets: None,
+        ism_maps: 0,
+        visibility: VIS_NONE,
+        view_data: HashMap::new(),
+        scene_radius: 1.0,
+        ray_offset: 0.0,
+    }))
+}
+
+impl Vals {
+    /// The clusters of the last frame (None before one ran).
+    pub fn targets(&self) -> Option<&ValTargets> {
+        self.targets.as_ref().filter(|_| self.state.is_some())
+    }
+    /// The per-pixel buffers (raw estimate, diagnostics).
+    pub fn buffers(&self) -> &ValBuffers {
+        &self.buffers
+    }
+    /// The last frame's maps and how many it built (None when it built none).
+    pub fn ism(&self) -> Option<(&IsmTargets, u32)> {
+        self.ism_targets
+            .as_ref()
+            .filter(|_| self.ism_maps > 0)
+            .map(|t| (t, self.ism_maps))
+    }
+    /// The point cloud of the maps (None before maps were built).
+    pub fn ism_points(&self) -> Option<&IsmPoints> {
+        self.ism_points.as_ref().map(|(_, p)| p)
+    }
+    /// Counters of a recent diagnostic frame (non-blocking).
+    pub fn poll_stats(&mut self) -> Option<ValStats> {
+        self.stats.as_mut()?.poll()
+    }
+    /// The frame's interleaving offset (a new one per frame unless `sampling.fixed_seed`).
+    pub fn offset(s: &RenderSettings, n: u32, frame_index: u64) -> u32 {
+        let seed = if s.sampling.fixed_seed {
+            s.vpl.seed ^ 0x7a15
+        } else {
+            (s.vpl.seed ^ 0x7a15) ^ (frame_index as u32).wrapping_mul(0x9e37_79b9)
+        };
+        pcg_hash(seed) % (n * n).max(1)
+    }
+
+    fn fail(&mut self, cx: &FrameCx<'_>, enc: &mut wgpu::CommandEncoder, msg: Option<String>) -> f32 {
+        if let Some(m) = msg {
+            cx.errors.report(m);
+        }
+        enc.clear_buffer(cx.gi_accum, 0, None);
+        self.state = None;
+        self.ism_maps = 0;
+        1.0
+    }
+
+    /// The point cloud and the atlas for `vs` on the frame's scene (rebuilt when either changed);
+    /// Err when the atlas is beyond the device's binding size.
+    fn ensure_ism(&mut self, cx: &FrameCx<'_>, vs: &ValSettings) -> Result<(), String> {
+        let s = &vs.ism;
+        let need = 4 * (s.atlas as u64).pow(2);
+        let limit = cx.device.limits().max_storage_buffer_binding_size;
+        if need > limit {
+            return Err(format!(
+                "VAL: an ISM atlas of {0} x {0} needs a {1} MiB buffer; this device binds at most \
+                 {2} MiB (lower methods.val.ism.atlas)",
+                s.atlas,
+                need >> 20,
+                limit >> 20
+            ));
+        }
+        if vs.clusters > s.capacity() {
+            return Err(format!(
+                "VAL: {} VALs need as many maps, but an atlas of {} with {} x {} maps holds {} \
+                 (raise methods.val.ism.atlas or lower ism.tile or methods.val.clusters)",
+                vs.clusters,
+                s.atlas,
+                s.tile,
+                s.tile,
+                s.capacity()
+            ));
+        }
+        let key = (s.points, ISM_CLOUD_SEED);
+        let generation = cx.scene.generation;
+        if !matches!(&self.ism_points, Some((g, p)) if *g == generation && p.key == key) {
+            let points =
+                IsmPoints::from_bvh(cx.device, cx.queue, &cx.scene.bvh, s.points, ISM_CLOUD_SEED, key);
+            self.ism_points = Some((generation, points));
+        }
+        if !self.ism_targets.as_ref().is_some_and(|t| t.matches(s)) {
+            self.ism_targets = Some(IsmTargets::new(cx.device, s));
+        }
+        Ok(())
+    }
+
+    fn data_buffer(&mut self, device: &wgpu::Device, view: MethodView, size: (u32, u32)) {
+        if self.view_data.get(view.name()).is_none_or(|(s, _)| *s != size) {
+            let bytes = 16 * size.0 as u64 * size.1 as u64;
+            let data = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("val::view_data"),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            self.view_data.insert(view.name(), (size, data));
+        }
+    }
+
+    /// The distance scale of the map views (metres).
+    fn depth_range(&self) -> (f32, f32) {
+        (0.005 * self.scene_radius, 2.0 * self.scene_radius)
+    }
+
+    /// The penumbra view's scale (metres).
+    fn penumbra_range(&self) -> (f32, f32) {
+        (0.001 * self.scene_radius, self.scene_radius)
+    }
+}
+
+impl Method for Vals {
+    fn record(&mut self, cx: &mut FrameCx<'_>, enc: &mut wgpu::CommandEncoder) -> f32 {
+        let s = cx.settings;
+        let vs: ValSettings = s.method(ID).unwrap_or_default();
+        self.scene_radius = cx.scene_radius;
+        self.ray_offset = s.gi.ray_offset;
+        // Without a light there is no RSM and no indirect light.
+        let Some(rsm) = cx.rsm else {
+            return self.fail(cx, enc, None);
+        };
+        if self.buffers.size != cx.size {
+            self.buffers = ValBuffers::new(cx.device, cx.size);
+        }
+        if !self
+            .targets
+            .as_ref()
+            .is_some_and(|t| t.matches(vs.clusters, rsm.res))
+        {
+            let t = ValTargets::new(cx.device, vs.clusters, rsm.res);
+            self.stats = Some(CounterReadback::new(
+                cx.device,
+                "val::stats_readback",
+                (t.clusters as usize * std::mem::size_of::<GpuVal>()) as u64,
+                ValStats::from_words,
+            ));
+            self.targets = Some(t);
+        }
+        let frames = match self.state {
+            Some((k, m, n)) if s.sampling.accumulate && k == cx.key && m == cx.method => n + 1,
+            _ => 1,
+        };
+        let visibility = if !s.gi.shadow_rays {
+            VIS_NONE
+        } else {
+            match vs.visibility {
+                ValVisibility::Rays => VIS_RAYS,
+                ValVisibility::Ism => VIS_ISM,
+                ValVisibility::Pcss => VIS_PCSS,
+            }
+        };
+        let maps_shown = cx.diagnostics && (cx.views.contains(&ISM_ATLAS) || cx.views.contains(&ISM_TRUE));
+        let build = visibility == VIS_ISM || visibility == VIS_PCSS || maps_shown;
+        self.ism_maps = 0;
+        if build && let Err(e) = self.ensure_ism(cx, &vs) {
+            return self.fail(cx, enc, Some(e));
+        }
+        let n = vs.interleave.n.max(1);
+        let p = GpuValShadeParams {
+            width: cx.size.0,
+            height: cx.size.1,
+            n,
+            offset: Self::offset(s, n, cx.frame_index),
+            clusters: vs.clusters,
+            as_point: (cx.method == VPL) as u32,
+            visibility,
+            count: cx.vpl_frame.count.min(cx.vpl_buffers.capacity),
+            eps: s.gi.distance_epsilon,
+            ray_offset: s.gi.ray_offset,
+            blocker_samples: vs.pcss.blocker_samples,
+            pcf_samples: vs.pcss.pcf_samples,
+            max_radius: vs.pcss.max_radius,
+            res: rsm.res,
+            layer: 0,
+            inspect: vs.inspect.min(vs.clusters - 1),
+        };
+        let cp = GpuValParams::new(
+            rsm.view_proj,
+            rsm.direction,
+            rsm.texel,
+            rsm.res,
+            0,
+            &vs.cluster_params(),
+        );
+        let fp = GpuFilterParams {
+            accumulate: (frames > 1) as u32,
+            scale: std::f32::consts::FRAC_1_PI,
+            ..GpuFilterParams::new(cx.size, &vs.interleave)
+        };
+        let shadow = &cx.targets.shadow;
+        let f = ValFrame {
+            scene: cx.scene,
+            gbuffer: &cx.targets.gbuffer,
+            camera: cx.camera,
+            vpls: &cx.vpl_buffers.vpls,
+            accum: cx.gi_accum,
+            rsm: [&shadow.position_array, &shadow.normal_array, &shadow.flux_array],
+        };
+        let ism = match (build, self.ism_points.as_ref(), self.ism_targets.as_ref()) {
+            (true, Some((_, points)), Some(targets)) => Some(ValIsm {
+                settings: &vs.ism,
+                points,
+                targets,
+            }),
+            _ => None,
+        };
+        let Some(t) = self.targets.as_mut() else {
+            return 0.0;
+        };
+        let built = ism.is_some();
+        let r = self.pass.record(
+            cx.diagnostics,
+            cx.device,
+            cx.queue,
+            enc,
+            cx.timer,
+            p,
+            cp,
+            vs.iterations,
+            fp,
+            &f,
+            &self.buffers,
+            t,
+            ism.as_ref(),
+        );
+        if let Err(e) = r {
+            return self.fail(cx, enc, Some(e));
+        }
+        if cx.diagnostics
+            && let Some(st) = self.stats.as_mut()
+        {
+            let bytes = t.clusters as u64 * std::mem::size_of::<GpuVal>() as u64;
+            st.record(enc, &[(t.vals(), 0, 0, bytes)]);
+        }
+        self.ism_maps = if built { vs.clusters } else { 0 };
+        self.visibility = visibility;
+        self.state = Some((cx.key, cx.method, frames));
+        self.settings = vs;
+        1.0 / frames as f32
+    }
+
+    fn after_submit(&mut self) {
+        if let Some(st) = self.stats.as_ref() {
+            st.after_submit();
+        }
+    }
+
+    fn frames_averaged(&self) -> Option<u32> {
+        Some(self.state.map_or(0, |(_, _, n)| n))
+    }
+
+    fn reset(&mut self) {
+        self.state = None;
+    }
+
+    fn view_size(&self, view: MethodView, frame: (u32, u32)) -> Option<(u32, u32)> {
+        self.state?;
+        if view == CLUSTERS {
+            return self.targets.as_ref().map(|t| (t.res, t.res));
+        }
+        if view == ISM_ATLAS || view == ISM_TRUE {
+            let (t, _) = self.ism()?;
+            if view == ISM_TRUE {
+                return Some((2 * t.layout.tile + GAP, t.layout.tile));
+            }
+        }
+        (self.buffers.size == frame).then_some(frame)
+    }
+
+    fn record_view(&mut self, view: MethodView, cx: &mut ViewCx<'_>, enc: &mut wgpu::CommandEncoder) {
+        let Some(size) = self.view_size(view, self.buffers.size) else {
+            return;
+        };
+        self.data_buffer(cx.device, view, size);
+        let Some((_, data)) = self.view_data.get(view.name()) else {
+            return;
+        };
+        let ism = self.ism_targets.as_ref().filter(|_| self.ism_maps > 0);
+        if view == ISM_ATLAS {
+            if let Some(t) = ism {
+                self.pass.ism.record_view(
+                    cx.device,
+                    cx.queue,
+                    enc,
+                    cx.timer,
+                    t,
+                    self.ism_maps,
+                    self.depth_range(),
+                    size,
+                    cx.dst,
+                    data,
+                );
+            }
+            return;
+        }
+        let Some(t) = self.targets.as_ref() else {
+            return;
+        };
+        let (lo, hi) = if view == PENUMBRA {
+            self.penumbra_range()
+        } else {
+            self.depth_range()
+        };
+        let p = GpuValViewParams {
+            mode: if view == CLUSTERS {
+                0
+            } else if view == DISKS {
+                1
+            } else if view == PENUMBRA {
+                2
+            } else {
+                3
+            },
+            clusters: self.settings.clusters.min(t.clusters),
+            exposure: cx.look.exposure_ev.exp2(),
+            tonemap: cx.look.tonemap.gpu_id(),
+            lo,
+            hi,
+            inspect: self.settings.inspect.min(t.clusters.saturating_sub(1)),
+            gap: GAP,
+            ray_offset: self.ray_offset,
+            res: t.res,
+            _pad: [0; 2],
+        };
+        self.pass.record_view(
+            cx.device,
+            cx.queue,
+            enc,
+            cx.timer,
+            p,
+            size,
+            &cx.targets.lighting.final_view,
+            &cx.targets.gbuffer.position_view,
+            cx.scene,
+            &self.buffers,
+            t,
+            ism.map(|it| (it, &self.settings.ism, self.ism_maps)),
+            cx.dst,
+            data,
+        );
+    }
+
+    fn read_view(&self, ctx: &GpuContext, view: MethodView) -> Result<Option<ImageF32>, GpuError> {
+        if self.state.is_none() {
+            return Ok(None);
+        }
+        match self.view_data.get(view.name()) {
+            Some((size, data)) => readback::read_vec4_image(ctx, data, *size),
+            None => Ok(None),
+        }
+    }
+
+    fn legend(&self, view: MethodView, _tree_levels: u32) -> Option<Legend> {
+        if view == ISM_ATLAS || view == ISM_TRUE {
+            let (lo, hi) = self.depth_range();
+            let tile = self.ism_targets.as_ref().map_or(0, |t| t.layout.tile);
+            let title = if self.ism_maps == 0 {
+                "no maps this frame (visibility by rays or none and the view not drawn yet, or \
+                 refused: see the problems window)"
+                    .to_string()
+            } else if view == ISM_TRUE {
+                format!(
+                    "distance from VAL {} (m): its {tile}^2 map (left) and the traced one (right); \
+                     black: hole / nothing hit",
+                    self.settings.inspect.min(self.settings.clusters - 1)
+                )
+            } else {
+                format!(
+                    "distance from the VAL (m; {} maps of {tile}^2; dim: filled by pull-push; black: hole)",
+                    self.ism_maps
+                )
+            };
+            return Some(Legend {
+                title,
+                lo: lo.log10(),
+                hi: hi.log10(),
+                log: true,
+            });
+        }
+        if view == PENUMBRA {
+            let (lo, hi) = self.penumbra_range();
+            return Some(Legend {
+                title: if self.visibility == VIS_PCSS {
+                    "PCSS penumbra width on the receiver (m, eq. 3)".into()
+                } else {
+                    "no PCSS lookups this frame (visibility is not pcss)".into()
+                },
+                lo: lo.log10(),
+                hi: hi.log10(),
+                log: true,
+            });
+        }
+        None
+    }
+
+    fn pixel_rows(
+        &self,
+        ctx: &GpuContext,
+        x: u32,
+        y: u32,
+        frame: (u32, u32),
+    ) -> Result<Vec<(&'static str, [f32; 4])>, GpuError> {
+        let b = &self.buffers;
+        if b.size != frame || x >= frame.0 || y >= frame.1 || self.state.is_none() {
+            return Ok(Vec::new());
+        }
+        let d = readback::read_vec4_pixel(ctx, &b.diag, b.size.0, x, y)?;
+        Ok(vec![(
+            "VAL (penumbra width m, lookups with blockers, VALs lighting it, -)",
+            d,
+        )])
+    }
+
+    fn status(&mut self) -> Option<String> {
+        let st = self.stats.as_ref()?.last()?;
+        let vis = match self.visibility {
+            VIS_RAYS => "shadow rays",
+            VIS_ISM => "ISM lookups",
+            VIS_PCSS => "PCSS lookups",
+            _ => "no visibility",
+        };
+        Some(format!(
+            "{} of {} VALs lit · mean disk radius {:.3} m · {:.3} W · {vis}",
+            st.lit, st.clusters, st.mean_radius, st.flux
+        ))
+    }
+
+    fn stats(&mut self) -> Vec<(&'static str, f64)> {
+        let Some(st) = self.stats.as_mut().and_then(|s| s.poll()) else {
+            return Vec::new();
+        };
+        vec![
+            ("vals", st.clusters as f64),
+            ("vals_lit", st.lit as f64),
+            ("val_rsm_texels", st.pixels as f64),
+            ("val_flux_w", st.flux),
+            ("val_mean_radius_m", st.mean_radius),
+            ("ism_maps", self.ism_maps as f64),
+            ("visibility", self.visibility as f64),
+        ]
+    }
+}

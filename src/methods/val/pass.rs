@@ -1,0 +1,380 @@
+//! The VAL method's GPU passes, in frame order: `val_seeds` (per cluster its seed texel from
+//! the frame's VPLs), `val_cluster` (the shared `passes::val_cluster`: k steps of section 4's
+//! clustering of light 0's RSM), `val_ism_lights` and `val_ism` (with map visibility, or while
+//! a map view is shown: each VAL's imperfect shadow map, the shared `passes::ism`),
+//! `val_shade` (per pixel its interleaving subset's VALs, eq. 2, visibility; demodulated) and
+//! `val_filter` (the shared geometry-aware filter, x albedo / pi, into the GI accumulation),
+//! then the views (`val_views.wgsl`).
+//! Reads: the VPLs, light 0's RSM, the G-buffer, camera, BVH. CPU twins: `crate::reference::val`,
+//! `crate::reference::ism`.
+
+use bytemuck::{Pod, Zeroable};
+
+use super::settings::{IsmSettings, IsmVal};
+use crate::renderer::{
+    frame::GbufferTargets,
+    passes::{
+        WG_1D, bind_group_seq, compute_pipeline_with, float_texture_entry, groups_image,
+        interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
+        ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
+        run_compute, storage_buffer, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
+        val_cluster::{GpuValParams, ValClusterPass, ValSeeds, ValTargets},
+    },
+    scene_gpu::SceneGpu,
+    shaders,
+    timing::GpuTimer,
+};
+
+/// Twin: `ValShadeParams` in `val_common.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuValShadeParams {
+    pub width: u32,
+    pub height: u32,
+    pub n: u32,
+    pub offset: u32,
+    pub clusters: u32,
+    /// 1: every VAL shaded as a point light (`val-vpl`).
+    pub as_point: u32,
+    /// 0 none, 1 BVH ray to the centre, 2 simple ISM lookup, 3 PCSS lookup.
+    pub visibility: u32,
+    /// The frame's VPLs (the seeds' source).
+    pub count: u32,
+    pub eps: f32,
+    pub ray_offset: f32,
+    pub blocker_samples: u32,
+    pub pcf_samples: u32,
+    pub max_radius: f32,
+    pub res: u32,
+    pub layer: u32,
+    pub inspect: u32,
+}
+
+/// `GpuValShadeParams::visibility` values.
+pub const VIS_NONE: u32 = 0;
+pub const VIS_RAYS: u32 = 1;
+pub const VIS_ISM: u32 = 2;
+pub const VIS_PCSS: u32 = 3;
+
+/// Twin: `ValViewParams` in `val_views.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuValViewParams {
+    pub mode: u32,
+    pub clusters: u32,
+    pub exposure: f32,
+    pub tonemap: u32,
+    pub lo: f32,
+    pub hi: f32,
+    pub inspect: u32,
+    pub gap: u32,
+    pub ray_offset: f32,
+    pub res: u32,
+    pub _pad: [u32; 2],
+}
+
+/// The per-pixel buffers of a frame size.
+pub struct ValBuffers {
+    pub size: (u32, u32),
+    /// Demodulated interleaved estimate (before the filter).
+    pub raw: wgpu::Buffer,
+    /// Per pixel: mean PCSS penumbra width, lookups with blockers, VALs with a non-zero term, 1.
+    pub diag: wgpu::Buffer,
+}
+
+impl ValBuffers {
+    pub fn new(device: &wgpu::Device, size: (u32, u32)) -> Self {
+        let px = (size.0.max(1) * size.1.max(1)) as u64;
+        Self {
+            size,
+            raw: storage_buffer(device, "val::raw", 16 * px),
+            diag: storage_buffer(device, "val::diag", 16 * px),
+        }
+    }
+}
+
+/// What the frame's passes read and write.
+pub struct ValFrame<'a> {
+    pub scene: &'a SceneGpu,
+    pub gbuffer: &'a GbufferTargets,
+    pub camera: &'a wgpu::Buffer,
+    pub vpls: &'a wgpu::Buffer,
+    pub accum: &'a wgpu::Buffer,
+    /// Light 0's RSM: position, normal and flux array views.
+    pub rsm: [&'a wgpu::TextureView; 3],
+}
+
+/// The VALs' maps to build this frame.
+pub struct ValIsm<'a> {
+    pub settings: &'a IsmSettings<IsmVal>,
+    pub points: &'a IsmPoints,
+    pub targets: &'a IsmTargets,
+}
+
+pub struct ValPass {
+    params: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    seeds: wgpu::ComputePipeline,
+    lights: wgpu::ComputePipeline,
+    shade: wgpu::ComputePipeline,
+    shade_timed: wgpu::ComputePipeline,
+    pub cluster: ValClusterPass,
+    pub ism: IsmPass,
+    ism_params: wgpu::Buffer,
+    /// Bound in the maps' place without them: depth, lights.
+    ism_dummy: [wgpu::Buffer; 2],
+    filter: InterleaveFilter,
+    filter_params: FilterUniform,
+    views_layout: wgpu::BindGroupLayout,
+    views: wgpu::ComputePipeline,
+    view_params: wgpu::Buffer,
+    view_ism_params: wgpu::Buffer,
+}
+
+impl ValPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let smod = shaders::create_module(device, "methods/val/val_shade.wgsl")?;
+        let vmod = shaders::create_module(device, "methods/val/val_views.wgsl")?;
+        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        let mut se = vec![
+            uniform_entry(0, c),
+            float_texture_entry(1),
+            float_texture_entry(2),
+        ];
+        se.extend((3..=6).map(|b| storage_entry(b, c, true)));
+        se.extend((7..=10).map(|b| storage_entry(b, c, false)));
+        se.extend([uniform_entry(11, c), storage_entry(12, c, true)]);
+        let shade_layout = layout("val_shade::layout", &se);
+        let views_layout = layout(
+            "val_views::layout",
+            &[
+                uniform_entry(0, c),
+                float_texture_entry(1),
+                float_texture_entry(2),
+                storage_entry(3, c, true),
+                storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm),
+                storage_entry(5, c, true),
+                storage_entry(6, c, true),
+                uniform_entry(7, c),
+                storage_entry(8, c, true),
+                storage_entry(9, c, true),
+                storage_entry(10, c, true),
+                storage_entry(11, c, false),
+            ],
+        );
+        let pipe =
+            |label: &str,
+             l: &wgpu::BindGroupLayout,
+             m: &wgpu::ShaderModule,
+             entry: &str,
+             k: &[(&str, f64)]| { compute_pipeline_with(device, label, &[Some(l)], m, entry, k) };
+        let timed = &[("DIAGNOSTICS", 0.0)];
+        Ok(Self {
+            params: uniform_buffer::<GpuValShadeParams>(device, "val::params"),
+            seeds: pipe("val_seeds", &shade_layout, &smod, "seeds_main", &[]),
+            lights: pipe("val_ism_lights", &shade_layout, &smod, "lights_main", &[]),
+            shade: pipe("val_shade", &shade_layout, &smod, "shade_main", &[]),
+            shade_timed: pipe("val_shade_timed", &shade_layout, &smod, "shade_main", timed),
+            layout: shade_layout,
+            cluster: ValClusterPass::new(device)?,
+            ism: IsmPass::new(device)?,
+            ism_params: uniform_buffer::<GpuIsmParams>(device, "val::ism_params"),
+            ism_dummy: [
+                storage_buffer(device, "val::ism_dummy_depth", 16),
+                storage_buffer(device, "val::ism_dummy_lights", 32),
+            ],
+            filter: InterleaveFilter::new(device)?,
+            filter_params: FilterUniform::new(device, "val::filter_params"),
+            views: pipe("val_views", &views_layout, &vmod, "main", &[]),
+            views_layout,
+            view_params: uniform_buffer::<GpuValViewParams>(device, "val_views::params"),
+            view_ism_params: uniform_buffer::<GpuIsmParams>(device, "val_views::ism_params"),
+        })
+    }
+
+    /// Records the frame (module doc): seeds, `iterations` clustering steps with `cp`, the maps
+    /// (`ism`), shading with `p` and the filter with `fp` into `f.accum`. Refused (nothing
+    /// recorded) when the clustering refuses its targets.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        diagnostics: bool,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: GpuValShadeParams,
+        cp: GpuValParams,
+        iterations: u32,
+        fp: GpuFilterParams,
+        f: &ValFrame<'_>,
+        b: &ValBuffers,
+        t: &mut ValTargets,
+        ism: Option<&ValIsm<'_>>,
+    ) -> Result<(), String> {
+        if p.clusters == 0 || p.clusters > t.clusters {
+            return Err(format!(
+                "VAL: {} clusters for targets of {}",
+                p.clusters, t.clusters
+            ));
+        }
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let (ism_depth, ism_lights) = match ism {
+            Some(m) => {
+                let ip = GpuIsmParams::new(m.targets, m.settings, p.clusters, m.points.count);
+                queue.write_buffer(&self.ism_params, 0, bytemuck::bytes_of(&ip));
+                (&m.targets.depth, &m.targets.lights)
+            }
+            None => (&self.ism_dummy[0], &self.ism_dummy[1]),
+        };
+        let tv = wgpu::BindingResource::TextureView;
+        let g = f.gbuffer;
+        let bind = |vals: &wgpu::Buffer, seeds: &wgpu::Buffer| {
+            bind_group_seq(
+                device,
+                "val_shade::bind_group",
+                &self.layout,
+                &[
+                    self.params.as_entire_binding(),
+                    tv(&g.position_view),
+                    tv(&g.normal_view),
+                    f.scene.bvh_nodes.as_entire_binding(),
+                    f.scene.bvh_triangles.as_entire_binding(),
+                    f.vpls.as_entire_binding(),
+                    vals.as_entire_binding(),
+                    seeds.as_entire_binding(),
+                    ism_lights.as_entire_binding(),
+                    b.raw.as_entire_binding(),
+                    b.diag.as_entire_binding(),
+                    self.ism_params.as_entire_binding(),
+                    ism_depth.as_entire_binding(),
+                ],
+            )
+        };
+        let per_cluster = (p.clusters.div_ceil(WG_1D), 1, 1);
+        // The seeds (the VALs bound are not read).
+        let before = bind(t.vals(), &t.seeds);
+        run_compute(encoder, timer, "val_seeds", &self.seeds, &before, per_cluster);
+        self.cluster.record(
+            device,
+            queue,
+            encoder,
+            timer,
+            "val_cluster",
+            f.rsm,
+            cp,
+            ValSeeds::Written(p.clusters),
+            iterations,
+            t,
+        )?;
+        // The clusters as the last step left them; the seeds buffer is bound again unread.
+        let after = bind(t.vals(), &t.seeds);
+        if let Some(m) = ism {
+            run_compute(
+                encoder,
+                timer,
+                "val_ism_lights",
+                &self.lights,
+                &after,
+                per_cluster,
+            );
+            self.ism.record_maps(
+                device, queue, encoder, timer, "val_ism", m.settings, m.points, p.clusters, m.targets,
+            );
+        }
+        let shade = if diagnostics {
+            &self.shade
+        } else {
+            &self.shade_timed
+        };
+        run_compute(
+            encoder,
+            timer,
+            "val_shade",
+            shade,
+            &after,
+            groups_image(p.width, p.height),
+        );
+        self.filter.record(
+            device,
+            queue,
+            encoder,
+            timer,
+            "val_filter",
+            &self.filter_params,
+            fp,
+            &FilterInputs {
+                gbuffer: f.gbuffer,
+                camera: f.camera,
+                raw: &b.raw,
+                accum: f.accum,
+            },
+        );
+        Ok(())
+    }
+
+    /// Draws a view (`val_views.wgsl`, `p.mode`) into `dst`, its linear data into `data`
+    /// (vec4 per `dst` pixel).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_view(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: GpuValViewParams,
+        size: (u32, u32),
+        final_image: &wgpu::TextureView,
+        gb_position: &wgpu::TextureView,
+        scene: &SceneGpu,
+        b: &ValBuffers,
+        t: &ValTargets,
+        ism: Option<(&IsmTargets, &IsmSettings<IsmVal>, u32)>,
+        dst: &wgpu::TextureView,
+        data: &wgpu::Buffer,
+    ) {
+        queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
+        let depth = match ism {
+            Some((it, s, maps)) => {
+                let ip = GpuIsmParams::new(it, s, maps, 0);
+                queue.write_buffer(&self.view_ism_params, 0, bytemuck::bytes_of(&ip));
+                &it.depth
+            }
+            None => &self.ism_dummy[0],
+        };
+        let tv = wgpu::BindingResource::TextureView;
+        let bind = bind_group_seq(
+            device,
+            "val_views::bind_group",
+            &self.views_layout,
+            &[
+                self.view_params.as_entire_binding(),
+                tv(final_image),
+                tv(gb_position),
+                b.diag.as_entire_binding(),
+                tv(dst),
+                t.vals().as_entire_binding(),
+                t.keys.as_entire_binding(),
+                self.view_ism_params.as_entire_binding(),
+                depth.as_entire_binding(),
+                scene.bvh_nodes.as_entire_binding(),
+                scene.bvh_triangles.as_entire_binding(),
+                data.as_entire_binding(),
+            ],
+        );
+        run_compute(
+            encoder,
+            timer,
+            "val_views",
+            &self.views,
+            &bind,
+            groups_image(size.0, size.1),
+        );
+    }
+}

@@ -1,0 +1,266 @@
+//! The VAL method's settings (`[methods.val]` in a settings file; `val-vpl`, the same pipeline
+//! shading every VAL as a point light, reads the same table so that the two compare on the same
+//! clusters).
+
+use serde::{Deserialize, Serialize};
+
+use crate::reference::val::{ClusterParams, MAX_CLUSTERS, MetricWeights, POISSON, Pcss};
+pub use crate::renderer::settings::{Interleave4, InterleaveSettings, IsmSettings, IsmVal};
+
+pub const MAX_INTERLEAVE: u32 = 16;
+pub const MAX_ITERATIONS: u32 = 16;
+pub const MAX_SPLAT: u32 = 512;
+
+/// How a VAL is shadowed (while `gi.shadow_rays` is on; off: every VAL visible).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ValVisibility {
+    /// One lookup in the VAL's imperfect shadow map (section 5; the paper's "simple" lookup).
+    Ism,
+    /// The PCSS-style lookup in its map (section 6: blocker search, eq. 3, Poisson PCF), the
+    /// paper's answer to few VALs.
+    #[default]
+    Pcss,
+    /// A BVH shadow ray to the VAL's centre (exact for a point at the centre: the reference
+    /// that separates the maps' error from the clustering's).
+    Rays,
+}
+
+impl ValVisibility {
+    pub fn name(self) -> &'static str {
+        match self {
+            ValVisibility::Ism => "ism",
+            ValVisibility::Pcss => "pcss",
+            ValVisibility::Rays => "rays",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ValSettings {
+    /// VALs (clusters) per frame, seeded at this many of the frame's VPLs (spread over them;
+    /// the paper: 64 with PCSS, 512 with simple lookups; up to 1024, one map each).
+    pub clusters: u32,
+    /// Edge of a cluster's splat window in RSM texels (the paper: 32 - 128 pixel splats).
+    pub splat: u32,
+    /// k-means steps per frame (the paper runs one per frame and carries the clusters over).
+    pub iterations: u32,
+    /// Eq. 1's convex weights (position, normal, flux).
+    pub weights: MetricWeights,
+    pub visibility: ValVisibility,
+    /// The PCSS lookup's samples and its largest filter radius.
+    pub pcss: Pcss,
+    pub interleave: InterleaveSettings<Interleave4>,
+    /// The VALs' imperfect shadow maps (the paper's 128^2 maps in a 4096^2 atlas, the cloud
+    /// shared round-robin, 2 pull-push iterations).
+    pub ism: IsmSettings<IsmVal>,
+    /// The VAL whose map the "VAL ISM vs true map" view shows.
+    pub inspect: u32,
+}
+
+impl Default for ValSettings {
+    fn default() -> Self {
+        Self {
+            clusters: 64,
+            splat: 32,
+            iterations: 4,
+            weights: MetricWeights::default(),
+            visibility: ValVisibility::Pcss,
+            pcss: Pcss::default(),
+            interleave: InterleaveSettings::pattern(4),
+            ism: IsmSettings::default(),
+            inspect: 0,
+        }
+    }
+}
+
+impl ValSettings {
+    pub fn cluster_params(&self) -> ClusterParams {
+        ClusterParams {
+            splat: self.splat,
+            weights: self.weights,
+        }
+    }
+
+    pub fn validate(&self) -> Result<(), String> {
+        let f = |name: &str, v: String, range: &str| {
+            Err(format!("methods.val.{name} {v} is out of range ({range})"))
+        };
+        if !(1..=MAX_CLUSTERS).contains(&self.clusters) {
+            return f(
+                "clusters",
+                self.clusters.to_string(),
+                &format!("1..={MAX_CLUSTERS}"),
+            );
+        }
+        if !(1..=MAX_SPLAT).contains(&self.splat) {
+            return f("splat", self.splat.to_string(), &format!("1..={MAX_SPLAT}"));
+        }
+        if !(1..=MAX_ITERATIONS).contains(&self.iterations) {
+            return f(
+                "iterations",
+                self.iterations.to_string(),
+                &format!("1..={MAX_ITERATIONS}"),
+            );
+        }
+        let w = self.weights;
+        for (name, v) in [
+            ("weights.position", w.position),
+            ("weights.normal", w.normal),
+            ("weights.flux", w.flux),
+        ] {
+            if !(0.0..=1.0).contains(&v) {
+                return f(name, v.to_string(), "0..=1");
+            }
+        }
+        if !(w.position + w.normal + w.flux > 0.0) {
+            return Err("methods.val.weights: at least one of position, normal, flux must be > 0".into());
+        }
+        let n = POISSON.len() as u32;
+        if !(1..=n).contains(&self.pcss.blocker_samples) {
+            return f(
+                "pcss.blocker_samples",
+                self.pcss.blocker_samples.to_string(),
+                &format!("1..={n}"),
+            );
+        }
+        if !(1..=n).contains(&self.pcss.pcf_samples) {
+            return f(
+                "pcss.pcf_samples",
+                self.pcss.pcf_samples.to_string(),
+                &format!("1..={n}"),
+            );
+        }
+        if !(self.pcss.max_radius >= 1.0 && self.pcss.max_radius <= 64.0) {
+            return f(
+                "pcss.max_radius",
+                self.pcss.max_radius.to_string(),
+                "1..=64 texels",
+            );
+        }
+        self.interleave.validate("methods.val", MAX_INTERLEAVE)?;
+        self.ism.validate("methods.val")?;
+        if self.clusters > self.ism.capacity() {
+            return Err(format!(
+                "methods.val.clusters {} exceeds the ISM atlas's {} maps (an atlas of {} with {} x {} \
+                 maps; raise methods.val.ism.atlas or lower ism.tile)",
+                self.clusters,
+                self.ism.capacity(),
+                self.ism.atlas,
+                self.ism.tile,
+                self.ism.tile
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_papers_and_partial_tables_keep_them() {
+        let v: ValSettings =
+            toml::from_str("clusters = 512\nvisibility = \"ism\"\n[ism]\nbias = 0.05").unwrap();
+        assert_eq!((v.clusters, v.visibility), (512, ValVisibility::Ism));
+        assert_eq!((v.ism.tile, v.ism.atlas, v.ism.pull_push_levels), (128, 4096, 2));
+        assert_eq!(v.interleave.n, 4);
+        assert!(v.validate().is_ok());
+        let back: ValSettings = toml::from_str(&toml::to_string(&v).unwrap()).unwrap();
+        assert_eq!(back, v);
+    }
+
+    #[test]
+    fn out_of_range_fields_are_named() {
+        let ok = ValSettings::default();
+        assert!(ok.validate().is_ok());
+        let cases: Vec<(ValSettings, &str)> = vec![
+            (
+                ValSettings {
+                    clusters: 0,
+                    ..ok.clone()
+                },
+                "clusters",
+            ),
+            (
+                ValSettings {
+                    clusters: 2000,
+                    ..ok.clone()
+                },
+                "clusters",
+            ),
+            (
+                ValSettings {
+                    splat: 0,
+                    ..ok.clone()
+                },
+                "splat",
+            ),
+            (
+                ValSettings {
+                    iterations: 0,
+                    ..ok.clone()
+                },
+                "iterations",
+            ),
+            (
+                ValSettings {
+                    weights: MetricWeights {
+                        position: 2.0,
+                        ..ok.weights
+                    },
+                    ..ok.clone()
+                },
+                "weights.position",
+            ),
+            (
+                ValSettings {
+                    weights: MetricWeights {
+                        position: 0.0,
+                        normal: 0.0,
+                        flux: 0.0,
+                    },
+                    ..ok.clone()
+                },
+                "weights",
+            ),
+            (
+                ValSettings {
+                    pcss: Pcss {
+                        pcf_samples: 0,
+                        ..ok.pcss
+                    },
+                    ..ok.clone()
+                },
+                "pcss.pcf_samples",
+            ),
+            (
+                ValSettings {
+                    pcss: Pcss {
+                        max_radius: f32::NAN,
+                        ..ok.pcss
+                    },
+                    ..ok.clone()
+                },
+                "pcss.max_radius",
+            ),
+            (
+                ValSettings {
+                    ism: IsmSettings {
+                        tile: 256,
+                        ..ok.ism.clone()
+                    },
+                    clusters: 512,
+                    ..ok.clone()
+                },
+                "clusters",
+            ),
+        ];
+        for (s, field) in cases {
+            let e = s.validate().unwrap_err();
+            assert!(e.contains(field), "{e} should name {field}");
+        }
+    }
+}
