@@ -1,6 +1,7 @@
 // The geometry-aware filter of interleaved sampling (Stochastic Light Culling, Tokuyoshi &
 // Harada 2016, section 4.2, after Segovia et al. 2006): per pixel, the mean of `raw` over the
-// (2r + 1)^2 window's pixels on the same surface (normal within normal_cos of the pixel's,
+// (2r + 1)^2 window's (or, with a period p, the p x p window's: one pixel per subset, the VAL
+// paper's n x m filter) pixels on the same surface (normal within normal_cos of the pixel's,
 // within plane_tolerance x view depth of its tangent plane), x albedo (modulate) x scale, into
 // (or added to) `accum`. Shared by light culling (raw before albedo / pi: scale 1 / pi) and
 // the tree samplers (raw demodulated: scale 1; modulate 0 at half resolution, where the
@@ -18,6 +19,10 @@ struct FilterParams {
     plane_tolerance: f32,
     scale: f32,
     modulate: u32,     // 1: x the pixel's albedo
+    period: u32,       // 0: the (2 radius + 1)^2 window; p: the p x p window -p/2 ..= p - p/2 - 1
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 @group(0) @binding(0) var<uniform> fp: FilterParams;
@@ -40,11 +45,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if g.w != 0.0 {
         let n = normalize(textureLoad(gb_normal, px, 0).xyz);
         let tol = fp.plane_tolerance * max(dot(g.xyz - camera.position.xyz, camera.forward.xyz), 1e-6);
-        let r = i32(fp.radius);
+        var lo = -i32(fp.radius);
+        var hi = i32(fp.radius);
+        if fp.period > 0u {
+            let p = i32(fp.period);
+            lo = -(p / 2);
+            hi = p - p / 2 - 1;
+        }
         var sum = vec3<f32>(0.0);
         var w = 0.0;
-        for (var dy = -r; dy <= r; dy++) {
-            for (var dx = -r; dx <= r; dx++) {
+        for (var dy = lo; dy <= hi; dy++) {
+            for (var dx = lo; dx <= hi; dx++) {
                 let q = px + vec2<i32>(dx, dy);
                 if q.x < 0 || q.y < 0 || q.x >= i32(fp.width) || q.y >= i32(fp.height) {
                     continue;

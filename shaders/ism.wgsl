@@ -44,11 +44,38 @@ fn splat_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     if ism.front_cull != 0u && dot(points[2u * idx + 1u].xyz, d) < 0.0 {
         return;
     }
-    let p = ism_project(c.xyz, lights[2u * m + 1u].xyz, x);
+    let nl = lights[2u * m + 1u].xyz;
+    let p = ism_project(c.xyz, nl, x);
     if p.z < 0.0 {
         return;
     }
-    atomicMax(&keys[ism_texel(m, p.xy)], 0xffffffffu - bitcast<u32>(p.z));
+    let key = 0xffffffffu - bitcast<u32>(p.z);
+    if ism.point_radius <= 0.0 {
+        atomicMax(&keys[ism_texel(m, p.xy)], key);
+        return;
+    }
+    // A sized point (the VAL paper's point sprites): the texels within its radius as seen
+    // from the light, a square of (2k + 1)^2 around its own. Map coordinates per radian at
+    // cosine z to the normal: 0.5 / (1 + z). Twin: reference::ism::splat_sized.
+    let z = dot(d / p.z, nl);
+    let r = ism.point_radius / p.z * 0.5 / (1.0 + z) * f32(ism.tile);
+    let reach = i32(min(r, ISM_MAX_POINT_TEXELS));
+    let t = i32(ism.tile);
+    let u0 = clamp(i32(p.x * f32(ism.tile)), 0, t - 1);
+    let v0 = clamp(i32(p.y * f32(ism.tile)), 0, t - 1);
+    for (var dv = -reach; dv <= reach; dv++) {
+        let v = v0 + dv;
+        if v < 0 || v >= t {
+            continue;
+        }
+        for (var du = -reach; du <= reach; du++) {
+            let u = u0 + du;
+            if u < 0 || u >= t {
+                continue;
+            }
+            atomicMax(&keys[ism_index(m, u32(u), u32(v))], key);
+        }
+    }
 }
 
 // The texel (x, y) of map m at level l (0: the atlas).

@@ -28,6 +28,10 @@ struct ValParams {
     w_n: f32,
     w_f: f32,
     extent: f32,
+    area_mode: u32,     // 1: a texel's surface area is its flux's alpha (a summed-down RSM)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 // Twin: reference::val::Val (texel packed x | y << 16).
@@ -60,6 +64,7 @@ struct Texel {
     position: vec3<f32>,
     normal: vec3<f32>,
     flux: vec3<f32>,
+    area: f32,
     lit: bool,
 };
 
@@ -68,8 +73,9 @@ fn load(t: vec2<u32>) -> Texel {
     let l = i32(vp.layer);
     let p = textureLoad(rsm_position, c, l, 0);
     let n = textureLoad(rsm_normal, c, l, 0).xyz;
-    let f = textureLoad(rsm_flux, c, l, 0).rgb;
-    return Texel(p.xyz, n, f, p.w > 0.0 && max(f.r, max(f.g, f.b)) > 0.0);
+    let f = textureLoad(rsm_flux, c, l, 0);
+    let area = select(surface_area(n), f.a, vp.area_mode != 0u);
+    return Texel(p.xyz, n, f.rgb, area, p.w > 0.0 && max(f.r, max(f.g, f.b)) > 0.0);
 }
 
 fn unpack_texel(t: u32) -> vec2<u32> {
@@ -158,7 +164,7 @@ fn fallback_main(@builtin(global_invocation_id) gid: vec3<u32>) {
 // A cluster seeded at texel t (packed): its attributes, one pixel. Twin: reference::val::seed.
 fn seed_val(t: u32) -> Val {
     let x = load(unpack_texel(t));
-    return Val(x.position, surface_area(x.normal), x.normal, 1u, x.flux, t);
+    return Val(x.position, x.area, x.normal, 1u, x.flux, t);
 }
 
 // Every cluster from its seed (the first step's input: vals_out).
@@ -241,7 +247,7 @@ fn average_main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_
             position += x.position;
             normal += x.normal;
             flux += x.flux;
-            area += surface_area(x.normal);
+            area += x.area;
             pixels += 1u;
         }
     }

@@ -13,15 +13,18 @@ use lightcut::methods::val::{
     self as val_method, Vals,
     settings::{InterleaveSettings, IsmSettings, ValSettings, ValVisibility},
 };
-use lightcut::reference::ism::{self, IsmLayout};
+use lightcut::reference::interleave::filter_pixel_window;
+use lightcut::reference::ism::{self, IsmLayout, IsmLight};
+use lightcut::reference::light_culling::TileCamera;
 use lightcut::reference::val::{self, ClusterParams, MetricWeights, NONE, Rsm, RsmTexel};
 use lightcut::reference::vpl::{pcg_hash, u01};
 use lightcut::renderer::{
     Buffer,
     context::GpuContext,
     gpu_data::light_frustum,
+    passes::ism::{bvh_area, cloud_of_bvh},
     passes::val_cluster::{GpuVal, GpuValParams, ValClusterPass, ValSeeds, ValTargets, key_cluster},
-    readback::read_storage_buffer,
+    readback::{read_storage_buffer, read_texture_f32},
     settings::RenderSettings,
     timing::GpuTimer,
 };
@@ -36,6 +39,11 @@ fn rsm(ctx: &GpuContext) -> Rsm {
     s.vpl.count = 64;
     let mut st = Setup::new(ctx, s, (32, 24));
     st.frame();
+    rsm_of(&st, RES)
+}
+
+/// Light 0's `res`^2 RSM of the setup's last frame.
+fn rsm_of(st: &Setup, res: u32) -> Rsm {
     let read = |b| st.r.read(b).unwrap();
     let (pos, nrm, flux) = (
         read(Buffer::RsmPosition(0)),
@@ -43,8 +51,8 @@ fn rsm(ctx: &GpuContext) -> Rsm {
         read(Buffer::RsmFlux(0)),
     );
     let light = &st.scene.lights[0];
-    let (view_proj, texel, _) = light_frustum(light.direction, &st.scene.bounds, RES);
-    let texels = (0..(RES * RES) as usize)
+    let (view_proj, texel, _) = light_frustum(light.direction, &st.scene.bounds, res);
+    let texels = (0..(res * res) as usize)
         .map(|i| RsmTexel {
             position: Vec3::from_slice(&pos.pixels[i][..3]),
             normal: Vec3::from_slice(&nrm.pixels[i][..3]),
@@ -53,11 +61,12 @@ fn rsm(ctx: &GpuContext) -> Rsm {
         })
         .collect();
     Rsm {
-        res: RES,
+        res,
         texels,
         texel_area: texel * texel,
         light_dir: light.direction.normalize(),
         view_proj,
+        areas: Vec::new(),
     }
 }
 
@@ -277,6 +286,7 @@ fn a_mismatched_clustering_is_refused() {
             texel_area: 0.01,
             light_dir: -Vec3::Y,
             view_proj: glam::Mat4::IDENTITY,
+            areas: Vec::new(),
         },
     );
     let mut timer = GpuTimer::new(&ctx.device, &ctx.queue);
@@ -306,12 +316,17 @@ fn a_mismatched_clustering_is_refused() {
 
 const W: u32 = 48;
 const H: u32 = 32;
-const METHOD_RES: u32 = 128;
+const METHOD_RES: u32 = 256;
+/// The clustering RSM of the method tests (4 x 4 RSM texels each).
+const CLUSTER_RES: u32 = 64;
 
-/// Tiny VAL settings: 24 VALs, 2 steps, a 2 x 2 pattern, 64^2 maps in a 512^2 atlas.
+/// Tiny VAL settings: 24 VALs on a 64^2 clustering RSM, 2 steps, a 2 x 2 pattern, 64^2 maps
+/// in a 512^2 atlas.
 fn small() -> ValSettings {
     ValSettings {
         clusters: 24,
+        resolution: CLUSTER_RES,
+        splat: 16,
         iterations: 2,
         interleave: InterleaveSettings::pattern(2),
         ism: IsmSettings {
@@ -418,24 +433,54 @@ fn seeds_shading_and_pcss_equal_the_cpu_reference() {
     // Seeds: the GPU's from the frame's VPLs are the CPU twin's.
     let vpls = st.r.read_vpls().unwrap();
     let ids: Vec<u32> = vpls.iter().map(|v| v.id).collect();
-    let want = val::seeds_from_vpls(&ids, vs.clusters, 0, METHOD_RES);
+    let want = val::seeds_from_vpls(&ids, vs.clusters, 0, METHOD_RES, METHOD_RES / CLUSTER_RES);
     let t = vals_of(&st).targets().unwrap();
     let got: Vec<u32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &t.seeds).unwrap());
     assert_eq!(&got[..vs.clusters as usize], &want[..], "seed texels");
 
-    // The clusters partition the RSM's lit texels and keep its flux.
-    let flux = st.r.read(Buffer::RsmFlux(0)).unwrap();
-    let pos = st.r.read(Buffer::RsmPosition(0)).unwrap();
-    let (mut lit_texels, mut total) = (0u32, Vec3::ZERO);
-    for (f, p) in flux.pixels.iter().zip(&pos.pixels) {
-        let f = Vec3::from_slice(&f[..3]);
-        if p[3] > 0.0 && f.max_element() > 0.0 {
-            lit_texels += 1;
-            total += f;
-        }
+    // The clustering RSM: the GPU's summed-down RSM is the CPU twin's.
+    let coarse = val::downsample(&rsm_of(&st, METHOD_RES), CLUSTER_RES);
+    let c = vals_of(&st).clustering_rsm().unwrap();
+    assert_eq!(c.res, CLUSTER_RES);
+    let read = |i: usize| read_texture_f32(&ctx, &c.textures[i], 0).unwrap();
+    let (gp, gn, gf) = (read(0), read(1), read(2));
+    let mut same = 0;
+    for (k, t) in coarse.texels.iter().enumerate() {
+        let lit = coarse.lit(k);
+        let close =
+            |a: Vec3, b: Vec3, tol: f32| (a - b).abs().max_element() <= tol * b.abs().max_element().max(1e-3);
+        let ok = if lit {
+            gp.pixels[k][3] > 0.0
+                && close(Vec3::from_slice(&gp.pixels[k][..3]), t.position, 1e-4)
+                && close(Vec3::from_slice(&gn.pixels[k][..3]), t.normal, 1e-4)
+                && close(Vec3::from_slice(&gf.pixels[k][..3]), t.flux, 1e-4)
+                && (gf.pixels[k][3] - coarse.surface_area(k)).abs() <= 1e-4 * coarse.surface_area(k)
+        } else {
+            gp.pixels[k][3] == 0.0
+        };
+        same += ok as usize;
     }
+    assert_eq!(same, coarse.texels.len(), "coarse texels equal to the CPU's");
+
+    // The clusters partition the clustering RSM's lit texels and keep the RSM's flux.
+    let lit_texels = (0..coarse.texels.len()).filter(|&i| coarse.lit(i)).count() as u32;
+    let total = coarse.total_flux();
+    let fine_total = rsm_of(&st, METHOD_RES).total_flux();
+    assert!(
+        (total - fine_total).abs().max_element() <= 1e-3 * total.max_element(),
+        "{total} vs {fine_total}"
+    );
     let vals = read_vals(&st);
     assert_eq!(vals.iter().map(|v| v.pixels).sum::<u32>(), lit_texels);
+    // ... and follow the CPU's clustering of the CPU's coarse RSM from the same seeds.
+    let seeds: Vec<UVec2> = want.iter().map(|&p| UVec2::new(p & 0xffff, p >> 16)).collect();
+    let (_, assignment) = val::cluster(&coarse, &vs.cluster_params(), &seeds, vs.iterations);
+    let keys: Vec<u32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &t.keys).unwrap());
+    let agree = (0..coarse.texels.len())
+        .filter(|&i| coarse.lit(i) && key_cluster(keys[i]) == assignment[i])
+        .count();
+    println!("clustering: {agree} of {lit_texels} coarse texels in the CPU's cluster");
+    assert!(agree as f64 >= 0.99 * lit_texels as f64, "{agree} / {lit_texels}");
     let vf: Vec3 = vals.iter().filter(|v| v.pixels > 0).map(|v| v.flux).sum();
     assert!(
         (vf - total).abs().max_element() <= 1e-3 * total.max_element(),
@@ -454,12 +499,53 @@ fn seeds_shading_and_pcss_equal_the_cpu_reference() {
         assert_eq!(Vec3::from_slice(&lights[2 * i][..3]), v.position);
         assert_eq!(lights[2 * i][3] > 0.0, v.pixels > 0);
     }
-
-    // PCSS shading (the default) against the CPU's lookups in the GPU's atlas.
+    // The maps equal the CPU twin's: the cloud shared round-robin, points sized by distance
+    // (the VAL defaults), pull-push.
     let layout = IsmLayout {
         atlas: vs.ism.atlas,
         tile: vs.ism.tile,
     };
+    let bvh_gpu = &st.r.scene_gpu().bvh;
+    let points: Vec<Vec3> = cloud_of_bvh(bvh_gpu, vs.ism.points, val_method::ISM_CLOUD_SEED)
+        .into_iter()
+        .map(|(p, _)| p)
+        .collect();
+    let radius = vs.ism.point_radius(
+        bvh_area(bvh_gpu),
+        vs.ism.points_per_map(points.len() as u32, vs.clusters),
+    );
+    assert!(radius > 0.0, "the VAL maps size their points");
+    let ism_lights: Vec<IsmLight> = vals
+        .iter()
+        .map(|v| IsmLight {
+            range: if v.pixels > 0 { f32::MAX.sqrt() } else { 0.0 },
+            ..IsmLight::new(v.position, v.normal)
+        })
+        .collect();
+    let mut cpu_atlas = ism::splat_sized(layout, &ism_lights, &points, None, 0, radius);
+    let one_texel = ism::splat(layout, &ism_lights, &points, 0);
+    let filled = |a: &[f32]| a.iter().filter(|&&d| d < ism::EMPTY).count();
+    println!(
+        "VAL maps: the sized points fill {} texels, one texel per point {}",
+        filled(&cpu_atlas),
+        filled(&one_texel)
+    );
+    assert!(filled(&cpu_atlas) > 2 * filled(&one_texel));
+    ism::pull_push(layout, &mut cpu_atlas, vs.clusters, vs.ism.levels());
+    let gpu_atlas: Vec<f32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &it.depth).unwrap());
+    let texels = (vs.clusters * vs.ism.tile * vs.ism.tile) as usize;
+    let same = (0..vs.clusters)
+        .flat_map(|m| (0..vs.ism.tile).flat_map(move |v| (0..vs.ism.tile).map(move |u| (m, u, v))))
+        .filter(|&(m, u, v)| {
+            let k = layout.texel(m, u, v);
+            let (a, b) = (gpu_atlas[k], cpu_atlas[k]);
+            a == b || (a - b).abs() <= 1e-5 * b.abs()
+        })
+        .count();
+    println!("VAL maps: {same} of {texels} texels equal the CPU's");
+    assert!(same * 1000 >= texels * 995, "{same} of {texels}");
+
+    // PCSS shading (the default) against the CPU's lookups in the GPU's atlas.
     let atlas: Vec<f32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &it.depth).unwrap());
     let n = vs.interleave.n;
     let offset = Vals::offset(&s, n, 0);
@@ -512,6 +598,52 @@ fn seeds_shading_and_pcss_equal_the_cpu_reference() {
         "the search finds some blockers"
     );
 
+    // The paper's n x n filter (from the GPU's raw estimates) x albedo / pi is the indirect
+    // image.
+    assert!(vs.paper_filter, "the paper's window by default");
+    let cam = TileCamera::new(&st.cam, W, H);
+    let (pos, nrm) = (
+        st.r.read(Buffer::Position).unwrap(),
+        st.r.read(Buffer::Normal).unwrap(),
+    );
+    let surf: Vec<Option<(Vec3, Vec3)>> = (0..(W * H) as usize)
+        .map(|k| {
+            (pos.pixels[k][3] != 0.0).then(|| {
+                (
+                    Vec3::from_slice(&pos.pixels[k][..3]),
+                    Vec3::from_slice(&nrm.pixels[k][..3]).normalize(),
+                )
+            })
+        })
+        .collect();
+    let (alb, ind, raw) = (st.r.read(Buffer::Albedo).unwrap(), st.indirect(), gpu_raw(&st));
+    let window = lightcut::renderer::passes::interleave_filter::window(vs.interleave.filter_radius, n);
+    assert_eq!(window, (-1, 0), "a 2 x 2 pattern: one pixel of each subset");
+    let mut worst = 0.0f32;
+    for y in 0..H {
+        for x in 0..W {
+            let k = (y * W + x) as usize;
+            let f = filter_pixel_window(
+                x,
+                y,
+                W,
+                H,
+                window,
+                vs.interleave.filter_normal_cos,
+                vs.interleave.filter_plane_tolerance,
+                cam.eye,
+                cam.forward,
+                &surf,
+                &raw,
+            );
+            let want = Vec3::from_slice(&alb.pixels[k][..3]) / std::f32::consts::PI * f;
+            let got = Vec3::from_slice(&ind.pixels[k][..3]);
+            worst = worst.max((got - want).abs().max_element() / want.max_element().max(1e-4));
+        }
+    }
+    println!("filter: worst relative difference {worst:e}");
+    assert!(worst < 1e-3, "filter {worst}");
+
     // The simple lookup, and the VPL mode with shadow rays.
     st.set(|s| val_method::set_visibility(s, ValVisibility::Ism));
     st.frame();
@@ -555,6 +687,7 @@ fn the_method_converges_to_its_own_sum_and_its_maps_agree_with_rays() {
     let mut vs = small();
     vs.visibility = ValVisibility::Rays;
     vs.interleave.filter_radius = 0;
+    vs.paper_filter = false;
     let mut s = method_settings(&vs, val_method::ID);
     s.sampling.fixed_seed = false;
     s.sampling.accumulate = true;
@@ -622,43 +755,106 @@ fn the_method_converges_to_its_own_sum_and_its_maps_agree_with_rays() {
         "the mean of the frames is nearer the sum over all VALs"
     );
 
-    // The maps against rays over the (pixel, VAL) pairs that light each other.
-    st.set(|s| val_method::set_visibility(s, ValVisibility::Ism));
-    st.frame();
-    let vals = read_vals(&st);
-    let (it, _) = vals_of(&st).ism().unwrap();
-    let layout = IsmLayout {
-        atlas: vs.ism.atlas,
-        tile: vs.ism.tile,
-    };
-    let atlas: Vec<f32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &it.depth).unwrap());
-    let (mut pairs, mut agree, mut ray_lit) = (0usize, 0usize, 0usize);
+    // The maps against rays over the (pixel, VAL) pairs that light each other, with the
+    // simple and the PCSS lookup, for the point sizes and front-face culling.
     let eps = s.gi.distance_epsilon;
     let pos = st.r.read(Buffer::Position).unwrap();
     let nrm = st.r.read(Buffer::Normal).unwrap();
-    for k in 0..(W * H) as usize {
-        let g = pos.pixels[k];
-        if g[3] == 0.0 {
-            continue;
-        }
-        let p = Vec3::new(g[0], g[1], g[2]);
-        let nx = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
-        for (i, v) in vals.iter().enumerate() {
-            if val::term(v, false, eps, p, nx) == Vec3::ZERO {
+    let mut results = Vec::new();
+    let d = IsmSettings::<lightcut::renderer::settings::IsmVal>::default();
+    assert_eq!(
+        (d.point_size, d.front_face_culling, d.bias),
+        (0.5, false, 0.1),
+        "the VAL defaults"
+    );
+    for (point_size, ffc, bias) in [
+        (0.5, false, 0.1),
+        (0.0, false, 0.1),
+        (1.0, false, 0.1),
+        (0.5, true, 0.05),
+    ] {
+        st.set(|s| {
+            let mut v: ValSettings = s.method(val_method::ID).unwrap();
+            v.visibility = ValVisibility::Ism;
+            v.ism.point_size = point_size;
+            v.ism.front_face_culling = ffc;
+            v.ism.bias = bias;
+            s.set_method(val_method::ID, &v).unwrap();
+        });
+        st.frame();
+        let vals = read_vals(&st);
+        let (it, _) = vals_of(&st).ism().unwrap();
+        let cur: ValSettings = st.r.settings().method(val_method::ID).unwrap();
+        let layout = IsmLayout {
+            atlas: cur.ism.atlas,
+            tile: cur.ism.tile,
+        };
+        let atlas: Vec<f32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &it.depth).unwrap());
+        let (mut simple_disk, mut pcss_disk) = (0.0f64, 0.0f64);
+        let (mut pairs, mut agree, mut ray_lit, mut pcss_err) = (0usize, 0usize, 0usize, 0.0f64);
+        for k in 0..(W * H) as usize {
+            let g = pos.pixels[k];
+            if g[3] == 0.0 {
                 continue;
             }
-            pairs += 1;
-            let r = ray(v, p, nx);
-            ray_lit += r as usize;
-            agree +=
-                (ism::visible(layout, &atlas, i as u32, v.position, v.normal, p, vs.ism.bias) == r) as usize;
+            let p = Vec3::new(g[0], g[1], g[2]);
+            let nx = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
+            for (i, v) in vals.iter().enumerate() {
+                if val::term(v, false, eps, p, nx) == Vec3::ZERO {
+                    continue;
+                }
+                pairs += 1;
+                let r = ray(v, p, nx);
+                ray_lit += r as usize;
+                agree +=
+                    (ism::visible(layout, &atlas, i as u32, v.position, v.normal, p, bias) == r) as usize;
+                let q = val::pcss(
+                    layout, &atlas, i as u32, v.position, v.normal, v.area, p, bias, &vs.pcss,
+                );
+                pcss_err += (q.visibility as f64 - r as u32 as f64).abs();
+                // The disk's visible fraction: rays to 16 points of the VAL's disk.
+                let (t, b) = ism::basis(v.normal);
+                let rl = (v.area / std::f32::consts::PI).sqrt();
+                let disk = val::POISSON
+                    .iter()
+                    .filter(|o| {
+                        let c = v.position + (t * o[0] + b * o[1]) * rl;
+                        ray(&val::Val { position: c, ..*v }, p, nx)
+                    })
+                    .count() as f64
+                    / 16.0;
+                let simple =
+                    ism::visible(layout, &atlas, i as u32, v.position, v.normal, p, bias) as u32 as f64;
+                simple_disk += (simple - disk).abs();
+                pcss_disk += (q.visibility as f64 - disk).abs();
+            }
         }
+        let (agree, all_lit) = (agree as f64 / pairs as f64, ray_lit as f64 / pairs as f64);
+        println!(
+            "point size {point_size}, front-face culling {ffc}, bias {bias}: simple lookups agree with \
+             rays on {:.1}% of {pairs} pairs (all lit: {:.1}%), PCSS mean |error| {:.3}; vs the disk's \
+             visible fraction: simple {:.3}, PCSS {:.3}",
+            100.0 * agree,
+            100.0 * all_lit,
+            pcss_err / pairs as f64,
+            simple_disk / pairs as f64,
+            pcss_disk / pairs as f64
+        );
+        assert!(pairs > 1000);
+        results.push((
+            agree,
+            all_lit,
+            simple_disk / pairs as f64,
+            pcss_disk / pairs as f64,
+        ));
     }
-    let (agree, all_lit) = (agree as f64 / pairs as f64, ray_lit as f64 / pairs as f64);
-    println!(
-        "maps agree with rays on {:.1}% of {pairs} pairs (all lit: {:.1}%)",
-        100.0 * agree,
-        100.0 * all_lit
+    // The defaults: the maps see shadows, sized points more than one texel per point, and
+    // PCSS is nearer the VAL disk's visible fraction than the simple lookup.
+    let (agree, all_lit, simple, pcss) = results[0];
+    assert!(agree > all_lit, "the maps see shadows");
+    assert!(
+        agree > results[1].0,
+        "sized points agree more often than one texel per point"
     );
-    assert!(pairs > 1000 && agree > all_lit, "the maps see shadows");
+    assert!(pcss < simple, "PCSS is nearer the disk's visibility");
 }

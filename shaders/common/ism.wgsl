@@ -16,8 +16,11 @@ struct IsmParams {
     per_light: u32,  // 0: point k to map k mod lights; else map m takes per_light points spread over the cloud
     threads: u32,    // splat threads: points, or lights x per_light
     front_cull: u32, // 1: points whose normal faces the light are left out
-    _pad0: u32,
+    point_radius: f32, // a point's world radius (m): its splat covers the texels within it; 0: one texel
 };
+
+// A point's splat reaches at most this many texels from its own (a (2k + 1)^2 square).
+const ISM_MAX_POINT_TEXELS: f32 = 8.0;
 
 const ISM_EMPTY: f32 = 1e30;
 
@@ -47,6 +50,13 @@ fn ism_project(c: vec3<f32>, n: vec3<f32>, p: vec3<f32>) -> vec3<f32> {
     let f = ism_basis(n);
     let q = vec2<f32>(dot(w, f[0]), dot(w, f[1])) / (1.0 + z);
     return vec3<f32>(q * 0.5 + 0.5, dist);
+}
+
+// The atlas index of map m's texel (u, v). Twin: IsmLayout::texel.
+fn ism_index(m: u32, u: u32, v: u32) -> u32 {
+    let mx = m % ism.per_row;
+    let my = m / ism.per_row;
+    return (my * ism.tile + v) * ism.atlas + mx * ism.tile + u;
 }
 
 // The atlas index of map m's texel at map coordinates uv. Twin: IsmLayout::texel(texel_of).

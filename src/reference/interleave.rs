@@ -113,13 +113,44 @@ pub fn filter_pixel(
     surf: &[Option<(Vec3, Vec3)>],
     raw: &[Vec3],
 ) -> Vec3 {
+    let r = radius as i32;
+    filter_pixel_window(
+        x,
+        y,
+        width,
+        height,
+        (-r, r),
+        normal_cos,
+        plane_tolerance,
+        eye,
+        forward,
+        surf,
+        raw,
+    )
+}
+
+/// [`filter_pixel`] over the window of offsets `lo ..= hi` along each axis
+/// (`interleave_filter::window`: the VAL method's p x p window).
+#[allow(clippy::too_many_arguments)]
+pub fn filter_pixel_window(
+    x: u32,
+    y: u32,
+    width: u32,
+    height: u32,
+    (lo, hi): (i32, i32),
+    normal_cos: f32,
+    plane_tolerance: f32,
+    eye: Vec3,
+    forward: Vec3,
+    surf: &[Option<(Vec3, Vec3)>],
+    raw: &[Vec3],
+) -> Vec3 {
     let k = (y * width + x) as usize;
     let Some((p, n)) = surf[k] else { return Vec3::ZERO };
     let tol = plane_tolerance * (p - eye).dot(forward).max(1e-6);
-    let r = radius as i32;
     let (mut sum, mut w) = (Vec3::ZERO, 0.0f32);
-    for dy in -r..=r {
-        for dx in -r..=r {
+    for dy in lo..=hi {
+        for dx in lo..=hi {
             let (qx, qy) = (x as i32 + dx, y as i32 + dy);
             if qx < 0 || qy < 0 || qx >= width as i32 || qy >= height as i32 {
                 continue;

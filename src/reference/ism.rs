@@ -177,6 +177,25 @@ pub fn splat_culled(
     normals: Option<&[Vec3]>,
     per_light: u32,
 ) -> Vec<f32> {
+    splat_sized(layout, lights, points, normals, per_light, 0.0)
+}
+
+/// A splat reaches at most this many texels from a point's own. Twin: `ISM_MAX_POINT_TEXELS`.
+pub const MAX_POINT_TEXELS: f32 = 8.0;
+
+/// [`splat_culled`] with points of world radius `point_radius` (the VAL paper's point
+/// sprites, sized by distance): a point at distance d, at cosine z to the light's normal,
+/// covers r = point_radius / d x 0.5 / (1 + z) x tile texels, the (2k + 1)^2 square of
+/// k = floor(min(r, MAX_POINT_TEXELS)) around its own texel (inside the map); 0: one texel.
+/// Twin: `splat_main` in `ism.wgsl`.
+pub fn splat_sized(
+    layout: IsmLayout,
+    lights: &[IsmLight],
+    points: &[Vec3],
+    normals: Option<&[Vec3]>,
+    per_light: u32,
+    point_radius: f32,
+) -> Vec<f32> {
     let mut atlas = vec![EMPTY; (layout.atlas * layout.atlas) as usize];
     let n = (lights.len() as u32).min(layout.capacity());
     if points.is_empty() {
@@ -194,8 +213,24 @@ pub fn splat_culled(
             }
             if let Some((uv, dist)) = project(l.position, l.normal, p) {
                 let (u, v) = texel_of(uv, layout.tile);
-                let i = layout.texel(m, u, v);
-                atlas[i] = atlas[i].min(dist);
+                let k = if point_radius > 0.0 {
+                    let z = ((p - l.position) / dist).dot(l.normal);
+                    let r = point_radius / dist * 0.5 / (1.0 + z) * layout.tile as f32;
+                    r.min(MAX_POINT_TEXELS) as i32
+                } else {
+                    0
+                };
+                let t = layout.tile as i32;
+                for dv in -k..=k {
+                    for du in -k..=k {
+                        let (uu, vv) = (u as i32 + du, v as i32 + dv);
+                        if uu < 0 || vv < 0 || uu >= t || vv >= t {
+                            continue;
+                        }
+                        let i = layout.texel(m, uu as u32, vv as u32);
+                        atlas[i] = atlas[i].min(dist);
+                    }
+                }
             }
         }
     }
@@ -270,6 +305,24 @@ pub fn visible(layout: IsmLayout, atlas: &[f32], m: u32, c: Vec3, n: Vec3, x: Ve
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_sized_point_covers_the_texels_within_its_radius() {
+        let layout = IsmLayout { atlas: 64, tile: 64 };
+        let light = IsmLight::new(Vec3::ZERO, Vec3::Z);
+        // On the axis at 2 m: 0.25 uv per radian; radius 0.1 m = 0.05 rad = 0.8 texels (one
+        // texel), 0.4 m = 3.2 texels (7 x 7), 10 m capped at 8 texels (17 x 17).
+        for (radius, k) in [(0.0, 0), (0.1, 0), (0.4, 3), (10.0, 8)] {
+            let a = splat_sized(layout, &[light], &[Vec3::new(0.0, 0.0, 2.0)], None, 0, radius);
+            let filled = a.iter().filter(|&&d| d < EMPTY).count();
+            assert_eq!(filled, ((2 * k + 1) * (2 * k + 1)) as usize, "radius {radius}");
+            assert!(a.iter().all(|&d| d == EMPTY || d == 2.0));
+        }
+        // Near the map's edge (texel 63 of 64; 1.6 texels: 3 x 3) the square is cut off.
+        let p = Vec3::new(2.0, 0.0, 0.01);
+        let a = splat_sized(layout, &[light], &[p], None, 0, 0.1);
+        assert_eq!(a.iter().filter(|&&d| d < EMPTY).count(), 6);
+    }
 
     #[test]
     fn the_projection_covers_the_hemisphere_and_the_frame_is_orthonormal() {

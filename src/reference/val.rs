@@ -53,6 +53,9 @@ pub struct Rsm {
     pub light_dir: Vec3,
     /// World -> the light's clip space (orthographic; the RSM's raster).
     pub view_proj: Mat4,
+    /// Per texel its surface area (m^2) where known (a [`downsample`]d RSM: the sum over its
+    /// lit texels); empty: computed from `texel_area` and the normal.
+    pub areas: Vec<f32>,
 }
 
 impl Rsm {
@@ -67,6 +70,9 @@ impl Rsm {
     /// The surface area a texel covers: its area perpendicular to the light over the cosine
     /// between the surface and the light (at least 0.05, grazing texels bounded).
     pub fn surface_area(&self, i: usize) -> f32 {
+        if let Some(&a) = self.areas.get(i) {
+            return a;
+        }
         let c = self.texels[i].normal.dot(-self.light_dir).max(0.05);
         self.texel_area / c
     }
@@ -87,6 +93,58 @@ impl Rsm {
             .filter(|&i| self.lit(i))
             .map(|i| self.texels[i].flux)
             .sum()
+    }
+}
+
+/// The RSM the clustering runs on: `rsm` summed down to `res`^2 (a power-of-two fraction of
+/// its resolution; at least its resolution: a copy). A coarse texel holds its block's lit
+/// texels (geometry with flux): their summed flux, mean position, normalised summed normal and
+/// summed surface area; it is lit when any of them is. Flux and area are kept exactly.
+/// (The paper clusters a low-resolution RSM without saying which; clustering at full
+/// resolution sends most texels through the fallback, which costs clusters x texels.)
+/// Twin: `val_downsample.wgsl`.
+pub fn downsample(rsm: &Rsm, res: u32) -> Rsm {
+    let res = res.clamp(1, rsm.res);
+    let f = rsm.res / res;
+    let mut texels = vec![RsmTexel::default(); (res * res) as usize];
+    let mut areas = vec![0.0f32; (res * res) as usize];
+    for y in 0..res {
+        for x in 0..res {
+            let (mut n, mut pos, mut nrm, mut flux, mut area) =
+                (0u32, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, 0.0f32);
+            for dy in 0..f {
+                for dx in 0..f {
+                    let i = ((y * f + dy) * rsm.res + x * f + dx) as usize;
+                    if !rsm.lit(i) {
+                        continue;
+                    }
+                    let t = &rsm.texels[i];
+                    n += 1;
+                    pos += t.position;
+                    nrm += t.normal;
+                    flux += t.flux;
+                    area += rsm.surface_area(i);
+                }
+            }
+            let k = (y * res + x) as usize;
+            if n > 0 {
+                texels[k] = RsmTexel {
+                    position: pos / n as f32,
+                    normal: nrm.normalize_or(Vec3::Z),
+                    flux,
+                    valid: true,
+                };
+                areas[k] = area;
+            }
+        }
+    }
+    Rsm {
+        res,
+        texels,
+        texel_area: rsm.texel_area * (f * f) as f32,
+        light_dir: rsm.light_dir,
+        view_proj: rsm.view_proj,
+        areas,
     }
 }
 
@@ -326,13 +384,15 @@ pub fn disk_irradiance(flux: f32, c: Vec3, nc: Vec3, area: f32, x: Vec3, nx: Vec
     flux * cx * cc / (std::f32::consts::PI * d2 + area)
 }
 
-/// The seed texel (packed x | y << 16) of each of `clusters` clusters from the frame's VPL ids
-/// (`layer << 24 | texel index` of a `res`^2 RSM, `NONE` for an empty VPL): cluster j starts
+/// The seed texel (packed x | y << 16, in the clustering RSM `factor` times coarser) of each
+/// of `clusters` clusters from the frame's VPL ids (`layer << 24 | texel index` of a `res`^2
+/// RSM, `NONE` for an empty VPL): cluster j starts
 /// at VPL j x count / clusters and takes the first VPL of `layer` from there (wrapping); 0
 /// when there is none (that cluster ends empty). The VPLs are importance-sampled RSM texels
 /// (thesis 4.1's BRSM warping of a Hammersley set), our form of the paper's "Halton sequence
 /// warped by an importance map". Twin: `seeds_main` in `methods/val/val_shade.wgsl`.
-pub fn seeds_from_vpls(ids: &[u32], clusters: u32, layer: u32, res: u32) -> Vec<u32> {
+pub fn seeds_from_vpls(ids: &[u32], clusters: u32, layer: u32, res: u32, factor: u32) -> Vec<u32> {
+    let f = factor.max(1);
     let count = ids.len() as u64;
     (0..clusters as u64)
         .map(|j| {
@@ -345,7 +405,7 @@ pub fn seeds_from_vpls(ids: &[u32], clusters: u32, layer: u32, res: u32) -> Vec<
                 .find(|&id| id != NONE && id >> 24 == layer)
                 .map_or(0, |id| {
                     let i = id & 0x00ff_ffff;
-                    (i % res) | (i / res) << 16
+                    ((i % res) / f) | ((i / res) / f) << 16
                 })
         })
         .collect()
@@ -556,7 +616,50 @@ mod tests {
             texel_area: 0.01,
             light_dir: -Vec3::Y,
             view_proj,
+            areas: Vec::new(),
         }
+    }
+
+    #[test]
+    fn downsampling_keeps_flux_area_and_the_clusters_texels() {
+        let fine = floor(64);
+        for res in [64, 32, 16, 8] {
+            let c = downsample(&fine, res);
+            let f = 64 / res;
+            assert_eq!((c.res, c.texels.len()), (res, (res * res) as usize));
+            let total = fine.total_flux();
+            assert!((c.total_flux() - total).abs().max_element() < 1e-4 * total.max_element());
+            let area = |r: &Rsm| {
+                (0..r.texels.len())
+                    .filter(|&i| r.lit(i))
+                    .map(|i| r.surface_area(i))
+                    .sum::<f32>()
+            };
+            assert!((area(&c) - area(&fine)).abs() < 1e-3 * area(&fine), "{res}");
+            // A block of one quadrant keeps its normal and its texels' mean position.
+            let t = c.texel(UVec2::new(res - 1, 0));
+            assert!((t.normal - Vec3::new(-1.5, 1.0, 0.0).normalize()).length() < 1e-5);
+            let want: Vec3 = (0..f * f)
+                .map(|k| fine.texel(UVec2::new((res - 1) * f + k % f, k / f)).position)
+                .sum::<Vec3>()
+                / (f * f) as f32;
+            assert!((t.position - want).length() < 1e-4);
+            // The world-to-texel raster is the same: a coarse texel's mean position maps into it.
+            assert_eq!(c.texel_of(t.position), Some(UVec2::new(res - 1, 0)));
+        }
+        // Clustering the coarse map partitions its texels and keeps the flux.
+        let c = downsample(&fine, 16);
+        let seeds: Vec<UVec2> = (0..8).map(|k| UVec2::new(2 * k, 2 * k)).collect();
+        let p = ClusterParams {
+            splat: 8,
+            weights: MetricWeights::default(),
+        };
+        let (vals, assignment) = cluster(&c, &p, &seeds, 3);
+        let lit = (0..c.texels.len()).filter(|&i| c.lit(i)).count();
+        assert_eq!(assignment.iter().filter(|&&a| a != NONE).count(), lit);
+        let flux: Vec3 = vals.iter().filter(|v| v.pixels > 0).map(|v| v.flux).sum();
+        let total = fine.total_flux();
+        assert!((flux - total).abs().max_element() < 1e-4 * total.max_element());
     }
 
     #[test]

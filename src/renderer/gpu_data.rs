@@ -634,7 +634,7 @@ mod tests {
                         offset_of!(P, per_light),
                         offset_of!(P, threads),
                         offset_of!(P, front_cull),
-                        offset_of!(P, _pad),
+                        offset_of!(P, point_radius),
                     ]
                 },
             ),
@@ -656,6 +656,94 @@ mod tests {
                         offset_of!(P, w_n),
                         offset_of!(P, w_f),
                         offset_of!(P, extent),
+                        offset_of!(P, area_mode),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                        offset_of!(P, _pad) + 8,
+                    ]
+                },
+            ),
+            (
+                "methods/val/val_shade.wgsl",
+                "ValShadeParams",
+                size_of::<crate::methods::val::pass::GpuValShadeParams>(),
+                {
+                    use crate::methods::val::pass::GpuValShadeParams as P;
+                    vec![
+                        offset_of!(P, width),
+                        offset_of!(P, height),
+                        offset_of!(P, n),
+                        offset_of!(P, offset),
+                        offset_of!(P, clusters),
+                        offset_of!(P, as_point),
+                        offset_of!(P, visibility),
+                        offset_of!(P, count),
+                        offset_of!(P, eps),
+                        offset_of!(P, ray_offset),
+                        offset_of!(P, blocker_samples),
+                        offset_of!(P, pcf_samples),
+                        offset_of!(P, max_radius),
+                        offset_of!(P, res),
+                        offset_of!(P, layer),
+                        offset_of!(P, inspect),
+                        offset_of!(P, factor),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                        offset_of!(P, _pad) + 8,
+                    ]
+                },
+            ),
+            (
+                "methods/val/val_shade.wgsl",
+                "Val",
+                size_of::<crate::renderer::passes::val_cluster::GpuVal>(),
+                {
+                    use crate::renderer::passes::val_cluster::GpuVal as P;
+                    vec![
+                        offset_of!(P, position),
+                        offset_of!(P, area),
+                        offset_of!(P, normal),
+                        offset_of!(P, pixels),
+                        offset_of!(P, flux),
+                        offset_of!(P, texel),
+                    ]
+                },
+            ),
+            (
+                "methods/val/val_views.wgsl",
+                "ValViewParams",
+                size_of::<crate::methods::val::pass::GpuValViewParams>(),
+                {
+                    use crate::methods::val::pass::GpuValViewParams as P;
+                    vec![
+                        offset_of!(P, mode),
+                        offset_of!(P, clusters),
+                        offset_of!(P, exposure),
+                        offset_of!(P, tonemap),
+                        offset_of!(P, lo),
+                        offset_of!(P, hi),
+                        offset_of!(P, inspect),
+                        offset_of!(P, gap),
+                        offset_of!(P, ray_offset),
+                        offset_of!(P, res),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                    ]
+                },
+            ),
+            (
+                "methods/val/val_downsample.wgsl",
+                "DownParams",
+                size_of::<crate::methods::val::pass::GpuDownParams>(),
+                {
+                    use crate::methods::val::pass::GpuDownParams as P;
+                    vec![
+                        offset_of!(P, res),
+                        offset_of!(P, factor),
+                        offset_of!(P, layer),
+                        offset_of!(P, _pad),
+                        offset_of!(P, light_dir),
+                        offset_of!(P, texel_area),
                     ]
                 },
             ),
@@ -708,6 +796,10 @@ mod tests {
                         offset_of!(P, plane_tolerance),
                         offset_of!(P, scale),
                         offset_of!(P, modulate),
+                        offset_of!(P, period),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                        offset_of!(P, _pad) + 8,
                     ]
                 },
             ),

@@ -19,6 +19,10 @@ struct ValShadeParams {
     res: u32,            // RSM resolution (seeds)
     layer: u32,          // the RSM layer clustered (light 0)
     inspect: u32,        // the VAL of the "ISM vs true map" view
+    factor: u32,         // RSM texels per clustering texel edge (seeds)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 // Twin: `Val` in val_cluster.wgsl (reference::val::Val).

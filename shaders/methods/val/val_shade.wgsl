@@ -1,7 +1,8 @@
 // The VAL method's per-frame kernels around the shared clustering (`val_cluster.wgsl`) and
 // maps (`ism.wgsl`):
-//   seeds_main:  per cluster its seed texel from the frame's VPLs (cluster j starts at VPL
-//                j x count / clusters and takes the first VPL of the clustered layer);
+//   seeds_main:  per cluster its seed texel (in the clustering RSM, `factor` times coarser)
+//                from the frame's VPLs (cluster j starts at VPL j x count / clusters and takes
+//                the first VPL of the clustered layer);
 //   lights_main: per VAL its map's light (centre, normal; an empty VAL splats nothing);
 //   shade_main:  per pixel the VALs of its interleaving subset (section 6), each with eq. 2
 //                (or as a point light) and its visibility: none, a BVH ray to the centre, a
@@ -51,7 +52,8 @@ fn seeds_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let id = vpls[(start + t) % count].id;
         if id != VPL_NONE && (id >> 24u) == params.layer {
             let i = id & 0x00ffffffu;
-            seeds[j] = (i % params.res) | ((i / params.res) << 16u);
+            let f = max(params.factor, 1u);
+            seeds[j] = ((i % params.res) / f) | (((i / params.res) / f) << 16u);
             return;
         }
     }

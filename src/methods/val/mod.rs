@@ -36,8 +36,8 @@ use crate::renderer::{
     shaders::ShaderError,
 };
 use pass::{
-    GpuValShadeParams, GpuValViewParams, VIS_ISM, VIS_NONE, VIS_PCSS, VIS_RAYS, ValBuffers, ValFrame, ValIsm,
-    ValPass,
+    GpuDownParams, GpuValShadeParams, GpuValViewParams, VIS_ISM, VIS_NONE, VIS_PCSS, VIS_RAYS, ValBuffers,
+    ValFrame, ValIsm, ValPass, ValRsm,
 };
 use settings::{ValSettings, ValVisibility};
 
@@ -62,8 +62,13 @@ pub static MODULE: Module = Module {
         shader!("val_common.wgsl"),
         shader!("val_shade.wgsl"),
         shader!("val_views.wgsl"),
+        shader!("val_downsample.wgsl"),
     ],
-    entry_shaders: &["methods/val/val_shade.wgsl", "methods/val/val_views.wgsl"],
+    entry_shaders: &[
+        "methods/val/val_shade.wgsl",
+        "methods/val/val_views.wgsl",
+        "methods/val/val_downsample.wgsl",
+    ],
 };
 
 /// The clusters over light 0's RSM.
@@ -125,6 +130,7 @@ const VIEWS: &[ViewInfo] = &[
 ];
 
 const TIMED: &[&str] = &[
+    "val_downsample",
     "val_seeds",
     "val_cluster",
     "val_ism_lights",
@@ -272,6 +278,8 @@ impl ValStats {
 pub struct Vals {
     pass: ValPass,
     buffers: ValBuffers,
+    /// The clustering RSM.
+    coarse: Option<ValRsm>,
     targets: Option<ValTargets>,
     stats: Option<CounterReadback<ValStats>>,
     /// Accumulation: (key, method, frames summed).
@@ -294,6 +302,7 @@ fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
     Ok(Box::new(Vals {
         pass: ValPass::new(device)?,
         buffers: ValBuffers::new(device, (1, 1)),
+        coarse: None,
         targets: None,
         stats: None,
         state: None,
@@ -312,6 +321,10 @@ impl Vals {
     /// The clusters of the last frame (None before one ran).
     pub fn targets(&self) -> Option<&ValTargets> {
         self.targets.as_ref().filter(|_| self.state.is_some())
+    }
+    /// The clustering RSM of the last frame (None before one ran).
+    pub fn clustering_rsm(&self) -> Option<&ValRsm> {
+        self.coarse.as_ref().filter(|_| self.state.is_some())
     }
     /// The per-pixel buffers (raw estimate, diagnostics).
     pub fn buffers(&self) -> &ValBuffers {
@@ -428,12 +441,14 @@ impl Method for Vals {
         if self.buffers.size != cx.size {
             self.buffers = ValBuffers::new(cx.device, cx.size);
         }
-        if !self
-            .targets
-            .as_ref()
-            .is_some_and(|t| t.matches(vs.clusters, rsm.res))
-        {
-            let t = ValTargets::new(cx.device, vs.clusters, rsm.res);
+        // The clustering RSM: light 0's summed down by `factor`.
+        let res = vs.resolution.min(rsm.res).max(1);
+        let factor = (rsm.res / res).max(1);
+        if self.coarse.as_ref().is_none_or(|c| c.res != res) {
+            self.coarse = Some(ValRsm::new(cx.device, res));
+        }
+        if !self.targets.as_ref().is_some_and(|t| t.matches(vs.clusters, res)) {
+            let t = ValTargets::new(cx.device, vs.clusters, res);
             self.stats = Some(CounterReadback::new(
                 cx.device,
                 "val::stats_readback",
@@ -479,22 +494,41 @@ impl Method for Vals {
             res: rsm.res,
             layer: 0,
             inspect: vs.inspect.min(vs.clusters - 1),
+            factor,
+            _pad: [0; 3],
         };
-        let cp = GpuValParams::new(
-            rsm.view_proj,
-            rsm.direction,
-            rsm.texel,
-            rsm.res,
-            0,
-            &vs.cluster_params(),
-        );
+        let cp = GpuValParams {
+            area_mode: 1,
+            ..GpuValParams::new(
+                rsm.view_proj,
+                rsm.direction,
+                rsm.texel * factor as f32,
+                res,
+                0,
+                &vs.cluster_params(),
+            )
+        };
+        let down = GpuDownParams {
+            res,
+            factor,
+            layer: 0,
+            _pad: 0,
+            light_dir: rsm.direction.to_array(),
+            texel_area: rsm.texel * rsm.texel,
+        };
         let fp = GpuFilterParams {
             accumulate: (frames > 1) as u32,
             scale: std::f32::consts::FRAC_1_PI,
+            period: if vs.paper_filter { n } else { 0 },
             ..GpuFilterParams::new(cx.size, &vs.interleave)
         };
         let shadow = &cx.targets.shadow;
+        let Some(coarse) = self.coarse.as_ref() else {
+            return 0.0;
+        };
         let f = ValFrame {
+            coarse,
+            down,
             scene: cx.scene,
             gbuffer: &cx.targets.gbuffer,
             camera: cx.camera,

@@ -1,5 +1,6 @@
-//! The VAL method's GPU passes, in frame order: `val_seeds` (per cluster its seed texel from
-//! the frame's VPLs), `val_cluster` (the shared `passes::val_cluster`: k steps of section 4's
+//! The VAL method's GPU passes, in frame order: `val_downsample` (light 0's RSM summed down to
+//! the clustering resolution), `val_seeds` (per cluster its seed texel from the frame's VPLs),
+//! `val_cluster` (the shared `passes::val_cluster`: k steps of section 4's
 //! clustering of light 0's RSM), `val_ism_lights` and `val_ism` (with map visibility, or while
 //! a map view is shown: each VAL's imperfect shadow map, the shared `passes::ism`),
 //! `val_shade` (per pixel its interleaving subset's VALs, eq. 2, visibility; demodulated) and
@@ -14,7 +15,8 @@ use super::settings::{IsmSettings, IsmVal};
 use crate::renderer::{
     frame::GbufferTargets,
     passes::{
-        WG_1D, bind_group_seq, compute_pipeline_with, float_texture_entry, groups_image,
+        WG_1D, bind_group_seq, compute_pipeline_with, float_array_texture_entry, float_texture_entry,
+        groups_image,
         interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
         ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
         run_compute, storage_buffer, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
@@ -48,6 +50,75 @@ pub struct GpuValShadeParams {
     pub res: u32,
     pub layer: u32,
     pub inspect: u32,
+    /// RSM texels per clustering texel edge.
+    pub factor: u32,
+    pub _pad: [u32; 3],
+}
+
+/// Twin: `DownParams` in `val_downsample.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuDownParams {
+    pub res: u32,
+    pub factor: u32,
+    pub layer: u32,
+    pub _pad: u32,
+    pub light_dir: [f32; 3],
+    /// A fine texel's area perpendicular to the light (m^2).
+    pub texel_area: f32,
+}
+
+/// The clustering RSM (light 0's summed down, `reference::val::downsample`): position,
+/// normal, flux (+ surface area in alpha), Rgba32Float.
+pub struct ValRsm {
+    pub res: u32,
+    pub textures: [wgpu::Texture; 3],
+    /// One-layer array views (the clustering reads them).
+    pub arrays: [wgpu::TextureView; 3],
+    /// Storage views (the downsample writes them).
+    storage: [wgpu::TextureView; 3],
+}
+
+impl ValRsm {
+    pub fn new(device: &wgpu::Device, res: u32) -> Self {
+        let res = res.max(1);
+        let tex = |label| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: res,
+                    height: res,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Float,
+                usage: wgpu::TextureUsages::STORAGE_BINDING
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        };
+        let textures = [
+            tex("val::rsm_position"),
+            tex("val::rsm_normal"),
+            tex("val::rsm_flux"),
+        ];
+        let arrays = textures.each_ref().map(|t| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        });
+        let storage = textures.each_ref().map(|t| t.create_view(&Default::default()));
+        Self {
+            res,
+            textures,
+            arrays,
+            storage,
+        }
+    }
 }
 
 /// `GpuValShadeParams::visibility` values.
@@ -102,6 +173,9 @@ pub struct ValFrame<'a> {
     pub accum: &'a wgpu::Buffer,
     /// Light 0's RSM: position, normal and flux array views.
     pub rsm: [&'a wgpu::TextureView; 3],
+    /// The clustering RSM they are summed down into.
+    pub coarse: &'a ValRsm,
+    pub down: GpuDownParams,
 }
 
 /// The VALs' maps to build this frame.
@@ -113,6 +187,9 @@ pub struct ValIsm<'a> {
 
 pub struct ValPass {
     params: wgpu::Buffer,
+    down_params: wgpu::Buffer,
+    down_layout: wgpu::BindGroupLayout,
+    down: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     seeds: wgpu::ComputePipeline,
     lights: wgpu::ComputePipeline,
@@ -136,6 +213,7 @@ impl ValPass {
         let c = wgpu::ShaderStages::COMPUTE;
         let smod = shaders::create_module(device, "methods/val/val_shade.wgsl")?;
         let vmod = shaders::create_module(device, "methods/val/val_views.wgsl")?;
+        let dmod = shaders::create_module(device, "methods/val/val_downsample.wgsl")?;
         let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some(label),
@@ -151,6 +229,19 @@ impl ValPass {
         se.extend((7..=10).map(|b| storage_entry(b, c, false)));
         se.extend([uniform_entry(11, c), storage_entry(12, c, true)]);
         let shade_layout = layout("val_shade::layout", &se);
+        let rgba32 = wgpu::TextureFormat::Rgba32Float;
+        let down_layout = layout(
+            "val_downsample::layout",
+            &[
+                uniform_entry(0, c),
+                float_array_texture_entry(1),
+                float_array_texture_entry(2),
+                float_array_texture_entry(3),
+                storage_texture_entry(4, rgba32),
+                storage_texture_entry(5, rgba32),
+                storage_texture_entry(6, rgba32),
+            ],
+        );
         let views_layout = layout(
             "val_views::layout",
             &[
@@ -177,6 +268,9 @@ impl ValPass {
         let timed = &[("DIAGNOSTICS", 0.0)];
         Ok(Self {
             params: uniform_buffer::<GpuValShadeParams>(device, "val::params"),
+            down_params: uniform_buffer::<GpuDownParams>(device, "val::down_params"),
+            down: pipe("val_downsample", &down_layout, &dmod, "main", &[]),
+            down_layout,
             seeds: pipe("val_seeds", &shade_layout, &smod, "seeds_main", &[]),
             lights: pipe("val_ism_lights", &shade_layout, &smod, "lights_main", &[]),
             shade: pipe("val_shade", &shade_layout, &smod, "shade_main", &[]),
@@ -258,6 +352,30 @@ impl ValPass {
             )
         };
         let per_cluster = (p.clusters.div_ceil(WG_1D), 1, 1);
+        // The clustering RSM.
+        queue.write_buffer(&self.down_params, 0, bytemuck::bytes_of(&f.down));
+        let down = bind_group_seq(
+            device,
+            "val_downsample::bind_group",
+            &self.down_layout,
+            &[
+                self.down_params.as_entire_binding(),
+                tv(f.rsm[0]),
+                tv(f.rsm[1]),
+                tv(f.rsm[2]),
+                tv(&f.coarse.storage[0]),
+                tv(&f.coarse.storage[1]),
+                tv(&f.coarse.storage[2]),
+            ],
+        );
+        run_compute(
+            encoder,
+            timer,
+            "val_downsample",
+            &self.down,
+            &down,
+            groups_image(f.coarse.res, f.coarse.res),
+        );
         // The seeds (the VALs bound are not read).
         let before = bind(t.vals(), &t.seeds);
         run_compute(encoder, timer, "val_seeds", &self.seeds, &before, per_cluster);
@@ -267,7 +385,7 @@ impl ValPass {
             encoder,
             timer,
             "val_cluster",
-            f.rsm,
+            [&f.coarse.arrays[0], &f.coarse.arrays[1], &f.coarse.arrays[2]],
             cp,
             ValSeeds::Written(p.clusters),
             iterations,

@@ -42,7 +42,11 @@ pub struct ValSettings {
     /// VALs (clusters) per frame, seeded at this many of the frame's VPLs (spread over them;
     /// the paper: 64 with PCSS, 512 with simple lookups; up to 1024, one map each).
     pub clusters: u32,
-    /// Edge of a cluster's splat window in RSM texels (the paper: 32 - 128 pixel splats).
+    /// Edge of the RSM the clustering runs on: light 0's RSM summed down to it (at most the
+    /// RSM's; `reference::val::downsample`). The paper clusters a low-resolution RSM without
+    /// naming its size.
+    pub resolution: u32,
+    /// Edge of a cluster's splat window in clustering-RSM texels (the paper: 32 - 128 pixel splats).
     pub splat: u32,
     /// k-means steps per frame (the paper runs one per frame and carries the clusters over).
     pub iterations: u32,
@@ -52,6 +56,11 @@ pub struct ValSettings {
     /// The PCSS lookup's samples and its largest filter radius.
     pub pcss: Pcss,
     pub interleave: InterleaveSettings<Interleave4>,
+    /// The geometry-aware filter's window: the paper's n x n (one pixel of each interleaving
+    /// subset, equal weights: section 6's "filter of size n x m"); off: the shared (2r + 1)^2
+    /// window of `interleave.filter_radius`, whose odd edge weights the subsets unevenly and
+    /// leaves an n-periodic pattern.
+    pub paper_filter: bool,
     /// The VALs' imperfect shadow maps (the paper's 128^2 maps in a 4096^2 atlas, the cloud
     /// shared round-robin, 2 pull-push iterations).
     pub ism: IsmSettings<IsmVal>,
@@ -63,12 +72,14 @@ impl Default for ValSettings {
     fn default() -> Self {
         Self {
             clusters: 64,
+            resolution: 128,
             splat: 32,
             iterations: 4,
             weights: MetricWeights::default(),
             visibility: ValVisibility::Pcss,
             pcss: Pcss::default(),
             interleave: InterleaveSettings::pattern(4),
+            paper_filter: true,
             ism: IsmSettings::default(),
             inspect: 0,
         }
@@ -92,6 +103,13 @@ impl ValSettings {
                 "clusters",
                 self.clusters.to_string(),
                 &format!("1..={MAX_CLUSTERS}"),
+            );
+        }
+        if !(self.resolution.is_power_of_two() && (8..=1024).contains(&self.resolution)) {
+            return f(
+                "resolution",
+                self.resolution.to_string(),
+                "a power of two in 8..=1024",
             );
         }
         if !(1..=MAX_SPLAT).contains(&self.splat) {

@@ -23,6 +23,14 @@ pub fn settings_ui(ui: &mut egui::Ui, _method: MethodId, s: &mut RenderSettings)
             .text("VALs"),
     )
     .on_hover_text("clusters of the RSM, one map each (paper: 64 with PCSS, 512 with simple lookups)");
+    let mut res_log = vs.resolution.clamp(8, 1024).ilog2();
+    if ui
+        .add(egui::Slider::new(&mut res_log, 3..=10).text("clustering RSM (log2)"))
+        .on_hover_text("the RSM is summed down to 2^k texels a side before clustering (flux and area kept)")
+        .changed()
+    {
+        vs.resolution = 1 << res_log;
+    }
     ui.add(
         egui::Slider::new(&mut vs.splat, 1..=MAX_SPLAT)
             .logarithmic(true)
@@ -61,6 +69,11 @@ pub fn settings_ui(ui: &mut egui::Ui, _method: MethodId, s: &mut RenderSettings)
         "VALs",
         "paper n x m, not given",
     );
+    ui.checkbox(&mut vs.paper_filter, "the paper's n x n filter window")
+        .on_hover_text(
+            "one pixel of each subset (section 6); off: the (2r + 1)^2 window of the filter radius, \
+             which weights the subsets unevenly (an n-periodic pattern)",
+        );
     ui.add_enabled_ui(s.gi.shadow_rays, |ui| {
         ui.horizontal(|ui| {
             ui.label("visibility");

@@ -32,6 +32,10 @@ pub struct GpuFilterParams {
     pub scale: f32,
     /// 1: times the pixel's albedo (0: the output stays demodulated).
     pub modulate: u32,
+    /// 0: the (2 radius + 1)^2 window; p > 0: the p x p window from -p/2 to p - p/2 - 1,
+    /// one pixel of each subset of a p x p pattern (the VAL paper's "filter of size n x m").
+    pub period: u32,
+    pub _pad: [u32; 3],
 }
 
 impl GpuFilterParams {
@@ -46,7 +50,24 @@ impl GpuFilterParams {
             plane_tolerance: il.filter_plane_tolerance,
             scale: 1.0,
             modulate: 1,
+            period: 0,
+            _pad: [0; 3],
         }
+    }
+    /// The window's offsets along each axis, from `lo` to `hi` inclusive. Twin: the shader's.
+    pub fn window(&self) -> (i32, i32) {
+        window(self.radius, self.period)
+    }
+}
+
+/// The filter window's offsets (lo, hi) along each axis: -r ..= r, or with a period p
+/// -p/2 ..= p - p/2 - 1. Twin: `window` in `interleave_filter.wgsl`.
+pub fn window(radius: u32, period: u32) -> (i32, i32) {
+    if period > 0 {
+        let p = period as i32;
+        (-(p / 2), p - p / 2 - 1)
+    } else {
+        (-(radius as i32), radius as i32)
     }
 }
 

@@ -41,7 +41,8 @@ pub struct GpuIsmParams {
     pub threads: u32,
     /// 1: front-face culling (points facing the light left out).
     pub front_cull: u32,
-    pub _pad: u32,
+    /// A point's world radius (m; 0: one texel per point), `IsmSettings::point_radius`.
+    pub point_radius: f32,
 }
 
 impl GpuIsmParams {
@@ -64,7 +65,7 @@ impl GpuIsmParams {
                 lights.saturating_mul(s.points_per_light)
             },
             front_cull: s.front_face_culling as u32,
-            _pad: 0,
+            point_radius: 0.0,
         }
     }
 }
@@ -91,6 +92,9 @@ pub struct GpuIsmViewParams {
 pub struct IsmPoints {
     pub buffer: wgpu::Buffer,
     pub count: u32,
+    /// The surface area (m^2) the points were sampled on (0: unknown; sized points then take
+    /// one texel).
+    pub area: f32,
     /// (point count, seed) it was sampled with.
     pub key: (u32, u32),
 }
@@ -118,6 +122,7 @@ impl IsmPoints {
         Self {
             buffer,
             count: points.len() as u32,
+            area: 0.0,
             key,
         }
     }
@@ -133,7 +138,10 @@ impl IsmPoints {
         seed: u32,
         key: (u32, u32),
     ) -> Self {
-        Self::oriented(device, queue, &cloud_of_bvh(bvh, count, seed), key)
+        Self {
+            area: bvh_area(bvh),
+            ..Self::oriented(device, queue, &cloud_of_bvh(bvh, count, seed), key)
+        }
     }
 }
 
@@ -142,6 +150,17 @@ pub fn cloud_of_bvh(bvh: &crate::scene::bvh::Bvh, count: u32, seed: u32) -> Vec<
     let positions: Vec<Vec3> = bvh.triangles.iter().flat_map(|t| t.vertices()).collect();
     let indices: Vec<u32> = (0..positions.len() as u32).collect();
     sample_oriented_points(&positions, &indices, count, seed)
+}
+
+/// The total area (m^2) of a scene BVH's triangles (what [`cloud_of_bvh`] samples).
+pub fn bvh_area(bvh: &crate::scene::bvh::Bvh) -> f32 {
+    bvh.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.vertices();
+            0.5 * (b - a).cross(c - a).length() as f64
+        })
+        .sum::<f64>() as f32
 }
 
 /// The atlas (resolved distances), its splat keys, the pull-push pyramid and the lights.
@@ -290,7 +309,10 @@ impl IsmPass {
         t: &IsmTargets,
     ) {
         let n = n.min(t.capacity);
-        let base = GpuIsmParams::new(t, s, n, points.count);
+        let base = GpuIsmParams {
+            point_radius: s.point_radius(points.area, s.points_per_map(points.count, n)),
+            ..GpuIsmParams::new(t, s, n, points.count)
+        };
         // Uniforms: 0 splat / resolve, then pull levels 1..=L, then push levels L-1..=0.
         let level_base = |l: u32| IsmTargets::pyramid_len(t.layout.tile, n, l.saturating_sub(1)) as u32;
         let mut items = vec![base];

@@ -32,6 +32,10 @@ pub struct GpuValParams {
     pub w_f: f32,
     /// d_p's unit: splat texels x texel edge (`reference::val::extent`).
     pub extent: f32,
+    /// 1: a texel's surface area is its flux's alpha (the method's summed-down RSM,
+    /// `reference::val::downsample`); 0: the texel area over the cosine to the light.
+    pub area_mode: u32,
+    pub _pad: [u32; 3],
 }
 
 impl GpuValParams {
@@ -58,6 +62,8 @@ impl GpuValParams {
             w_n: p.weights.normal,
             w_f: p.weights.flux,
             extent: p.splat as f32 * texel,
+            area_mode: 0,
+            _pad: [0; 3],
         }
     }
 }
