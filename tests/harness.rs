@@ -391,6 +391,8 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         "interpolation.png",
         "images/interpolation_li_interp.png",
         "images/interpolation_li_full_error.png",
+        "images/val_64_pcss.png",
+        "images/val_512_ism_error.png",
     ] {
         decodes(&d.join(p));
     }
@@ -399,7 +401,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     assert_eq!(run["width"], 64);
     // Each figure's wall time and the share of it outside rendering / GPU waits.
     let times = run["scenes"][0]["figure_times"].as_array().unwrap();
-    assert_eq!(times.len(), 9, "{times:?}");
+    assert_eq!(times.len(), 10, "{times:?}");
     for t in times {
         let share = t["share_outside_gpu"].as_f64().unwrap();
         assert!(

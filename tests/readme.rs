@@ -35,6 +35,8 @@ const EXAMPLES: &[&str] = &[
     "-- render --scene default --width 320 --height 240 --method lightcuts --set methods.lightcuts.relative_error=0.02 --compare-gt --out out/lc",
     "-- render --scene default --width 320 --height 240 --method lightcut-interpolation --set methods.lightcut-interpolation.visibility=interpolated --compare-gt --out out/li",
     "-- render --scene default --width 320 --height 240 --method light-culling --visibility none --compare-gt --out out/lcull",
+    "-- render --scene default --width 320 --height 240 --method val --val-visibility pcss --compare-gt --out out/val",
+    "-- results val --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
     "-- results interpolation --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
     "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",
     "-- --view albedo --settings docs/settings-example.toml --tree-stats",
@@ -497,6 +499,38 @@ fn cli_examples_write_what_they_promise() {
         lcull.join("culling_lights_per_tile.png").is_file() && lcull.join("culling_pattern.png").is_file()
     );
     let _ = std::fs::remove_dir_all(&lcull);
+    // Virtual Area Lights with PCSS lookups: its maps built, its views written.
+    let val = tmp("val");
+    run_cli(&args(
+        "-- render --scene default --width 320 --height 240 --method val --val-visibility pcss --compare-gt --out out/val",
+        &[
+            ("--width", "32"),
+            ("--height", "24"),
+            ("--out", val.to_str().unwrap()),
+        ],
+        &["--vpls", "256", "--set", "methods.val.clusters=16"],
+    ));
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(val.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(m["method"], "val");
+    assert_eq!(m["method_stats"]["ism_maps"].as_f64(), Some(16.0), "{m}");
+    assert!(
+        m["method_stats"]["vals_lit"].as_f64().is_some_and(|v| v > 0.0),
+        "{m}"
+    );
+    assert!(
+        m["vs_ground_truth"]["rmse"].as_f64().is_some_and(f64::is_finite),
+        "{m}"
+    );
+    for f in [
+        "val_clusters.png",
+        "val_disks.png",
+        "val_ism_atlas.png",
+        "val_penumbra_width.png",
+    ] {
+        assert!(val.join(f).is_file(), "{f}");
+    }
+    let _ = std::fs::remove_dir_all(&val);
     // The interpolation paper's comparison (the default scene, tiny, here).
     let lr = tmp("li-results");
     run_cli(&args(
@@ -524,6 +558,28 @@ fn cli_examples_write_what_they_promise() {
     for d in [li, lr] {
         let _ = std::fs::remove_dir_all(d);
     }
+    // The VAL paper's Table 1 (the default scene, tiny: its 64 and 512 VALs on a 32 x 24
+    // frame).
+    let vr = tmp("val-results");
+    run_cli(&args(
+        "-- results val --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
+        &[("--scenes", "default"), ("--out", vr.to_str().unwrap())],
+        &[
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--frames",
+            "1",
+            "--timing-frames",
+            "2",
+            "--vpls",
+            "256",
+        ],
+    ));
+    let csv = std::fs::read_to_string(vr.join("default").join("val_table1.csv")).expect("val_table1.csv");
+    assert_eq!(csv.lines().count(), 5, "{csv}");
+    let _ = std::fs::remove_dir_all(&vr);
     // The tree's pairing and Lightcuts' cost per relative error (the default scene here).
     let out = run_cli(&args(
         "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",

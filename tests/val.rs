@@ -725,6 +725,7 @@ fn the_method_converges_to_its_own_sum_and_its_maps_agree_with_rays() {
     let albedo = st.r.read(Buffer::Albedo).unwrap();
     let gpu = st.indirect();
     let (mut lit, mut close, mut err_mean, mut err_one, mut norm) = (0, 0, 0.0f64, 0.0f64, 0.0f64);
+    #[allow(clippy::needless_range_loop)] // k indexes the images and every offset's estimate
     for k in 0..(W * H) as usize {
         let Some(truth) = full(k) else { continue };
         let a = Vec3::from_slice(&albedo.pixels[k][..3]) / std::f32::consts::PI;

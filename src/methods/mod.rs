@@ -476,6 +476,8 @@ pub struct ViewCx<'a> {
     pub tree: &'a TreeBuffers,
     /// The scene (its BVH: views that trace rays).
     pub scene: &'a SceneGpu,
+    /// The frame's camera uniform (`GpuCamera`): views that cast camera rays.
+    pub camera: &'a wgpu::Buffer,
     /// Destination (`Rgba8Unorm` storage view) of the size [`Method::view_size`] gave.
     pub dst: &'a wgpu::TextureView,
     /// Block outlined in the cut views (set by the UI).

@@ -155,6 +155,7 @@ impl Renderer {
             }
             let mut cx = ViewCx {
                 scene: &self.scene,
+                camera: &self.camera_buf,
                 device: &device,
                 queue: &queue,
                 timer: &mut self.timer,

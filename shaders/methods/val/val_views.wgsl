@@ -2,10 +2,10 @@
 //   mode 0, the clusters over the RSM (res^2): each lit texel in its cluster's colour (the last
 //           step's keys), the clusters' centre texels white, texels without flux black;
 //           data (cluster or -1, 1 at a centre, the cluster's pixels, 1);
-//   mode 1, the VALs as disks in the camera view: the grey final, and where the pixel's point
-//           lies on a VAL's disk (radius sqrt(A / pi) around its centre, within a tenth of it of
-//           its plane) that VAL's colour, its rim light; data (VAL or -1, distance from the
-//           centre / radius, 0, 1);
+//   mode 1, the VALs as disks in the camera view: the grey final, and where the pixel's camera
+//           ray meets a VAL's disk (radius sqrt(A / pi) around its centre, in its plane) before
+//           the visible surface, the nearest such disk's colour over it, its rim white; data
+//           (VAL or -1, distance from the centre / radius, distance along the ray, 1);
 //   mode 2, the PCSS penumbra width (eq. 3, metres on the receiver, averaged over the
 //           pixel's lookups that found blockers), log scale lo .. hi; lookups without blockers
 //           dark blue; data: the shading's diagnostics (width, lookups with blockers, VALs
@@ -14,6 +14,7 @@
 //           traced through the BVH from the same point (right), distance on a log scale lo ..
 //           hi, holes / misses black; data (ISM depth, true depth, 0, 1), 0 where empty.
 #include "common/math.wgsl"
+#include "common/camera.wgsl"
 #include "common/color.wgsl"
 #include "common/bvh.wgsl"
 #include "common/ism.wgsl"
@@ -46,6 +47,7 @@ struct ValViewParams {
 @group(0) @binding(9) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(10) var<storage, read> bvh_triangles: array<BvhTriangle>;
 @group(0) @binding(11) var<storage, read_write> data: array<vec4<f32>>;
+@group(0) @binding(12) var<uniform> camera: Camera;
 
 // The direction of map coordinates uv of a paraboloid map around n (the inverse of
 // ism_project); w = 0 outside the hemisphere's disk.
@@ -97,26 +99,40 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         case 1u: {
             let g = textureLoad(gb_position, vec2<i32>(gid.xy), 0);
             out = vec4<f32>(-1.0, 0.0, 0.0, 1.0);
+            let o = camera.position.xyz;
+            let d = normalize(camera_ray_dir(camera, gid.xy));
+            var t_max = 3.0e38;
             if g.w > 0.0 {
                 c = vec3<f32>(display_grey(textureLoad(final_image, vec2<i32>(gid.xy), 0).rgb, vp.exposure, vp.tonemap)) * 0.6;
-                var best = 2.0;
-                for (var i = 0u; i < vp.clusters; i++) {
-                    let v = vals[i];
-                    if v.pixels == 0u {
-                        continue;
-                    }
-                    let r = sqrt(v.area / PI);
-                    let d = g.xyz - v.position;
-                    let h = dot(d, v.normal);
-                    let q = length(d - h * v.normal) / max(r, 1e-6);
-                    if q < 1.0 && abs(h) < 0.1 * r && q < best {
-                        best = q;
-                        c = id_color(i) * select(0.85, 1.0, q > 0.85);
-                        if q > 0.92 {
-                            c = vec3<f32>(1.0);
-                        }
-                        out = vec4<f32>(f32(i), q, 0.0, 1.0);
-                    }
+                // Disks just behind the surface they lie on still show.
+                t_max = dot(g.xyz - o, d) * 1.001 + 1e-3;
+            }
+            var best = t_max;
+            for (var i = 0u; i < vp.clusters; i++) {
+                let v = vals[i];
+                if v.pixels == 0u {
+                    continue;
+                }
+                let den = dot(d, v.normal);
+                if abs(den) < 1e-6 {
+                    continue;
+                }
+                let t = dot(v.position - o, v.normal) / den;
+                if t <= 0.0 || t >= best {
+                    continue;
+                }
+                let r = sqrt(v.area / PI);
+                let q = length(o + t * d - v.position) / max(r, 1e-6);
+                if q < 1.0 {
+                    best = t;
+                    out = vec4<f32>(f32(i), q, t, 1.0);
+                }
+            }
+            if out.x >= 0.0 {
+                let grey = c;
+                c = mix(grey, id_color(u32(out.x)), 0.75);
+                if out.y > 0.93 {
+                    c = vec3<f32>(1.0);
                 }
             }
         }

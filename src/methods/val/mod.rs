@@ -98,8 +98,8 @@ const VIEWS: &[ViewInfo] = &[
         name: DISKS.name(),
         file: "val_disks",
         about: "the VALs as the disks they shade with (radius sqrt(area / pi) at the cluster's \
-                mean position, in its mean normal's plane) over the grey final, in the cluster \
-                colours of the clusters view",
+                mean position, in its mean normal's plane) as the camera sees them in front of \
+                the grey final, in the cluster colours of the clusters view, rims white",
         passes: &["val_cluster"],
     },
     ViewInfo {
@@ -672,6 +672,7 @@ impl Method for Vals {
             &cx.targets.lighting.final_view,
             &cx.targets.gbuffer.position_view,
             cx.scene,
+            cx.camera,
             &self.buffers,
             t,
             ism.map(|it| (it, &self.settings.ism, self.ism_maps)),

@@ -257,6 +257,7 @@ impl ValPass {
                 storage_entry(9, c, true),
                 storage_entry(10, c, true),
                 storage_entry(11, c, false),
+                uniform_entry(12, c),
             ],
         );
         let pipe =
@@ -451,6 +452,7 @@ impl ValPass {
         final_image: &wgpu::TextureView,
         gb_position: &wgpu::TextureView,
         scene: &SceneGpu,
+        camera: &wgpu::Buffer,
         b: &ValBuffers,
         t: &ValTargets,
         ism: Option<(&IsmTargets, &IsmSettings<IsmVal>, u32)>,
@@ -484,6 +486,7 @@ impl ValPass {
                 scene.bvh_nodes.as_entire_binding(),
                 scene.bvh_triangles.as_entire_binding(),
                 data.as_entire_binding(),
+                camera.as_entire_binding(),
             ],
         );
         run_compute(

@@ -132,7 +132,7 @@ impl ValSettings {
                 return f(name, v.to_string(), "0..=1");
             }
         }
-        if !(w.position + w.normal + w.flux > 0.0) {
+        if w.position + w.normal + w.flux <= 0.0 {
             return Err("methods.val.weights: at least one of position, normal, flux must be > 0".into());
         }
         let n = POISSON.len() as u32;
