@@ -315,16 +315,23 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "ism_ms",
             "gi_gpu_ms",
             "rmse_vs_ground_truth",
-            "rmse_vs_exact_visibility",
         ],
-        8,
+        10,
     );
     let (_, rows) = read_csv(&d.join("val.csv"));
+    assert_eq!(rows.iter().filter(|r| r["clusters_carried"] == "true").count(), 2);
     for r in &rows {
         let ism: f64 = r["ism_ms"].parse().unwrap();
-        assert_eq!(ism > 0.0, r["visibility"] != "rays", "{r:?}");
+        let maps = r["visibility"] == "ism" || r["visibility"] == "pcss";
+        assert_eq!(ism > 0.0, maps, "{r:?}");
+        // Exact visibility is the disk's (VALs) or a ray (their point lights); carried
+        // clusters have no exact-visibility twin.
         let exact: f64 = r["rmse_vs_exact_visibility"].parse().unwrap();
-        assert_eq!(exact == 0.0, r["visibility"] == "rays", "{r:?}");
+        if r["clusters_carried"] == "true" {
+            assert!(exact.is_nan(), "{r:?}");
+        } else {
+            assert_eq!(exact == 0.0, !maps, "{r:?}");
+        }
     }
     check_csv(
         &d,

@@ -70,8 +70,10 @@ pub enum ValVisibilityArg {
     Ism,
     /// The PCSS-style lookup in its map (section 6; the default).
     Pcss,
-    /// A BVH shadow ray to the VAL's centre (the same VALs without the maps' error).
+    /// A BVH shadow ray to the VAL's centre (a point light's visibility).
     Rays,
+    /// 16 BVH rays to points of each VAL's disk (its visible fraction: exact visibility).
+    Disk,
 }
 
 /// Settings of the tree samplers (override `--settings`).
@@ -112,7 +114,8 @@ pub struct SamplingArgs {
     pub visibility: Option<VisibilityArg>,
     /// How the VAL methods (`val`, `val-vpl`) shadow their VALs while shadow rays are on:
     /// `ism` (a simple lookup in each VAL's imperfect shadow map), `pcss` (the PCSS-style
-    /// lookup) or `rays` (a BVH ray to each VAL's centre). Other methods refuse it.
+    /// lookup), `rays` (a BVH ray to each VAL's centre) or `disk` (16 rays to each VAL's
+    /// disk: exact visibility). Other methods refuse it.
     #[arg(long, value_enum)]
     pub val_visibility: Option<ValVisibilityArg>,
     /// GI at half resolution, joint-bilateral upsampled with the similarity S.
@@ -226,6 +229,7 @@ impl SamplingArgs {
                     ValVisibilityArg::Ism => ValVisibility::Ism,
                     ValVisibilityArg::Pcss => ValVisibility::Pcss,
                     ValVisibilityArg::Rays => ValVisibility::Rays,
+                    ValVisibilityArg::Disk => ValVisibility::Disk,
                 },
             );
         }

@@ -51,6 +51,11 @@ pub fn settings_ui<D: IsmDefault>(
     ui.add(egui::Slider::new(&mut m.pull_push_levels, 0..=4).text("pull-push levels"))
         .on_hover_text("hole filling (paper 2)");
     ui.add(egui::Slider::new(&mut m.bias, 0.0..=0.3).text("relative depth bias"));
+    ui.add(egui::Slider::new(&mut m.point_size, 0.0..=8.0).text("point size"))
+        .on_hover_text(
+            "a point's world radius as a multiple of sqrt(scene area / (pi x points per map)): near \
+             points cover several texels (the VAL paper's sized points); 0: one texel per point",
+        );
     ui.checkbox(&mut m.front_face_culling, "cull front faces (Program 1)")
         .on_hover_text(format!(
             "a map leaves out points whose surface faces its {light} (no self-shadowing of lit surfaces)"

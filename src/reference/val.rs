@@ -349,10 +349,27 @@ pub fn average(rsm: &Rsm, assignment: &[u32], vals: &[Val]) -> Vec<Val> {
 /// flux exactly once (a duplicate seed's cluster is one such empty cluster). Returns the
 /// clusters and the last assignment. Twin: `ValClusterPass::record`.
 pub fn cluster(rsm: &Rsm, p: &ClusterParams, seeds: &[UVec2], iterations: u32) -> (Vec<Val>, Vec<u32>) {
-    let mut vals: Vec<Val> = seeds.iter().map(|&t| seed(rsm, t)).collect();
+    cluster_from(rsm, p, None, seeds, iterations)
+}
+
+/// [`cluster`] from `carried` clusters (the last frame's, on an RSM of the same resolution:
+/// the paper carries its clusters over frames, one step each) instead of the seeds; the
+/// carried clusters that are empty are re-seeded before the first step. None: [`cluster`].
+/// Twin: `ValClusterPass::record` with `carry`.
+pub fn cluster_from(
+    rsm: &Rsm,
+    p: &ClusterParams,
+    carried: Option<&[Val]>,
+    seeds: &[UVec2],
+    iterations: u32,
+) -> (Vec<Val>, Vec<u32>) {
+    let mut vals: Vec<Val> = match carried {
+        Some(c) => c.to_vec(),
+        None => seeds.iter().map(|&t| seed(rsm, t)).collect(),
+    };
     let mut assignment = vec![NONE; rsm.texels.len()];
     for step in 0..iterations.max(1) {
-        if step > 0 {
+        if step > 0 || carried.is_some() {
             for (v, &s) in vals.iter_mut().zip(seeds) {
                 if v.pixels == 0 {
                     *v = seed(rsm, s);
@@ -386,34 +403,50 @@ pub fn disk_irradiance(flux: f32, c: Vec3, nc: Vec3, area: f32, x: Vec3, nx: Vec
 
 /// The seed texel (packed x | y << 16, in the clustering RSM `factor` times coarser) of each
 /// of `clusters` clusters from the frame's VPL ids (`layer << 24 | texel index` of a `res`^2
-/// RSM, `NONE` for an empty VPL): cluster j starts
-/// at VPL j x count / clusters and takes the first VPL of `layer` from there (wrapping); 0
-/// when there is none (that cluster ends empty). The VPLs are importance-sampled RSM texels
-/// (thesis 4.1's BRSM warping of a Hammersley set), our form of the paper's "Halton sequence
-/// warped by an importance map". Twin: `seeds_main` in `methods/val/val_shade.wgsl`.
+/// RSM, `NONE` for an empty VPL): cluster j starts at VPL j x count / clusters and takes the
+/// first VPL of `layer` from there (wrapping) whose clustering texel no earlier cluster took;
+/// when every such texel is taken, the first VPL of `layer` from there (a duplicate seed:
+/// that cluster ends empty); 0 when there is none. Several VPLs share a clustering texel
+/// (importance sampling concentrates them, and a clustering texel holds factor^2 RSM
+/// texels): without the "taken" rule most clusters of a large count start on one another
+/// and end empty. The VPLs are importance-sampled RSM texels (thesis 4.1's BRSM warping of a
+/// Hammersley set), our form of the paper's "Halton sequence warped by an importance map".
+/// Twin: `seeds_main` in `methods/val/val_shade.wgsl` (one thread, clusters in order).
 pub fn seeds_from_vpls(ids: &[u32], clusters: u32, layer: u32, res: u32, factor: u32) -> Vec<u32> {
     let f = factor.max(1);
+    let cres = (res / f).max(1);
     let count = ids.len() as u64;
+    let mut taken = vec![false; (cres * cres) as usize];
     (0..clusters as u64)
         .map(|j| {
             if count == 0 {
                 return 0;
             }
             let i0 = j * count / clusters.max(1) as u64;
-            (0..count)
-                .map(|t| ids[((i0 + t) % count) as usize])
-                .find(|&id| id != NONE && id >> 24 == layer)
-                .map_or(0, |id| {
-                    let i = id & 0x00ff_ffff;
-                    ((i % res) / f) | ((i / res) / f) << 16
-                })
+            let mut first = None;
+            for t in 0..count {
+                let id = ids[((i0 + t) % count) as usize];
+                if id == NONE || id >> 24 != layer {
+                    continue;
+                }
+                let i = id & 0x00ff_ffff;
+                let (x, y) = ((i % res) / f, (i / res) / f);
+                let packed = x | y << 16;
+                first.get_or_insert(packed);
+                let c = (y * cres + x) as usize;
+                if !taken[c] {
+                    taken[c] = true;
+                    return packed;
+                }
+            }
+            first.unwrap_or(0)
         })
         .collect()
 }
 
 /// The VALs of interleaving subset `s` of an `n` x `n` pattern shifted by `offset` (section
 /// 6: VAL v shades the tile (v + offset) mod n^2; pixel (x, y) is in subset x mod n + n (y
-/// mod n)). Twin: `val_member` / `val_members` in `val_common.wgsl`.
+/// mod n)). Twin: `val_first` and its stride n^2 in `val_common.wgsl` / `shade_main`.
 pub fn subset(clusters: u32, n: u32, offset: u32, s: u32) -> impl Iterator<Item = u32> {
     let c = (n * n).max(1);
     let j = (s + c - offset % c) % c;
@@ -464,6 +497,15 @@ pub const POISSON: [[f32; 2]; 16] = [
     [0.143_831_61, -0.141_007_9],
 ];
 
+/// The 16 points of VAL `v`'s disk its disk visibility traces to: the Poisson offsets x its
+/// radius sqrt(A / pi) in its plane (the frame of `reference::ism::basis`). Twin: the
+/// `VIS_DISK` case of `shade_main`.
+pub fn disk_points(v: &Val) -> [Vec3; 16] {
+    let (t, b) = crate::reference::ism::basis(v.normal);
+    let rl = (v.area.max(0.0) / std::f32::consts::PI).sqrt();
+    POISSON.map(|o| v.position + (t * o[0] + b * o[1]) * rl)
+}
+
 /// The PCSS lookup's parameters (section 6; the paper gives no sample counts).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -501,11 +543,11 @@ pub struct PcssLookup {
 /// The PCSS-style lookup of `x` in map `m` of a VAL at `c` (normal `n`, area `area`), section
 /// 6, in the paraboloid map (map coordinates per radian near a direction at cos theta = z to
 /// the normal: 0.5 / (1 + z)):
-/// - blocker search: the Poisson samples over a disk of angular radius r_L / z_r around x's
-///   texel (the light's disk seen from the receiver, at least one texel); depths nearer than
-///   x's (with the lookup's bias) are averaged into z_b;
+/// - blocker search: the Poisson samples over a disk of angular radius atan(r_L / z_r) around
+///   x's texel (the light's disk seen from the receiver; 1 texel .. `max_radius`); depths
+///   nearer than x's (with the lookup's bias) are averaged into z_b;
 /// - penumbra (eq. 3): r = (z_r - z_b) / z_b; on the receiver the penumbra's half-width is
-///   r_L r, seen from the light an angle r_L r / z_r;
+///   r_L r, seen from the light an angle atan(r_L r / z_r);
 /// - filter: the fraction of the Poisson samples over that disk (1 texel .. `max_radius`)
 ///   that see x.
 ///
@@ -539,7 +581,8 @@ pub fn pcss(
         atlas[layout.texel(m, u, v)]
     };
     let cmp = zr * (1.0 - bias);
-    let search = (per_radian * rl / zr).max(texel);
+    let max_radius = p.max_radius * texel;
+    let search = (per_radian * (rl / zr).atan()).clamp(texel, max_radius);
     let (mut sum, mut nb) = (0.0f32, 0u32);
     for o in POISSON.iter().take(p.blocker_samples as usize) {
         let d = depth(*o, search);
@@ -553,7 +596,7 @@ pub fn pcss(
     }
     let zb = sum / nb as f32;
     let ratio = (zr - zb) / zb.max(1e-6);
-    let radius = (per_radian * rl * ratio / zr).clamp(texel, p.max_radius * texel);
+    let radius = (per_radian * (rl * ratio / zr).atan()).clamp(texel, max_radius);
     let lit = POISSON
         .iter()
         .take(p.pcf_samples as usize)
@@ -618,6 +661,22 @@ mod tests {
             view_proj,
             areas: Vec::new(),
         }
+    }
+
+    #[test]
+    fn seeds_take_distinct_texels_while_there_are_any() {
+        // An 8^2 RSM clustered at 4^2 (factor 2): VPLs on texels 0, 1 (both coarse texel 0),
+        // 18 (coarse (1, 1)), one of layer 1 and an empty one.
+        let ids = [0, 1, NONE, 18, 1 << 24 | 5];
+        let seeds = seeds_from_vpls(&ids, 2, 0, 8, 2);
+        // Cluster 0 from VPL 0: texel 0; cluster 1 from VPL 2 on: texel 18 -> (1, 1).
+        assert_eq!(seeds, vec![0, 1 | 1 << 16]);
+        // Three clusters: the second skips the taken texel to VPL 3's; the third (from VPL 3)
+        // finds no free texel and repeats its first VPL's.
+        let seeds = seeds_from_vpls(&ids, 3, 0, 8, 2);
+        assert_eq!(seeds, vec![0, 1 | 1 << 16, 1 | 1 << 16]);
+        // No VPL of the layer: texel 0.
+        assert_eq!(seeds_from_vpls(&[NONE, 1 << 24], 2, 0, 8, 1), vec![0, 0]);
     }
 
     #[test]

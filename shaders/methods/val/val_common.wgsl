@@ -9,7 +9,7 @@ struct ValShadeParams {
     offset: u32,         // the frame's interleaving offset
     clusters: u32,       // VALs
     as_point: u32,       // 1: every VAL shaded as a point light (the VPL-shading mode)
-    visibility: u32,     // 0 none, 1 BVH ray to the centre, 2 simple ISM lookup, 3 PCSS lookup
+    visibility: u32,     // 0 none, 1 BVH ray to the centre, 2 simple ISM lookup, 3 PCSS lookup, 4 rays to the disk
     count: u32,          // the frame's VPLs (seeds)
     eps: f32,            // gi.distance_epsilon (the point-light mode's clamp)
     ray_offset: f32,

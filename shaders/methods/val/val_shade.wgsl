@@ -2,11 +2,11 @@
 // maps (`ism.wgsl`):
 //   seeds_main:  per cluster its seed texel (in the clustering RSM, `factor` times coarser)
 //                from the frame's VPLs (cluster j starts at VPL j x count / clusters and takes
-//                the first VPL of the clustered layer);
+//                the first VPL of the clustered layer on a texel no earlier cluster took);
 //   lights_main: per VAL its map's light (centre, normal; an empty VAL splats nothing);
 //   shade_main:  per pixel the VALs of its interleaving subset (section 6), each with eq. 2
 //                (or as a point light) and its visibility: none, a BVH ray to the centre, a
-//                simple lookup in its ISM or the PCSS lookup; the sum x n^2 demodulated into
+//                simple lookup in its ISM, the PCSS lookup, or 16 rays to its disk; the sum x n^2 demodulated into
 //                `raw` (the shared geometry-aware filter follows). Diagnostics per pixel:
 //                mean penumbra width of the lookups that found blockers, those lookups, the
 //                VALs with a non-zero term, 1.
@@ -30,32 +30,52 @@
 @group(0) @binding(10) var<storage, read_write> diag: array<vec4<f32>>;
 @group(0) @binding(11) var<uniform> ism: IsmParams;
 @group(0) @binding(12) var<storage, read> ism_depth: array<f32>;
+// A bit per clustering texel: taken by a seed (seeds_main).
+@group(0) @binding(13) var<storage, read_write> taken: array<u32>;
 
 override DIAGNOSTICS: bool = true;
 
-@compute @workgroup_size(64, 1, 1)
-fn seeds_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let j = gid.x;
-    if j >= params.clusters {
-        return;
-    }
+// One thread: clusters in order, each taking the first VPL of the layer from its start whose
+// clustering texel no earlier cluster took (`taken`: a bit per texel, cleared by the caller).
+@compute @workgroup_size(1, 1, 1)
+fn seeds_main() {
     let count = params.count;
-    seeds[j] = 0u;
-    if count == 0u {
-        return;
-    }
+    let f = max(params.factor, 1u);
+    let cres = max(params.res / f, 1u);
     // floor(j x count / clusters) without overflow.
-    let q = count / params.clusters;
-    let r = count % params.clusters;
-    let start = j * q + (j * r) / params.clusters;
-    for (var t = 0u; t < count; t++) {
-        let id = vpls[(start + t) % count].id;
-        if id != VPL_NONE && (id >> 24u) == params.layer {
-            let i = id & 0x00ffffffu;
-            let f = max(params.factor, 1u);
-            seeds[j] = ((i % params.res) / f) | (((i / params.res) / f) << 16u);
-            return;
+    let q = count / max(params.clusters, 1u);
+    let r = count % max(params.clusters, 1u);
+    for (var j = 0u; j < params.clusters; j++) {
+        seeds[j] = 0u;
+        if count == 0u {
+            continue;
         }
+        let start = j * q + (j * r) / params.clusters;
+        var first = 0xffffffffu;
+        var chosen = 0xffffffffu;
+        for (var t = 0u; t < count; t++) {
+            let id = vpls[(start + t) % count].id;
+            if id == VPL_NONE || (id >> 24u) != params.layer {
+                continue;
+            }
+            let i = id & 0x00ffffffu;
+            let x = (i % params.res) / f;
+            let y = (i / params.res) / f;
+            let packed = x | (y << 16u);
+            if first == 0xffffffffu {
+                first = packed;
+            }
+            let c = y * cres + x;
+            if (taken[c / 32u] & (1u << (c % 32u))) == 0u {
+                taken[c / 32u] |= 1u << (c % 32u);
+                chosen = packed;
+                break;
+            }
+        }
+        if chosen == 0xffffffffu {
+            chosen = select(first, 0u, first == 0xffffffffu);
+        }
+        seeds[j] = chosen;
     }
 }
 
@@ -91,7 +111,8 @@ fn val_pcss(m: u32, v: Val, x: vec3<f32>) -> Pcss {
     let texel = 1.0 / f32(ism.tile);
     let rl = sqrt(max(v.area, 0.0) / PI);
     let cmp = zr * (1.0 - ism.bias);
-    let search = max(per_radian * rl / zr, texel);
+    let max_radius = params.max_radius * texel;
+    let search = clamp(per_radian * atan(rl / zr), texel, max_radius);
     var sum = 0.0;
     var nb = 0u;
     for (var i = 0u; i < params.blocker_samples; i++) {
@@ -106,7 +127,7 @@ fn val_pcss(m: u32, v: Val, x: vec3<f32>) -> Pcss {
     }
     let zb = sum / f32(nb);
     let ratio = (zr - zb) / max(zb, 1e-6);
-    let radius = clamp(per_radian * rl * ratio / zr, texel, params.max_radius * texel);
+    let radius = clamp(per_radian * atan(rl * ratio / zr), texel, max_radius);
     var lit = 0u;
     for (var i = 0u; i < params.pcf_samples; i++) {
         if cmp <= ism_depth[ism_texel(m, pr.xy + VAL_POISSON[i] * radius)] {
@@ -153,6 +174,20 @@ fn shade_main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             case 2u: {
                 vis = select(0.0, 1.0, ism_visible(i, v.position, v.normal, x));
+            }
+            case 4u: {
+                // The disk's visible fraction: rays to its 16 Poisson points.
+                let f = ism_basis(v.normal);
+                let rl = sqrt(max(v.area, 0.0) / PI);
+                var seen = 0u;
+                for (var j = 0u; j < 16u; j++) {
+                    let o = VAL_POISSON[j];
+                    let c = v.position + (f[0] * o.x + f[1] * o.y) * rl;
+                    if vpl_visible(c, v.normal, x, nx, params.ray_offset) {
+                        seen += 1u;
+                    }
+                }
+                vis = f32(seen) / 16.0;
             }
             case 3u: {
                 let q = val_pcss(i, v, x);

@@ -2,9 +2,11 @@
 //! PCSS lookup against 512 VALs with the simple lookup, GPU time of clustering, indirect
 //! illumination, ISM generation and the whole frame, and the error of each against the ground
 //! truth of the frame's VPLs with shadow rays and against the same VALs with exact visibility
-//! (a ray to each VAL's centre: the maps' error alone, apart from the clustering's). Every
-//! count also runs with the other lookup, and the VPL-shading mode (`val-vpl`, figure 7's
-//! comparison) with rays. Fixed seeds: every run of a count shades the same interleaving
+//! (16 rays to each VAL's disk, its visible fraction: the maps' error alone, apart from the
+//! clustering's). Every
+//! count also runs with the other lookup, the VPL-shading mode (`val-vpl`, figure 7's
+//! comparison) with a ray to each point light, and the paper's clustering (carried over
+//! frames, one step each). Fixed seeds: every run of a count shades the same interleaving
 //! subsets, so two of them differ only in visibility.
 
 use super::*;
@@ -35,6 +37,8 @@ struct Row {
     method: MethodId,
     vals: u32,
     vis: ValVisibility,
+    /// The paper's clustering: one step per frame from the last frame's clusters.
+    carried: bool,
     groups: Vec<f64>,
     gi_ms: f64,
     frame_gpu_ms: f64,
@@ -54,7 +58,7 @@ fn stat(m: &Measured, k: &str) -> f64 {
 pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let base: ValSettings = b.base.method(val_method::ID).map_err(|e| anyhow::anyhow!(e))?;
     let img = images(dir)?;
-    let settings = |b: &Bench, method: MethodId, vals: u32, vis: ValVisibility| {
+    let settings = |b: &Bench, method: MethodId, vals: u32, vis: ValVisibility, carried: bool| {
         with(b, |s| {
             s.gi.method = method;
             s.gi.shadow_rays = true;
@@ -65,34 +69,43 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 &ValSettings {
                     clusters: vals,
                     visibility: vis,
+                    carry_over: carried,
+                    iterations: if carried { 1 } else { base.iterations },
                     ..base.clone()
                 },
             );
         })
     };
     let mut rows: Vec<Row> = Vec::new();
+    // (method, VALs, visibility, clusters carried over frames with one step each: the
+    // paper's clustering, after the warm-up frames).
     let configs = [
-        (val_method::ID, 64, ValVisibility::Rays),
-        (val_method::ID, 64, ValVisibility::Pcss),
-        (val_method::ID, 64, ValVisibility::Ism),
-        (val_method::ID, 512, ValVisibility::Rays),
-        (val_method::ID, 512, ValVisibility::Ism),
-        (val_method::ID, 512, ValVisibility::Pcss),
-        (val_method::VPL, 64, ValVisibility::Rays),
-        (val_method::VPL, 512, ValVisibility::Rays),
+        (val_method::ID, 64, ValVisibility::Disk, false),
+        (val_method::ID, 64, ValVisibility::Pcss, false),
+        (val_method::ID, 64, ValVisibility::Ism, false),
+        (val_method::ID, 512, ValVisibility::Disk, false),
+        (val_method::ID, 512, ValVisibility::Ism, false),
+        (val_method::ID, 512, ValVisibility::Pcss, false),
+        (val_method::VPL, 64, ValVisibility::Rays, false),
+        (val_method::VPL, 512, ValVisibility::Rays, false),
+        (val_method::ID, 64, ValVisibility::Pcss, true),
+        (val_method::ID, 512, ValVisibility::Ism, true),
     ];
     let mut exact: Vec<(MethodId, u32, ImageF32)> = Vec::new();
-    for (method, vals, vis) in configs {
-        let s = settings(b, method, vals, vis);
+    for (method, vals, vis, carried) in configs {
+        let s = settings(b, method, vals, vis, carried);
         let m = b.measure(&s, o.size, o.per_config(), true)?;
         let Some(x) = m.indirect.clone() else {
             anyhow::bail!("{method} with {vals} VALs produced no image");
         };
-        if vis == ValVisibility::Rays {
+        // Exact visibility: the disk's visible fraction (VALs), a ray (their point lights).
+        if matches!(vis, ValVisibility::Rays | ValVisibility::Disk) {
             exact.push((method, vals, x.clone()));
         }
+        // Carried clusters are not the rays run's: no exact-visibility twin.
         let rmse_exact = exact
             .iter()
+            .filter(|_| !carried)
             .find(|(em, ev, _)| *em == method && *ev == vals)
             .map_or(f64::NAN, |(_, _, e)| {
                 metrics::compare_without_flip(&x, e, b.gi_exposure, b.base.display.tonemap).rmse
@@ -103,6 +116,7 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             method,
             vals,
             vis,
+            carried,
             groups,
             gi_ms: m.gi_ms().0,
             frame_gpu_ms: median(&all),
@@ -112,15 +126,20 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             radius: stat(&m, "val_mean_radius_m"),
         };
         eprintln!(
-            "[{}] {method} {vals} VALs, {}: GI {:.3} ms GPU, RMSE vs GT {:.4e}, vs exact visibility {:.4e}",
+            "[{}] {method} {vals} VALs, {}{}: GI {:.3} ms GPU, RMSE vs GT {:.4e}, vs exact visibility {:.4e}",
             b.scene,
             vis.name(),
+            if carried { ", carried" } else { "" },
             row.gi_ms,
             row.rmse_gt,
             row.rmse_exact
         );
         if method == val_method::ID {
-            let stem = format!("val_{vals}_{}", vis.name());
+            let stem = format!(
+                "val_{vals}_{}{}",
+                vis.name(),
+                if carried { "_carried" } else { "" }
+            );
             b.write_gi_png(&img.join(format!("{stem}.png")), &x)?;
             let gt = b.ground_truth(&s, o.size)?;
             b.write_error_png(&img.join(format!("{stem}_error.png")), &x, &gt)?;
@@ -133,6 +152,7 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "method",
         "vals",
         "visibility",
+        "clusters_carried",
         "clustering_ms",
         "indirect_ms",
         "ism_ms",
@@ -149,6 +169,7 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             r.method.to_string(),
             r.vals.to_string(),
             r.vis.name().to_string(),
+            r.carried.to_string(),
         ];
         cells.extend(r.groups.iter().map(|&v| num(v)));
         cells.extend([
@@ -164,7 +185,8 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     csv.write(&dir.join("val.csv"))?;
 
     let find = |m: MethodId, n: u32, v: ValVisibility| {
-        rows.iter().find(|r| r.method == m && r.vals == n && r.vis == v)
+        rows.iter()
+            .find(|r| r.method == m && r.vals == n && r.vis == v && !r.carried)
     };
     let mut table = format!(
         "Virtual Area Lights ({}x{}, {} VPLs as seeds, splat {}, {} steps, {} x {} interleaving, {}^2 maps of {} cloud points, {}):\n",
@@ -181,10 +203,10 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     );
     for r in &rows {
         table.push_str(&format!(
-            "  {:<8} {:>4} VALs {:<5}: GI {:>8.3} ms GPU (clustering {:.3}, indirect {:.3}, ISMs {:.3}), frame {:.3} ms GPU, RMSE vs GT {:.4e}, vs exact visibility {:.4e}, {:.0} VALs lit\n",
+            "  {:<8} {:>4} VALs {:<13}: GI {:>8.3} ms GPU (clustering {:.3}, indirect {:.3}, ISMs {:.3}), frame {:.3} ms GPU, RMSE vs GT {:.4e}, vs exact visibility {:.4e}, {:.0} VALs lit\n",
             r.method.to_string(),
             r.vals,
-            r.vis.name(),
+            format!("{}{}", r.vis.name(), if r.carried { " carried" } else { "" }),
             r.gi_ms,
             r.groups[0],
             r.groups[1],
@@ -251,7 +273,7 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             1.0,
             false,
             format!(
-                "GPU timestamps of the VAL passes (val_seeds .. val_filter), median of {} timed frames (the paper: 26 / 52 ms whole frames)",
+                "GPU timestamps of the VAL passes (val_downsample .. val_filter), median of {} timed frames (the paper: 26 / 52 ms whole frames)",
                 o.timing_frames
             ),
         ));

@@ -36,8 +36,8 @@ use crate::renderer::{
     shaders::ShaderError,
 };
 use pass::{
-    GpuDownParams, GpuValShadeParams, GpuValViewParams, VIS_ISM, VIS_NONE, VIS_PCSS, VIS_RAYS, ValBuffers,
-    ValFrame, ValIsm, ValPass, ValRsm,
+    GpuDownParams, GpuValShadeParams, GpuValViewParams, VIS_DISK, VIS_ISM, VIS_NONE, VIS_PCSS, VIS_RAYS,
+    ValBuffers, ValFrame, ValIsm, ValPass, ValRsm,
 };
 use settings::{ValSettings, ValVisibility};
 
@@ -90,8 +90,9 @@ const VIEWS: &[ViewInfo] = &[
     ViewInfo {
         name: CLUSTERS.name(),
         file: "val_clusters",
-        about: "light 0's reflective shadow map, each texel with flux in its VAL's colour (the \
-                last clustering step's assignment, section 4), the VALs' centre texels white",
+        about: "light 0's reflective shadow map summed down to the clustering resolution \
+                (methods.val.resolution), each texel with flux in its VAL's colour (the last \
+                clustering step's assignment, section 4), the VALs' centre texels white",
         passes: &["val_cluster"],
     },
     ViewInfo {
@@ -296,6 +297,8 @@ pub struct Vals {
     view_data: HashMap<&'static str, ((u32, u32), wgpu::Buffer)>,
     scene_radius: f32,
     ray_offset: f32,
+    /// The scene upload the carried clusters belong to.
+    scene_generation: u64,
 }
 
 fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
@@ -314,6 +317,7 @@ fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
         view_data: HashMap::new(),
         scene_radius: 1.0,
         ray_offset: 0.0,
+        scene_generation: u64::MAX,
     }))
 }
 
@@ -361,6 +365,9 @@ impl Vals {
         }
         enc.clear_buffer(cx.gi_accum, 0, None);
         self.state = None;
+        if let Some(t) = self.targets.as_mut() {
+            t.unprime();
+        }
         self.ism_maps = 0;
         1.0
     }
@@ -457,6 +464,13 @@ impl Method for Vals {
             ));
             self.targets = Some(t);
         }
+        // Clusters carried over belong to one scene.
+        if self.scene_generation != cx.scene.generation {
+            self.scene_generation = cx.scene.generation;
+            if let Some(t) = self.targets.as_mut() {
+                t.unprime();
+            }
+        }
         let frames = match self.state {
             Some((k, m, n)) if s.sampling.accumulate && k == cx.key && m == cx.method => n + 1,
             _ => 1,
@@ -468,6 +482,7 @@ impl Method for Vals {
                 ValVisibility::Rays => VIS_RAYS,
                 ValVisibility::Ism => VIS_ISM,
                 ValVisibility::Pcss => VIS_PCSS,
+                ValVisibility::Disk => VIS_DISK,
             }
         };
         let maps_shown = cx.diagnostics && (cx.views.contains(&ISM_ATLAS) || cx.views.contains(&ISM_TRUE));
@@ -493,7 +508,7 @@ impl Method for Vals {
             max_radius: vs.pcss.max_radius,
             res: rsm.res,
             layer: 0,
-            inspect: vs.inspect.min(vs.clusters - 1),
+            inspect: vs.inspect.min(vs.clusters.saturating_sub(1)),
             factor,
             _pad: [0; 3],
         };
@@ -557,6 +572,7 @@ impl Method for Vals {
             p,
             cp,
             vs.iterations,
+            vs.carry_over,
             fp,
             &f,
             &self.buffers,
@@ -591,6 +607,9 @@ impl Method for Vals {
 
     fn reset(&mut self) {
         self.state = None;
+        if let Some(t) = self.targets.as_mut() {
+            t.unprime();
+        }
     }
 
     fn view_size(&self, view: MethodView, frame: (u32, u32)) -> Option<(u32, u32)> {
@@ -703,7 +722,9 @@ impl Method for Vals {
                 format!(
                     "distance from VAL {} (m): its {tile}^2 map (left) and the traced one (right); \
                      black: hole / nothing hit",
-                    self.settings.inspect.min(self.settings.clusters - 1)
+                    self.settings
+                        .inspect
+                        .min(self.settings.clusters.saturating_sub(1))
                 )
             } else {
                 format!(
@@ -758,6 +779,7 @@ impl Method for Vals {
             VIS_RAYS => "shadow rays",
             VIS_ISM => "ISM lookups",
             VIS_PCSS => "PCSS lookups",
+            VIS_DISK => "rays to the disks",
             _ => "no visibility",
         };
         Some(format!(

@@ -77,6 +77,8 @@ pub struct ValRsm {
     pub arrays: [wgpu::TextureView; 3],
     /// Storage views (the downsample writes them).
     storage: [wgpu::TextureView; 3],
+    /// A bit per texel: taken by a seed (`seeds_main`).
+    taken: wgpu::Buffer,
 }
 
 impl ValRsm {
@@ -112,11 +114,13 @@ impl ValRsm {
             })
         });
         let storage = textures.each_ref().map(|t| t.create_view(&Default::default()));
+        let words = (res as u64 * res as u64).div_ceil(32);
         Self {
             res,
             textures,
             arrays,
             storage,
+            taken: storage_buffer(device, "val::seed_taken", 4 * words),
         }
     }
 }
@@ -126,6 +130,8 @@ pub const VIS_NONE: u32 = 0;
 pub const VIS_RAYS: u32 = 1;
 pub const VIS_ISM: u32 = 2;
 pub const VIS_PCSS: u32 = 3;
+/// 16 BVH rays to points of the VAL's disk (its visible fraction: exact visibility).
+pub const VIS_DISK: u32 = 4;
 
 /// Twin: `ValViewParams` in `val_views.wgsl`.
 #[repr(C)]
@@ -227,7 +233,11 @@ impl ValPass {
         ];
         se.extend((3..=6).map(|b| storage_entry(b, c, true)));
         se.extend((7..=10).map(|b| storage_entry(b, c, false)));
-        se.extend([uniform_entry(11, c), storage_entry(12, c, true)]);
+        se.extend([
+            uniform_entry(11, c),
+            storage_entry(12, c, true),
+            storage_entry(13, c, false),
+        ]);
         let shade_layout = layout("val_shade::layout", &se);
         let rgba32 = wgpu::TextureFormat::Rgba32Float;
         let down_layout = layout(
@@ -293,7 +303,8 @@ impl ValPass {
         })
     }
 
-    /// Records the frame (module doc): seeds, `iterations` clustering steps with `cp`, the maps
+    /// Records the frame (module doc): seeds, `iterations` clustering steps with `cp` (from the
+    /// last frame's clusters with `carry`), the maps
     /// (`ism`), shading with `p` and the filter with `fp` into `f.accum`. Refused (nothing
     /// recorded) when the clustering refuses its targets.
     #[allow(clippy::too_many_arguments)]
@@ -307,6 +318,7 @@ impl ValPass {
         p: GpuValShadeParams,
         cp: GpuValParams,
         iterations: u32,
+        carry: bool,
         fp: GpuFilterParams,
         f: &ValFrame<'_>,
         b: &ValBuffers,
@@ -349,6 +361,7 @@ impl ValPass {
                     b.diag.as_entire_binding(),
                     self.ism_params.as_entire_binding(),
                     ism_depth.as_entire_binding(),
+                    f.coarse.taken.as_entire_binding(),
                 ],
             )
         };
@@ -377,9 +390,10 @@ impl ValPass {
             &down,
             groups_image(f.coarse.res, f.coarse.res),
         );
-        // The seeds (the VALs bound are not read).
+        // The seeds, one thread (the VALs bound are not read).
         let before = bind(t.vals(), &t.seeds);
-        run_compute(encoder, timer, "val_seeds", &self.seeds, &before, per_cluster);
+        encoder.clear_buffer(&f.coarse.taken, 0, None);
+        run_compute(encoder, timer, "val_seeds", &self.seeds, &before, (1, 1, 1));
         self.cluster.record(
             device,
             queue,
@@ -390,6 +404,7 @@ impl ValPass {
             cp,
             ValSeeds::Written(p.clusters),
             iterations,
+            carry,
             t,
         )?;
         // The clusters as the last step left them; the seeds buffer is bound again unread.

@@ -21,9 +21,11 @@ pub enum ValVisibility {
     /// paper's answer to few VALs.
     #[default]
     Pcss,
-    /// A BVH shadow ray to the VAL's centre (exact for a point at the centre: the reference
-    /// that separates the maps' error from the clustering's).
+    /// A BVH shadow ray to the VAL's centre (a point light's visibility).
     Rays,
+    /// 16 BVH shadow rays to points of the VAL's disk: its visible fraction, the exact
+    /// visibility that separates the maps' error from the clustering's (Table 1's reference).
+    Disk,
 }
 
 impl ValVisibility {
@@ -32,6 +34,7 @@ impl ValVisibility {
             ValVisibility::Ism => "ism",
             ValVisibility::Pcss => "pcss",
             ValVisibility::Rays => "rays",
+            ValVisibility::Disk => "disk",
         }
     }
 }
@@ -50,6 +53,11 @@ pub struct ValSettings {
     pub splat: u32,
     /// k-means steps per frame (the paper runs one per frame and carries the clusters over).
     pub iterations: u32,
+    /// Start each frame's steps from the last frame's clusters (their empty ones re-seeded)
+    /// instead of the frame's seeds: the paper's, with `iterations` 1, converging over frames.
+    /// Off: every frame clusters afresh from its seeds (no history: nothing lags when the sun
+    /// moves).
+    pub carry_over: bool,
     /// Eq. 1's convex weights (position, normal, flux).
     pub weights: MetricWeights,
     pub visibility: ValVisibility,
@@ -75,6 +83,7 @@ impl Default for ValSettings {
             resolution: 128,
             splat: 32,
             iterations: 4,
+            carry_over: false,
             weights: MetricWeights::default(),
             visibility: ValVisibility::Pcss,
             pcss: Pcss::default(),

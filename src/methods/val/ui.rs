@@ -39,8 +39,10 @@ pub fn settings_ui(ui: &mut egui::Ui, _method: MethodId, s: &mut RenderSettings)
     .on_hover_text("edge of a cluster's splat window: texels beyond it join a cluster only by the fallback (paper 32 - 128)");
     ui.add(egui::Slider::new(&mut vs.iterations, 1..=MAX_ITERATIONS).text("k-means steps"))
         .on_hover_text(
-            "clustering steps per frame from the frame's seeds (the paper: one per frame, carried over)",
+            "clustering steps per frame, from the frame's seeds or the last frame's clusters (the paper: one per frame, carried over)",
         );
+    ui.checkbox(&mut vs.carry_over, "carry the clusters over frames")
+        .on_hover_text("the paper's: each frame's steps start from the last frame's clusters (with 1 step: one per frame)");
     ui.horizontal(|ui| {
         ui.label("eq. 1 weights");
         ui.add(
@@ -81,8 +83,10 @@ pub fn settings_ui(ui: &mut egui::Ui, _method: MethodId, s: &mut RenderSettings)
                 .on_hover_text("one lookup in the VAL's imperfect shadow map (section 5)");
             ui.radio_value(&mut vs.visibility, ValVisibility::Pcss, "PCSS")
                 .on_hover_text("blocker search, eq. 3's penumbra, Poisson PCF in the VAL's map (section 6)");
-            ui.radio_value(&mut vs.visibility, ValVisibility::Rays, "rays")
-                .on_hover_text("a BVH shadow ray to the VAL's centre: the same VALs without the maps' error");
+            ui.radio_value(&mut vs.visibility, ValVisibility::Rays, "ray to centre")
+                .on_hover_text("a BVH shadow ray to the VAL's centre (a point light's visibility)");
+            ui.radio_value(&mut vs.visibility, ValVisibility::Disk, "rays to disk")
+                .on_hover_text("16 BVH rays to the VAL's disk: its visible fraction, exact visibility (the maps' reference)");
         });
     })
     .response

@@ -116,6 +116,8 @@ pub struct ValTargets {
     pub seeds: wgpu::Buffer,
     /// Which of `vals` the last run left its clusters in.
     last: usize,
+    /// Whether a run left clusters to carry over.
+    primed: bool,
 }
 
 impl ValTargets {
@@ -131,10 +133,16 @@ impl ValTargets {
             fallback: storage_buffer(device, "val::fallback", 4 * (texels + 1)),
             seeds: storage_buffer(device, "val::seeds", 4 * n),
             last: 0,
+            primed: false,
         }
     }
     pub fn matches(&self, clusters: u32, res: u32) -> bool {
         self.clusters == clusters && self.res == res
+    }
+    /// Forget the last run's clusters: the next run with `carry` seeds (a new scene, a reset,
+    /// a failed frame).
+    pub fn unprime(&mut self) {
+        self.primed = false;
     }
     /// The buffer holding the clusters after the last run.
     pub fn vals(&self) -> &wgpu::Buffer {
@@ -204,7 +212,8 @@ impl ValClusterPass {
     }
 
     /// Clusters seeded at `seeds` (one per cluster, at most the targets' clusters; a seed on a
-    /// texel without flux gives a cluster that ends empty), then
+    /// texel without flux gives a cluster of no flux that may still take texels), or with `carry` the clusters the
+    /// last run left in `t` (their empty ones re-seeded first; the first run seeds), then
     /// `iterations` steps, in one compute pass timed as `name`: a cluster left empty by a step
     /// is re-seeded before the next; after the last step it stays empty (`pixels` 0). `rsm`:
     /// the position, normal and flux array views. The parameters and seeds live in the pass
@@ -222,6 +231,7 @@ impl ValClusterPass {
         p: GpuValParams,
         seeds: ValSeeds<'_>,
         iterations: u32,
+        carry: bool,
         t: &mut ValTargets,
     ) -> Result<(), String> {
         if p.res != t.res {
@@ -276,13 +286,17 @@ impl ValClusterPass {
                 let (cx, cy) = (texel_groups.min(65535), texel_groups.div_ceil(65535));
                 let splat = p.splat.div_ceil(WG_2D);
                 let image = p.res.div_ceil(WG_2D);
-                // Seed into vals[0] (the bind group whose output is 0).
-                pass.set_bind_group(0, &groups[1], &[]);
-                pass.set_pipeline(&self.seed);
-                pass.dispatch_workgroups(per_cluster, 1, 1);
-                let mut cur = 0;
+                // Carried over: the last run's clusters are the first step's input.
+                // Else seed into vals[0] (the bind group whose output is 0).
+                let carry = carry && t.primed;
+                let mut cur = if carry { t.last } else { 0 };
+                if !carry {
+                    pass.set_bind_group(0, &groups[1], &[]);
+                    pass.set_pipeline(&self.seed);
+                    pass.dispatch_workgroups(per_cluster, 1, 1);
+                }
                 for step in 0..iterations.max(1) {
-                    if step > 0 {
+                    if step > 0 || carry {
                         // Re-seed the empty clusters of the step's input (the bind group
                         // whose output is vals[cur]).
                         pass.set_bind_group(0, &groups[1 - cur], &[]);
@@ -301,6 +315,7 @@ impl ValClusterPass {
                     cur = 1 - cur;
                 }
                 t.last = cur;
+                t.primed = true;
             }
         }
         encoder.pop_debug_group();
