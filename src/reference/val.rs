@@ -403,43 +403,45 @@ pub fn disk_irradiance(flux: f32, c: Vec3, nc: Vec3, area: f32, x: Vec3, nx: Vec
 
 /// The seed texel (packed x | y << 16, in the clustering RSM `factor` times coarser) of each
 /// of `clusters` clusters from the frame's VPL ids (`layer << 24 | texel index` of a `res`^2
-/// RSM, `NONE` for an empty VPL): cluster j starts at VPL j x count / clusters and takes the
-/// first VPL of `layer` from there (wrapping) whose clustering texel no earlier cluster took;
-/// when every such texel is taken, the first VPL of `layer` from there (a duplicate seed:
-/// that cluster ends empty); 0 when there is none. Several VPLs share a clustering texel
-/// (importance sampling concentrates them, and a clustering texel holds factor^2 RSM
-/// texels): without the "taken" rule most clusters of a large count start on one another
-/// and end empty. The VPLs are importance-sampled RSM texels (thesis 4.1's BRSM warping of a
-/// Hammersley set), our form of the paper's "Halton sequence warped by an importance map".
-/// Twin: `seeds_main` in `methods/val/val_shade.wgsl` (one thread, clusters in order).
+/// RSM, `NONE` for an empty VPL): the VPLs of `layer` that are the first (in VPL order) on
+/// their clustering texel are the U unique seeds; cluster j takes unique seed j x U /
+/// clusters (distinct texels spread over the VPLs), or j mod U when U < clusters (repeats:
+/// those clusters end empty); all 0 without a VPL of `layer`. Several VPLs share a clustering
+/// texel (importance sampling concentrates them, and a clustering texel holds factor^2 RSM
+/// texels): seeding at every (count / clusters)-th VPL put most of 512 clusters on one
+/// another (a third of them kept texels). The VPLs are importance-sampled RSM texels (thesis
+/// 4.1's BRSM warping of a Hammersley set, which the VPL order stratifies), our form of the
+/// paper's "Halton sequence warped by an importance map". Twin: `claim_main`, `unique_main`,
+/// `seeds_main` in `methods/val/val_shade.wgsl`.
 pub fn seeds_from_vpls(ids: &[u32], clusters: u32, layer: u32, res: u32, factor: u32) -> Vec<u32> {
     let f = factor.max(1);
     let cres = (res / f).max(1);
-    let count = ids.len() as u64;
-    let mut taken = vec![false; (cres * cres) as usize];
+    let mut seen = vec![false; (cres * cres) as usize];
+    let mut unique = Vec::new();
+    for &id in ids {
+        if id == NONE || id >> 24 != layer {
+            continue;
+        }
+        let i = id & 0x00ff_ffff;
+        let (x, y) = ((i % res) / f, (i / res) / f);
+        let c = (y * cres + x) as usize;
+        if !seen[c] {
+            seen[c] = true;
+            unique.push(x | y << 16);
+        }
+    }
+    let u = unique.len() as u64;
     (0..clusters as u64)
         .map(|j| {
-            if count == 0 {
+            if u == 0 {
                 return 0;
             }
-            let i0 = j * count / clusters.max(1) as u64;
-            let mut first = None;
-            for t in 0..count {
-                let id = ids[((i0 + t) % count) as usize];
-                if id == NONE || id >> 24 != layer {
-                    continue;
-                }
-                let i = id & 0x00ff_ffff;
-                let (x, y) = ((i % res) / f, (i / res) / f);
-                let packed = x | y << 16;
-                first.get_or_insert(packed);
-                let c = (y * cres + x) as usize;
-                if !taken[c] {
-                    taken[c] = true;
-                    return packed;
-                }
-            }
-            first.unwrap_or(0)
+            let k = if u >= clusters as u64 {
+                j * u / clusters as u64
+            } else {
+                j % u
+            };
+            unique[k as usize]
         })
         .collect()
 }
@@ -666,15 +668,21 @@ mod tests {
     #[test]
     fn seeds_take_distinct_texels_while_there_are_any() {
         // An 8^2 RSM clustered at 4^2 (factor 2): VPLs on texels 0, 1 (both coarse texel 0),
-        // 18 (coarse (1, 1)), one of layer 1 and an empty one.
-        let ids = [0, 1, NONE, 18, 1 << 24 | 5];
-        let seeds = seeds_from_vpls(&ids, 2, 0, 8, 2);
-        // Cluster 0 from VPL 0: texel 0; cluster 1 from VPL 2 on: texel 18 -> (1, 1).
-        assert_eq!(seeds, vec![0, 1 | 1 << 16]);
-        // Three clusters: the second skips the taken texel to VPL 3's; the third (from VPL 3)
-        // finds no free texel and repeats its first VPL's.
-        let seeds = seeds_from_vpls(&ids, 3, 0, 8, 2);
-        assert_eq!(seeds, vec![0, 1 | 1 << 16, 1 | 1 << 16]);
+        // 18 (coarse (1, 1)), one of layer 1, an empty one, 63 (coarse (3, 3)).
+        let ids = [0, 1, NONE, 18, 1 << 24 | 5, 63];
+        // Unique: (0, 0), (1, 1), (3, 3); two clusters take unique 0 and 3 / 2 = 1.
+        assert_eq!(seeds_from_vpls(&ids, 2, 0, 8, 2), vec![0, 1 | 1 << 16]);
+        assert_eq!(
+            seeds_from_vpls(&ids, 3, 0, 8, 2),
+            vec![0, 1 | 1 << 16, 3 | 3 << 16]
+        );
+        // More clusters than unique texels: they repeat (j mod 3).
+        assert_eq!(
+            seeds_from_vpls(&ids, 4, 0, 8, 2),
+            vec![0, 1 | 1 << 16, 3 | 3 << 16, 0]
+        );
+        // Factor 1: texels 0 and 1 differ.
+        assert_eq!(seeds_from_vpls(&ids, 2, 0, 8, 1), vec![0, 2 | 2 << 16]);
         // No VPL of the layer: texel 0.
         assert_eq!(seeds_from_vpls(&[NONE, 1 << 24], 2, 0, 8, 1), vec![0, 0]);
     }

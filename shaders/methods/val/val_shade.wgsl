@@ -1,8 +1,8 @@
 // The VAL method's per-frame kernels around the shared clustering (`val_cluster.wgsl`) and
 // maps (`ism.wgsl`):
-//   seeds_main:  per cluster its seed texel (in the clustering RSM, `factor` times coarser)
-//                from the frame's VPLs (cluster j starts at VPL j x count / clusters and takes
-//                the first VPL of the clustered layer on a texel no earlier cluster took);
+//   claim_main, unique_main, seeds_main: per cluster its seed texel (in the clustering RSM,
+//                `factor` times coarser): the VPLs of the clustered layer that are the first on
+//                their texel, in VPL order, spread over the clusters;
 //   lights_main: per VAL its map's light (centre, normal; an empty VAL splats nothing);
 //   shade_main:  per pixel the VALs of its interleaving subset (section 6), each with eq. 2
 //                (or as a point light) and its visibility: none, a BVH ray to the centre, a
@@ -30,53 +30,106 @@
 @group(0) @binding(10) var<storage, read_write> diag: array<vec4<f32>>;
 @group(0) @binding(11) var<uniform> ism: IsmParams;
 @group(0) @binding(12) var<storage, read> ism_depth: array<f32>;
-// A bit per clustering texel: taken by a seed (seeds_main).
-@group(0) @binding(13) var<storage, read_write> taken: array<u32>;
+// Per clustering texel the inverted least VPL index on it (claim_main; cleared to 0).
+@group(0) @binding(13) var<storage, read_write> claim: array<atomic<u32>>;
+// The unique VPLs: [count, their indices in VPL order] (unique_main).
+@group(0) @binding(14) var<storage, read_write> list: array<u32>;
 
 override DIAGNOSTICS: bool = true;
 
-// One thread: clusters in order, each taking the first VPL of the layer from its start whose
-// clustering texel no earlier cluster took (`taken`: a bit per texel, cleared by the caller).
-@compute @workgroup_size(1, 1, 1)
-fn seeds_main() {
-    let count = params.count;
+// The seeds, three dispatches: claim_main (per VPL of the layer: its clustering texel's
+// claim keeps the least VPL index, as atomicMax of ~i), unique_main (one workgroup: the VPLs
+// that won their texel's claim, in VPL order, compacted into `list` = [count, indices..]),
+// seeds_main (cluster j takes unique VPL j x U / clusters, or j mod U when there are fewer
+// unique texels U than clusters: distinct texels spread over the VPLs).
+fn seed_texel(id: u32) -> vec2<u32> {
+    let i = id & 0x00ffffffu;
     let f = max(params.factor, 1u);
-    let cres = max(params.res / f, 1u);
-    // floor(j x count / clusters) without overflow.
-    let q = count / max(params.clusters, 1u);
-    let r = count % max(params.clusters, 1u);
-    for (var j = 0u; j < params.clusters; j++) {
-        seeds[j] = 0u;
-        if count == 0u {
-            continue;
-        }
-        let start = j * q + (j * r) / params.clusters;
-        var first = 0xffffffffu;
-        var chosen = 0xffffffffu;
-        for (var t = 0u; t < count; t++) {
-            let id = vpls[(start + t) % count].id;
-            if id == VPL_NONE || (id >> 24u) != params.layer {
-                continue;
-            }
-            let i = id & 0x00ffffffu;
-            let x = (i % params.res) / f;
-            let y = (i / params.res) / f;
-            let packed = x | (y << 16u);
-            if first == 0xffffffffu {
-                first = packed;
-            }
-            let c = y * cres + x;
-            if (taken[c / 32u] & (1u << (c % 32u))) == 0u {
-                taken[c / 32u] |= 1u << (c % 32u);
-                chosen = packed;
-                break;
-            }
-        }
-        if chosen == 0xffffffffu {
-            chosen = select(first, 0u, first == 0xffffffffu);
-        }
-        seeds[j] = chosen;
+    return vec2<u32>((i % params.res) / f, (i / params.res) / f);
+}
+
+fn seed_claim_index(id: u32) -> u32 {
+    let t = seed_texel(id);
+    return t.y * max(params.res / max(params.factor, 1u), 1u) + t.x;
+}
+
+fn seed_valid(id: u32) -> bool {
+    return id != VPL_NONE && (id >> 24u) == params.layer;
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn claim_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if i >= params.count {
+        return;
     }
+    let id = vpls[i].id;
+    if seed_valid(id) {
+        atomicMax(&claim[seed_claim_index(id)], ~i);
+    }
+}
+
+fn seed_unique(i: u32) -> bool {
+    let id = vpls[i].id;
+    return seed_valid(id) && atomicLoad(&claim[seed_claim_index(id)]) == ~i;
+}
+
+var<workgroup> chunk_sums: array<u32, 256>;
+
+@compute @workgroup_size(256, 1, 1)
+fn unique_main(@builtin(local_invocation_index) li: u32) {
+    let count = params.count;
+    let chunk = (count + 255u) / 256u;
+    let lo = min(li * chunk, count);
+    let hi = min(lo + chunk, count);
+    var n = 0u;
+    for (var i = lo; i < hi; i++) {
+        if seed_unique(i) {
+            n += 1u;
+        }
+    }
+    chunk_sums[li] = n;
+    workgroupBarrier();
+    // Inclusive prefix sum over the chunks (Hillis-Steele).
+    for (var off = 1u; off < 256u; off <<= 1u) {
+        var v = 0u;
+        if li >= off {
+            v = chunk_sums[li - off];
+        }
+        workgroupBarrier();
+        chunk_sums[li] += v;
+        workgroupBarrier();
+    }
+    var at = chunk_sums[li] - n;
+    for (var i = lo; i < hi; i++) {
+        if seed_unique(i) {
+            list[1u + at] = i;
+            at += 1u;
+        }
+    }
+    if li == 255u {
+        list[0] = chunk_sums[255];
+    }
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn seeds_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let j = gid.x;
+    if j >= params.clusters {
+        return;
+    }
+    let u = list[0];
+    if u == 0u {
+        seeds[j] = 0u;
+        return;
+    }
+    var k = j % u;
+    if u >= params.clusters {
+        // floor(j x u / clusters) without overflow.
+        k = j * (u / params.clusters) + (j * (u % params.clusters)) / params.clusters;
+    }
+    let t = seed_texel(vpls[list[1u + k]].id);
+    seeds[j] = t.x | (t.y << 16u);
 }
 
 @compute @workgroup_size(64, 1, 1)

@@ -281,6 +281,8 @@ pub struct Vals {
     buffers: ValBuffers,
     /// The clustering RSM.
     coarse: Option<ValRsm>,
+    /// The unique seed VPLs' list (VPL capacity, buffer).
+    seed_list: Option<(u32, wgpu::Buffer)>,
     targets: Option<ValTargets>,
     stats: Option<CounterReadback<ValStats>>,
     /// Accumulation: (key, method, frames summed).
@@ -306,6 +308,7 @@ fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
         pass: ValPass::new(device)?,
         buffers: ValBuffers::new(device, (1, 1)),
         coarse: None,
+        seed_list: None,
         targets: None,
         stats: None,
         state: None,
@@ -454,6 +457,16 @@ impl Method for Vals {
         if self.coarse.as_ref().is_none_or(|c| c.res != res) {
             self.coarse = Some(ValRsm::new(cx.device, res));
         }
+        let capacity = cx.vpl_buffers.capacity;
+        if self.seed_list.as_ref().is_none_or(|(c, _)| *c != capacity) {
+            let b = cx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("val::seed_list"),
+                size: pass::seed_list_bytes(capacity),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            self.seed_list = Some((capacity, b));
+        }
         if !self.targets.as_ref().is_some_and(|t| t.matches(vs.clusters, res)) {
             let t = ValTargets::new(cx.device, vs.clusters, res);
             self.stats = Some(CounterReadback::new(
@@ -538,11 +551,12 @@ impl Method for Vals {
             ..GpuFilterParams::new(cx.size, &vs.interleave)
         };
         let shadow = &cx.targets.shadow;
-        let Some(coarse) = self.coarse.as_ref() else {
+        let (Some(coarse), Some((_, seed_list))) = (self.coarse.as_ref(), self.seed_list.as_ref()) else {
             return 0.0;
         };
         let f = ValFrame {
             coarse,
+            seed_list,
             down,
             scene: cx.scene,
             gbuffer: &cx.targets.gbuffer,

@@ -77,8 +77,8 @@ pub struct ValRsm {
     pub arrays: [wgpu::TextureView; 3],
     /// Storage views (the downsample writes them).
     storage: [wgpu::TextureView; 3],
-    /// A bit per texel: taken by a seed (`seeds_main`).
-    taken: wgpu::Buffer,
+    /// Per texel the inverted least VPL index on it (`claim_main`).
+    claim: wgpu::Buffer,
 }
 
 impl ValRsm {
@@ -114,13 +114,12 @@ impl ValRsm {
             })
         });
         let storage = textures.each_ref().map(|t| t.create_view(&Default::default()));
-        let words = (res as u64 * res as u64).div_ceil(32);
         Self {
             res,
             textures,
             arrays,
             storage,
-            taken: storage_buffer(device, "val::seed_taken", 4 * words),
+            claim: storage_buffer(device, "val::seed_claim", 4 * res as u64 * res as u64),
         }
     }
 }
@@ -181,6 +180,8 @@ pub struct ValFrame<'a> {
     pub rsm: [&'a wgpu::TextureView; 3],
     /// The clustering RSM they are summed down into.
     pub coarse: &'a ValRsm,
+    /// The unique seed VPLs: [count, indices] (`seed_list_bytes`).
+    pub seed_list: &'a wgpu::Buffer,
     pub down: GpuDownParams,
 }
 
@@ -191,8 +192,15 @@ pub struct ValIsm<'a> {
     pub targets: &'a IsmTargets,
 }
 
+/// The bytes of the unique seed VPLs' list for `vpls` VPLs.
+pub fn seed_list_bytes(vpls: u32) -> u64 {
+    4 * (vpls as u64 + 1)
+}
+
 pub struct ValPass {
     params: wgpu::Buffer,
+    claim: wgpu::ComputePipeline,
+    unique: wgpu::ComputePipeline,
     down_params: wgpu::Buffer,
     down_layout: wgpu::BindGroupLayout,
     down: wgpu::ComputePipeline,
@@ -237,6 +245,7 @@ impl ValPass {
             uniform_entry(11, c),
             storage_entry(12, c, true),
             storage_entry(13, c, false),
+            storage_entry(14, c, false),
         ]);
         let shade_layout = layout("val_shade::layout", &se);
         let rgba32 = wgpu::TextureFormat::Rgba32Float;
@@ -282,6 +291,8 @@ impl ValPass {
             down_params: uniform_buffer::<GpuDownParams>(device, "val::down_params"),
             down: pipe("val_downsample", &down_layout, &dmod, "main", &[]),
             down_layout,
+            claim: pipe("val_seed_claim", &shade_layout, &smod, "claim_main", &[]),
+            unique: pipe("val_seed_unique", &shade_layout, &smod, "unique_main", &[]),
             seeds: pipe("val_seeds", &shade_layout, &smod, "seeds_main", &[]),
             lights: pipe("val_ism_lights", &shade_layout, &smod, "lights_main", &[]),
             shade: pipe("val_shade", &shade_layout, &smod, "shade_main", &[]),
@@ -361,7 +372,8 @@ impl ValPass {
                     b.diag.as_entire_binding(),
                     self.ism_params.as_entire_binding(),
                     ism_depth.as_entire_binding(),
-                    f.coarse.taken.as_entire_binding(),
+                    f.coarse.claim.as_entire_binding(),
+                    f.seed_list.as_entire_binding(),
                 ],
             )
         };
@@ -390,10 +402,22 @@ impl ValPass {
             &down,
             groups_image(f.coarse.res, f.coarse.res),
         );
-        // The seeds, one thread (the VALs bound are not read).
+        // The seeds: claims, the unique VPLs, a seed per cluster (the VALs bound are not read).
         let before = bind(t.vals(), &t.seeds);
-        encoder.clear_buffer(&f.coarse.taken, 0, None);
-        run_compute(encoder, timer, "val_seeds", &self.seeds, &before, (1, 1, 1));
+        encoder.clear_buffer(&f.coarse.claim, 0, None);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("val_seeds"),
+                timestamp_writes: timer.compute_pass("val_seeds"),
+            });
+            pass.set_bind_group(0, &before, &[]);
+            pass.set_pipeline(&self.claim);
+            pass.dispatch_workgroups(p.count.div_ceil(WG_1D).clamp(1, 65535), 1, 1);
+            pass.set_pipeline(&self.unique);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&self.seeds);
+            pass.dispatch_workgroups(per_cluster.0, 1, 1);
+        }
         self.cluster.record(
             device,
             queue,
