@@ -882,3 +882,178 @@ fn the_substitute_ray_offset_only_shortens_substitute_shadow_rays() {
     }
     assert!(ctx.errors.take().is_empty());
 }
+
+/// ISM visibility of the tree samplers (issue 21: the imperfect shadow maps as their
+/// approximate-visibility option): a map per light-tree leaf (the leaf's VPL, 32^2, 4096
+/// points of a 2^17 cloud, front faces culled), built as the CPU twin builds it; each traced
+/// sample looks up the map the CPU expects (its leaf, or for a substitute a leaf of its
+/// node's subtree) and is lit exactly when the CPU's lookup in the GPU's atlas says so; the
+/// image stays near the one with shadow rays.
+#[test]
+fn ism_visibility_looks_samples_up_in_the_leaves_maps_as_the_cpu_does() {
+    use lightcut::base::gpu_layout::{GpuVpl, VPL_NONE};
+    use lightcut::methods::tree_samplers::{
+        TreeSamplers,
+        pass::SampleVisibility,
+        settings::{IsmSettings, SamplerVisibility},
+    };
+    use lightcut::reference::ism::{self, IsmLayout, IsmLight};
+    use lightcut::renderer::passes::ism::cloud_of_bvh;
+    let Some(ctx) = common::gpu() else { return };
+    let mut s = RenderSettings::default();
+    s.gi.method = SLC;
+    s.vpl.count = 256;
+    s.sampling.fixed_seed = true;
+    s.sampling.visibility = SamplerVisibility::Ism;
+    s.sampling.ism = IsmSettings {
+        points: 1 << 17,
+        points_per_light: 4096,
+        atlas: 512,
+        tile: 32,
+        ..Default::default()
+    };
+    let mut st = Setup::new(&ctx, s.clone(), (W, H));
+    st.frame();
+    assert!(ctx.errors.take().is_empty());
+    let ts = st.r.method_module::<TreeSamplers>().expect("registered");
+    let (targets, maps) = ts.ism().expect("ISM visibility builds the leaves' maps");
+    let sorted: Vec<GpuVpl> =
+        bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &st.r.tree_buffers().1.sorted_vpls).unwrap());
+    let leaves = maps as usize;
+    assert!(leaves >= 256 && leaves.is_power_of_two());
+    // The maps: the CPU twin's splat of the same cloud (each leaf's share, front faces
+    // culled) and pull-push.
+    let layout = IsmLayout {
+        atlas: s.sampling.ism.atlas,
+        tile: s.sampling.ism.tile,
+    };
+    let cloud = cloud_of_bvh(
+        &st.r.scene_gpu().bvh,
+        s.sampling.ism.points,
+        lightcut::methods::tree_samplers::ISM_CLOUD_SEED,
+    );
+    let (points, normals): (Vec<Vec3>, Vec<Vec3>) = cloud.into_iter().unzip();
+    let lights: Vec<IsmLight> = sorted[..leaves]
+        .iter()
+        .map(|v| IsmLight {
+            range: if v.id == VPL_NONE { 0.0 } else { ism::EMPTY },
+            ..IsmLight::new(Vec3::from_slice(&v.position[..3]), Vec3::from_array(v.normal))
+        })
+        .collect();
+    let mut cpu = ism::splat_culled(
+        layout,
+        &lights,
+        &points,
+        Some(&normals),
+        s.sampling.ism.points_per_light,
+    );
+    ism::pull_push(layout, &mut cpu, maps, s.sampling.ism.levels());
+    let gpu: Vec<f32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &targets.depth).unwrap());
+    let texels = leaves * (layout.tile * layout.tile) as usize;
+    let same = (0..maps)
+        .flat_map(|m| (0..layout.tile).flat_map(move |v| (0..layout.tile).map(move |u| (m, u, v))))
+        .filter(|&(m, u, v)| {
+            let k = layout.texel(m, u, v);
+            gpu[k] == cpu[k] || (gpu[k] - cpu[k]).abs() <= 1e-5 * cpu[k].abs()
+        })
+        .count();
+    eprintln!("leaf maps: {same} of {texels} texels equal the CPU's");
+    assert!(same * 1000 >= texels * 995, "{same} of {texels}");
+
+    // Traced samples: the map each looked up and its answer, as the CPU's lookup.
+    let pos = st.r.read(Buffer::Position).unwrap();
+    let (mut checked, mut substitutes, mut blocked) = (0, 0, 0);
+    for (x, y) in [
+        (10u32, 10u32),
+        (30, 20),
+        (40, 8),
+        (20, 28),
+        (5, 25),
+        (24, 16),
+        (44, 28),
+        (14, 4),
+        (36, 14),
+        (2, 12),
+    ] {
+        let k = (y * W + x) as usize;
+        if pos.pixels[k][3] == 0.0 {
+            continue;
+        }
+        let p = Vec3::from_slice(&pos.pixels[k][..3]);
+        st.r.set_trace_pixel(Some((x, y)));
+        st.frame();
+        let trace = st.r.read_pixel_trace().unwrap().expect("a trace");
+        for smp in &trace.samples {
+            let Some((_, vis)) = smp.point else { continue };
+            if vis == SampleVisibility::FacingAway {
+                assert_eq!(smp.ism_map, None);
+                continue;
+            }
+            let m = smp.ism_map.expect("a lit-facing sample looked a map up");
+            // Its leaf, or a leaf of its node's subtree (level l: 2^(L - l) leaves).
+            let node = smp.end;
+            if node as usize >= leaves {
+                assert_eq!(m as usize, node as usize - leaves);
+            } else {
+                substitutes += 1;
+                let down = leaves.ilog2() - node.ilog2();
+                let first = ((node as usize) << down) - leaves;
+                assert!(
+                    (first..first + (1 << down)).contains(&(m as usize)),
+                    "{m} under {node}"
+                );
+            }
+            let lv = sorted[m as usize];
+            let want = lv.id == VPL_NONE
+                || ism::visible(
+                    layout,
+                    &gpu,
+                    m,
+                    Vec3::from_slice(&lv.position[..3]),
+                    Vec3::from_array(lv.normal),
+                    p,
+                    s.sampling.ism.bias,
+                );
+            assert_eq!(
+                vis == SampleVisibility::Visible,
+                want,
+                "sample at node {node}, map {m}"
+            );
+            checked += 1;
+            blocked += (!want) as usize;
+        }
+    }
+    eprintln!("{checked} samples checked ({substitutes} substitutes, {blocked} in shadow)");
+    assert!(checked > 30 && substitutes > 0 && blocked > 0, "{checked} {substitutes} {blocked}");
+
+    // The image stays near the shadow rays' one (16-frame means).
+    let mean = |st: &mut Setup, ism_on: bool| {
+        st.r.set_trace_pixel(None);
+        st.set(|s| {
+            s.sampling.fixed_seed = false;
+            s.sampling.accumulate = true;
+            s.sampling.visibility = if ism_on {
+                SamplerVisibility::Ism
+            } else {
+                SamplerVisibility::Rays
+            };
+        });
+        for _ in 0..16 {
+            st.frame();
+        }
+        st.indirect()
+    };
+    let with_maps = mean(&mut st, true);
+    let with_rays = mean(&mut st, false);
+    let m = metrics::compare_without_flip(
+        &with_maps,
+        &with_rays,
+        0.0,
+        lightcut::renderer::settings::Tonemap::Aces,
+    );
+    eprintln!(
+        "ISM vs rays (16-frame means): relative RMSE {:.3}, mean ratio {:.3}",
+        m.relative_rmse, m.mean_ratio
+    );
+    assert!(m.mean_ratio > 0.8 && m.mean_ratio < 1.3, "{m:?}");
+}

@@ -22,7 +22,7 @@ struct SlcParams {
     demodulate: u32, // 1: write the estimate without the albedo (half-resolution GI, interleaving)
     trace_pixel: u32, // x | y << 16: the pixel whose samples slc_sample records (pixel story); ~0 none
     near_field: f32, // near-field refinement factor (0 = off): see slc_far_enough
-    shadow_rays: u32, // 1 trace shadow rays, 0 every sample visible
+    shadow_rays: u32, // 1 trace shadow rays, 0 every sample visible, 2 the leaves' imperfect shadow maps
     substitute_offset: f32, // m: substitute samples' shadow rays end this far short (slc_substitute_end)
     child_probability: u32, // 0 mean position (eq. 5.5), 1 min-max box distance (RTSLC's), 2 defensive: slc_child_prob
     interleave: u32,        // n of the n x n slot interleaving (1 = off)

@@ -59,7 +59,8 @@ pub enum VisibilityArg {
     None,
     /// A BVH shadow ray per evaluated VPL or sample.
     Rays,
-    /// Imperfect shadow maps, one per VPL (the light-culling methods; others refuse it).
+    /// Imperfect shadow maps: one per VPL (the light-culling methods) or per light-tree leaf
+    /// (the tree samplers); the others refuse it.
     Ism,
 }
 
@@ -109,7 +110,8 @@ pub struct SamplingArgs {
     /// Visibility of the VPL methods and their ground truth: `rays` (BVH shadow rays),
     /// `none` (every VPL visible: the unshadowed estimate, as Stochastic Light Culling's
     /// figures 1 and 4; the same switch as `--no-shadow-rays`) or `ism` (the light-culling
-    /// methods look each VPL up in its imperfect shadow map; the ground truth traces rays).
+    /// methods look each VPL up in its imperfect shadow map, the tree samplers a light-tree
+    /// leaf's; the ground truth traces rays).
     #[arg(long, value_enum)]
     pub visibility: Option<VisibilityArg>,
     /// How the VAL methods (`val`, `val-vpl`) shadow their VALs while shadow rays are on:

@@ -24,6 +24,7 @@
 #include "common/slc.wgsl"
 #include "common/slc_params.wgsl"
 #include "common/stats64.wgsl"
+#include "common/ism.wgsl"
 
 @group(0) @binding(0) var<uniform> sp: SlcParams;
 @group(0) @binding(1) var<storage, read> tree: array<SstNode>;
@@ -52,10 +53,15 @@ override DIAGNOSTICS: bool = true;
 // bitcast) in `methods::tree_samplers::pass::PixelTrace`: a 32-word header, then per sample (the first
 // TRACE_SAMPLES) a 64-word record: block slot, start node, end node, steps, stop reason,
 // path probability, sampled point xyz, visible, contribution rgb (flux/pi x G x V / prob),
-// the cut slot (word 13), then from word 16 the path as (child taken, its probability)
+// the cut slot (word 13), 1 + the leaf map looked up (word 14; 0: none), then from word 16 the path as (child taken, its probability)
 // pairs. Header words 16-18 (written after the samples): samples taken, the interleaving's
 // n^2, the pixel's subset.
 @group(0) @binding(13) var<storage, read_write> trace: array<u32>;
+// The leaves' imperfect shadow maps (shadow_rays == 2; dummies otherwise): the lookups'
+// parameters, the atlas, and per leaf its map's light (written by ism_leaves_main).
+@group(0) @binding(14) var<uniform> ism: IsmParams;
+@group(0) @binding(15) var<storage, read> ism_depth: array<f32>;
+@group(0) @binding(16) var<storage, read_write> ism_lights: array<vec4<f32>>;
 const TRACE_HEADER: u32 = 32u;
 const TRACE_RECORD: u32 = 64u;
 const TRACE_SAMPLES: u32 = 64u;
@@ -144,7 +150,22 @@ fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: 
     }
     let geo = vpl_geometry(pv, nv, x, n, sp.epsilon);
     var lit = geo > 0.0;
-    if lit && sp.shadow_rays != 0u {
+    if lit && sp.shadow_rays == 2u {
+        // The leaf's map; a substitute sample: a random leaf of the node's subtree
+        // (level l of the perfect tree: 2^(L - l) leaves from node << (L - l)).
+        var m = node - sp.leaves;
+        if node < sp.leaves {
+            let down = firstLeadingBit(sp.leaves) - firstLeadingBit(node);
+            let span = 1u << down;
+            m = (node << down) - sp.leaves + min(u32(rng_next(rng) * f32(span)), span - 1u);
+        }
+        let lv = sorted_vpls[m];
+        lit = lv.id == VPL_NONE || ism_visible(m, lv.position.xyz, lv.normal, x);
+        *rays += 1u;
+        if tb != NO_TRACE {
+            trace[tb + 14u] = m + 1u;
+        }
+    } else if lit && sp.shadow_rays != 0u {
         let o = x + n * sp.ray_offset;
         var e = pv + nv * sp.ray_offset;
         if node < sp.leaves {
@@ -164,6 +185,20 @@ fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: 
         return vec3<f32>(0.0);
     }
     return flux / PI * geo;
+}
+
+// Per leaf its map's light: the leaf's VPL (position, +inf range; an empty leaf: range 0,
+// its map stays empty), normal. Twin: the lights of tests/slc.rs's atlas check.
+@compute @workgroup_size(64, 1, 1)
+fn ism_leaves_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if i >= sp.leaves {
+        return;
+    }
+    let v = sorted_vpls[i];
+    let r2 = select(3.0e38, 0.0, v.id == VPL_NONE);
+    ism_lights[2u * i] = vec4<f32>(v.position.xyz, r2);
+    ism_lights[2u * i + 1u] = vec4<f32>(v.normal, 0.0);
 }
 
 @compute @workgroup_size(8, 8, 1)

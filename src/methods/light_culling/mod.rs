@@ -286,16 +286,30 @@ pub static SWEEP: super::Sweep = super::Sweep {
     integer: false,
 };
 
-/// The methods that can look VPLs up in imperfect shadow maps (`render --visibility ism`).
-pub const ISM_METHODS: [MethodId; 3] = [ID, CLAMPED, TREE];
+/// The methods that can look VPLs up in imperfect shadow maps (`render --visibility ism`):
+/// light culling's three variants and the tree samplers (a map per light-tree leaf).
+pub const ISM_METHODS: [MethodId; 6] = [
+    ID,
+    CLAMPED,
+    TREE,
+    super::tree_samplers::SLC,
+    super::tree_samplers::SST,
+    super::tree_samplers::RTSLC,
+];
 
 /// Whether `m` can use ISM visibility.
 pub fn has_ism(m: MethodId) -> bool {
     ISM_METHODS.contains(&m)
 }
 
-/// Sets light culling's visibility (while `gi.shadow_rays` is on): maps or rays.
+/// Sets light culling's and the tree samplers' visibility (while `gi.shadow_rays` is on):
+/// maps or rays.
 pub fn set_visibility(s: &mut RenderSettings, ism: bool) {
+    s.sampling.visibility = if ism {
+        super::tree_samplers::settings::SamplerVisibility::Ism
+    } else {
+        super::tree_samplers::settings::SamplerVisibility::Rays
+    };
     // A malformed table is left for validation to name.
     let Ok(mut lc) = s.method::<LightCullingSettings>(ID) else {
         return;

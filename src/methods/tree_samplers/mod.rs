@@ -109,6 +109,7 @@ const TESTS: &[&str] = &[
     "slc::half_resolution_upsampling_equals_the_cpu_reference",
     "slc::the_pixel_story_matches_the_frame_and_the_tree",
     "slc::interleaved_sampling_shares_the_cut_slots_out_and_its_filter_equals_the_cpu_reference",
+    "slc::ism_visibility_looks_samples_up_in_the_leaves_maps_as_the_cpu_does",
 ];
 
 /// Samples per pixel (the cut size), over `results --spp`.
@@ -138,6 +139,8 @@ pub static SLC_INFO: MethodInfo = MethodInfo {
     views: VIEWS,
     timed_passes: &[
         "slc_cuts",
+        "slc_ism_lights",
+        "slc_ism",
         "slc_sample",
         "slc_filter",
         "gi_downsample",
@@ -165,7 +168,14 @@ pub static SST_INFO: MethodInfo = MethodInfo {
     module: &MODULE,
     reads: READS,
     views: VIEWS,
-    timed_passes: &["sst_sample", "slc_filter", "gi_downsample", "gi_upsample"],
+    timed_passes: &[
+        "slc_ism_lights",
+        "slc_ism",
+        "sst_sample",
+        "slc_filter",
+        "gi_downsample",
+        "gi_upsample",
+    ],
     story: true,
     shadow_ray_switch: true,
     truth_of_vpls: false,
@@ -190,6 +200,8 @@ pub static RTSLC_INFO: MethodInfo = MethodInfo {
     views: VIEWS,
     timed_passes: &[
         "slc_cuts",
+        "slc_ism_lights",
+        "slc_ism",
         "rtslc_sample",
         "slc_filter",
         "gi_downsample",
@@ -208,6 +220,7 @@ pub static RTSLC_INFO: MethodInfo = MethodInfo {
 /// `[sampling]`: every field in range, or a message naming it.
 fn validate(s: &RenderSettings) -> Result<(), String> {
     let sm = &s.sampling;
+    sm.ism.validate("sampling")?;
     if !(1..=64).contains(&sm.block_size) {
         return Err(format!(
             "sampling.block_size {} is out of range (1..=64)",
@@ -251,7 +264,16 @@ pub struct TreeSamplers {
     state: Option<(u64, u32)>,
     /// Whether the last recorded frame traced a pixel's story.
     traced: bool,
+    /// The leaves' maps (ISM visibility): the scene's point cloud (and the scene upload it
+    /// was sampled from) and the atlas; maps built by the last frame (0: none).
+    ism_points: Option<(u64, crate::renderer::passes::ism::IsmPoints)>,
+    ism_targets: Option<crate::renderer::passes::ism::IsmTargets>,
+    ism_maps: u32,
 }
+
+/// Seed of the scene's point cloud for the leaves' maps (light culling's, so that the two
+/// methods' maps of one scene are built from the same points).
+pub const ISM_CLOUD_SEED: u32 = crate::methods::light_culling::ISM_CLOUD_SEED;
 
 fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
     Ok(Box::new(TreeSamplers {
@@ -265,10 +287,69 @@ fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
         raw: None,
         state: None,
         traced: false,
+        ism_points: None,
+        ism_targets: None,
+        ism_maps: 0,
     }))
 }
 
 impl TreeSamplers {
+    /// The leaves' maps of the last frame that built them, and how many (None: none).
+    pub fn ism(&self) -> Option<(&crate::renderer::passes::ism::IsmTargets, u32)> {
+        self.ism_targets
+            .as_ref()
+            .filter(|_| self.ism_maps > 0)
+            .map(|t| (t, self.ism_maps))
+    }
+
+    /// ISM visibility for this frame: the cloud and atlas ready and the maps to build
+    /// (`Some(leaves)`), or None (rays or no shadows; more leaves than the atlas holds or an
+    /// atlas beyond the device's binding size: reported, the frame traces rays).
+    fn plan_ism(&mut self, cx: &FrameCx<'_>) -> Option<u32> {
+        use crate::renderer::passes::ism::{IsmPoints, IsmTargets};
+        let s = cx.settings;
+        let sm = &s.sampling;
+        self.ism_maps = 0;
+        if !(s.gi.shadow_rays && sm.visibility == settings::SamplerVisibility::Ism) {
+            return None;
+        }
+        let leaves = cx.tree.leaves.max(1);
+        let need = 4 * (sm.ism.atlas as u64).pow(2);
+        let limit = cx.device.limits().max_storage_buffer_binding_size;
+        if leaves > sm.ism.capacity() || need > limit {
+            cx.errors.report(format!(
+                "tree samplers: ISM visibility needs a map per light-tree leaf ({leaves}) in an \
+                 atlas of {0} x {0} ({1} maps of {2}^2, {3} MiB; this device binds {4} MiB): \
+                 tracing shadow rays instead (raise sampling.ism.atlas, lower sampling.ism.tile \
+                 or the VPL count)",
+                sm.ism.atlas,
+                sm.ism.capacity(),
+                sm.ism.tile,
+                need >> 20,
+                limit >> 20
+            ));
+            return None;
+        }
+        let key = (sm.ism.points, ISM_CLOUD_SEED);
+        let generation = cx.scene.generation;
+        if !matches!(&self.ism_points, Some((g, p)) if *g == generation && p.key == key) {
+            let points = IsmPoints::from_bvh(
+                cx.device,
+                cx.queue,
+                &cx.scene.bvh,
+                sm.ism.points,
+                ISM_CLOUD_SEED,
+                key,
+            );
+            self.ism_points = Some((generation, points));
+        }
+        if !self.ism_targets.as_ref().is_some_and(|t| t.matches(&sm.ism)) {
+            self.ism_targets = Some(IsmTargets::new(cx.device, &sm.ism));
+        }
+        self.ism_maps = leaves;
+        Some(leaves)
+    }
+
     /// Cuts, per-pixel diagnostics, counters and the story of the last frame.
     pub fn buffers(&self) -> &SlcBuffers {
         &self.buffers
@@ -395,6 +476,7 @@ impl Method for TreeSamplers {
             s.vpl.seed ^ (cx.frame_index as u32).wrapping_mul(0x9e37_79b9)
         };
         let grid = self.buffers.grid;
+        let ism_maps = self.plan_ism(cx);
         let p = GpuSlcParams {
             width: gi_size.0,
             height: gi_size.1,
@@ -436,7 +518,11 @@ impl Method for TreeSamplers {
                 None => u32::MAX,
             },
             near_field: sm.near_field,
-            shadow_rays: s.gi.shadow_rays as u32,
+            shadow_rays: if ism_maps.is_some() {
+                2
+            } else {
+                s.gi.shadow_rays as u32
+            },
             substitute_offset: sm.substitute_offset,
             child_probability: match sm.child_probability {
                 ChildProbability::Mean => 0,
@@ -456,6 +542,15 @@ impl Method for TreeSamplers {
             None => (&cx.targets.gbuffer, cx.gi_accum),
         };
         let raw = self.raw.as_ref().map(|(b, _)| b);
+        let ism = match (ism_maps, self.ism_points.as_ref(), self.ism_targets.as_ref()) {
+            (Some(maps), Some((_, points)), Some(targets)) => Some(pass::SlcIsm {
+                settings: &s.sampling.ism,
+                points,
+                targets,
+                maps,
+            }),
+            _ => None,
+        };
         self.pass.record(
             cx.diagnostics,
             device,
@@ -468,6 +563,7 @@ impl Method for TreeSamplers {
             gbuffer,
             raw.unwrap_or(accum),
             &self.buffers,
+            ism.as_ref(),
         );
         if let Some(raw) = raw {
             // The demodulated estimate's mean over the pattern, x albedo (at half resolution

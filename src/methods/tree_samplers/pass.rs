@@ -14,7 +14,10 @@ use crate::renderer::{
 
 use crate::renderer::passes::{
     WG_1D, bind_group_seq, compute_pipeline, compute_pipeline_with, float_texture_entry, groups_image,
-    run_compute, sst_build::TreeBuffers, storage_entry, storage_texture_entry, uniform_entry,
+    ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
+    run_compute,
+    sst_build::TreeBuffers,
+    storage_entry, storage_texture_entry, uniform_entry,
 };
 
 /// Frame counter words written by `slc_sample`: two 32-bit counters, then four 64-bit ones
@@ -150,6 +153,8 @@ pub struct TraceSample {
     /// Flux/pi x G x V / prob: the sample's estimate of the incident sum (times rho/pi is
     /// radiance; SST divides by the sample count).
     pub contribution: glam::Vec3,
+    /// With ISM visibility: the light-tree leaf whose map it looked up.
+    pub ism_map: Option<u32>,
 }
 
 /// The story of one pixel in the last tree-sampling frame: the 4 surrounding blocks, their
@@ -219,6 +224,7 @@ impl PixelTrace {
                     path,
                     point,
                     contribution: glam::Vec3::new(f(b + 10), f(b + 11), f(b + 12)),
+                    ism_map: w[b + 14].checked_sub(1),
                 }
             })
             .collect();
@@ -335,8 +341,24 @@ pub struct GpuSlcViewParams {
     pub _pad: [u32; 2],
 }
 
+/// The leaves' maps of a frame with ISM visibility.
+pub struct SlcIsm<'a> {
+    pub settings: &'a super::settings::IsmSettings<super::settings::IsmAdaptive>,
+    pub points: &'a IsmPoints,
+    pub targets: &'a IsmTargets,
+    /// Maps: the tree's leaves.
+    pub maps: u32,
+}
+
 pub struct SlcPass {
     views: wgpu::ComputePipeline,
+    /// Per leaf its map's light (`ism_leaves_main`).
+    ism_leaves: wgpu::ComputePipeline,
+    /// The maps' build (the shared ISM component).
+    pub ism: IsmPass,
+    ism_params: wgpu::Buffer,
+    /// Bound in the maps' place without ISM visibility: depth (read), lights (written).
+    ism_dummy: [wgpu::Buffer; 2],
     views_layout: wgpu::BindGroupLayout,
     view_params: wgpu::Buffer,
     cuts: wgpu::ComputePipeline,
@@ -384,6 +406,9 @@ impl SlcPass {
                 storage_entry(11, c, false),
                 storage_entry(12, c, false),
                 storage_entry(13, c, false),
+                uniform_entry(14, c),
+                storage_entry(15, c, true),
+                storage_entry(16, c, false),
             ],
         });
         let vmod = shaders::create_module(device, "methods/tree_samplers/slc_views.wgsl")?;
@@ -407,6 +432,19 @@ impl SlcPass {
             ),
             cuts: compute_pipeline(device, "slc_cuts", &[Some(&cuts_layout)], &cmod, "build_cuts"),
             sample: compute_pipeline(device, "slc_sample", &[Some(&sample_layout)], &smod, "main"),
+            ism_leaves: compute_pipeline(
+                device,
+                "slc_ism_lights",
+                &[Some(&sample_layout)],
+                &smod,
+                "ism_leaves_main",
+            ),
+            ism: IsmPass::new(device)?,
+            ism_params: crate::renderer::passes::uniform_buffer::<GpuIsmParams>(device, "slc::ism_params"),
+            ism_dummy: [
+                crate::renderer::passes::storage_buffer(device, "slc::ism_dummy_depth", 16),
+                crate::renderer::passes::storage_buffer(device, "slc::ism_dummy_lights", 32),
+            ],
             sample_timed: compute_pipeline_with(
                 device,
                 "slc_sample::timed",
@@ -444,8 +482,17 @@ impl SlcPass {
         gbuffer: &GbufferTargets,
         accum: &wgpu::Buffer,
         out: &SlcBuffers,
+        ism: Option<&SlcIsm<'_>>,
     ) {
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let (ism_depth, ism_lights) = match ism {
+            Some(m) => {
+                let ip = GpuIsmParams::new(m.targets, m.settings, m.maps, m.points.count);
+                queue.write_buffer(&self.ism_params, 0, bytemuck::bytes_of(&ip));
+                (&m.targets.depth, &m.targets.lights)
+            }
+            None => (&self.ism_dummy[0], &self.ism_dummy[1]),
+        };
         let tv = wgpu::BindingResource::TextureView;
         if p.method != 1 {
             let entries = [
@@ -480,8 +527,25 @@ impl SlcPass {
             out.diag.as_entire_binding(),
             out.stats.as_entire_binding(),
             out.trace.as_entire_binding(),
+            self.ism_params.as_entire_binding(),
+            ism_depth.as_entire_binding(),
+            ism_lights.as_entire_binding(),
         ];
         let bind = bind_group_seq(device, "slc_sample::bind_group", &self.sample_layout, &entries);
+        if let Some(m) = ism {
+            // The leaves' map lights, then the maps (the shared component).
+            run_compute(
+                encoder,
+                timer,
+                "slc_ism_lights",
+                &self.ism_leaves,
+                &bind,
+                (m.maps.div_ceil(WG_1D).max(1), 1, 1),
+            );
+            self.ism.record_maps(
+                device, queue, encoder, timer, "slc_ism", m.settings, m.points, m.maps, m.targets,
+            );
+        }
         if diagnostics {
             encoder.clear_buffer(&out.stats, 0, None);
             encoder.clear_buffer(&out.trace, 0, None);

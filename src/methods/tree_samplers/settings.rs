@@ -3,6 +3,22 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::renderer::settings::{IsmAdaptive, IsmSettings};
+
+/// How the samplers' samples are shadowed while `gi.shadow_rays` is on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SamplerVisibility {
+    /// A BVH shadow ray per sample (the thesis).
+    #[default]
+    Rays,
+    /// Imperfect shadow maps, one per light-tree leaf (issue 21's component, Stochastic Light
+    /// Culling's adaptive maps: 32^2, 8192 points): a leaf sample looks its VPL's map up; a
+    /// substitute sample the map of a random leaf of its node's subtree (an approximation:
+    /// the leaf's VPL stands for the drawn point).
+    Ism,
+}
+
 /// How a pixel picks a cut per slot (thesis 5.1.3, fig. 7.4).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum CutBlending {
@@ -112,6 +128,10 @@ pub struct SamplingSettings {
     /// The samplers' random numbers are the same every frame (debugging: a pixel's story
     /// repeats); off, the seed changes per frame (needed to accumulate).
     pub fixed_seed: bool,
+    /// Visibility of the samples while shadow rays are on: rays, or the leaves' maps.
+    pub visibility: SamplerVisibility,
+    /// The leaves' maps (`[sampling.ism]`; light culling's adaptive-map defaults).
+    pub ism: IsmSettings<IsmAdaptive>,
 }
 
 impl Default for SamplingSettings {
@@ -135,6 +155,8 @@ impl Default for SamplingSettings {
             half_resolution: false,
             interleave: InterleaveSettings::pattern(1),
             fixed_seed: false,
+            visibility: SamplerVisibility::Rays,
+            ism: IsmSettings::default(),
         }
     }
 }

@@ -1,7 +1,7 @@
 //! The tree samplers' settings in the GUI (SST hides the cut and blending controls it does
 //! not use; RTSLC hides the substitute controls).
 
-use super::settings::{ChildProbability, CutBlending, CutFallback};
+use super::settings::{ChildProbability, CutBlending, CutFallback, SamplerVisibility};
 use super::{RTSLC, SST};
 use crate::methods::MethodId;
 use crate::renderer::settings::RenderSettings;
@@ -80,4 +80,25 @@ pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) 
         "RTSLC's code 2 x 2 or 4 x 4",
     );
     ui.checkbox(&mut sm.accumulate, "accumulate frames while static");
+    let shadow_rays = s.gi.shadow_rays;
+    let sm = &mut s.sampling;
+    ui.add_enabled_ui(shadow_rays, |ui| {
+        ui.horizontal(|ui| {
+            ui.label("visibility");
+            ui.radio_value(&mut sm.visibility, SamplerVisibility::Rays, "shadow rays")
+                .on_hover_text("a BVH shadow ray per sample (the thesis)");
+            ui.radio_value(&mut sm.visibility, SamplerVisibility::Ism, "ISM")
+                .on_hover_text(
+                    "an imperfect shadow map per light-tree leaf: a leaf sample looks up its VPL's \
+                     map, a substitute sample a random leaf's of its node (approximate)",
+                );
+        });
+    })
+    .response
+    .on_disabled_hover_text("turn shadow rays on to pick how samples are shadowed");
+    if shadow_rays && sm.visibility == SamplerVisibility::Ism {
+        ui.indent("sampler_ism", |ui| {
+            crate::methods::ism_ui::settings_ui(ui, &mut sm.ism, "leaf", "32^2", "8192");
+        });
+    }
 }

@@ -192,6 +192,11 @@ pub struct ValIsm<'a> {
     pub targets: &'a IsmTargets,
 }
 
+/// Workgroup size of `unique_main` (one workgroup compacts the unique seed VPLs).
+pub const SEED_WG: u32 = 256;
+/// The entry that uses it.
+pub const SEED_WG_ENTRY: &str = "unique_main";
+
 /// The bytes of the unique seed VPLs' list for `vpls` VPLs.
 pub fn seed_list_bytes(vpls: u32) -> u64 {
     4 * (vpls as u64 + 1)

@@ -317,7 +317,11 @@ mod tests {
                 // Light culling's tile kernel: one workgroup per tile.
                 let culling = file == "methods/light_culling/lcull_tiles.wgsl"
                     && ws == [crate::methods::light_culling::pass::TILE_WG, 1, 1];
-                let ok = own || tile || culling || ws == [WG_2D, WG_2D, 1] || ws == [WG_1D, 1, 1];
+                // The VAL seeds' compaction: one workgroup.
+                let seeds = file == "methods/val/val_shade.wgsl"
+                    && ep.name == crate::methods::val::pass::SEED_WG_ENTRY
+                    && ws == [crate::methods::val::pass::SEED_WG, 1, 1];
+                let ok = own || tile || culling || seeds || ws == [WG_2D, WG_2D, 1] || ws == [WG_1D, 1, 1];
                 assert!(ok, "{file}::{} has workgroup size {ws:?}", ep.name);
             }
         }
