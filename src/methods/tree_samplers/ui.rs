@@ -85,7 +85,7 @@ pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) 
     ui.add_enabled_ui(shadow_rays, |ui| {
         ui.horizontal(|ui| {
             ui.label("visibility");
-            ui.radio_value(&mut sm.visibility, SamplerVisibility::Rays, "shadow rays")
+            ui.radio_value(&mut sm.visibility, SamplerVisibility::Rays, "BVH rays")
                 .on_hover_text("a BVH shadow ray per sample (the thesis)");
             ui.radio_value(&mut sm.visibility, SamplerVisibility::Ism, "ISM")
                 .on_hover_text(
