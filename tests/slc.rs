@@ -1024,7 +1024,10 @@ fn ism_visibility_looks_samples_up_in_the_leaves_maps_as_the_cpu_does() {
         }
     }
     eprintln!("{checked} samples checked ({substitutes} substitutes, {blocked} in shadow)");
-    assert!(checked > 30 && substitutes > 0 && blocked > 0, "{checked} {substitutes} {blocked}");
+    assert!(
+        checked > 30 && substitutes > 0 && blocked > 0,
+        "{checked} {substitutes} {blocked}"
+    );
 
     // The image stays near the shadow rays' one (16-frame means).
     let mean = |st: &mut Setup, ism_on: bool| {

@@ -532,10 +532,11 @@ impl IsmDefault for IsmVal {
     const TILE: u32 = 128;
     const POINTS_PER_LIGHT: u32 = 0;
     const FRONT_FACE_CULLING: bool = false;
-    // Measured (tests/val.rs, the default room, 64 VALs of 4096 points on 128^2 maps): the
-    // simple lookup agrees with a ray to the VAL's centre on 77.4% of (pixel, VAL) pairs with
-    // one texel per point, 79.9% with size 0.5, 65.4% with 1 (grazing surfaces shadow
-    // themselves: sprites are squares) at bias 0.05; 84.0% with size 0.5 at bias 0.1.
+    // Measured once with tests/val.rs's map-quality loop scaled up (the default room, 64 VALs of
+    // 4096 points on 128^2 maps; docs/ism.md): the simple lookup agrees with a ray to the VAL's
+    // centre on 77.4% of (pixel, VAL) pairs with one texel per point, 79.9% with size 0.5,
+    // 65.4% with 1 (grazing surfaces shadow themselves: sprites are squares) at bias 0.05;
+    // 84.0% with size 0.5 at bias 0.1. The test itself checks the tiny case.
     const POINT_SIZE: f32 = 0.5;
     const BIAS: f32 = 0.1;
 }
@@ -576,6 +577,10 @@ impl<D: IsmDefault> IsmSettings<D> {
     /// Maps the atlas holds.
     pub fn capacity(&self) -> u32 {
         (self.atlas / self.tile.max(1)).pow(2)
+    }
+    /// Bytes of the atlas's depth buffer (what the device must bind in one piece).
+    pub fn atlas_bytes(&self) -> u64 {
+        4 * (self.atlas as u64).pow(2)
     }
     /// The pull-push levels that fit the map.
     pub fn levels(&self) -> u32 {

@@ -451,16 +451,15 @@ impl LightCulling {
     /// The point cloud and the atlas for `s` on the frame's scene (rebuilt when either
     /// changed).
     fn ensure_ism(&mut self, cx: &FrameCx<'_>, s: &IsmSettings<IsmAdaptive>) {
-        let key = (s.points, ISM_CLOUD_SEED);
-        let generation = cx.scene.generation;
-        if !matches!(&self.ism_points, Some((g, p)) if *g == generation && p.key == key) {
-            let points =
-                IsmPoints::from_bvh(cx.device, cx.queue, &cx.scene.bvh, s.points, ISM_CLOUD_SEED, key);
-            self.ism_points = Some((generation, points));
-        }
-        if !self.ism_targets.as_ref().is_some_and(|t| t.matches(s)) {
-            self.ism_targets = Some(IsmTargets::new(cx.device, s));
-        }
+        crate::renderer::passes::ism::ensure_maps(
+            cx.device,
+            cx.queue,
+            cx.scene,
+            s,
+            ISM_CLOUD_SEED,
+            &mut self.ism_points,
+            &mut self.ism_targets,
+        );
     }
 
     /// The frame's visibility and maps: (GpuLcullParams::shadow_rays, ism_flags, maps to
@@ -502,7 +501,7 @@ impl LightCulling {
             ));
             return None;
         }
-        let need = 4 * (lc.ism.atlas as u64).pow(2);
+        let need = lc.ism.atlas_bytes();
         let limit = cx.device.limits().max_storage_buffer_binding_size;
         if (on || shown) && need > limit {
             cx.errors.report(format!(

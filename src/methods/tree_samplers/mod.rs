@@ -306,7 +306,6 @@ impl TreeSamplers {
     /// (`Some(leaves)`), or None (rays or no shadows; more leaves than the atlas holds or an
     /// atlas beyond the device's binding size: reported, the frame traces rays).
     fn plan_ism(&mut self, cx: &FrameCx<'_>) -> Option<u32> {
-        use crate::renderer::passes::ism::{IsmPoints, IsmTargets};
         let s = cx.settings;
         let sm = &s.sampling;
         self.ism_maps = 0;
@@ -314,7 +313,7 @@ impl TreeSamplers {
             return None;
         }
         let leaves = cx.tree.leaves.max(1);
-        let need = 4 * (sm.ism.atlas as u64).pow(2);
+        let need = sm.ism.atlas_bytes();
         let limit = cx.device.limits().max_storage_buffer_binding_size;
         if leaves > sm.ism.capacity() || need > limit {
             cx.errors.report(format!(
@@ -330,22 +329,15 @@ impl TreeSamplers {
             ));
             return None;
         }
-        let key = (sm.ism.points, ISM_CLOUD_SEED);
-        let generation = cx.scene.generation;
-        if !matches!(&self.ism_points, Some((g, p)) if *g == generation && p.key == key) {
-            let points = IsmPoints::from_bvh(
-                cx.device,
-                cx.queue,
-                &cx.scene.bvh,
-                sm.ism.points,
-                ISM_CLOUD_SEED,
-                key,
-            );
-            self.ism_points = Some((generation, points));
-        }
-        if !self.ism_targets.as_ref().is_some_and(|t| t.matches(&sm.ism)) {
-            self.ism_targets = Some(IsmTargets::new(cx.device, &sm.ism));
-        }
+        crate::renderer::passes::ism::ensure_maps(
+            cx.device,
+            cx.queue,
+            cx.scene,
+            &sm.ism,
+            ISM_CLOUD_SEED,
+            &mut self.ism_points,
+            &mut self.ism_targets,
+        );
         self.ism_maps = leaves;
         Some(leaves)
     }

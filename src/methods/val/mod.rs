@@ -155,62 +155,61 @@ fn invalid_example(s: &mut RenderSettings) -> &'static str {
     "methods.val.clusters"
 }
 
-pub static INFO: MethodInfo = MethodInfo {
-    id: ID,
-    aliases: &["virtual-area-lights", "vals"],
-    label: "Virtual Area Lights",
-    short: "VAL",
-    about: "Weinzierl-Heigl: the RSM clustered into virtual area lights each frame, shaded with \
-            the point-to-disk form factor, interleaved, shadowed by imperfect shadow maps with \
-            a simple or PCSS lookup.",
-    progress_unit: "",
-    kind: Kind::PerFrame,
-    module: &MODULE,
-    reads: &[
-        Resource::Gbuffer,
-        Resource::ShadowMaps,
-        Resource::Vpls,
-        Resource::Bvh,
-    ],
-    views: VIEWS,
-    timed_passes: TIMED,
-    story: false,
-    shadow_ray_switch: true,
-    truth_of_vpls: false,
-    validate,
-    invalid_example: Some(invalid_example),
-    ui: ui::settings_ui,
-    tests: TESTS,
-    sweep: Some(&SWEEP),
-};
+/// The two methods' registry rows: one module, settings, views, passes and tests; they differ
+/// in identity and in how a VAL is shaded.
+const fn info(
+    id: MethodId,
+    aliases: &'static [&'static str],
+    label: &'static str,
+    short: &'static str,
+    about: &'static str,
+) -> MethodInfo {
+    MethodInfo {
+        id,
+        aliases,
+        label,
+        short,
+        about,
+        progress_unit: "",
+        kind: Kind::PerFrame,
+        module: &MODULE,
+        reads: &[
+            Resource::Gbuffer,
+            Resource::ShadowMaps,
+            Resource::Vpls,
+            Resource::Bvh,
+        ],
+        views: VIEWS,
+        timed_passes: TIMED,
+        story: false,
+        shadow_ray_switch: true,
+        truth_of_vpls: false,
+        validate,
+        invalid_example: Some(invalid_example),
+        ui: ui::settings_ui,
+        tests: TESTS,
+        sweep: Some(&SWEEP),
+    }
+}
 
-pub static VPL_INFO: MethodInfo = MethodInfo {
-    id: VPL,
-    aliases: &["val-as-vpls"],
-    label: "VALs shaded as VPLs",
-    short: "VAL as VPL",
-    about: "The VAL pipeline with every cluster shaded as a point light (the VAL paper's \
-            figure 7 comparison): same clusters, maps and lookups.",
-    progress_unit: "",
-    kind: Kind::PerFrame,
-    module: &MODULE,
-    reads: &[
-        Resource::Gbuffer,
-        Resource::ShadowMaps,
-        Resource::Vpls,
-        Resource::Bvh,
-    ],
-    views: VIEWS,
-    timed_passes: TIMED,
-    story: false,
-    shadow_ray_switch: true,
-    truth_of_vpls: false,
-    validate,
-    invalid_example: Some(invalid_example),
-    ui: ui::settings_ui,
-    tests: TESTS,
-    sweep: Some(&SWEEP),
-};
+pub static INFO: MethodInfo = info(
+    ID,
+    &["virtual-area-lights", "vals"],
+    "Virtual Area Lights",
+    "VAL",
+    "Weinzierl-Heigl: the RSM clustered into virtual area lights each frame, shaded with the \
+     point-to-disk form factor, interleaved, shadowed by imperfect shadow maps with a simple or \
+     PCSS lookup.",
+);
+
+pub static VPL_INFO: MethodInfo = info(
+    VPL,
+    &["val-as-vpls"],
+    "VALs shaded as VPLs",
+    "VAL as VPL",
+    "The VAL pipeline with every cluster shaded as a point light (the VAL paper's figure 7 \
+     comparison): same clusters, maps and lookups.",
+);
 
 /// The VAL count (the paper's Table 1 compares 64 and 512).
 pub static SWEEP: super::Sweep = super::Sweep {
@@ -344,10 +343,6 @@ impl Vals {
             .filter(|_| self.ism_maps > 0)
             .map(|t| (t, self.ism_maps))
     }
-    /// The point cloud of the maps (None before maps were built).
-    pub fn ism_points(&self) -> Option<&IsmPoints> {
-        self.ism_points.as_ref().map(|(_, p)| p)
-    }
     /// Counters of a recent diagnostic frame (non-blocking).
     pub fn poll_stats(&mut self) -> Option<ValStats> {
         self.stats.as_mut()?.poll()
@@ -379,7 +374,7 @@ impl Vals {
     /// Err when the atlas is beyond the device's binding size.
     fn ensure_ism(&mut self, cx: &FrameCx<'_>, vs: &ValSettings) -> Result<(), String> {
         let s = &vs.ism;
-        let need = 4 * (s.atlas as u64).pow(2);
+        let need = s.atlas_bytes();
         let limit = cx.device.limits().max_storage_buffer_binding_size;
         if need > limit {
             return Err(format!(
@@ -401,16 +396,15 @@ impl Vals {
                 s.capacity()
             ));
         }
-        let key = (s.points, ISM_CLOUD_SEED);
-        let generation = cx.scene.generation;
-        if !matches!(&self.ism_points, Some((g, p)) if *g == generation && p.key == key) {
-            let points =
-                IsmPoints::from_bvh(cx.device, cx.queue, &cx.scene.bvh, s.points, ISM_CLOUD_SEED, key);
-            self.ism_points = Some((generation, points));
-        }
-        if !self.ism_targets.as_ref().is_some_and(|t| t.matches(s)) {
-            self.ism_targets = Some(IsmTargets::new(cx.device, s));
-        }
+        crate::renderer::passes::ism::ensure_maps(
+            cx.device,
+            cx.queue,
+            cx.scene,
+            s,
+            ISM_CLOUD_SEED,
+            &mut self.ism_points,
+            &mut self.ism_targets,
+        );
         Ok(())
     }
 

@@ -145,6 +145,31 @@ impl IsmPoints {
     }
 }
 
+/// Keeps a method's maps ready for `s` on `scene`: the point cloud (sampled again for a new
+/// scene upload, point count or `seed`) and the atlas (made again for another size). Shared by
+/// every method that builds maps.
+pub fn ensure_maps<D: IsmDefault>(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    scene: &crate::renderer::scene_gpu::SceneGpu,
+    s: &IsmSettings<D>,
+    seed: u32,
+    points: &mut Option<(u64, IsmPoints)>,
+    targets: &mut Option<IsmTargets>,
+) {
+    let key = (s.points, seed);
+    let generation = scene.generation;
+    if !matches!(points, Some((g, p)) if *g == generation && p.key == key) {
+        *points = Some((
+            generation,
+            IsmPoints::from_bvh(device, queue, &scene.bvh, s.points, seed, key),
+        ));
+    }
+    if !targets.as_ref().is_some_and(|t| t.matches(s)) {
+        *targets = Some(IsmTargets::new(device, s));
+    }
+}
+
 /// The point cloud [`IsmPoints::from_bvh`] uploads, with normals (its CPU twin, for tests).
 pub fn cloud_of_bvh(bvh: &crate::scene::bvh::Bvh, count: u32, seed: u32) -> Vec<(Vec3, Vec3)> {
     let positions: Vec<Vec3> = bvh.triangles.iter().flat_map(|t| t.vertices()).collect();
