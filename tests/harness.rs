@@ -96,6 +96,15 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             // per-pixel walks stay short at this size).
             "--set",
             "methods.light-culling.epsilon_max=0.002",
+            // The temporal figure: three frames per motion, timings at the frame size.
+            "--temporal-frames",
+            "3",
+            "--temporal-path-frames",
+            "30",
+            "--temporal-timing-width",
+            "64",
+            "--temporal-timing-height",
+            "48",
             "--out",
         ])
         .arg(&out)
@@ -403,12 +412,39 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     ] {
         decodes(&d.join(p));
     }
+    // The temporal figure: a row per motion and method, a per-frame row each, GPU times of
+    // the stage's passes, a plot per motion.
+    let (_, rows) = common::read_csv(&d.join("temporal_summary.csv"));
+    assert_eq!(rows.len(), 3 * 5, "{rows:?}");
+    for r in &rows {
+        let (raw, filt): (f64, f64) = (
+            r["rmse_raw"].parse().unwrap(),
+            r["rmse_filtered"].parse().unwrap(),
+        );
+        assert!(raw.is_finite() && filt.is_finite() && raw > 0.0, "{r:?}");
+        assert_eq!(r["temporal"], "svgf");
+    }
+    let (_, rows) = common::read_csv(&d.join("temporal.csv"));
+    assert_eq!(rows.len(), 3 * 5 * 3);
+    let (_, rows) = common::read_csv(&d.join("temporal_timing.csv"));
+    assert!(
+        rows.iter()
+            .any(|r| r["pass"] == "temporal_atrous" && r["median_ms"].parse::<f64>().unwrap() > 0.0),
+        "{rows:?}"
+    );
+    for p in [
+        "temporal_rmse_camera_path.png",
+        "temporal_rmse_sun_sweep.png",
+        "temporal_rmse_still.png",
+    ] {
+        decodes(&d.join(p));
+    }
     let run: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
     assert_eq!(run["width"], 64);
     // Each figure's wall time and the share of it outside rendering / GPU waits.
     let times = run["scenes"][0]["figure_times"].as_array().unwrap();
-    assert_eq!(times.len(), 10, "{times:?}");
+    assert_eq!(times.len(), 11, "{times:?}");
     for t in times {
         let share = t["share_outside_gpu"].as_f64().unwrap();
         assert!(

@@ -37,6 +37,8 @@ const EXAMPLES: &[&str] = &[
     "-- render --scene default --width 320 --height 240 --method light-culling --visibility none --compare-gt --out out/lcull",
     "-- render --scene default --width 320 --height 240 --method val --val-visibility pcss --compare-gt --out out/val",
     "-- results val --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
+    "-- render --scene default --width 320 --height 240 --method slc --temporal svgf --camera-path --path-frames 60 --compare-gt --out out/temporal",
+    "-- results temporal --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
     "-- results interpolation --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
     "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",
     "-- --view albedo --settings docs/settings-example.toml --tree-stats",
@@ -580,6 +582,56 @@ fn cli_examples_write_what_they_promise() {
     let csv = std::fs::read_to_string(vr.join("default").join("val_table1.csv")).expect("val_table1.csv");
     assert_eq!(csv.lines().count(), 5, "{csv}");
     let _ = std::fs::remove_dir_all(&vr);
+    // SLC with SVGF along the default scene's camera path: per-frame errors of the raw and
+    // filtered GI against each frame's ground truth, and the frames' PNGs.
+    let tp = tmp("temporal");
+    let out = run_cli(&args(
+        "-- render --scene default --width 320 --height 240 --method slc --temporal svgf --camera-path --path-frames 60 --compare-gt --out out/temporal",
+        &[
+            ("--width", "32"),
+            ("--height", "24"),
+            ("--path-frames", "3"),
+            ("--out", tp.to_str().unwrap()),
+        ],
+        &["--vpls", "256"],
+    ));
+    assert!(out.contains("RMSE raw") && out.contains("filtered"), "{out}");
+    let (_, rows) = common::read_csv(&tp.join("sequence.csv"));
+    assert_eq!(rows.len(), 3);
+    for r in &rows {
+        for k in ["rmse_raw", "rmse_filtered", "ssim_filtered"] {
+            assert!(r[k].parse::<f64>().is_ok_and(f64::is_finite), "{k}: {r:?}");
+        }
+    }
+    assert!(tp.join("frames").join("0002.png").is_file() && tp.join("indirect.exr").is_file());
+    let _ = std::fs::remove_dir_all(&tp);
+    // The temporal figure (the default scene, SLC, tiny).
+    let tr = tmp("temporal-results");
+    run_cli(&args(
+        "-- results temporal --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
+        &[("--scenes", "default"), ("--out", tr.to_str().unwrap())],
+        &[
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--temporal-frames",
+            "2",
+            "--temporal-timing-width",
+            "32",
+            "--temporal-timing-height",
+            "24",
+            "--timing-frames",
+            "2",
+            "--vpls",
+            "256",
+            "--methods",
+            "slc",
+        ],
+    ));
+    let (_, rows) = common::read_csv(&tr.join("default").join("temporal_summary.csv"));
+    assert_eq!(rows.len(), 3, "{rows:?}");
+    let _ = std::fs::remove_dir_all(&tr);
     // The tree's pairing and Lightcuts' cost per relative error (the default scene here).
     let out = run_cli(&args(
         "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",

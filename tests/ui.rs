@@ -600,3 +600,49 @@ fn tree_sampler_controls_reach_the_renderer() {
     );
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }
+
+#[test]
+fn the_temporal_switch_and_the_camera_path_reach_the_renderer() {
+    use lightcut::renderer::settings::{TemporalMode, TemporalView};
+    // Tall, so that the GI section's temporal combo and the animation section are on screen;
+    // one view: the disocclusion mask.
+    let Some(mut h) = slc_harness(
+        vec![ViewBuffer::Temporal(TemporalView::Disocclusion)],
+        egui::vec2(600.0, 1700.0),
+    ) else {
+        return;
+    };
+    h.run_steps(3);
+    let settings = |h: &Harness<'_, WorkbenchApp>| h.state().renderer().expect("renderer").settings().clone();
+    assert_eq!(settings(&h).temporal.mode, TemporalMode::Off);
+    h.get_by_label("temporal").click();
+    h.run_steps(2);
+    h.get_by_label(TemporalMode::Svgf.label()).click();
+    h.run_steps(3);
+    assert_eq!(
+        settings(&h).temporal.mode,
+        TemporalMode::Svgf,
+        "the temporal combo did not reach the renderer"
+    );
+    let frame = h.state().renderer().and_then(|r| r.temporal().last_frame());
+    assert!(frame.is_some_and(|f| f.iterations == 5), "{frame:?}");
+    // A still view: every covered pixel keeps its four taps (white or black background only).
+    let still = shown_pixels(&h);
+    let partial = |px: &[u8]| {
+        px.chunks(4)
+            .filter(|p| p[0] != p[1] || (p[0] > 0 && p[0] < 250))
+            .count()
+    };
+    assert_eq!(partial(&still), 0, "a still camera disoccluded pixels");
+    // Play the path through the default scene's two bookmarks: the camera moves, the mask
+    // shows disoccluded or partially kept pixels.
+    h.state_mut().animation_mut().path.frames = 12;
+    h.get_by_label("play path").click();
+    h.run_steps(4);
+    assert!(h.state().animation().path.at.is_some_and(|i| i >= 2));
+    assert!(
+        partial(&shown_pixels(&h)) > 0,
+        "the path moved the camera but nothing was disoccluded"
+    );
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+}

@@ -73,6 +73,11 @@ impl WorkbenchApp {
                 open.controller.yaw += self.anim.orbit_deg_per_frame.to_radians();
                 open.camera_index = None;
             }
+            if let Some(cam) = self.anim.path.step(&open.scene) {
+                open.camera = cam;
+                open.controller = CameraController::from_camera(&open.camera, &open.scene.bounds);
+                open.camera_index = None;
+            }
         }
         if open.camera_index.is_none() {
             open.controller.apply(&mut open.camera);

@@ -5,6 +5,7 @@ pub mod camera_control;
 pub mod cut_story;
 pub mod image_views;
 pub mod story_panel;
+pub mod temporal_panel;
 pub mod timings_panel;
 pub mod tree_panel;
 pub mod viewport_texture;
@@ -221,6 +222,8 @@ pub struct Animation {
     pub sun_deg_per_frame: f32,
     /// Degrees the orbit camera turns about its target per frame (0 = still).
     pub orbit_deg_per_frame: f32,
+    /// The camera path through the bookmarks, played one step per rendered frame.
+    pub path: temporal_panel::PathPlayer,
     /// No new frames (the views keep the last one) until unpaused or stepped.
     pub paused: bool,
     /// Render one frame while paused.
@@ -398,7 +401,11 @@ impl WorkbenchApp {
             p.spec.buffer = v;
         }
     }
-    /// The animation state (sun sweep, camera orbit, pause).
+    /// The animation state (sun sweep, camera orbit, camera path, pause).
+    pub fn animation(&self) -> &Animation {
+        &self.anim
+    }
+    /// The animation state (sun sweep, camera orbit, camera path, pause).
     pub fn animation_mut(&mut self) -> &mut Animation {
         &mut self.anim
     }

@@ -250,6 +250,9 @@ impl WorkbenchApp {
                     .text("camera orbit (deg/frame)"),
             )
             .on_hover_text("the camera circles its orbit target");
+            if let Some(open) = &self.open {
+                self.anim.path.ui(ui, &open.scene);
+            }
             ui.horizontal(|ui| {
                 let label = if self.anim.paused { "resume" } else { "pause" };
                 if ui.button(label).clicked() {
@@ -301,6 +304,7 @@ impl WorkbenchApp {
                 );
             }
             (info.ui)(ui, method, &mut self.settings);
+            super::temporal_panel::temporal_ui(ui, &mut self.settings.temporal, method.per_frame());
             if method.per_frame() {
                 ui.checkbox(&mut self.compare_gt, "compare with the ground truth")
                     .on_hover_text(

@@ -6,6 +6,7 @@ pub mod compare;
 pub mod export_scene;
 pub mod methods;
 pub mod render;
+mod render_sequence;
 pub mod results;
 pub mod sheet;
 

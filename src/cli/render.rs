@@ -77,6 +77,17 @@ pub enum ValVisibilityArg {
     Disk,
 }
 
+/// The temporal stage for `--temporal`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TemporalArg {
+    /// The method's estimate as it is.
+    Off,
+    /// Temporal reprojection and an exponential history.
+    Reproject,
+    /// Reprojection, history, variance and the à-trous filter (SVGF, Schied et al. 2017).
+    Svgf,
+}
+
 /// Settings of the tree samplers (override `--settings`).
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct SamplingArgs {
@@ -123,6 +134,11 @@ pub struct SamplingArgs {
     /// GI at half resolution, joint-bilateral upsampled with the similarity S.
     #[arg(long)]
     pub half_res: bool,
+    /// The temporal stage after a per-frame method: `off`, `reproject` (motion vectors,
+    /// history rejection, exponential history) or `svgf` (also the variance-guided à-trous
+    /// filter). Its parameters: `--set temporal.<field>=..` (docs/temporal.md).
+    #[arg(long, value_enum)]
+    pub temporal: Option<TemporalArg>,
     /// Least normal similarity of a usable SST node.
     #[arg(long)]
     pub v_min: Option<f32>,
@@ -238,6 +254,14 @@ impl SamplingArgs {
         if self.half_res {
             s.sampling.half_resolution = true;
         }
+        if let Some(t) = self.temporal {
+            use crate::renderer::settings::TemporalMode;
+            s.temporal.mode = match t {
+                TemporalArg::Off => TemporalMode::Off,
+                TemporalArg::Reproject => TemporalMode::Reproject,
+                TemporalArg::Svgf => TemporalMode::Svgf,
+            };
+        }
         if let Some(v) = self.v_min {
             s.tree.v_min = v;
         }
@@ -309,6 +333,20 @@ pub struct RenderArgs {
     /// Samples per pixel of the converged reference.
     #[arg(long)]
     pub samples: Option<u32>,
+    /// Render a sequence along a smooth camera path (Catmull-Rom, constant speed) through the
+    /// scene's bookmarks: all in order, or the comma-separated names given. Writes
+    /// sequence.csv (per frame: camera, sun, GPU times, and with --compare-gt the raw and
+    /// temporally filtered GI's RMSE / SSIM / flicker against each frame's ground truth),
+    /// frames/NNNN.png, and the last frame's images.
+    #[arg(long, value_name = "NAMES", num_args = 0..=1, default_missing_value = "")]
+    pub camera_path: Option<String>,
+    /// Turn the sun's azimuth by this many degrees over the sequence (with or without
+    /// --camera-path).
+    #[arg(long, value_name = "DEGREES", allow_negative_numbers = true)]
+    pub sun_sweep: Option<f32>,
+    /// Frames of the --camera-path / --sun-sweep sequence.
+    #[arg(long, default_value_t = 60)]
+    pub path_frames: u32,
     #[command(flatten)]
     pub settings: SettingsArgs,
     #[command(flatten)]
@@ -421,7 +459,7 @@ fn write_metrics(
 }
 
 /// GPU time of `method`'s own passes in one frame's timings.
-fn method_ms(t: &PassTimings, method: MethodId) -> f64 {
+pub(super) fn method_ms(t: &PassTimings, method: MethodId) -> f64 {
     method.info().timed_passes.iter().filter_map(|p| t.get(p)).sum()
 }
 
@@ -479,6 +517,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         .scene
         .camera_or_default(cam_name.as_deref())
         .map_err(|e| anyhow!("{e}"))?;
+    if args.camera_path.is_some() || args.sun_sweep.is_some() {
+        return super::render_sequence::run(args, &opened, settings, &camera);
+    }
     let ctx = GpuContext::new_headless()?;
     println!("adapter: {}", ctx.describe());
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
@@ -668,6 +709,14 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
                 redraw(&mut r, ViewBuffer::Method(MethodView::new(v.name)));
                 let (w, h, bytes) = r.read_view_rgba8()?;
                 write_png(&out.join(format!("{}.png", v.file)), w, h, &bytes)?;
+            }
+        }
+        // The temporal stage's views (motion, disocclusion, history, variance, ...).
+        if r.settings().temporal.mode != crate::renderer::settings::TemporalMode::Off && method.per_frame() {
+            for v in crate::renderer::settings::TemporalView::ALL {
+                redraw(&mut r, ViewBuffer::Temporal(v));
+                let (w, h, bytes) = r.read_view_rgba8()?;
+                write_png(&out.join(format!("{}.png", v.file())), w, h, &bytes)?;
             }
         }
         // The light tree over the albedo (which shows the geometry): distributions by flux

@@ -49,15 +49,20 @@ pub enum Figure {
     /// indirect illumination and maps, error against the ground truth and against the same
     /// VALs with exact visibility; the VPL-shading mode beside them.
     Val,
+    /// Temporal reuse (reprojection, history, SVGF) after every per-frame method along a
+    /// camera path, a sun sweep and a still view: per-frame RMSE / SSIM of raw and filtered GI
+    /// against each frame's ground truth, flicker, and the stage's GPU time per pass.
+    Temporal,
 }
 
-const ORDER: [Figure; 10] = [
+const ORDER: [Figure; 11] = [
     Figure::Timings,
     Figure::Steps,
     Figure::EqualTime,
     Figure::Interpolation,
     Figure::Culling,
     Figure::Val,
+    Figure::Temporal,
     Figure::Blocks,
     Figure::Blending,
     Figure::Upsampling,
@@ -116,6 +121,21 @@ pub struct ResultsArgs {
     /// `--sweep lightcuts=0.1,0.02` (relative error), `--sweep sst=4,16` (spp). Repeatable.
     #[arg(long = "sweep", value_name = "METHOD=V1,V2,..")]
     pub sweeps: Vec<String>,
+    /// The temporal figure's frames per motion (camera path, sun sweep, still view).
+    #[arg(long, default_value_t = 30)]
+    pub temporal_frames: u32,
+    /// The camera path's length in frames from the first bookmark to the last (its first
+    /// --temporal-frames are measured: a few pixels of motion per frame).
+    #[arg(long, default_value_t = 240)]
+    pub temporal_path_frames: u32,
+    /// Degrees the sun's azimuth turns over the temporal figure's sun sweep.
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    pub sun_sweep_deg: f32,
+    /// Frame size of the temporal stage's GPU timings.
+    #[arg(long, default_value_t = 1280)]
+    pub temporal_timing_width: u32,
+    #[arg(long, default_value_t = 720)]
+    pub temporal_timing_height: u32,
     /// Number of VPLs (default 4096, as the thesis).
     #[arg(long)]
     pub vpls: Option<u32>,
@@ -184,7 +204,22 @@ impl ResultsArgs {
             }
             sweeps.push((m, v));
         }
+        if !(2..=10_000).contains(&self.temporal_frames) || self.temporal_path_frames < 2 {
+            bail!("--temporal-frames must be 2..=10000 and --temporal-path-frames at least 2");
+        }
+        if !self.sun_sweep_deg.is_finite() {
+            bail!("--sun-sweep-deg must be a number of degrees");
+        }
+        if !(16..=8192).contains(&self.temporal_timing_width)
+            || !(16..=8192).contains(&self.temporal_timing_height)
+        {
+            bail!("--temporal-timing-width/--temporal-timing-height must be 16..=8192");
+        }
         Ok(Opts {
+            temporal_frames: self.temporal_frames,
+            temporal_path_frames: self.temporal_path_frames,
+            sun_sweep_deg: self.sun_sweep_deg,
+            temporal_timing_size: (self.temporal_timing_width, self.temporal_timing_height),
             methods,
             sweeps,
             size: (self.width, self.height),
@@ -260,6 +295,8 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
             label.clone(),
             adapter.clone(),
         );
+        b.bookmarks = sc.scene.cameras.clone();
+        b.scene_radius = sc.scene.bounds.radius().max(1e-3);
         let mut figure_times = Vec::new();
         for f in &figures {
             let t = std::time::Instant::now();
@@ -269,6 +306,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
                 Figure::EqualTime => figures::equal_time(&mut b, &o, &dir)?,
                 Figure::Culling => figures::culling(&mut b, &o, &dir)?,
                 Figure::Val => figures::val(&mut b, &o, &dir)?,
+                Figure::Temporal => figures::temporal(&mut b, &o, &dir)?,
                 Figure::Steps => figures::steps(&mut b, &o, &dir)?,
                 Figure::Blocks => figures::blocks(&mut b, &o, &dir)?,
                 Figure::Blending => figures::blending(&mut b, &o, &dir)?,

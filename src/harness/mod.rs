@@ -12,6 +12,7 @@
 
 pub mod figures;
 pub mod plot;
+pub mod sequence;
 
 use std::{
     collections::HashMap,
@@ -193,6 +194,9 @@ pub struct Bench {
     pub r: Renderer,
     pub camera: Camera,
     pub lights: Vec<DirectionalLight>,
+    /// The scene's bookmarks (the temporal figure's camera path) and bounding radius.
+    pub bookmarks: Vec<Camera>,
+    pub scene_radius: f32,
     pub base: RenderSettings,
     /// Scene label (file stem), for file names and tables.
     pub scene: String,
@@ -242,6 +246,8 @@ impl Bench {
             r,
             camera,
             lights,
+            bookmarks: Vec::new(),
+            scene_radius: 1.0,
             base,
             scene,
             gi_exposure,

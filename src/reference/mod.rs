@@ -24,5 +24,6 @@ pub mod lightcuts;
 pub mod slc;
 pub mod sst;
 pub mod sst_tree;
+pub mod temporal;
 pub mod val;
 pub mod vpl;

@@ -252,16 +252,44 @@ impl Renderer {
         } else {
             0.0
         };
+        // The temporal stage after a per-frame method (reprojection, history, SVGF): the
+        // composite then reads its result at scale 1.
+        let temporal_on = vpl_ok && s.temporal.mode != TemporalMode::Off && s.gi.method.per_frame();
+        // Off frees its buffers; a frame of a progressive method (the ground truth of the
+        // same view, say) leaves the history as it was: the next per-frame frame reprojects
+        // from the last frame the stage ran (its camera and G-buffer are kept with it).
+        if s.temporal.mode == TemporalMode::Off {
+            self.temporal.release();
+        }
         let t = &self.targets;
+        let filtered = if temporal_on {
+            let inputs = passes::temporal::TemporalInputs {
+                gbuffer: &t.gbuffer,
+                camera_buf: &self.camera_buf,
+                camera: GpuCamera::new(input.camera, size.0, size.1),
+                accum: &t.lighting.gi_accum,
+                scale: indirect_scale,
+                size,
+                key: temporal_key(s.gi.method, &s.temporal),
+            };
+            self.temporal
+                .record(&device, &queue, &mut enc, &mut self.timer, &s.temporal, &inputs)
+        } else {
+            None
+        };
+        let (accum, scale) = match filtered {
+            Some(b) => (b, 1.0),
+            None => (&t.lighting.gi_accum, indirect_scale),
+        };
         self.composite.record(
             &device,
             &queue,
             &mut enc,
             &mut self.timer,
             size,
-            indirect_scale,
+            scale,
             &t.lighting.direct_view,
-            &t.lighting.gi_accum,
+            accum,
             &t.lighting.indirect_view,
             &t.lighting.final_view,
         );
@@ -513,6 +541,20 @@ pub(super) fn create_methods(device: &wgpu::Device) -> Result<Vec<MethodInstance
         .into_iter()
         .map(|m| Ok((m.name, (m.create)(device)?)))
         .collect()
+}
+
+/// What the temporal history belongs to: the method and the stage's mode and history
+/// parameters (not the filter's, which act on each frame anew).
+fn temporal_key(method: MethodId, t: &TemporalSettings) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    method.cli().hash(&mut h);
+    format!(
+        "{:?}{}{}{}{}",
+        t.mode, t.max_history, t.normal_cos, t.depth_tolerance, t.feedback_iteration
+    )
+    .hash(&mut h);
+    h.finish()
 }
 
 /// Hashes what a frame's image depends on besides the settings: camera, lights, size.

@@ -225,6 +225,33 @@ impl Renderer {
     }
 
     /// The colour scale of a method's view (None: no legend).
+    /// The colour scale of a temporal-stage view (None for its radiance views).
+    pub fn temporal_legend(&self, view: TemporalView) -> Option<methods::Legend> {
+        self.temporal.legend(view)
+    }
+
+    /// The temporal stage's last frame (None when it did not run) and its buffers (tests,
+    /// the harness's raw-vs-filtered metrics).
+    pub fn temporal(&self) -> &passes::temporal::TemporalPass {
+        &self.temporal
+    }
+
+    /// Forgets the temporal history (the next frame starts without one).
+    pub fn reset_temporal(&mut self) {
+        self.temporal.invalidate();
+    }
+
+    /// The method's own estimate of the last frame the temporal stage ran (radiance, before
+    /// the stage): None when it has not run at the current size.
+    pub fn read_temporal_raw(&self) -> Result<Option<ImageF32>, GpuError> {
+        match (self.temporal.last_frame(), self.temporal.buffers()) {
+            (Some(_), Some(b)) if b.size == self.targets.size => {
+                readback::read_vec4_image(&self.ctx, &b.raw, b.size)
+            }
+            _ => Ok(None),
+        }
+    }
+
     pub fn method_legend(&self, view: MethodView) -> Option<methods::Legend> {
         let (_, owner) = view.find()?;
         self.method_instance(owner)?.legend(view, self.tree.levels())

@@ -12,6 +12,7 @@ pub mod readback;
 pub mod scene_gpu;
 pub mod settings;
 pub mod shaders;
+pub mod temporal_settings;
 pub mod timing;
 pub mod views;
 
@@ -52,7 +53,7 @@ use passes::{
 };
 use readback::ImageF32;
 use scene_gpu::SceneGpu;
-use settings::{RenderSettings, TreeOverlay, ViewBuffer};
+use settings::{RenderSettings, TemporalMode, TemporalSettings, TemporalView, TreeOverlay, ViewBuffer};
 use timing::{GpuTimer, PassTimings};
 use views::{AbMode, AbSource, ViewSpec};
 
@@ -157,6 +158,8 @@ pub struct Renderer {
     /// The comparison ground truth's composite: its own pass (and parameter buffer), since the
     /// sampler's composite with scale 1/frames is recorded in the same encoder.
     compare_composite: CompositePass,
+    /// Temporal reuse and SVGF after a per-frame method (`settings.temporal`).
+    temporal: passes::temporal::TemporalPass,
     vpl_buffers: VplBuffers,
     vpl_frame: VplFrame,
     /// Luminance of light 0's irradiance and its shadow texel size, last frame (RSM flux view).
@@ -274,6 +277,7 @@ impl Renderer {
             compare: None,
             compare_views: passes::compare::CompareViewsPass::new(device)?,
             compare_composite: CompositePass::new(device)?,
+            temporal: passes::temporal::TemporalPass::new(device)?,
             vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
             vpl_frame: VplFrame::default(),
             light0_lum: 0.0,
@@ -328,12 +332,15 @@ impl Renderer {
                 CompositePass::new(device),
             ),
             create_methods(device),
+            passes::temporal::TemporalPass::new(device),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
         }
-        let (g, s, d, disp, v, (vg, c, sp, so, b, ov, cv, cc), m) = passes;
-        let new = (g?, s?, d?, disp?, v?, vg?, c?, sp?, so?, b?, ov?, cv?, cc?, m?);
+        let (g, s, d, disp, v, (vg, c, sp, so, b, ov, cv, cc), m, tp) = passes;
+        let new = (
+            g?, s?, d?, disp?, v?, vg?, c?, sp?, so?, b?, ov?, cv?, cc?, m?, tp?,
+        );
         (
             self.gbuffer,
             self.rsm,
@@ -349,6 +356,7 @@ impl Renderer {
             self.compare_views,
             self.compare_composite,
             self.methods,
+            self.temporal,
         ) = new;
         // The comparison's truth restarts with new pipelines.
         self.compare = None;

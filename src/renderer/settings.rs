@@ -14,6 +14,8 @@ pub struct RenderSettings {
     pub sampling: SamplingSettings,
     pub display: DisplaySettings,
     pub textures: TextureSettings,
+    /// Temporal reuse and SVGF after a per-frame method (`renderer::passes::temporal`).
+    pub temporal: TemporalSettings,
     /// Settings of the methods that own no section above: `[methods.<cli name>]` tables, each
     /// read and written as the method's own serde struct ([`RenderSettings::method`]), so a
     /// new method brings its settings in its folder without a field here.
@@ -188,6 +190,7 @@ impl Default for VplSettings {
     }
 }
 
+pub use super::temporal_settings::{MAX_ATROUS_ITERATIONS, TemporalMode, TemporalSettings, TemporalView};
 pub use crate::methods::{MethodId, MethodView};
 
 /// Shading of VPLs (shared by every GI method and the references).
@@ -790,6 +793,7 @@ impl RenderSettings {
                 ),
             });
         }
+        self.temporal.validate()?;
         crate::methods::validate_all(self)
     }
 }
@@ -844,6 +848,9 @@ pub enum ViewBuffer {
     /// A view a GI method draws (`MethodInfo::views`: the tree samplers' traversal steps,
     /// cuts, ...), by its name.
     Method(MethodView),
+    /// A view of the temporal stage (`settings.temporal`: history, motion, variance, the
+    /// filter's iterations), after a per-frame method.
+    Temporal(TemporalView),
 }
 
 impl ViewBuffer {
@@ -895,11 +902,13 @@ impl ViewBuffer {
             ViewBuffer::RelativeError => "relative error vs ground truth",
             ViewBuffer::AbCompare => "A/B comparison",
             ViewBuffer::Method(v) => v.name(),
+            ViewBuffer::Temporal(v) => v.name(),
         }
     }
-    /// Every view: the shared ones, then each registered method's.
+    /// Every view: the shared ones, the temporal stage's, then each registered method's.
     pub fn all() -> Vec<ViewBuffer> {
         let mut v = ViewBuffer::ALL.to_vec();
+        v.extend(TemporalView::ALL.into_iter().map(ViewBuffer::Temporal));
         v.extend(MethodView::all().into_iter().map(ViewBuffer::Method));
         v
     }

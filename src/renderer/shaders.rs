@@ -101,6 +101,7 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("common/ism.wgsl", include_str!("../../shaders/common/ism.wgsl")),
     ("ism_view.wgsl", include_str!("../../shaders/ism_view.wgsl")),
     ("val_cluster.wgsl", include_str!("../../shaders/val_cluster.wgsl")),
+    ("temporal.wgsl", include_str!("../../shaders/temporal.wgsl")),
 ];
 
 /// The shared shaders that are entry points (not include-only files); [`entry_shaders`] adds
@@ -125,6 +126,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "ism.wgsl",
     "ism_view.wgsl",
     "val_cluster.wgsl",
+    "temporal.wgsl",
 ];
 
 /// Every WGSL file: the shared ones and those the registered GI methods declare.

@@ -137,6 +137,28 @@ impl Renderer {
                 .record(&device, &queue, enc, &mut self.timer, &look, src, dst, want);
             return;
         }
+        if let ViewBuffer::Temporal(tv) = view {
+            if !self.temporal.has_view(tv, self.targets.size) {
+                // The stage has not run at this size (off, or a progressive method).
+                clear_view(enc, &self.targets.view.view);
+                return;
+            }
+            let shown = self.temporal.record_view(
+                &device,
+                &queue,
+                enc,
+                &mut self.timer,
+                tv,
+                &self.targets.gbuffer,
+                &self.camera_buf,
+                &self.targets.view.view,
+            );
+            if let Some(src) = shown {
+                self.display
+                    .record(&device, &queue, enc, &mut self.timer, &look, src, dst, want);
+            }
+            return;
+        }
         if let ViewBuffer::Method(view) = view {
             let frame = self.targets.size;
             let Some((_, owner)) = view.find() else {
@@ -265,6 +287,7 @@ impl Renderer {
                 [1.0; 4],
             ),
             ViewBuffer::Method(_)
+            | ViewBuffer::Temporal(_)
             | ViewBuffer::GroundTruthIndirect
             | ViewBuffer::GroundTruthFinal
             | ViewBuffer::SplitIndirect

@@ -6,6 +6,7 @@
 
 pub mod bvh;
 pub mod camera;
+pub mod camera_path;
 pub mod default_scene;
 pub mod gltf_load;
 pub mod preset;

@@ -175,9 +175,11 @@ pub(super) fn draw_legend(cx: &PaneContext<'_>, painter: &egui::Painter, rect: e
             look.range_log10[1],
             Scale::Log10,
         );
-    } else if let ViewBuffer::Method(v) = shown
-        && let Some(l) = cx.renderer.method_legend(v)
-    {
+    } else if let Some(l) = match shown {
+        ViewBuffer::Method(v) => cx.renderer.method_legend(v),
+        ViewBuffer::Temporal(v) => cx.renderer.temporal_legend(v),
+        _ => None,
+    } {
         let scale = if l.log { Scale::Log10 } else { Scale::Linear };
         legend_with(painter, rect, &l.title, l.lo, l.hi, scale);
     } else if ab.is_some_and(|a| a.mode == AbMode::RelativeError) {

@@ -6,12 +6,14 @@ mod culling;
 mod interpolation;
 mod resolution;
 mod sampling;
+mod temporal;
 mod val;
 
 pub use culling::culling;
 pub use interpolation::interpolation;
 pub use resolution::{scaling, upsampling};
 pub use sampling::{blending, blocks, steps};
+pub use temporal::temporal;
 pub use val::val;
 
 use std::path::Path;
@@ -48,6 +50,13 @@ pub struct Opts {
     pub methods: Vec<MethodId>,
     /// A method's quality-knob values replacing its registry sweep (`results --sweep`).
     pub sweeps: Vec<(MethodId, Vec<f64>)>,
+    /// The temporal figure: frames per motion, the camera path's length in frames (its
+    /// first `temporal_frames` are measured), the sun sweep's degrees over the frames, and
+    /// the frame size of its GPU timings.
+    pub temporal_frames: u32,
+    pub temporal_path_frames: u32,
+    pub sun_sweep_deg: f32,
+    pub temporal_timing_size: (u32, u32),
 }
 
 impl Opts {

@@ -13,6 +13,7 @@ pub mod rsm;
 pub mod sst_build;
 pub mod sst_overlay;
 pub mod sst_sort;
+pub mod temporal;
 pub mod val_cluster;
 pub mod visualise;
 pub mod vpl_gen;

@@ -1,0 +1,624 @@
+//! The temporal stage after a per-frame GI method (`shaders/temporal.wgsl`): SVGF (Schied et
+//! al. 2017) on the albedo-demodulated GI. Reads: the method's accumulation buffer and scale,
+//! the G-buffer, this frame's and the previous frame's camera. Keeps: the history (colour with
+//! its per-pixel length, luminance moments) and the previous G-buffer, ping-ponged by frame.
+//! Writes: the filtered GI radiance the composite reads. Passes (timer names):
+//! `temporal_reproject`, `temporal_accumulate`, and with SVGF `temporal_variance` and
+//! `temporal_atrous` (every iteration in one compute pass), then `temporal_modulate`.
+//! Settings: `settings::TemporalSettings` (`[temporal]`). Twin: `reference::temporal`.
+
+use bytemuck::{Pod, Zeroable};
+
+use super::{
+    compute_pipeline, direct::RADIANCE_FORMAT, dynamic_uniform_entry, float_texture_entry, groups_image,
+    storage_buffer, storage_entry, storage_texture_entry, uniform_entry,
+};
+use crate::renderer::{
+    frame::GbufferTargets,
+    gpu_data::GpuCamera,
+    settings::{TemporalMode, TemporalSettings, TemporalView},
+    shaders,
+    timing::GpuTimer,
+};
+
+/// Twin: `TemporalParams` in `shaders/temporal.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuTemporalParams {
+    pub width: u32,
+    pub height: u32,
+    pub first: u32,
+    pub gradient: u32,
+    pub scale: f32,
+    pub alpha: f32,
+    pub moments_alpha: f32,
+    pub max_history: f32,
+    pub normal_cos: f32,
+    pub depth_tolerance: f32,
+    pub sigma_l: f32,
+    pub sigma_n: f32,
+    pub sigma_z: f32,
+    pub gradient_scale: f32,
+    pub spatial_frames: f32,
+    pub step: u32,
+    pub iteration: u32,
+    pub feedback: u32,
+    pub view_iteration: u32,
+    pub view_mode: u32,
+    pub view_lo: f32,
+    pub view_hi: f32,
+    pub _pad: [u32; 2],
+}
+
+impl GpuTemporalParams {
+    pub fn new(s: &TemporalSettings, size: (u32, u32), scale: f32, first: bool) -> Self {
+        Self {
+            width: size.0,
+            height: size.1,
+            first: first as u32,
+            gradient: s.gradient_reset as u32,
+            scale,
+            alpha: s.alpha,
+            moments_alpha: s.moments_alpha,
+            max_history: s.max_history as f32,
+            normal_cos: s.normal_cos,
+            depth_tolerance: s.depth_tolerance,
+            sigma_l: s.sigma_l,
+            sigma_n: s.sigma_n,
+            sigma_z: s.sigma_z,
+            gradient_scale: s.gradient_scale,
+            spatial_frames: s.spatial_variance_frames as f32,
+            step: 1,
+            iteration: 0,
+            feedback: if s.mode == TemporalMode::Svgf {
+                s.feedback_iteration
+            } else {
+                0
+            },
+            view_iteration: s.view_iteration,
+            view_mode: 0,
+            view_lo: 0.0,
+            view_hi: 1.0,
+            _pad: [0; 2],
+        }
+    }
+    /// The twin's parameters.
+    pub fn reference(s: &TemporalSettings) -> crate::reference::temporal::Params {
+        crate::reference::temporal::Params {
+            alpha: s.alpha,
+            moments_alpha: s.moments_alpha,
+            max_history: s.max_history as f32,
+            normal_cos: s.normal_cos,
+            depth_tolerance: s.depth_tolerance,
+            sigma_l: s.sigma_l,
+            sigma_n: s.sigma_n,
+            sigma_z: s.sigma_z,
+            spatial_frames: s.spatial_variance_frames as f32,
+            gradient: s.gradient_reset,
+            gradient_scale: s.gradient_scale,
+        }
+    }
+}
+
+/// Parameter slots (dynamic offsets) of one frame: reproject, accumulate, variance, the
+/// iterations, modulate, then the views.
+const SLOT_REPROJECT: u32 = 0;
+const SLOT_ACCUMULATE: u32 = 1;
+const SLOT_VARIANCE: u32 = 2;
+const SLOT_ATROUS: u32 = 3;
+const SLOT_MODULATE: u32 = SLOT_ATROUS + crate::renderer::settings::MAX_ATROUS_ITERATIONS;
+const SLOT_VIEW: u32 = SLOT_MODULATE + 1;
+const SLOTS: u32 = SLOT_VIEW + 1;
+const SLOT_STRIDE: u64 = 256;
+
+/// The stage's per-pixel buffers (16 bytes per pixel each; the G-buffer copies 32).
+pub struct TemporalBuffers {
+    pub size: (u32, u32),
+    /// The method's estimate (radiance).
+    pub raw: wgpu::Buffer,
+    /// Demodulated rgb, luminance.
+    pub current: wgpu::Buffer,
+    /// Reprojected history (demodulated rgb, length) and moments.
+    pub reproj: wgpu::Buffer,
+    pub reproj_moments: wgpu::Buffer,
+    /// dx, dy (pixels to the previous position), mask (bilinear weight kept, -1 fallback,
+    /// 0 disoccluded), reset weight.
+    pub motion: wgpu::Buffer,
+    /// History colour (demodulated rgb, length) and moments (m1, m2, length), by frame parity.
+    pub hist_color: [wgpu::Buffer; 2],
+    pub hist_moments: [wgpu::Buffer; 2],
+    /// Position (w = material id + 1) and normal per pixel, by frame parity.
+    pub gb: [wgpu::Buffer; 2],
+    /// The blended colour (demodulated rgb, length).
+    pub integrated: wgpu::Buffer,
+    /// The filter's input (demodulated rgb, variance).
+    pub filter_input: wgpu::Buffer,
+    pub ping: wgpu::Buffer,
+    pub pong: wgpu::Buffer,
+    /// The iteration the view shows.
+    pub iter_copy: wgpu::Buffer,
+    /// The result (radiance) the composite reads.
+    pub out: wgpu::Buffer,
+    _view_tex: wgpu::Texture,
+    view_tex_view: wgpu::TextureView,
+}
+
+impl TemporalBuffers {
+    fn new(device: &wgpu::Device, size: (u32, u32)) -> Self {
+        let px = size.0 as u64 * size.1 as u64;
+        let b = |label: &str| storage_buffer(device, label, 16 * px);
+        let view_tex = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("temporal::view_radiance"),
+            size: wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: RADIANCE_FORMAT,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let view_tex_view = view_tex.create_view(&Default::default());
+        Self {
+            size,
+            raw: b("temporal::raw"),
+            current: b("temporal::current"),
+            reproj: b("temporal::reproj"),
+            reproj_moments: b("temporal::reproj_moments"),
+            motion: b("temporal::motion"),
+            hist_color: [b("temporal::hist_color0"), b("temporal::hist_color1")],
+            hist_moments: [b("temporal::hist_moments0"), b("temporal::hist_moments1")],
+            gb: [
+                storage_buffer(device, "temporal::gb0", 32 * px),
+                storage_buffer(device, "temporal::gb1", 32 * px),
+            ],
+            integrated: b("temporal::integrated"),
+            filter_input: b("temporal::filter_input"),
+            ping: b("temporal::ping"),
+            pong: b("temporal::pong"),
+            iter_copy: b("temporal::iter_copy"),
+            out: b("temporal::out"),
+            _view_tex: view_tex,
+            view_tex_view,
+        }
+    }
+}
+
+/// What one frame of the stage reads.
+pub struct TemporalInputs<'a> {
+    pub gbuffer: &'a GbufferTargets,
+    pub camera_buf: &'a wgpu::Buffer,
+    /// This frame's camera (the next frame reprojects through it).
+    pub camera: GpuCamera,
+    pub accum: &'a wgpu::Buffer,
+    pub scale: f32,
+    pub size: (u32, u32),
+    /// What the history belongs to (the method, the mode): a new key restarts it.
+    pub key: u64,
+}
+
+/// What the last frame of the stage did (its views and the tests read this).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TemporalFrame {
+    /// The parity of the history buffers it wrote.
+    pub parity: usize,
+    pub mode: TemporalMode,
+    /// It started without a history.
+    pub first: bool,
+    pub iterations: u32,
+}
+
+struct Pipe {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+    bindings: &'static [u32],
+}
+
+pub struct TemporalPass {
+    reproject: Pipe,
+    accumulate: Pipe,
+    variance: Pipe,
+    atrous: Pipe,
+    modulate: Pipe,
+    view_radiance: Pipe,
+    view_heat: Pipe,
+    params: wgpu::Buffer,
+    prev_camera: wgpu::Buffer,
+    buffers: Option<TemporalBuffers>,
+    last_camera: Option<GpuCamera>,
+    key: Option<u64>,
+    frame: Option<TemporalFrame>,
+    /// The settings of the last frame (views read their ranges).
+    settings: TemporalSettings,
+}
+
+/// The layout entry of binding `b` (`shaders/temporal.wgsl`'s declarations).
+fn entry(b: u32) -> wgpu::BindGroupLayoutEntry {
+    let c = wgpu::ShaderStages::COMPUTE;
+    match b {
+        0 => dynamic_uniform_entry(0, c, std::mem::size_of::<GpuTemporalParams>() as u64),
+        1 | 2 => uniform_entry(b, c),
+        3..=5 => float_texture_entry(b),
+        6 | 7 | 9 | 10 | 18 => storage_entry(b, c, true),
+        23 => storage_texture_entry(b, RADIANCE_FORMAT),
+        24 => storage_texture_entry(b, wgpu::TextureFormat::Rgba8Unorm),
+        _ => storage_entry(b, c, false),
+    }
+}
+
+impl TemporalPass {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        let module = shaders::create_module(device, "temporal.wgsl")?;
+        let pipe = |entry_point: &str, bindings: &'static [u32]| {
+            let entries: Vec<_> = bindings.iter().map(|&b| entry(b)).collect();
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("temporal::layout"),
+                entries: &entries,
+            });
+            let pipeline = compute_pipeline(device, entry_point, &[Some(&layout)], &module, entry_point);
+            Pipe {
+                layout,
+                pipeline,
+                bindings,
+            }
+        };
+        Ok(Self {
+            reproject: pipe(
+                "reproject",
+                &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 21],
+            ),
+            accumulate: pipe("accumulate", &[0, 1, 3, 4, 11, 12, 13, 14, 15, 16, 17]),
+            variance: pipe("variance", &[0, 1, 3, 4, 16, 17, 19]),
+            atrous: pipe("atrous", &[0, 1, 3, 4, 15, 18, 19, 22]),
+            modulate: pipe("modulate", &[0, 3, 5, 18, 20]),
+            view_radiance: pipe("view_radiance", &[0, 5, 18, 23]),
+            view_heat: pipe("view_heat", &[0, 3, 18, 24]),
+            params: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("temporal::params"),
+                size: SLOTS as u64 * SLOT_STRIDE,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            prev_camera: super::uniform_buffer::<GpuCamera>(device, "temporal::prev_camera"),
+            buffers: None,
+            last_camera: None,
+            key: None,
+            frame: None,
+            settings: TemporalSettings::default(),
+        })
+    }
+
+    /// Forgets the history (the stage did not run this frame, or the renderer was reset):
+    /// the next frame starts fresh and the views are empty.
+    pub fn invalidate(&mut self) {
+        self.key = None;
+        self.frame = None;
+        self.last_camera = None;
+    }
+
+    /// Frees the buffers (the stage is off).
+    pub fn release(&mut self) {
+        self.invalidate();
+        self.buffers = None;
+    }
+
+    pub fn buffers(&self) -> Option<&TemporalBuffers> {
+        self.buffers.as_ref()
+    }
+
+    pub fn last_frame(&self) -> Option<TemporalFrame> {
+        self.frame
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn bind(
+        &self,
+        device: &wgpu::Device,
+        pipe: &Pipe,
+        i: &TemporalInputs<'_>,
+        parity: usize,
+        src: Option<&wgpu::Buffer>,
+        dst: Option<&wgpu::Buffer>,
+        view_out: Option<&wgpu::TextureView>,
+    ) -> Option<wgpu::BindGroup> {
+        let b = self.buffers.as_ref()?;
+        let prev = 1 - parity;
+        let g = i.gbuffer;
+        fn buf(x: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
+            x.as_entire_binding()
+        }
+        let mut entries = Vec::new();
+        for &n in pipe.bindings {
+            let resource = match n {
+                0 => wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &self.params,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<GpuTemporalParams>() as u64),
+                }),
+                1 => buf(i.camera_buf),
+                2 => buf(&self.prev_camera),
+                3 => wgpu::BindingResource::TextureView(&g.position_view),
+                4 => wgpu::BindingResource::TextureView(&g.normal_view),
+                5 => wgpu::BindingResource::TextureView(&g.albedo_view),
+                6 => buf(i.accum),
+                7 => buf(&b.gb[prev]),
+                8 => buf(&b.gb[parity]),
+                9 => buf(&b.hist_color[prev]),
+                10 => buf(&b.hist_moments[prev]),
+                11 => buf(&b.current),
+                12 => buf(&b.reproj),
+                13 => buf(&b.reproj_moments),
+                14 => buf(&b.motion),
+                15 => buf(&b.hist_color[parity]),
+                16 => buf(&b.hist_moments[parity]),
+                17 => buf(&b.integrated),
+                18 => buf(src?),
+                19 => buf(dst?),
+                20 => buf(&b.out),
+                21 => buf(&b.raw),
+                22 => buf(&b.iter_copy),
+                23 => wgpu::BindingResource::TextureView(&b.view_tex_view),
+                24 => wgpu::BindingResource::TextureView(view_out?),
+                _ => return None,
+            };
+            entries.push(wgpu::BindGroupEntry { binding: n, resource });
+        }
+        Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("temporal::bind_group"),
+            layout: &pipe.layout,
+            entries: &entries,
+        }))
+    }
+
+    /// Records one frame of the stage with `s` (mode not off) and returns the buffer the
+    /// composite reads (radiance, scale 1).
+    pub fn record(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        enc: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        s: &TemporalSettings,
+        i: &TemporalInputs<'_>,
+    ) -> Option<&wgpu::Buffer> {
+        if s.mode == TemporalMode::Off {
+            self.release();
+            return None;
+        }
+        if self.buffers.as_ref().is_none_or(|b| b.size != i.size) {
+            self.buffers = Some(TemporalBuffers::new(device, i.size));
+            self.invalidate();
+        }
+        let first = self.key != Some(i.key) || self.frame.is_none();
+        let parity = self.frame.map_or(0, |f| 1 - f.parity);
+        let prev_cam = if first {
+            i.camera
+        } else {
+            self.last_camera.unwrap_or(i.camera)
+        };
+        queue.write_buffer(&self.prev_camera, 0, bytemuck::bytes_of(&prev_cam));
+        let base = GpuTemporalParams::new(s, i.size, i.scale, first);
+        let svgf = s.mode == TemporalMode::Svgf && s.iterations > 0;
+        let write = |slot: u32, p: GpuTemporalParams| {
+            queue.write_buffer(&self.params, slot as u64 * SLOT_STRIDE, bytemuck::bytes_of(&p));
+        };
+        for slot in [SLOT_REPROJECT, SLOT_ACCUMULATE, SLOT_VARIANCE, SLOT_MODULATE] {
+            write(slot, base);
+        }
+        let groups = groups_image(i.size.0, i.size.1);
+        let b = self.buffers.as_ref()?;
+        let dispatch = |enc: &mut wgpu::CommandEncoder,
+                        timer: &mut GpuTimer,
+                        name: &str,
+                        steps: &[(&Pipe, &wgpu::BindGroup, u32)]| {
+            enc.push_debug_group(name);
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(name),
+                    timestamp_writes: timer.compute_pass(name),
+                });
+                for (pipe, bind, slot) in steps {
+                    pass.set_pipeline(&pipe.pipeline);
+                    pass.set_bind_group(0, *bind, &[slot * SLOT_STRIDE as u32]);
+                    pass.dispatch_workgroups(groups.0, groups.1, groups.2);
+                }
+            }
+            enc.pop_debug_group();
+        };
+        let reproject = self.bind(device, &self.reproject, i, parity, None, None, None)?;
+        dispatch(
+            enc,
+            timer,
+            "temporal_reproject",
+            &[(&self.reproject, &reproject, SLOT_REPROJECT)],
+        );
+        let accumulate = self.bind(device, &self.accumulate, i, parity, None, None, None)?;
+        dispatch(
+            enc,
+            timer,
+            "temporal_accumulate",
+            &[(&self.accumulate, &accumulate, SLOT_ACCUMULATE)],
+        );
+        let result = if svgf {
+            let variance = self.bind(
+                device,
+                &self.variance,
+                i,
+                parity,
+                None,
+                Some(&b.filter_input),
+                None,
+            )?;
+            dispatch(
+                enc,
+                timer,
+                "temporal_variance",
+                &[(&self.variance, &variance, SLOT_VARIANCE)],
+            );
+            let mut binds = Vec::new();
+            let mut src = &b.filter_input;
+            for it in 1..=s.iterations {
+                let dst = if it % 2 == 1 { &b.ping } else { &b.pong };
+                let mut p = base;
+                p.step = 1 << (it - 1);
+                p.iteration = it;
+                write(SLOT_ATROUS + it - 1, p);
+                binds.push(self.bind(device, &self.atrous, i, parity, Some(src), Some(dst), None)?);
+                src = dst;
+            }
+            let steps: Vec<_> = binds
+                .iter()
+                .enumerate()
+                .map(|(k, bg)| (&self.atrous, bg, SLOT_ATROUS + k as u32))
+                .collect();
+            dispatch(enc, timer, "temporal_atrous", &steps);
+            src
+        } else {
+            &b.integrated
+        };
+        let modulate = self.bind(device, &self.modulate, i, parity, Some(result), None, None)?;
+        dispatch(
+            enc,
+            timer,
+            "temporal_modulate",
+            &[(&self.modulate, &modulate, SLOT_MODULATE)],
+        );
+        self.last_camera = Some(i.camera);
+        self.key = Some(i.key);
+        self.settings = s.clone();
+        self.frame = Some(TemporalFrame {
+            parity,
+            mode: s.mode,
+            first,
+            iterations: if svgf { s.iterations } else { 0 },
+        });
+        self.buffers.as_ref().map(|b| &b.out)
+    }
+
+    /// Whether `view` has something to show (a frame of the stage at `size`, and for the
+    /// filter's views a frame of SVGF).
+    pub fn has_view(&self, view: TemporalView, size: (u32, u32)) -> bool {
+        let (Some(f), Some(b)) = (self.frame, self.buffers.as_ref()) else {
+            return false;
+        };
+        b.size == size
+            && match view {
+                TemporalView::Variance => f.iterations > 0,
+                TemporalView::Iteration => f.iterations >= self.settings.view_iteration,
+                _ => true,
+            }
+    }
+
+    /// Draws `view` of the last frame: a radiance view into its texture (returned, for the
+    /// display pass to draw with the view's look), a diagnostic view straight into `dst`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_view(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        enc: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        view: TemporalView,
+        gbuffer: &GbufferTargets,
+        camera_buf: &wgpu::Buffer,
+        dst: &wgpu::TextureView,
+    ) -> Option<&wgpu::TextureView> {
+        let (Some(f), Some(b)) = (self.frame, self.buffers.as_ref()) else {
+            return None;
+        };
+        let s = &self.settings;
+        let mut p = GpuTemporalParams::new(s, b.size, 1.0, false);
+        let (src, mode, radiance) = match view {
+            TemporalView::Raw => (&b.raw, 0, true),
+            TemporalView::Reprojected => (&b.reproj, 1, true),
+            TemporalView::Iteration => (&b.iter_copy, 1, true),
+            TemporalView::Motion => (&b.motion, 0, false),
+            TemporalView::Disocclusion => (&b.motion, 1, false),
+            TemporalView::HistoryLength => (&b.hist_color[f.parity], 2, false),
+            TemporalView::Variance => (&b.filter_input, 3, false),
+            TemporalView::Reset => (&b.motion, 4, false),
+        };
+        p.view_mode = mode;
+        (p.view_lo, p.view_hi) = match view {
+            TemporalView::Motion => (0.0, MOTION_FULL_SCALE_PX),
+            TemporalView::HistoryLength => (0.0, s.max_history as f32),
+            TemporalView::Variance => VARIANCE_RANGE_LOG10,
+            _ => (0.0, 1.0),
+        };
+        queue.write_buffer(
+            &self.params,
+            SLOT_VIEW as u64 * SLOT_STRIDE,
+            bytemuck::bytes_of(&p),
+        );
+        let i = TemporalInputs {
+            gbuffer,
+            camera_buf,
+            camera: GpuCamera::zeroed(),
+            accum: &b.out,
+            scale: 1.0,
+            size: b.size,
+            key: 0,
+        };
+        let pipe = if radiance {
+            &self.view_radiance
+        } else {
+            &self.view_heat
+        };
+        let bind = self.bind(device, pipe, &i, f.parity, Some(src), None, Some(dst))?;
+        let groups = groups_image(b.size.0, b.size.1);
+        enc.push_debug_group("temporal_view");
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("temporal_view"),
+                timestamp_writes: timer.compute_pass("temporal_view"),
+            });
+            pass.set_pipeline(&pipe.pipeline);
+            pass.set_bind_group(0, &bind, &[SLOT_VIEW * SLOT_STRIDE as u32]);
+            pass.dispatch_workgroups(groups.0, groups.1, groups.2);
+        }
+        enc.pop_debug_group();
+        radiance.then_some(&b.view_tex_view)
+    }
+
+    /// The colour scale of a diagnostic view (None for the radiance views).
+    pub fn legend(&self, view: TemporalView) -> Option<crate::methods::Legend> {
+        let l = |title: &str, lo: f32, hi: f32, log: bool| {
+            Some(crate::methods::Legend {
+                title: title.into(),
+                lo,
+                hi,
+                log,
+            })
+        };
+        match view {
+            TemporalView::HistoryLength => l(
+                "history length (frames)",
+                0.0,
+                self.settings.max_history as f32,
+                false,
+            ),
+            TemporalView::Variance => l(
+                "relative std. dev. of the GI luminance (log)",
+                VARIANCE_RANGE_LOG10.0,
+                VARIANCE_RANGE_LOG10.1,
+                true,
+            ),
+            TemporalView::Reset => l("new-frame weight boost of the reset", 0.0, 1.0, false),
+            TemporalView::Motion => l(
+                "motion (pixels; hue = direction)",
+                0.0,
+                MOTION_FULL_SCALE_PX,
+                false,
+            ),
+            _ => None,
+        }
+    }
+}
+
+/// Motion of this many pixels shows at full brightness.
+pub const MOTION_FULL_SCALE_PX: f32 = 16.0;
+/// log10 range of the variance view's relative standard deviation.
+pub const VARIANCE_RANGE_LOG10: (f32, f32) = (-2.0, 1.0);
