@@ -152,7 +152,9 @@ fn reproject(@builtin(global_invocation_id) gid: vec3<u32>) {
         let pp = prev_pixel(g.xyz);
         mv = pp.xy - vec2<f32>(px);
         let tol = p.depth_tolerance * max(view_depth(g.xyz), 1e-6);
-        if pp.z > 0.0 {
+        // In front of the previous camera and not absurdly far off its image (a point on its
+        // plane would overflow the integer taps).
+        if pp.z > 0.0 && all(abs(pp.xy) < vec2<f32>(1e6)) {
             let base = vec2<i32>(floor(pp.xy));
             let f = pp.xy - floor(pp.xy);
             var wsum = 0.0;
@@ -268,8 +270,9 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>) {
     motion[k].w = reset;
 }
 
-// Screen-space derivative of the view depth at px (|dz/dx| + |dz/dy|, each the smaller
-// one-sided difference to a covered neighbour): SVGF's fwidth(z).
+// Screen-space derivative of the view depth at px: max(|dz/dx|, |dz/dy|), each the smaller
+// one-sided difference to a covered neighbour (the derivative the SVGF reference code keeps
+// beside its linear z).
 fn depth_fwidth(px: vec2<i32>, z: f32) -> f32 {
     var fw = 0.0;
     for (var axis = 0; axis < 2; axis++) {
@@ -284,7 +287,7 @@ fn depth_fwidth(px: vec2<i32>, z: f32) -> f32 {
             }
         }
         if best < 1e30 {
-            fw += best;
+            fw = max(fw, best);
         }
     }
     return fw;
@@ -340,7 +343,8 @@ fn variance(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             let nq = normalize(textureLoad(gb_normal, q, 0).xyz);
             let iq = integrated[idx(q)];
-            let phi_z = p.sigma_z * fw * length(vec2<f32>(f32(dx), f32(dy)));
+            // The reference code's moments filter widens the depth test threefold.
+            let phi_z = 3.0 * p.sigma_z * fw * length(vec2<f32>(f32(dx), f32(dy)));
             let w = edge_weight(z, view_depth(gq.xyz), phi_z, n, nq, lp, luminance(iq.rgb), p.sigma_l);
             wsum += w;
             c += w * iq.rgb;

@@ -109,6 +109,32 @@ fn bad_input_gives_one_clear_line() {
     assert!(e.contains("sampling.cut_size"), "{e}");
     let e = one_line_error(&["--view", "nope", "--frames", "1"]);
     assert!(e.contains("unknown view 'nope'"), "{e}");
+    // Temporal sequences: an unknown bookmark, a frame count without a sequence, a converging
+    // method, a bad setting, each named.
+    let e = one_line_error(&["render", "--camera-path", "Main,Nope", "--out", "/tmp/x"]);
+    assert!(e.contains("no bookmark 'Nope'") && e.contains("Overview"), "{e}");
+    let e = one_line_error(&["render", "--path-frames", "5", "--out", "/tmp/x"]);
+    assert!(e.contains("--camera-path"), "{e}");
+    let e = one_line_error(&[
+        "render",
+        "--method",
+        "ground-truth",
+        "--sun-sweep",
+        "10",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("per-frame method"), "{e}");
+    let e = one_line_error(&[
+        "render",
+        "--temporal",
+        "svgf",
+        "--set",
+        "temporal.iterations=12",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("temporal.iterations"), "{e}");
 }
 
 #[test]

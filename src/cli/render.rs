@@ -344,9 +344,9 @@ pub struct RenderArgs {
     /// --camera-path).
     #[arg(long, value_name = "DEGREES", allow_negative_numbers = true)]
     pub sun_sweep: Option<f32>,
-    /// Frames of the --camera-path / --sun-sweep sequence.
-    #[arg(long, default_value_t = 60)]
-    pub path_frames: u32,
+    /// Frames of the --camera-path / --sun-sweep sequence (default 60).
+    #[arg(long)]
+    pub path_frames: Option<u32>,
     #[command(flatten)]
     pub settings: SettingsArgs,
     #[command(flatten)]
@@ -519,6 +519,11 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         .map_err(|e| anyhow!("{e}"))?;
     if args.camera_path.is_some() || args.sun_sweep.is_some() {
         return super::render_sequence::run(args, &opened, settings, &camera);
+    }
+    if args.path_frames.is_some() {
+        return Err(anyhow!(
+            "--path-frames: a sequence needs --camera-path and/or --sun-sweep"
+        ));
     }
     let ctx = GpuContext::new_headless()?;
     println!("adapter: {}", ctx.describe());

@@ -19,7 +19,7 @@ use crate::{
 
 /// The motion the arguments ask for.
 fn motion(args: &RenderArgs, opened: &OpenedScene, camera: &Camera) -> anyhow::Result<Motion> {
-    let n = args.path_frames;
+    let n = args.path_frames.unwrap_or(60);
     if !(2..=100_000).contains(&n) {
         return Err(anyhow!("--path-frames must be 2..=100000 (got {n})"));
     }

@@ -178,7 +178,7 @@ pub fn reproject_pixel(
     };
     let (pp, z) = prev_cam.pixel_of(cur.point(k));
     out.motion = pp - Vec2::new(x as f32, y as f32);
-    if z <= 0.0 {
+    if z <= 0.0 || !(pp.x.abs() < 1e6 && pp.y.abs() < 1e6) {
         return out;
     }
     let tol = p.depth_tolerance * cam.view_depth(cur.point(k)).max(1e-6);
@@ -295,8 +295,8 @@ pub fn accumulate_pixel(k: usize, gb: &Gbuffer, cam: &Cam, rp: &[Reprojected], p
     }
 }
 
-/// SVGF's fwidth(z) at pixel (x, y): per axis the smaller one-sided difference of the view
-/// depth to a covered neighbour.
+/// The depth derivative at pixel (x, y): max over the axes of the smaller one-sided
+/// difference of the view depth to a covered neighbour.
 pub fn depth_fwidth(gb: &Gbuffer, cam: &Cam, x: i32, y: i32, z: f32) -> f32 {
     let mut fw = 0.0;
     for axis in 0..2 {
@@ -308,7 +308,7 @@ pub fn depth_fwidth(gb: &Gbuffer, cam: &Cam, x: i32, y: i32, z: f32) -> f32 {
             }
         }
         if best.is_finite() {
-            fw += best;
+            fw = f32::max(fw, best);
         }
     }
     fw
@@ -361,7 +361,7 @@ pub fn variance_pixel(k: usize, gb: &Gbuffer, cam: &Cam, acc: &[Accumulated], p:
                 continue;
             };
             let iq = Vec3::from_slice(&acc[q].color[..3]);
-            let phi_z = p.sigma_z * fw * Vec2::new(dx as f32, dy as f32).length();
+            let phi_z = 3.0 * p.sigma_z * fw * Vec2::new(dx as f32, dy as f32).length();
             let w = edge_weight(
                 z,
                 cam.view_depth(gb.point(q)),

@@ -260,6 +260,8 @@ impl Renderer {
         // from the last frame the stage ran (its camera and G-buffer are kept with it).
         if s.temporal.mode == TemporalMode::Off {
             self.temporal.release();
+        } else if !temporal_on {
+            self.temporal.skipped();
         }
         let t = &self.targets;
         let filtered = if temporal_on {

@@ -372,6 +372,8 @@ impl Renderer {
             self.settings.textures.max_size,
             self.settings.textures.anisotropy,
         );
+        // The history belongs to the old scene.
+        self.temporal.invalidate();
     }
 
     pub fn scene_gpu(&self) -> &SceneGpu {

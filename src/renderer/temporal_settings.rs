@@ -237,13 +237,6 @@ impl TemporalView {
             TemporalView::Reset => "temporal_reset",
         }
     }
-    /// Radiance views (the display's look applies; A/B can compare them).
-    pub fn is_radiance(self) -> bool {
-        matches!(
-            self,
-            TemporalView::Raw | TemporalView::Reprojected | TemporalView::Iteration
-        )
-    }
 }
 
 #[cfg(test)]

@@ -107,7 +107,10 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "flick.raw",
         "filt."
     );
+    // Flicker bars (raw, filtered) per method, for the motions with static pixels.
+    let mut flicker_bars: Vec<(String, Vec<plot::Bar>)> = Vec::new();
     for m in &motions {
+        let mut bars = Vec::new();
         let t0 = std::time::Instant::now();
         let truths = sequence::ground_truths(&mut b.r, &b.base, m, |_| {})?;
         b.gpu_wall += t0.elapsed();
@@ -206,6 +209,17 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                     "sum |dI - dG| / sum G over static pixels of consecutive frames, second half".into(),
                 ));
             }
+            if fr.is_finite() && ff.is_finite() {
+                // The method's name under its filtered bar, the raw one grey beside it.
+                for (label, v, c) in [(String::new(), fr, 8), (short.to_string(), ff, ci)] {
+                    bars.push(plot::Bar {
+                        label,
+                        value: v,
+                        spread: 0.0,
+                        color: c,
+                    });
+                }
+            }
             series.push(plot::Series {
                 name: short.to_string(),
                 color: ci,
@@ -224,6 +238,22 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             "RMSE ratio (vs each frame's ground truth)",
             &series,
             false,
+            true,
+        )?;
+        if !bars.is_empty() {
+            flicker_bars.push((file, bars));
+        }
+    }
+    for (file, bars) in &flicker_bars {
+        plot::bars(
+            &dir.join(format!("temporal_flicker_{file}.png")),
+            &format!(
+                "{}: flicker, raw (grey) vs filtered ({})",
+                b.scene,
+                file.replace('_', " ")
+            ),
+            "sum |dI - dG| / sum G, static pixels",
+            bars,
             true,
         )?;
     }

@@ -231,6 +231,8 @@ pub struct TemporalPass {
     last_camera: Option<GpuCamera>,
     key: Option<u64>,
     frame: Option<TemporalFrame>,
+    /// Whether the last rendered frame ran the stage (its views show only that frame's).
+    ran_last: bool,
     /// The settings of the last frame (views read their ranges).
     settings: TemporalSettings,
 }
@@ -287,6 +289,7 @@ impl TemporalPass {
             last_camera: None,
             key: None,
             frame: None,
+            ran_last: false,
             settings: TemporalSettings::default(),
         })
     }
@@ -297,6 +300,13 @@ impl TemporalPass {
         self.key = None;
         self.frame = None;
         self.last_camera = None;
+        self.ran_last = false;
+    }
+
+    /// The frame did not run the stage (a progressive method, no VPLs): the history stays for
+    /// the next frame that does, the views show nothing meanwhile.
+    pub fn skipped(&mut self) {
+        self.ran_last = false;
     }
 
     /// Frees the buffers (the stage is off).
@@ -309,8 +319,9 @@ impl TemporalPass {
         self.buffers.as_ref()
     }
 
+    /// The stage's frame if the last rendered frame ran it.
     pub fn last_frame(&self) -> Option<TemporalFrame> {
-        self.frame
+        self.frame.filter(|_| self.ran_last)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -489,6 +500,7 @@ impl TemporalPass {
         self.last_camera = Some(i.camera);
         self.key = Some(i.key);
         self.settings = s.clone();
+        self.ran_last = true;
         self.frame = Some(TemporalFrame {
             parity,
             mode: s.mode,
@@ -501,7 +513,7 @@ impl TemporalPass {
     /// Whether `view` has something to show (a frame of the stage at `size`, and for the
     /// filter's views a frame of SVGF).
     pub fn has_view(&self, view: TemporalView, size: (u32, u32)) -> bool {
-        let (Some(f), Some(b)) = (self.frame, self.buffers.as_ref()) else {
+        let (Some(f), Some(b)) = (self.last_frame(), self.buffers.as_ref()) else {
             return false;
         };
         b.size == size
@@ -526,7 +538,7 @@ impl TemporalPass {
         camera_buf: &wgpu::Buffer,
         dst: &wgpu::TextureView,
     ) -> Option<&wgpu::TextureView> {
-        let (Some(f), Some(b)) = (self.frame, self.buffers.as_ref()) else {
+        let (Some(f), Some(b)) = (self.last_frame(), self.buffers.as_ref()) else {
             return None;
         };
         let s = &self.settings;
