@@ -406,6 +406,11 @@ fn cli_examples_write_what_they_promise() {
         out.contains("baseline") && out.contains("parallel") && out.contains("speed-up"),
         "{out}"
     );
+    // The radix tree's topology, equal to its CPU twin.
+    assert!(
+        out.contains("radix topology") && out.contains("equals the CPU reference: yes"),
+        "{out}"
+    );
 
     // Lightcuts with a relative error set by --set, against the ground truth of its VPLs.
     let lc = tmp("lightcuts");
@@ -651,6 +656,8 @@ fn cli_examples_write_what_they_promise() {
         out.contains("far-paired") && out.contains("mean cut") && out.contains("0.2"),
         "{out}"
     );
+    // The same VPLs in a radix tree (issue 23's LBVH, its CPU reference so far).
+    assert!(out.contains("radix tree (Karras 2012"), "{out}");
 
     // A comparison sheet of three methods.
     let sh = tmp("sheet");

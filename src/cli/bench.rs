@@ -19,6 +19,7 @@ use crate::{
         gpu_data::{GpuCamera, GpuRay, GpuVpl},
         passes::{
             gbuffer::{COLOR_BYTES_PER_FRAGMENT, DEPTH_BYTES, GbufferPass, OverdrawCounter},
+            lbvh::{LbvhBuffers, LbvhPass},
             sst_build::{BuildPass, TreeBuffers},
             sst_sort::{SORT_TILE, SortBuffers, SortPass, SortVariant},
         },
@@ -362,6 +363,7 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
     let device = &ctx.device;
     let mut sort = SortPass::new(device)?;
     let build = BuildPass::new(device)?;
+    let lbvh = LbvhPass::new(device)?;
     let limit = device.limits().max_storage_buffer_binding_size;
     let mut timer = GpuTimer::new(device, &ctx.queue);
     if !timer.supported() {
@@ -446,6 +448,41 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
             both[0][1] / both[1][1],
             both[0].iter().sum::<f64>() / both[1].iter().sum::<f64>()
         );
+        // The radix tree's topology over the same sorted keys (Karras 2012; issue 23), checked
+        // against its CPU twin. Its node data and samplers are still to come: this is the
+        // topology alone, against the perfect tree's whole build.
+        sort.variant = SortVariant::Parallel;
+        let lb = LbvhBuffers::new(device, n);
+        let timed = time_back_to_back(&ctx, &mut timer, args.repeat, |enc, timer| {
+            sort.record(device, &ctx.queue, enc, timer, &buf, &sb);
+            lbvh.record(device, &ctx.queue, enc, timer, &sb, &lb);
+        })?;
+        let ms = median(
+            timed
+                .iter()
+                .map(|t| t.get("lbvh_build").unwrap_or(f64::NAN))
+                .collect(),
+        )
+        .unwrap_or(f64::NAN);
+        let keys: Vec<[u32; 4]> =
+            bytemuck::pod_collect_to_vec(&crate::renderer::readback::read_storage_buffer(&ctx, &sb.keys)?);
+        let keys: Vec<u64> = keys[..n as usize]
+            .iter()
+            .map(|k| (k[0] as u64) << 32 | k[1] as u64)
+            .collect();
+        let same = lb.read(&ctx)? == crate::reference::lbvh::build(&keys);
+        println!(
+            "{n:>9} {:>9} topology {ms:.3} ms ({:.2} Mnode/s; the perfect tree's whole build {:.3} ms); equals the CPU reference: {}",
+            "radix",
+            (n - 1) as f64 / (ms * 1e-3) / 1e6,
+            both[1][2],
+            if same { "yes" } else { "NO" }
+        );
+        if !same {
+            return Err(anyhow!(
+                "the radix tree of {n} keys differs from its CPU reference"
+            ));
+        }
         rows.push((n as f64, both));
     }
     for (vi, (_, name)) in variants.iter().enumerate() {

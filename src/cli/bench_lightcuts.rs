@@ -47,6 +47,39 @@ pub fn far_paired(nodes: &[SstNode], i: usize) -> bool {
     4 * i < nodes.len() && !a.is_empty() && !b.is_empty() && box_gap(a, b) > 0.5 * diagonal(&nodes[i])
 }
 
+/// The same VPLs in a binary radix tree (Karras 2012, the SST paper's construction; CPU
+/// reference `reference::lbvh`) over the same 64-bit keys: its far-paired clusters (the same
+/// test as the perfect tree's) and its leaf depths.
+fn radix_tree_pairing(vpls: &[crate::base::gpu_layout::GpuVpl], perfect_leaves: usize) {
+    use crate::reference::lbvh::{self, Child};
+    let (keys, sorted) = lbvh::sorted_keys(vpls);
+    if keys.len() < 2 {
+        return;
+    }
+    let tree = lbvh::build(&keys);
+    let leaves: Vec<SstNode> = sorted.iter().map(SstNode::leaf).collect();
+    let data = lbvh::node_data(&tree, &leaves);
+    let (mut clusters, mut far) = (0usize, 0usize);
+    for (i, n) in tree.iter().enumerate() {
+        if let (Child::Internal(a), Child::Internal(b)) = (n.left, n.right) {
+            let (a, b) = (&data[a as usize], &data[b as usize]);
+            if a.is_empty() || b.is_empty() {
+                continue;
+            }
+            clusters += 1;
+            far += (box_gap(a, b) > 0.5 * diagonal(&data[i])) as usize;
+        }
+    }
+    let depths = lbvh::leaf_depths(&tree);
+    let mean = depths.iter().map(|&d| d as f64).sum::<f64>() / depths.len() as f64;
+    println!(
+        "radix tree (Karras 2012, CPU reference) over the same keys: far-paired nodes over clusters: {far} of {clusters} ({:.1}%); leaf depth mean {mean:.1}, max {} (perfect tree: {})",
+        100.0 * far as f64 / clusters.max(1) as f64,
+        depths.iter().max().copied().unwrap_or(0),
+        perfect_leaves.trailing_zeros()
+    );
+}
+
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
     let scene = &opened.scene;
@@ -140,6 +173,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         far_total.1,
         100.0 * far_share
     );
+    radix_tree_pairing(&r.read_vpls()?, leaves);
     // The frame's G-buffer and sorted VPLs for the CPU reference.
     let bvh = Bvh::build(&scene.positions, &scene.indices);
     let pos = r.read(Buffer::Position)?;

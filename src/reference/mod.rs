@@ -18,6 +18,7 @@ pub mod gbuffer;
 pub mod gi;
 pub mod interleave;
 pub mod ism;
+pub mod lbvh;
 pub mod light_culling;
 pub mod lightcut_interpolation;
 pub mod lightcuts;

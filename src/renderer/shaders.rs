@@ -102,6 +102,7 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("ism_view.wgsl", include_str!("../../shaders/ism_view.wgsl")),
     ("val_cluster.wgsl", include_str!("../../shaders/val_cluster.wgsl")),
     ("temporal.wgsl", include_str!("../../shaders/temporal.wgsl")),
+    ("lbvh.wgsl", include_str!("../../shaders/lbvh.wgsl")),
 ];
 
 /// The shared shaders that are entry points (not include-only files); [`entry_shaders`] adds
@@ -127,6 +128,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "ism_view.wgsl",
     "val_cluster.wgsl",
     "temporal.wgsl",
+    "lbvh.wgsl",
 ];
 
 /// Every WGSL file: the shared ones and those the registered GI methods declare.

@@ -9,6 +9,7 @@ pub mod display;
 pub mod gbuffer;
 pub mod interleave_filter;
 pub mod ism;
+pub mod lbvh;
 pub mod rsm;
 pub mod sst_build;
 pub mod sst_overlay;
