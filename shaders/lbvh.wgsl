@@ -4,6 +4,11 @@
 // end (exponential, then binary search) and its split (binary search) from the keys' common
 // prefixes. Equal keys compare by their indices. Internal node 0 is the root; a child with
 // bit 31 set is a leaf (a sorted key's position). CPU twin: reference::lbvh::build.
+// `node_data`: the SST node data bottom-up (as sst_build.wgsl: one thread per leaf, the second
+// arrival at a node merges its two children and walks on). CPU twin: reference::lbvh::node_data.
+#include "common/color.wgsl"
+#include "common/vpl.wgsl"
+#include "common/sst_node.wgsl"
 
 // Twin: `GpuLbvhParams` in src/renderer/passes/lbvh.rs.
 struct LbvhParams {
@@ -17,9 +22,15 @@ struct LbvhParams {
 // (key hi, key lo, VPL index, 0) sorted ascending (sst_sort's output).
 @group(0) @binding(1) var<storage, read> keys: array<vec4<u32>>;
 // left, right (bit 31: leaf), first, last leaf of the range.
-@group(0) @binding(2) var<storage, read_write> nodes: array<vec4<u32>>;
+@group(0) @binding(2) var<storage, read_write> topology: array<vec4<u32>>;
 // Parents: internal nodes 0 .. n-1 (the root's NONE), then leaves at n - 1 + k.
 @group(0) @binding(3) var<storage, read_write> parents: array<u32>;
+@group(0) @binding(4) var<storage, read> vpls: array<Vpl>;
+// SST nodes (16 words each): internal node i at i, leaf k at n - 1 + k.
+@group(0) @binding(5) var<storage, read_write> nodes: array<atomic<u32>>;
+@group(0) @binding(6) var<storage, read_write> counters: array<atomic<u32>>;
+
+#include "common/sst_merge.wgsl"
 
 const LEAF_BIT: u32 = 0x80000000u;
 const NONE: u32 = 0xffffffffu;
@@ -92,8 +103,52 @@ fn build(@builtin(global_invocation_id) gid: vec3<u32>) {
     } else {
         parents[u32(gamma + 1)] = u32(i);
     }
-    nodes[i] = vec4<u32>(left, right, u32(first), u32(last));
+    topology[i] = vec4<u32>(left, right, u32(first), u32(last));
     if i == 0 {
         parents[0] = NONE;
+    }
+}
+
+// Where node data of a stored child lives.
+fn child_slot(c: u32) -> u32 {
+    if (c & LEAF_BIT) != 0u {
+        return params.count - 1u + (c & ~LEAF_BIT);
+    }
+    return c;
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn node_data(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let n = params.count;
+    let k = gid.x;
+    if k >= n {
+        return;
+    }
+    // Leaf k: the k-th VPL in key order (empty VPLs and the sort's padding: empty leaves).
+    var leaf = empty_node();
+    let vi = keys[k].z;
+    if vi < n && vpls[vi].id != VPL_NONE {
+        let v = vpls[vi];
+        let code = oct_encode(v.normal);
+        let p = v.position.xyz;
+        leaf = Node(p, 1.0, v.flux.rgb, oct_decode(code), code, p, p, vec3<f32>(0.0), 0u);
+    }
+    let slot = n - 1u + k;
+    store_node(slot, leaf);
+    if n < 2u {
+        return;
+    }
+    var node = parents[slot];
+    loop {
+        // First arrival: the other child is not done yet; leave the merge to the second.
+        if atomicAdd(&counters[node], 1u) == 0u {
+            return;
+        }
+        let t = topology[node];
+        store_node(node, merge(load_node(child_slot(t.x)), load_node(child_slot(t.y))));
+        if node == 0u {
+            return;
+        }
+        node = parents[node];
     }
 }

@@ -406,9 +406,11 @@ fn cli_examples_write_what_they_promise() {
         out.contains("baseline") && out.contains("parallel") && out.contains("speed-up"),
         "{out}"
     );
-    // The radix tree's topology, equal to its CPU twin.
+    // The radix tree: topology (equal to its CPU twin) and node data.
     assert!(
-        out.contains("radix topology") && out.contains("equals the CPU reference: yes"),
+        out.contains("radix topology")
+            && out.contains("node data")
+            && out.contains("topology equals the CPU reference: yes"),
         "{out}"
     );
 
@@ -656,7 +658,7 @@ fn cli_examples_write_what_they_promise() {
         out.contains("far-paired") && out.contains("mean cut") && out.contains("0.2"),
         "{out}"
     );
-    // The same VPLs in a radix tree (issue 23's LBVH, its CPU reference so far).
+    // The same VPLs in a radix tree (issue 23's LBVH, from its CPU reference).
     assert!(out.contains("radix tree (Karras 2012"), "{out}");
 
     // A comparison sheet of three methods.

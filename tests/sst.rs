@@ -402,3 +402,59 @@ fn frame_tree_reclassifies_without_rebuilding() {
     assert_ne!(flags2, flags, "stricter thresholds change some flags");
     assert!(ctx.errors.take().is_empty());
 }
+
+/// The radix tree (issue 23): the GPU's node data over its own topology equals the CPU twin
+/// (`reference::lbvh::node_data` over `reference::lbvh::build` of the same sorted keys), with
+/// the perfect tree's tolerances; its root holds the same flux and bounds as the perfect
+/// tree's root.
+#[test]
+fn gpu_radix_tree_node_data_equals_the_cpu_twin() {
+    use lightcut::reference::lbvh;
+    use lightcut::renderer::passes::lbvh::{LbvhBuffers, LbvhPass};
+    let Some(ctx) = common::gpu() else { return };
+    for n in [2usize, 3, 600, 3000] {
+        let vpls = synthetic_vpls(n, 7 + n as u64);
+        let buf = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("test::vpls"),
+            contents: bytemuck::cast_slice(&vpls),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let sort = SortPass::new(&ctx.device).unwrap();
+        let pass = LbvhPass::new(&ctx.device).unwrap();
+        let sb = SortBuffers::new(&ctx.device, n as u32);
+        let lb = LbvhBuffers::new(&ctx.device, n as u32);
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        let mut timer = GpuTimer::new(&ctx.device, &ctx.queue);
+        sort.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, &buf, &sb);
+        pass.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, &sb, &lb);
+        pass.record_node_data(&ctx.device, &ctx.queue, &mut enc, &mut timer, &sb, &buf, &lb);
+        ctx.queue.submit([enc.finish()]);
+        let pairs = read_pairs(&ctx, &sb).unwrap();
+        let keys: Vec<u64> = pairs.iter().take(n).map(|p| p.0).collect();
+        let topology = lbvh::build(&keys);
+        assert_eq!(lb.read(&ctx).unwrap(), topology, "{n} VPLs: topology");
+        let leaves: Vec<SstNode> = pairs
+            .iter()
+            .take(n)
+            .map(|&(_, i)| vpls.get(i as usize).map(SstNode::leaf).unwrap_or(SstNode::EMPTY))
+            .collect();
+        let internal = lbvh::node_data(&topology, &leaves);
+        // Index 0 is skipped by `compare_trees` (the perfect tree's unused node): pad.
+        let mut cpu = vec![SstNode::EMPTY];
+        cpu.extend(internal.iter().copied());
+        cpu.extend(leaves.iter().copied());
+        let mut gpu = vec![SstNode::EMPTY];
+        gpu.extend(lb.read_node_data(&ctx).unwrap());
+        compare_trees(&gpu, &cpu, 10.0);
+        // The root sums every VPL as the perfect tree's does.
+        let perfect = gpu_tree(&ctx, &vpls, 0.9, 0.1);
+        let (a, b) = (&gpu[1], &perfect.nodes[1]);
+        assert_eq!(
+            (a.bbox_min, a.bbox_max),
+            (b.bbox_min, b.bbox_max),
+            "{n} VPLs: root bounds"
+        );
+        assert!((a.intensity - b.intensity).abs().max_element() <= 1e-4 * b.intensity.max_element());
+    }
+    assert!(ctx.errors.take().is_empty());
+}

@@ -103,6 +103,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("val_cluster.wgsl", include_str!("../../shaders/val_cluster.wgsl")),
     ("temporal.wgsl", include_str!("../../shaders/temporal.wgsl")),
     ("lbvh.wgsl", include_str!("../../shaders/lbvh.wgsl")),
+    (
+        "common/sst_merge.wgsl",
+        include_str!("../../shaders/common/sst_merge.wgsl"),
+    ),
 ];
 
 /// The shared shaders that are entry points (not include-only files); [`entry_shaders`] adds
