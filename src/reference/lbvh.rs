@@ -14,8 +14,6 @@
 //! range at its longest common prefix. The tests hold the first to the second on random keys,
 //! with duplicates.
 
-use glam::Vec3;
-
 use crate::base::gpu_layout::{GpuVpl, VPL_NONE};
 use crate::base::sst_node::{SstNode, merge};
 
@@ -169,29 +167,14 @@ pub fn leaf_depths(nodes: &[Internal]) -> Vec<u32> {
     depth
 }
 
-/// The valid VPLs (not `VPL_NONE`) sorted by their 64-bit keys (`reference::sst::sort_key`
-/// in the VPLs' bounds, the id being the VPL's index, as the GPU's stage 8), with the keys.
+/// The valid VPLs (not `VPL_NONE`) sorted by their 64-bit keys, with the keys
+/// (`sst_tree::sorted_keys`, the GPU's stage 8-9 order, empty VPLs left out).
 pub fn sorted_keys(vpls: &[GpuVpl]) -> (Vec<u64>, Vec<GpuVpl>) {
-    let mut bounds = crate::scene::Aabb::EMPTY;
-    for v in vpls.iter().filter(|v| v.id != VPL_NONE) {
-        bounds.grow(Vec3::from_slice(&v.position[..3]));
-    }
-    let mut keyed: Vec<(u64, usize)> = vpls
-        .iter()
-        .enumerate()
-        .filter(|(_, v)| v.id != VPL_NONE)
-        .map(|(i, v)| {
-            let k = super::sst::sort_key(
-                Vec3::from_slice(&v.position[..3]),
-                Vec3::from_array(v.normal),
-                i as u32,
-                &bounds,
-            );
-            (k, i)
-        })
-        .collect();
-    keyed.sort_unstable();
-    keyed.into_iter().map(|(k, i)| (k, vpls[i])).unzip()
+    super::sst_tree::sorted_keys(vpls)
+        .into_iter()
+        .filter(|&(_, i)| vpls[i].id != VPL_NONE)
+        .map(|(k, i)| (k, vpls[i]))
+        .unzip()
 }
 
 /// The SST node data of every internal node, merged bottom-up from the leaves' (the same

@@ -60,6 +60,12 @@ pub fn build_with_leaves(sorted: &[GpuVpl], leaves: usize) -> Vec<SstNode> {
 
 /// The VPLs in the order of their sort keys (the CPU twin of stages 8-9 plus the permutation).
 pub fn sort_vpls(vpls: &[GpuVpl]) -> Vec<GpuVpl> {
+    sorted_keys(vpls).into_iter().map(|(_, i)| vpls[i]).collect()
+}
+
+/// Each VPL's 64-bit sort key (`reference::sst::sort_key` in the valid VPLs' bounds, its
+/// index as the id; empty VPLs `u64::MAX`) and index, in key order.
+pub fn sorted_keys(vpls: &[GpuVpl]) -> Vec<(u64, usize)> {
     let mut bounds = crate::scene::Aabb::EMPTY;
     for v in vpls.iter().filter(|v| v.id != VPL_NONE) {
         bounds.grow(Vec3::from_slice(&v.position[..3]));
@@ -82,7 +88,7 @@ pub fn sort_vpls(vpls: &[GpuVpl]) -> Vec<GpuVpl> {
         })
         .collect();
     keyed.sort_unstable();
-    keyed.into_iter().map(|(_, i)| vpls[i]).collect()
+    keyed
 }
 
 /// The usable flags, one bit per node (word w holds nodes 32w .. 32w+31).

@@ -7,34 +7,12 @@
 use glam::{Vec2, Vec3};
 
 use crate::base::display::luminance;
-use crate::scene::Camera;
 
-/// A camera as the pass sees it (`GpuCamera`'s fields: eye, unit forward, right and up
-/// scaled by the half-extents of the image plane at distance 1).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Cam {
-    pub eye: Vec3,
-    pub forward: Vec3,
-    pub right: Vec3,
-    pub up: Vec3,
-    pub width: u32,
-    pub height: u32,
-}
+/// A camera as the pass sees it: `GpuCamera`'s fields (eye, unit forward, right and up scaled
+/// by the half-extents of the image plane at distance 1), light culling's tile camera.
+pub use super::light_culling::TileCamera as Cam;
 
 impl Cam {
-    /// As `GpuCamera::new` builds it.
-    pub fn new(c: &Camera, width: u32, height: u32) -> Self {
-        let aspect = width as f32 / height.max(1) as f32;
-        let t = (0.5 * c.yfov).tan();
-        Self {
-            eye: c.position,
-            forward: c.forward,
-            right: c.right() * t * aspect,
-            up: c.up * t,
-            width,
-            height,
-        }
-    }
     pub fn view_depth(&self, x: Vec3) -> f32 {
         (x - self.eye).dot(self.forward)
     }
@@ -555,6 +533,7 @@ impl Frame {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::Camera;
 
     /// A camera looking down -z at the plane z = 0 (or a step in it), covering [-1, 1]^2.
     fn plane(w: u32, h: u32, step_at: Option<u32>) -> (Gbuffer, Cam) {

@@ -79,11 +79,8 @@ impl Renderer {
             s.shadow.slope_bias,
             s.shadow.pcf_radius,
         );
-        queue.write_buffer(
-            &self.camera_buf,
-            0,
-            bytemuck::bytes_of(&GpuCamera::new(input.camera, size.0, size.1)),
-        );
+        let gpu_camera = GpuCamera::new(input.camera, size.0, size.1);
+        queue.write_buffer(&self.camera_buf, 0, bytemuck::bytes_of(&gpu_camera));
         queue.write_buffer(&self.lights_buf, 0, bytemuck::bytes_of(&gpu_lights));
         self.light0_lum = lights
             .first()
@@ -268,7 +265,7 @@ impl Renderer {
             let inputs = passes::temporal::TemporalInputs {
                 gbuffer: &t.gbuffer,
                 camera_buf: &self.camera_buf,
-                camera: GpuCamera::new(input.camera, size.0, size.1),
+                camera: gpu_camera,
                 accum: &t.lighting.gi_accum,
                 scale: indirect_scale,
                 size,

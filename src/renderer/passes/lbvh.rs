@@ -148,6 +148,16 @@ impl LbvhPass {
         })
     }
 
+    /// The leaf count (the first `out.count` of `keys`) into the uniform both passes read.
+    fn write_params(&self, queue: &wgpu::Queue, keys: &SortBuffers, out: &LbvhBuffers) -> GpuLbvhParams {
+        let p = GpuLbvhParams {
+            count: out.count.min(keys.count),
+            _pad: [0; 3],
+        };
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        p
+    }
+
     /// Records the build over the first `out.count` keys of `keys` (sorted).
     pub fn record(
         &self,
@@ -158,11 +168,7 @@ impl LbvhPass {
         keys: &SortBuffers,
         out: &LbvhBuffers,
     ) {
-        let p = GpuLbvhParams {
-            count: out.count.min(keys.count),
-            _pad: [0; 3],
-        };
-        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let p = self.write_params(queue, keys, out);
         let bind = bind_group_seq(
             device,
             "lbvh::bind_group",
@@ -197,11 +203,7 @@ impl LbvhPass {
         vpls: &wgpu::Buffer,
         out: &LbvhBuffers,
     ) {
-        let p = GpuLbvhParams {
-            count: out.count.min(keys.count),
-            _pad: [0; 3],
-        };
-        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let p = self.write_params(queue, keys, out);
         encoder.clear_buffer(&out.counters, 0, None);
         let bind = bind_group_seq(
             device,

@@ -205,7 +205,6 @@ pub struct TemporalInputs<'a> {
 pub struct TemporalFrame {
     /// The parity of the history buffers it wrote.
     pub parity: usize,
-    pub mode: TemporalMode,
     /// It started without a history.
     pub first: bool,
     pub iterations: u32,
@@ -503,7 +502,6 @@ impl TemporalPass {
         self.ran_last = true;
         self.frame = Some(TemporalFrame {
             parity,
-            mode: s.mode,
             first,
             iterations: if svgf { s.iterations } else { 0 },
         });
