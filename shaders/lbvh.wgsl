@@ -2,10 +2,12 @@
 // in the Construction of BVHs, Octrees, and k-d Trees", section 4 and figure 4; the SST
 // paper's section 3.3): one thread per internal node finds its range's direction, its other
 // end (exponential, then binary search) and its split (binary search) from the keys' common
-// prefixes. Equal keys compare by their indices. Internal node 0 is the root; a child with
-// bit 31 set is a leaf (a sorted key's position). CPU twin: reference::lbvh::build.
+// prefixes. Equal keys compare by their indices. CPU twin: reference::lbvh::build.
+// Nodes are numbered as the samplers read both trees (common/tree_links.wgsl): Karras's
+// internal node i is node i + 1 (the root: 1), leaf k is node n + k.
 // `node_data`: the SST node data bottom-up (as sst_build.wgsl: one thread per leaf, the second
-// arrival at a node merges its two children and walks on). CPU twin: reference::lbvh::node_data.
+// arrival at a node merges its two children and walks on), and the VPLs in leaf order. CPU
+// twin: reference::lbvh::sampler_layout.
 #include "common/color.wgsl"
 #include "common/vpl.wgsl"
 #include "common/sst_node.wgsl"
@@ -21,18 +23,20 @@ struct LbvhParams {
 @group(0) @binding(0) var<uniform> params: LbvhParams;
 // (key hi, key lo, VPL index, 0) sorted ascending (sst_sort's output).
 @group(0) @binding(1) var<storage, read> keys: array<vec4<u32>>;
-// left, right (bit 31: leaf), first, last leaf of the range.
-@group(0) @binding(2) var<storage, read_write> topology: array<vec4<u32>>;
-// Parents: internal nodes 0 .. n-1 (the root's NONE), then leaves at n - 1 + k.
+// Per inner node (1 .. n-1; 0 unused): left, right, first, last leaf of the range.
+@group(0) @binding(2) var<storage, read_write> links: array<vec4<u32>>;
+// Per node (1 .. 2n-1): its parent (the root's NONE).
 @group(0) @binding(3) var<storage, read_write> parents: array<u32>;
 @group(0) @binding(4) var<storage, read> vpls: array<Vpl>;
-// SST nodes (16 words each): internal node i at i, leaf k at n - 1 + k.
+// SST nodes (16 words each), the frame's tree: node i at i.
 @group(0) @binding(5) var<storage, read_write> nodes: array<atomic<u32>>;
+// Per inner node: arrivals.
 @group(0) @binding(6) var<storage, read_write> counters: array<atomic<u32>>;
+// The VPLs in leaf order (empty ones and padding: VPL_NONE).
+@group(0) @binding(7) var<storage, read_write> sorted_vpls: array<Vpl>;
 
 #include "common/sst_merge.wgsl"
 
-const LEAF_BIT: u32 = 0x80000000u;
 const NONE: u32 = 0xffffffffu;
 
 // The common prefix length of keys i and j (-1 when j is outside), the indices' when the keys
@@ -89,32 +93,17 @@ fn build(@builtin(global_invocation_id) gid: vec3<u32>) {
     let gamma = i + s * d + min(d, 0);
     let first = min(i, j);
     let last = max(i, j);
-    var left = u32(gamma);
-    var right = u32(gamma + 1);
-    if first == gamma {
-        left |= LEAF_BIT;
-        parents[u32(n - 1 + gamma)] = u32(i);
-    } else {
-        parents[u32(gamma)] = u32(i);
-    }
-    if last == gamma + 1 {
-        right |= LEAF_BIT;
-        parents[u32(n + gamma)] = u32(i);
-    } else {
-        parents[u32(gamma + 1)] = u32(i);
-    }
-    topology[i] = vec4<u32>(left, right, u32(first), u32(last));
+    // Children: leaf gamma (node n + gamma) when the range starts there, else internal gamma
+    // (node gamma + 1); likewise gamma + 1.
+    let left = select(u32(gamma + 1), u32(n + gamma), first == gamma);
+    let right = select(u32(gamma + 2), u32(n + gamma + 1), last == gamma + 1);
+    let me = u32(i + 1);
+    parents[left] = me;
+    parents[right] = me;
+    links[me] = vec4<u32>(left, right, u32(first), u32(last));
     if i == 0 {
-        parents[0] = NONE;
+        parents[1] = NONE;
     }
-}
-
-// Where node data of a stored child lives.
-fn child_slot(c: u32) -> u32 {
-    if (c & LEAF_BIT) != 0u {
-        return params.count - 1u + (c & ~LEAF_BIT);
-    }
-    return c;
 }
 
 @compute @workgroup_size(64, 1, 1)
@@ -126,14 +115,18 @@ fn node_data(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // Leaf k: the k-th VPL in key order (empty VPLs and the sort's padding: empty leaves).
     var leaf = empty_node();
+    var vpl = Vpl(vec4<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0), VPL_NONE, vec4<f32>(0.0));
     let vi = keys[k].z;
-    if vi < n && vpls[vi].id != VPL_NONE {
-        let v = vpls[vi];
-        let code = oct_encode(v.normal);
-        let p = v.position.xyz;
-        leaf = Node(p, 1.0, v.flux.rgb, oct_decode(code), code, p, p, vec3<f32>(0.0), 0u);
+    if vi < n {
+        vpl = vpls[vi];
     }
-    let slot = n - 1u + k;
+    sorted_vpls[k] = vpl;
+    if vpl.id != VPL_NONE {
+        let code = oct_encode(vpl.normal);
+        let p = vpl.position.xyz;
+        leaf = Node(p, 1.0, vpl.flux.rgb, oct_decode(code), code, p, p, vec3<f32>(0.0), 0u);
+    }
+    let slot = n + k;
     store_node(slot, leaf);
     if n < 2u {
         return;
@@ -144,9 +137,9 @@ fn node_data(@builtin(global_invocation_id) gid: vec3<u32>) {
         if atomicAdd(&counters[node], 1u) == 0u {
             return;
         }
-        let t = topology[node];
-        store_node(node, merge(load_node(child_slot(t.x)), load_node(child_slot(t.y))));
-        if node == 0u {
+        let t = links[node];
+        store_node(node, merge(load_node(t.x), load_node(t.y)));
+        if node == 1u {
             return;
         }
         node = parents[node];

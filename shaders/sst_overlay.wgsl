@@ -3,7 +3,9 @@
 // deviations along tangent and bitangent, filled inside 1 sigma) or as their bounding boxes.
 // Parts behind the G-buffer surface are drawn faint. Colour: node flux on a log scale around
 // the level's mean (false colour: 1/100 of the mean -> 0, 100x -> 1), the usable flag
-// (green / red), or a colour per node.
+// (green / red), or a colour per node. On the radix tree (issue 23), whose leaves lie at many
+// depths, "level l" is the cut of the nodes at depth l and the leaves above it: every VPL once,
+// as the perfect tree's level.
 #include "common/camera.wgsl"
 #include "common/color.wgsl"
 #include "common/sst_node.wgsl"
@@ -12,7 +14,11 @@ struct OverlayParams {
     level: u32,      // tree level drawn (root = 0)
     color_mode: u32, // 0 intensity, 1 usable flag, 2 node id
     min_radius: f32, // smallest drawn semi-axis (metres), so leaves stay visible
-    _pad: u32,
+    radix: u32,      // 1: the radix tree (instances: every node; depth from the parents)
+    leaves: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 @group(0) @binding(0) var<uniform> op: OverlayParams;
@@ -20,6 +26,26 @@ struct OverlayParams {
 @group(0) @binding(2) var<storage, read> tree: array<SstNode>;
 @group(0) @binding(3) var<storage, read> flags: array<u32>;
 @group(0) @binding(4) var gb_position: texture_2d<f32>;
+// The radix tree's parents (a dummy on the perfect tree).
+@group(0) @binding(5) var<storage, read> parents: array<u32>;
+
+// The node instance `ii` draws, or 0 when it is not in the level's cut.
+fn instance_node(ii: u32) -> u32 {
+    if op.radix == 0u {
+        return (1u << op.level) + ii;
+    }
+    let i = ii + 1u;
+    var depth = 0u;
+    var n = i;
+    while n != 1u && depth <= op.level {
+        n = parents[n];
+        depth += 1u;
+    }
+    if depth == op.level || (i >= op.leaves && depth < op.level) {
+        return i;
+    }
+    return 0u;
+}
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -48,7 +74,10 @@ fn hidden() -> VsOut {
 
 @vertex
 fn vs_ellipse(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> VsOut {
-    let i = (1u << op.level) + ii;
+    let i = instance_node(ii);
+    if i == 0u {
+        return hidden();
+    }
     let node = tree[i];
     if sst_is_empty(node) {
         return hidden();
@@ -67,7 +96,10 @@ fn vs_ellipse(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) 
 
 @vertex
 fn vs_box(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> VsOut {
-    let i = (1u << op.level) + ii;
+    let i = instance_node(ii);
+    if i == 0u {
+        return hidden();
+    }
     let node = tree[i];
     if sst_is_empty(node) {
         return hidden();

@@ -135,6 +135,29 @@ fn bad_input_gives_one_clear_line() {
         "/tmp/x",
     ]);
     assert!(e.contains("temporal.iterations"), "{e}");
+    // The radix tree with a method that needs the perfect tree: refused, the method named.
+    let e = one_line_error(&[
+        "render",
+        "--method",
+        "lightcuts",
+        "--tree",
+        "lbvh",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("--tree lbvh") && e.contains("Lightcuts"), "{e}");
+    let e = one_line_error(&[
+        "render",
+        "--method",
+        "lightcut-interpolation",
+        "--set",
+        "tree.kind=lbvh",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("tree lbvh") && e.contains("perfect tree only"), "{e}");
+    let e = one_line_error(&["render", "--tree", "kd", "--out", "/tmp/x"]);
+    assert!(e.contains("kd"), "{e}");
 }
 
 #[test]

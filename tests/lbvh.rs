@@ -8,9 +8,11 @@ mod common;
 use lightcut::reference::lbvh::{self, Child};
 use lightcut::renderer::{
     passes::{
-        lbvh::{LbvhBuffers, LbvhPass},
+        lbvh::{LbvhPass, read_parents, read_topology},
+        sst_build::TreeBuffers,
         sst_sort::SortBuffers,
     },
+    settings::TreeKind,
     timing::GpuTimer,
 };
 
@@ -54,19 +56,19 @@ fn the_gpu_radix_tree_equals_karras_on_the_cpu() {
             })
             .collect();
         ctx.queue.write_buffer(&sb.keys, 0, bytemuck::cast_slice(&words));
-        let out = LbvhBuffers::new(device, n as u32);
+        let out = TreeBuffers::new(device, n as u32, TreeKind::Lbvh);
         let mut enc = device.create_command_encoder(&Default::default());
         timer.begin_frame(false);
         pass.record(device, &ctx.queue, &mut enc, &mut timer, &sb, &out);
         ctx.queue.submit([enc.finish()]);
-        let gpu = out.read(&ctx).unwrap();
+        let gpu = read_topology(&ctx, &out).unwrap();
         let cpu = lbvh::build(&k);
         assert_eq!(
             gpu, cpu,
             "{n} keys (seed {seed}, duplicates every {dup}, {bits} bits)"
         );
         // Parents: the root has none; every other node and every leaf its twin's parent.
-        let parents = out.read_parents(&ctx).unwrap();
+        let parents = read_parents(&ctx, &out).unwrap();
         let (ip, lp) = lbvh::parents(&cpu);
         assert_eq!(parents[0], u32::MAX);
         for (i, p) in ip.iter().enumerate().skip(1) {

@@ -7,18 +7,22 @@ mod common;
 use common::Setup;
 
 use glam::Vec3;
+use lightcut::base::sst_node::Topology;
 use lightcut::methods::tree_samplers::{RTSLC, SLC, SST};
 use lightcut::{
     metrics,
     reference::{
-        slc::{self, bilinear_blocks, block_centre, build_cut, check_cut, reachable_leaves, similar},
+        slc::{
+            self, bilinear_blocks, block_centre, build_cut_on, check_cut_on, reachable_leaves_on, similar,
+        },
         sst_tree::classify,
     },
     renderer::{
         Buffer, FrameInput,
         context::GpuContext,
+        passes::lbvh::read_links,
         readback::{ImageF32, read_storage_buffer},
-        settings::{ChildProbability, InterleaveSettings, MethodId, RenderSettings, ViewBuffer},
+        settings::{ChildProbability, InterleaveSettings, MethodId, RenderSettings, TreeKind, ViewBuffer},
     },
 };
 
@@ -51,16 +55,44 @@ fn v3(p: [f32; 4]) -> Vec3 {
 #[test]
 fn gpu_cuts_equal_the_cpu_cuts_and_are_valid() {
     let Some(ctx) = common::gpu() else { return };
-    for (cull, cut_size) in [(true, 16), (false, 16), (true, 64), (true, 1)] {
-        let mut st = setup(&ctx, settings(SLC));
+    check_cuts(
+        &ctx,
+        TreeKind::Perfect,
+        &[(true, 16), (false, 16), (true, 64), (true, 1)],
+    );
+}
+
+/// Issue 23: the cuts on the radix tree (children by its links) equal the CPU's on the same
+/// tree, and so does its mock cut (written after the blocks' cuts).
+#[test]
+fn gpu_cuts_on_the_radix_tree_equal_the_cpu_cuts_and_mock_cut() {
+    let Some(ctx) = common::gpu() else { return };
+    check_cuts(&ctx, TreeKind::Lbvh, &[(true, 16), (false, 64)]);
+}
+
+fn check_cuts(ctx: &GpuContext, kind: TreeKind, cases: &[(bool, u32)]) {
+    for &(cull, cut_size) in cases {
+        let mut st = setup(ctx, settings(SLC));
         st.set(|s| {
             s.sampling.cull_behind = cull;
             s.sampling.cut_size = cut_size;
+            s.tree.kind = kind;
         });
         st.frame();
         let (nodes, _) = st.r.read_tree().unwrap();
+        let tree = st.r.tree_buffers().1;
+        assert_eq!(tree.kind, kind);
+        let links = match kind {
+            TreeKind::Lbvh => read_links(ctx, tree).unwrap(),
+            TreeKind::Perfect => Vec::new(),
+        };
+        let topo = match kind {
+            TreeKind::Lbvh => Topology::radix(&links),
+            TreeKind::Perfect => Topology::perfect_of(&nodes),
+        };
+        assert_eq!(nodes.len(), 2 * topo.leaves as usize);
         let b = st.r.slc_buffers();
-        let cuts: Vec<u32> = bytemuck::cast_slice(&read_storage_buffer(&ctx, &b.cuts).unwrap()).to_vec();
+        let cuts: Vec<u32> = bytemuck::cast_slice(&read_storage_buffer(ctx, &b.cuts).unwrap()).to_vec();
         let (grid, k) = (b.grid, b.block);
         let pos = st.r.read(Buffer::Position).unwrap();
         let nrm = st.r.read(Buffer::Normal).unwrap();
@@ -81,13 +113,30 @@ fn gpu_cuts_equal_the_cpu_cuts_and_are_valid() {
                     continue;
                 }
                 let n = v3(nrm.get(cx, cy)).normalize();
-                check_cut(&gpu, &nodes).unwrap_or_else(|e| panic!("block {bi}: {e}"));
-                let reach = reachable_leaves(&nodes, v3(p), n, eps, cull);
+                check_cut_on(&gpu, &nodes, topo).unwrap_or_else(|e| panic!("block {bi}: {e}"));
+                let reach = reachable_leaves_on(&nodes, topo, v3(p), n, eps, cull);
                 assert_eq!(gpu.len() as u32, cut_size.min(reach), "block {bi}: size");
                 nonempty += !gpu.is_empty() as u32;
-                let cpu = build_cut(&nodes, v3(p), n, eps, cut_size, cull);
+                let cpu = build_cut_on(&nodes, topo, v3(p), n, eps, cut_size, cull);
                 equal += (cpu == gpu) as u32;
             }
+        }
+        if kind == TreeKind::Lbvh {
+            // The mock cut after the last block's: a partition of the VPLs, equal to the twin.
+            let tail = (grid.0 * grid.1 * cut_size) as usize;
+            let gpu: Vec<u32> = cuts[tail..tail + cut_size as usize]
+                .iter()
+                .copied()
+                .take_while(|&c| c != 0)
+                .collect();
+            let cpu = slc::mock_cut(topo, cut_size, tree.levels());
+            assert_eq!(gpu, cpu, "mock cut of {cut_size}");
+            assert_eq!(gpu.len(), 1 << slc::mock_level(cut_size, tree.levels()));
+            let covered: u32 = gpu
+                .iter()
+                .map(|&c| topo.leaf_range(c).1 - topo.leaf_range(c).0 + 1)
+                .sum();
+            assert_eq!(covered, topo.leaves, "the mock cut covers every leaf once");
         }
         // Same nodes in the same slots; float rounding (FMA) may reorder a near tie.
         assert!(
@@ -295,6 +344,40 @@ fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
             "{cp:?}: mean ratio after 128 frames {m128}"
         );
     }
+    assert!(ctx.errors.take().is_empty());
+}
+
+/// Issue 23: RTSLC traversing the radix tree (children by its links, a leaf per VPL, no
+/// padding) is unbiased as on the perfect tree: its mean over frames converges to the ground
+/// truth of the same VPLs at 1/sqrt(frames).
+#[test]
+fn rtslc_on_the_radix_tree_converges_to_the_ground_truth() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut st = setup(&ctx, settings(RTSLC));
+    let gt = st.ground_truth_of_these_vpls();
+    st.set(|s| {
+        s.gi.method = RTSLC;
+        s.tree.kind = TreeKind::Lbvh;
+        s.sampling.block_size = 1;
+        s.sampling.accumulate = true;
+    });
+    st.frame();
+    assert_eq!(st.r.tree_buffers().1.kind, TreeKind::Lbvh);
+    let mut errs = Vec::new();
+    for target in [8u32, 32, 128] {
+        while st.r.sampling_frames() < target {
+            st.frame();
+        }
+        let img = st.indirect();
+        let m = metrics::compare(&img, &gt, 3.0, lightcut::renderer::settings::Tonemap::Aces);
+        errs.push((target, m.rmse, block_error(&img, &gt), m.mean_ratio));
+    }
+    eprintln!("RTSLC on the radix tree vs ground truth (frames, RMSE, block error, mean ratio): {errs:?}");
+    let (_, r8, b8, _) = errs[0];
+    let (_, r128, b128, m128) = errs[2];
+    assert!(r8 / r128 > 2.5 && r8 / r128 < 7.5, "RMSE ratio {}", r8 / r128);
+    assert!(b8 / b128 > 2.5, "block error ratio {}", b8 / b128);
+    assert!((m128 - 1.0).abs() < 0.02, "mean ratio after 128 frames {m128}");
     assert!(ctx.errors.take().is_empty());
 }
 

@@ -207,6 +207,23 @@ fn gpu_tree(
     v_min: f32,
     sigma_max: f32,
 ) -> GpuTree {
+    gpu_tree_of(
+        ctx,
+        vpls,
+        v_min,
+        sigma_max,
+        lightcut::renderer::settings::TreeKind::Perfect,
+    )
+}
+
+/// [`gpu_tree`] of either kind (the frame's build pass).
+fn gpu_tree_of(
+    ctx: &lightcut::renderer::context::GpuContext,
+    vpls: &[GpuVpl],
+    v_min: f32,
+    sigma_max: f32,
+    kind: lightcut::renderer::settings::TreeKind,
+) -> GpuTree {
     let buf = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("test::vpls"),
         contents: bytemuck::cast_slice(vpls),
@@ -215,7 +232,7 @@ fn gpu_tree(
     let sort = SortPass::new(&ctx.device).unwrap();
     let build = BuildPass::new(&ctx.device).unwrap();
     let sb = SortBuffers::new(&ctx.device, vpls.len() as u32);
-    let tb = TreeBuffers::new(&ctx.device, vpls.len() as u32);
+    let tb = TreeBuffers::new(&ctx.device, vpls.len() as u32, kind);
     let mut enc = ctx.device.create_command_encoder(&Default::default());
     let mut timer = GpuTimer::new(&ctx.device, &ctx.queue);
     sort.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, &buf, &sb);
@@ -403,14 +420,15 @@ fn frame_tree_reclassifies_without_rebuilding() {
     assert!(ctx.errors.take().is_empty());
 }
 
-/// The radix tree (issue 23): the GPU's node data over its own topology equals the CPU twin
-/// (`reference::lbvh::node_data` over `reference::lbvh::build` of the same sorted keys), with
-/// the perfect tree's tolerances; its root holds the same flux and bounds as the perfect
-/// tree's root.
+/// The radix tree (issue 23): the GPU's node data over its own topology, in the samplers'
+/// numbering (root 1, leaf k at n + k), equals the CPU twin (`reference::lbvh::sampler_layout`
+/// over `reference::lbvh::build` of the same sorted keys) with the perfect tree's tolerances,
+/// links included; its root holds the same flux and bounds as the perfect tree's root.
 #[test]
 fn gpu_radix_tree_node_data_equals_the_cpu_twin() {
     use lightcut::reference::lbvh;
-    use lightcut::renderer::passes::lbvh::{LbvhBuffers, LbvhPass};
+    use lightcut::renderer::passes::lbvh::{LbvhPass, read_links, read_topology};
+    use lightcut::renderer::settings::TreeKind;
     let Some(ctx) = common::gpu() else { return };
     for n in [2usize, 3, 600, 3000] {
         let vpls = synthetic_vpls(n, 7 + n as u64);
@@ -422,7 +440,7 @@ fn gpu_radix_tree_node_data_equals_the_cpu_twin() {
         let sort = SortPass::new(&ctx.device).unwrap();
         let pass = LbvhPass::new(&ctx.device).unwrap();
         let sb = SortBuffers::new(&ctx.device, n as u32);
-        let lb = LbvhBuffers::new(&ctx.device, n as u32);
+        let lb = TreeBuffers::new(&ctx.device, n as u32, TreeKind::Lbvh);
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         let mut timer = GpuTimer::new(&ctx.device, &ctx.queue);
         sort.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, &buf, &sb);
@@ -432,19 +450,30 @@ fn gpu_radix_tree_node_data_equals_the_cpu_twin() {
         let pairs = read_pairs(&ctx, &sb).unwrap();
         let keys: Vec<u64> = pairs.iter().take(n).map(|p| p.0).collect();
         let topology = lbvh::build(&keys);
-        assert_eq!(lb.read(&ctx).unwrap(), topology, "{n} VPLs: topology");
+        assert_eq!(read_topology(&ctx, &lb).unwrap(), topology, "{n} VPLs: topology");
         let leaves: Vec<SstNode> = pairs
             .iter()
             .take(n)
             .map(|&(_, i)| vpls.get(i as usize).map(SstNode::leaf).unwrap_or(SstNode::EMPTY))
             .collect();
-        let internal = lbvh::node_data(&topology, &leaves);
-        // Index 0 is skipped by `compare_trees` (the perfect tree's unused node): pad.
-        let mut cpu = vec![SstNode::EMPTY];
-        cpu.extend(internal.iter().copied());
-        cpu.extend(leaves.iter().copied());
-        let mut gpu = vec![SstNode::EMPTY];
-        gpu.extend(lb.read_node_data(&ctx).unwrap());
+        let (cpu, links) = lbvh::sampler_layout(&topology, &leaves);
+        assert_eq!(read_links(&ctx, &lb).unwrap()[1..], links[1..], "{n} VPLs: links");
+        let gpu: Vec<SstNode> = read_nodes(&ctx, &lb)
+            .unwrap()
+            .iter()
+            .map(SstNode::decode)
+            .collect();
+        assert_eq!(gpu.len(), 2 * n);
+        // The frame's build pass on the radix tree: the same nodes, and the usable flags of
+        // the twin's classification.
+        let framed = gpu_tree_of(&ctx, &vpls, 0.9, 0.1, TreeKind::Lbvh);
+        assert_eq!(framed.nodes.len(), 2 * n);
+        compare_trees(&framed.nodes, &cpu, 10.0);
+        assert_eq!(
+            framed.flags[..(2 * n).div_ceil(32)],
+            lightcut::reference::sst_tree::classify(&framed.nodes, 0.9, 0.1)[..],
+            "{n} VPLs: usable flags"
+        );
         compare_trees(&gpu, &cpu, 10.0);
         // The root sums every VPL as the perfect tree's does.
         let perfect = gpu_tree(&ctx, &vpls, 0.9, 0.1);

@@ -1,7 +1,7 @@
 // Tree sampling helpers (thesis chapter 5): node weights (eq. 5.5 with the geometric term of
 // eq. 5.2) and shallow light cuts (5.1). CPU twin: src/reference/slc.rs.
 // Contract: the includer declares `tree: array<SstNode>` and includes common/sst_node.wgsl,
-// common/color.wgsl and common/box_term.wgsl.
+// common/color.wgsl, common/box_term.wgsl and common/tree_links.wgsl (with its contract).
 
 const SLC_MAX_CUT: u32 = 64u;
 
@@ -124,8 +124,8 @@ fn slc_build_cut(x: vec3<f32>, n: vec3<f32>, eps: f32, cut_size: u32, cull: bool
         if best == 0xffffffffu {
             break;
         }
-        let c0 = 2u * cut_ids[best];
-        let c1 = c0 + 1u;
+        let c0 = tree_left(cut_ids[best]);
+        let c1 = tree_right(cut_ids[best]);
         let w0 = slc_node_weight(tree[c0], x, n, eps);
         let w1 = slc_node_weight(tree[c1], x, n, eps);
         let k0 = slc_keep(c0, w0, cull);
@@ -147,6 +147,39 @@ fn slc_build_cut(x: vec3<f32>, n: vec3<f32>, eps: f32, cut_size: u32, cull: bool
             cut_ids[best] = cut_ids[count];
             cut_ws[best] = cut_ws[count];
         }
+    }
+    return count;
+}
+
+// The radix tree's mock cut (thesis 5.1.4 on a tree without levels of equal nodes) into
+// cut_ids: from the root, split the inner node covering the most leaves (ties: the lowest
+// slot) until `size` nodes or only leaves; returns the count. The perfect tree's mock cut is
+// its level, computed where it is used. Twin: `reference::slc::mock_cut`.
+fn slc_mock_cut(size: u32, leaves: u32) -> u32 {
+    cut_ids[0] = 1u;
+    var count = 1u;
+    loop {
+        if count >= min(size, SLC_MAX_CUT) {
+            break;
+        }
+        var best = 0xffffffffu;
+        var best_span = 0u;
+        for (var i = 0u; i < count; i++) {
+            if cut_ids[i] < leaves {
+                let r = tree_leaf_range(cut_ids[i], leaves);
+                if r.y - r.x + 1u > best_span {
+                    best = i;
+                    best_span = r.y - r.x + 1u;
+                }
+            }
+        }
+        if best == 0xffffffffu {
+            break;
+        }
+        let p = cut_ids[best];
+        cut_ids[best] = tree_left(p);
+        cut_ids[count] = tree_right(p);
+        count += 1u;
     }
     return count;
 }

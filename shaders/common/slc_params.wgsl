@@ -27,7 +27,7 @@ struct SlcParams {
     child_probability: u32, // 0 mean position (eq. 5.5), 1 min-max box distance (RTSLC's), 2 defensive: slc_child_prob
     interleave: u32,        // n of the n x n slot interleaving (1 = off)
     interleave_offset: u32, // the frame's subset offset
-    _pad0: u32,
+    radix: u32,             // 1: the radix tree (children from tree_links), 0: the perfect tree
     _pad1: u32,
 };
 

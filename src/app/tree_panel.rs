@@ -5,7 +5,7 @@
 use egui_plot::{Bar, BarChart, Plot, VLine};
 
 use crate::{
-    base::sst_node::{TreeStats, level_count, luminance, stats},
+    base::sst_node::{Topology, TreeStats, luminance, stats_on},
     renderer::{
         Renderer,
         settings::{RenderSettings, TreeColor, TreeOverlay},
@@ -55,7 +55,27 @@ impl TreePanel {
     /// Side-panel section. `levels`: the current tree's level count, if any.
     pub fn controls(&mut self, ui: &mut egui::Ui, settings: &mut RenderSettings, levels: Option<u32>) {
         ui.heading("Light tree (SST)");
+        let method = settings.gi.method;
         let t = &mut settings.tree;
+        egui::ComboBox::from_label("tree")
+            .selected_text(t.kind.name())
+            .show_ui(ui, |ui| {
+                for k in crate::renderer::settings::TreeKind::ALL {
+                    ui.selectable_value(&mut t.kind, k, k.label());
+                }
+            })
+            .response
+            .on_hover_text(
+                "the tree the samplers traverse: the thesis's perfect binary tree (VPLs padded to a \
+                 power of two, children 2i, 2i+1) or the SST paper's radix tree (Karras 2012: split where \
+                 the sorted keys' highest differing bit changes)",
+            );
+        if let Some(msg) = method.refuses_tree(t.kind) {
+            ui.colored_label(
+                egui::Color32::YELLOW,
+                format!("{msg}: this frame builds the perfect tree"),
+            );
+        }
         ui.add(egui::Slider::new(&mut t.v_min, 0.0..=1.0).text("v_min"))
             .on_hover_text("least normal similarity v (eq. 4.3) of a node usable for sampling");
         ui.add(
@@ -77,8 +97,18 @@ impl TreePanel {
             d.tree_level = d.tree_level.min(max_level);
             ui.add(egui::Slider::new(&mut d.tree_level, 0..=max_level).text("tree level"))
                 .on_hover_text(format!(
-                    "0 = the root; {max_level} = the leaves (the VPLs). Level l has 2^l nodes."
+                    "0 = the root; {max_level} = the leaves (the VPLs). Level l has 2^l nodes. On the \
+                     radix tree, level l is the cut of the nodes at depth l and the leaves above it."
                 ));
+            ui.checkbox(&mut d.tree_compare, "both trees side by side")
+                .on_hover_text(
+                    "the perfect binary tree over the left half of the view, the radix tree (LBVH) over \
+                     the right half: the same level of both trees over the same VPLs (the frame builds \
+                     the tree it does not sample too, untimed)",
+                );
+            if d.tree_compare {
+                ui.label("left: perfect binary tree · right: radix tree (LBVH)");
+            }
             egui::ComboBox::from_label("colour by")
                 .selected_text(d.tree_color.name())
                 .show_ui(ui, |ui| {
@@ -109,7 +139,12 @@ impl TreePanel {
         self.refresh_requested = false;
         self.last_refresh = now;
         let (nodes, flags) = renderer.read_tree().map_err(|e| e.to_string())?;
-        self.stats = Some(stats(&nodes, &flags));
+        let links = renderer.read_tree_links().map_err(|e| e.to_string())?;
+        let topo = match links.is_empty() {
+            true => Topology::perfect_of(&nodes),
+            false => Topology::radix(&links),
+        };
+        self.stats = Some(stats_on(&nodes, &flags, topo));
         Ok(())
     }
 
@@ -136,12 +171,11 @@ impl TreePanel {
             ui.label("no tree yet");
             return;
         };
-        let valid_leaves = s.per_level.last().map_or(0, |l| l.0);
         ui.label(format!(
             "{} VPLs in {} leaves, {} levels; root flux {:.4} {:.4} {:.4} W (lum. {:.4} W)",
-            valid_leaves,
+            s.valid_leaves,
             s.leaves,
-            level_count(s.leaves),
+            s.levels,
             s.root_intensity.x,
             s.root_intensity.y,
             s.root_intensity.z,
@@ -152,11 +186,15 @@ impl TreePanel {
         );
         if let Some(t) = timings {
             let get = |n| t.get(n).map_or("–".to_string(), |ms| format!("{ms:.3} ms"));
+            let build = match (t.get("sst_build"), t.get("lbvh_build"), t.get("lbvh_nodes")) {
+                (Some(ms), _, _) => format!("build {ms:.3} ms"),
+                (None, Some(a), Some(b)) => format!("radix build {a:.3} + nodes {b:.3} ms"),
+                _ => "build –".to_string(),
+            };
             ui.label(format!(
-                "GPU: keys {} · sort {} · build {} · classify {}",
+                "GPU: keys {} · sort {} · {build} · classify {}",
                 get("sst_keys"),
                 get("sst_sort"),
-                get("sst_build"),
                 get("sst_classify")
             ));
         }

@@ -20,6 +20,128 @@ pub fn level_count(leaves: u32) -> u32 {
     leaves.trailing_zeros() + 1
 }
 
+/// Which light tree the frame builds over the sorted VPL keys (`tree.kind`, `render --tree`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TreeKind {
+    /// The thesis's perfect binary tree: leaves padded to a power of two, children 2i, 2i + 1.
+    #[default]
+    Perfect,
+    /// The SST paper's binary radix tree (LBVH, Karras 2012): split where the keys' highest
+    /// differing bit changes; children by explicit links.
+    Lbvh,
+}
+
+impl TreeKind {
+    pub const ALL: [TreeKind; 2] = [TreeKind::Perfect, TreeKind::Lbvh];
+
+    /// The CLI / settings spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            TreeKind::Perfect => "perfect",
+            TreeKind::Lbvh => "lbvh",
+        }
+    }
+
+    pub fn label(self) -> &'static str {
+        match self {
+            TreeKind::Perfect => "perfect binary tree (thesis)",
+            TreeKind::Lbvh => "radix tree / LBVH (SST paper)",
+        }
+    }
+
+    pub fn parse(s: &str) -> Result<TreeKind, String> {
+        TreeKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("unknown tree '{s}' (perfect, lbvh)"))
+    }
+}
+
+/// A light tree's shape in the samplers' numbering, shared by both trees: the root is node 1
+/// and leaf k (the k-th VPL in key order) is node `leaves + k`, so a node is a leaf iff its
+/// id >= `leaves`. The perfect tree's inner node i has children 2i and 2i + 1; the radix
+/// tree's inner node i (Karras's internal node i - 1) has `links[i]` = (left, right, first
+/// leaf, last leaf). Twin of `common/tree_links.wgsl`.
+#[derive(Clone, Copy, Debug)]
+pub struct Topology<'a> {
+    pub leaves: u32,
+    pub links: Option<&'a [[u32; 4]]>,
+}
+
+impl<'a> Topology<'a> {
+    /// The perfect tree whose nodes (2 x leaves, node 0 unused) are `nodes`.
+    pub fn perfect_of(nodes: &[SstNode]) -> Topology<'static> {
+        Topology {
+            leaves: (nodes.len() / 2) as u32,
+            links: None,
+        }
+    }
+
+    /// The radix tree of `links.len()` leaves (`links[0]` unused).
+    pub fn radix(links: &'a [[u32; 4]]) -> Self {
+        Topology {
+            leaves: links.len().max(1) as u32,
+            links: Some(links),
+        }
+    }
+
+    pub fn is_leaf(&self, i: u32) -> bool {
+        i >= self.leaves
+    }
+
+    /// The two children of inner node `i`.
+    pub fn children(&self, i: u32) -> (u32, u32) {
+        match self.links {
+            Some(l) => (l[i as usize][0], l[i as usize][1]),
+            None => (2 * i, 2 * i + 1),
+        }
+    }
+
+    /// The leaves (indices, not node ids) node `i` covers: first ..= last.
+    pub fn leaf_range(&self, i: u32) -> (u32, u32) {
+        if self.is_leaf(i) {
+            return (i - self.leaves, i - self.leaves);
+        }
+        match self.links {
+            Some(l) => (l[i as usize][2], l[i as usize][3]),
+            None => {
+                let depth = self.leaves.trailing_zeros() - i.ilog2();
+                let first = (i << depth) - self.leaves;
+                (first, first + (1 << depth) - 1)
+            }
+        }
+    }
+
+    /// Whether `a` is `b` or one of its ancestors (their leaf ranges nest; a radix tree node's
+    /// range is never its child's).
+    pub fn contains(&self, a: u32, b: u32) -> bool {
+        let (fa, la) = self.leaf_range(a);
+        let (fb, lb) = self.leaf_range(b);
+        fa <= fb && lb <= la && (a == b || !self.is_leaf(a))
+    }
+
+    /// Depth of node `i` (root 0): the perfect tree's level; for the radix tree, walked down
+    /// from the root along the leaf ranges.
+    pub fn depth(&self, i: u32) -> u32 {
+        if self.links.is_none() {
+            return i.max(1).ilog2();
+        }
+        let (f, l) = self.leaf_range(i);
+        let (mut node, mut d) = (1u32, 0u32);
+        while node != i && !self.is_leaf(node) {
+            let (c0, c1) = self.children(node);
+            node = if self.leaf_range(c0).1 >= l && self.leaf_range(c0).0 <= f {
+                c0
+            } else {
+                c1
+            };
+            d += 1;
+        }
+        d
+    }
+}
+
 /// Orthonormal tangent frame of a unit normal (Duff et al. 2017, "Building an orthonormal
 /// basis, revisited"). Twin: `basis` in `common/sst_node.wgsl`.
 pub fn basis(n: Vec3) -> (Vec3, Vec3) {
@@ -225,6 +347,8 @@ pub fn flag(words: &[u32], node: usize) -> bool {
 #[derive(Clone, Debug, Default)]
 pub struct TreeStats {
     pub leaves: u32,
+    /// Non-empty leaves (the frame's VPLs).
+    pub valid_leaves: u32,
     pub levels: u32,
     /// Per level (root first): (non-empty nodes, usable nodes).
     pub per_level: Vec<(u32, u32)>,
@@ -237,29 +361,44 @@ pub struct TreeStats {
 }
 
 pub fn stats(nodes: &[SstNode], flags: &[u32]) -> TreeStats {
-    let leaves = (nodes.len() / 2) as u32;
-    if leaves < 1 {
+    stats_on(nodes, flags, Topology::perfect_of(nodes))
+}
+
+/// [`stats`] of either tree: per depth from the root (the radix tree's leaves lie at many
+/// depths; `leaves` counts its VPLs' leaves, `levels` its depth + 1).
+pub fn stats_on(nodes: &[SstNode], flags: &[u32], topo: Topology<'_>) -> TreeStats {
+    let leaves = topo.leaves;
+    if leaves < 1 || nodes.len() < 2 {
         return TreeStats::default();
     }
-    let levels = level_count(leaves);
     let mut s = TreeStats {
         leaves,
-        levels,
-        per_level: vec![(0, 0); levels as usize],
         root_intensity: nodes.get(1).map(|n| n.intensity).unwrap_or(Vec3::ZERO),
         ..Default::default()
     };
-    for (i, n) in nodes.iter().enumerate().skip(1) {
+    let mut stack = vec![(1u32, 0usize)];
+    while let Some((i, depth)) = stack.pop() {
+        let Some(n) = nodes.get(i as usize) else { continue };
+        if s.per_level.len() <= depth {
+            s.per_level.resize(depth + 1, (0, 0));
+        }
+        if !topo.is_leaf(i) {
+            let (c0, c1) = topo.children(i);
+            stack.push((c1, depth + 1));
+            stack.push((c0, depth + 1));
+        }
         if n.is_empty() {
             continue;
         }
-        let level = (usize::BITS - 1 - i.leading_zeros()) as usize;
-        s.per_level[level].0 += 1;
-        s.per_level[level].1 += flag(flags, i) as u32;
-        if i < leaves as usize {
+        s.per_level[depth].0 += 1;
+        s.per_level[depth].1 += flag(flags, i as usize) as u32;
+        if topo.is_leaf(i) {
+            s.valid_leaves += 1;
+        } else {
             s.v.push(n.v);
             s.sigma_z.push(n.sigma_z());
         }
     }
+    s.levels = s.per_level.len() as u32;
     s
 }

@@ -19,7 +19,7 @@ use crate::{
         gpu_data::{GpuCamera, GpuRay, GpuVpl},
         passes::{
             gbuffer::{COLOR_BYTES_PER_FRAGMENT, DEPTH_BYTES, GbufferPass, OverdrawCounter},
-            lbvh::{LbvhBuffers, LbvhPass},
+            lbvh::{LbvhPass, read_topology},
             sst_build::{BuildPass, TreeBuffers},
             sst_sort::{SORT_TILE, SortBuffers, SortPass, SortVariant},
         },
@@ -402,7 +402,7 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
             usage: wgpu::BufferUsages::STORAGE,
         });
         let sb = SortBuffers::new(device, n);
-        let tb = TreeBuffers::new(device, n);
+        let tb = TreeBuffers::new(device, n, crate::base::sst_node::TreeKind::Perfect);
         let mut both = [[f64::NAN; 4]; 2];
         for (vi, (variant, name)) in variants.iter().enumerate() {
             sort.variant = *variant;
@@ -452,7 +452,7 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
         // checked against its CPU twin, and its node data bottom-up, against the perfect
         // tree's build (whose topology is implicit).
         sort.variant = SortVariant::Parallel;
-        let lb = LbvhBuffers::new(device, n);
+        let lb = TreeBuffers::new(device, n, crate::base::sst_node::TreeKind::Lbvh);
         let timed = time_back_to_back(&ctx, &mut timer, args.repeat, |enc, timer| {
             sort.record(device, &ctx.queue, enc, timer, &buf, &sb);
             lbvh.record(device, &ctx.queue, enc, timer, &sb, &lb);
@@ -468,7 +468,7 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
             .iter()
             .map(|k| (k[0] as u64) << 32 | k[1] as u64)
             .collect();
-        let same = lb.read(&ctx)? == crate::reference::lbvh::build(&keys);
+        let same = read_topology(&ctx, &lb)? == crate::reference::lbvh::build(&keys);
         println!(
             "{n:>9} {:>9} topology {ms:.3} ms + node data {nodes_ms:.3} ms = {:.3} ms (the perfect tree's build {:.3} ms); topology equals the CPU reference: {}",
             "radix",

@@ -88,6 +88,15 @@ pub enum TemporalArg {
     Svgf,
 }
 
+/// The light tree for `--tree`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TreeArg {
+    /// The thesis's perfect binary tree over the sorted VPLs (padded to a power of two).
+    Perfect,
+    /// The SST paper's binary radix tree (LBVH, Karras 2012) over the same keys.
+    Lbvh,
+}
+
 /// Settings of the tree samplers (override `--settings`).
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct SamplingArgs {
@@ -139,6 +148,11 @@ pub struct SamplingArgs {
     /// filter). Its parameters: `--set temporal.<field>=..` (docs/temporal.md).
     #[arg(long, value_enum)]
     pub temporal: Option<TemporalArg>,
+    /// The light tree the tree samplers (SST, SLC, RTSLC) traverse: `perfect` (the thesis)
+    /// or `lbvh` (the SST paper's radix tree). Lightcuts, Lightcut Interpolation and the
+    /// light-culling tree need the perfect tree and refuse `lbvh`.
+    #[arg(long, value_enum)]
+    pub tree: Option<TreeArg>,
     /// Least normal similarity of a usable SST node.
     #[arg(long)]
     pub v_min: Option<f32>,
@@ -165,6 +179,15 @@ impl SamplingArgs {
     /// would trace rays without saying so).
     pub fn check_visibility(&self, methods: &[crate::methods::MethodId]) -> anyhow::Result<()> {
         use crate::methods::light_culling::{ISM_METHODS, has_ism};
+        // `--tree lbvh` with a method that needs the perfect tree is refused (it would run
+        // on the perfect tree without saying so).
+        if self.tree == Some(TreeArg::Lbvh)
+            && let Some(msg) = methods
+                .iter()
+                .find_map(|m| m.refuses_tree(crate::renderer::settings::TreeKind::Lbvh))
+        {
+            return Err(anyhow!("--{msg}"));
+        }
         if self.visibility == Some(VisibilityArg::Ism)
             && let Some(m) = methods.iter().find(|&&m| crate::methods::val::is_val(m))
         {
@@ -260,6 +283,13 @@ impl SamplingArgs {
                 TemporalArg::Off => TemporalMode::Off,
                 TemporalArg::Reproject => TemporalMode::Reproject,
                 TemporalArg::Svgf => TemporalMode::Svgf,
+            };
+        }
+        if let Some(t) = self.tree {
+            use crate::renderer::settings::TreeKind;
+            s.tree.kind = match t {
+                TreeArg::Perfect => TreeKind::Perfect,
+                TreeArg::Lbvh => TreeKind::Lbvh,
             };
         }
         if let Some(v) = self.v_min {
@@ -492,6 +522,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let method = settings.gi.method;
     args.sampling.apply(&mut settings);
     args.sampling.check_visibility(&[method])?;
+    // `tree.kind = lbvh` from a settings file or --set: the same refusal as --tree's.
+    if let Some(msg) = method.refuses_tree(settings.tree.kind) {
+        return Err(anyhow!("{msg}"));
+    }
     if args.sampling.frames == 0 {
         return Err(anyhow!("--frames must be at least 1"));
     }

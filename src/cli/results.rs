@@ -53,9 +53,12 @@ pub enum Figure {
     /// camera path, a sun sweep and a still view: per-frame RMSE / SSIM of raw and filtered GI
     /// against each frame's ground truth, flicker, and the stage's GPU time per pass.
     Temporal,
+    /// Issue 23: the tree samplers on the perfect binary tree and on the radix tree (LBVH):
+    /// RMSE over GPU time (method + tree build), steps, and RMSE at equal time.
+    Trees,
 }
 
-const ORDER: [Figure; 11] = [
+const ORDER: [Figure; 12] = [
     Figure::Timings,
     Figure::Steps,
     Figure::EqualTime,
@@ -63,6 +66,7 @@ const ORDER: [Figure; 11] = [
     Figure::Culling,
     Figure::Val,
     Figure::Temporal,
+    Figure::Trees,
     Figure::Blocks,
     Figure::Blending,
     Figure::Upsampling,
@@ -307,6 +311,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
                 Figure::Culling => figures::culling(&mut b, &o, &dir)?,
                 Figure::Val => figures::val(&mut b, &o, &dir)?,
                 Figure::Temporal => figures::temporal(&mut b, &o, &dir)?,
+                Figure::Trees => figures::trees(&mut b, &o, &dir)?,
                 Figure::Steps => figures::steps(&mut b, &o, &dir)?,
                 Figure::Blocks => figures::blocks(&mut b, &o, &dir)?,
                 Figure::Blending => figures::blending(&mut b, &o, &dir)?,

@@ -43,7 +43,10 @@ pub const PASS_GROUPS: [(&str, &[&str]); 8] = [
         &["brsm_importance", "brsm_filter", "pdf_pyramid", "vpl_warp"],
     ),
     ("sort VPLs", &["sst_keys", "sst_sort"]),
-    ("build SST", &["sst_build", "sst_classify"]),
+    (
+        "build SST",
+        &["sst_build", "lbvh_build", "lbvh_nodes", "sst_classify"],
+    ),
     ("light cuts", &["slc_cuts"]),
     (
         "GI",

@@ -102,6 +102,31 @@ impl MethodId {
     pub fn samples_tree(self) -> bool {
         self.info().module.name == tree_samplers::MODULE.name
     }
+    /// Whether it runs on the radix tree too ([`Resource::AnyTree`]).
+    pub fn any_tree(self) -> bool {
+        self.info().reads.contains(&Resource::AnyTree)
+    }
+    /// The tree a frame of this method builds when `wanted` is asked for: `wanted`, unless the
+    /// method needs the perfect tree (it reads the tree but not through its links).
+    pub fn tree_kind(self, wanted: crate::base::sst_node::TreeKind) -> crate::base::sst_node::TreeKind {
+        if self.any_tree() {
+            wanted
+        } else {
+            crate::base::sst_node::TreeKind::Perfect
+        }
+    }
+    /// The refusal of `tree.kind = lbvh` for a method that reads the tree without its links
+    /// (the CLI's message); None where the method takes either tree or no tree at all.
+    pub fn refuses_tree(self, wanted: crate::base::sst_node::TreeKind) -> Option<String> {
+        let reads_tree = self.info().reads.contains(&Resource::Tree);
+        (wanted != crate::base::sst_node::TreeKind::Perfect && reads_tree && !self.any_tree()).then(|| {
+            format!(
+                "tree {}: {} runs on the perfect tree only (the radix tree serves SST, SLC and RTSLC)",
+                wanted.name(),
+                self.info().label
+            )
+        })
+    }
     /// The method named `name` on the command line or in a settings file (case-insensitive;
     /// `-` and `_` ignored, so `ground-truth`, `GroundTruth` and `ground_truth` are one).
     pub fn parse(name: &str) -> Result<MethodId, String> {
@@ -349,6 +374,10 @@ pub enum Resource {
     Vpls,
     /// The light tree (SST nodes, usable flags, VPLs in leaf order).
     Tree,
+    /// Either light tree (`tree.kind`): the method follows the tree's links
+    /// (`common/tree_links.wgsl`), so it runs on the radix tree too. A method that reads
+    /// `Tree` without this needs the perfect tree, and its settings refuse `tree.kind = lbvh`.
+    AnyTree,
     /// The scene BVH (shadow rays).
     Bvh,
 }

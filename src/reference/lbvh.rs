@@ -181,6 +181,9 @@ pub fn sorted_keys(vpls: &[GpuVpl]) -> (Vec<u64>, Vec<GpuVpl>) {
 /// merge, eqs. 4.1-4.3, as the perfect tree's).
 pub fn node_data(nodes: &[Internal], leaves: &[SstNode]) -> Vec<SstNode> {
     let mut data = vec![SstNode::EMPTY; nodes.len()];
+    if nodes.is_empty() {
+        return data;
+    }
     let mut done = vec![false; nodes.len()];
     // Post-order without recursion: a node is merged once both children are done.
     let mut stack = vec![0u32];
@@ -206,6 +209,29 @@ pub fn node_data(nodes: &[Internal], leaves: &[SstNode]) -> Vec<SstNode> {
         }
     }
     data
+}
+
+/// The radix tree in the samplers' numbering (`base::sst_node::Topology`): nodes (2n; node 0
+/// unused, Karras's internal node i at i + 1, leaf k at n + k) and links (n; links[i + 1] =
+/// (left, right, first leaf, last leaf) of internal node i). `leaves`: the n leaves' data in
+/// key order. Twin of what `lbvh.wgsl` writes into the frame's tree.
+pub fn sampler_layout(nodes: &[Internal], leaves: &[SstNode]) -> (Vec<SstNode>, Vec<[u32; 4]>) {
+    let n = leaves.len().max(1) as u32;
+    let slot = |c: Child| match c {
+        Child::Leaf(k) => n + k,
+        Child::Internal(k) => k + 1,
+    };
+    let data = node_data(nodes, leaves);
+    let mut out = vec![SstNode::EMPTY; 2 * n as usize];
+    let mut links = vec![[0u32; 4]; n as usize];
+    for (i, nd) in nodes.iter().enumerate() {
+        out[i + 1] = data[i];
+        links[i + 1] = [slot(nd.left), slot(nd.right), nd.first, nd.last];
+    }
+    for (k, l) in leaves.iter().enumerate() {
+        out[n as usize + k] = *l;
+    }
+    (out, links)
 }
 
 #[cfg(test)]

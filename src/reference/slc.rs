@@ -15,6 +15,7 @@ use glam::Vec3;
 
 use super::sst_tree::{SstNode, luminance};
 use crate::base::sampling::ChildProbability;
+use crate::base::sst_node::Topology;
 
 /// Largest cut (samples per pixel) the GPU kernels hold in registers.
 pub const MAX_CUT: u32 = 64;
@@ -133,7 +134,20 @@ fn keep(node: &SstNode, w: f32, cull: bool) -> bool {
 /// appends the second; a parent with no kept child leaves the cut (the last slot moves into
 /// its place). Returns the node ids in slot order.
 pub fn build_cut(nodes: &[SstNode], x: Vec3, n: Vec3, eps: f32, cut_size: u32, cull: bool) -> Vec<u32> {
-    let leaves = (nodes.len() / 2) as u32;
+    build_cut_on(nodes, Topology::perfect_of(nodes), x, n, eps, cut_size, cull)
+}
+
+/// [`build_cut`] on either tree (`topo`: the perfect tree's heap or the radix tree's links).
+pub fn build_cut_on(
+    nodes: &[SstNode],
+    topo: Topology<'_>,
+    x: Vec3,
+    n: Vec3,
+    eps: f32,
+    cut_size: u32,
+    cull: bool,
+) -> Vec<u32> {
+    let leaves = topo.leaves;
     let cut_size = cut_size.clamp(1, MAX_CUT) as usize;
     let mut ids: Vec<u32> = Vec::with_capacity(cut_size);
     let mut ws: Vec<f32> = Vec::with_capacity(cut_size);
@@ -154,8 +168,7 @@ pub fn build_cut(nodes: &[SstNode], x: Vec3, n: Vec3, eps: f32, cut_size: u32, c
         if best == usize::MAX {
             break;
         }
-        let parent = ids[best];
-        let (c0, c1) = (2 * parent, 2 * parent + 1);
+        let (c0, c1) = topo.children(ids[best]);
         let (w0, w1) = (
             node_weight(&nodes[c0 as usize], x, n, eps),
             node_weight(&nodes[c1 as usize], x, n, eps),
@@ -242,9 +255,49 @@ pub fn mock_level(cut_size: u32, levels: u32) -> u32 {
     cut_size.max(1).ilog2().min(levels - 1)
 }
 
+/// The mock cut of a tree (thesis 5.1.4): the perfect tree's level [`mock_level`] (2^l nodes,
+/// slot i = node 2^l + i); on the radix tree, which has no levels of equal nodes, as many
+/// nodes (fewer when leaves stop it) from splitting, from the root, the node covering the
+/// most leaves (ties: the lowest slot), the first child taking its slot and the second
+/// appended: a partition of the VPLs into about equal key ranges, as the perfect tree's level
+/// is. Twin: `slc_mock_cut` in `common/slc.wgsl`.
+pub fn mock_cut(topo: Topology<'_>, cut_size: u32, levels: u32) -> Vec<u32> {
+    let l = mock_level(cut_size, levels);
+    if topo.links.is_none() {
+        return ((1u32 << l)..(2u32 << l)).collect();
+    }
+    let mut ids = vec![1u32];
+    while ids.len() < (1usize << l) {
+        let span = |i: u32| {
+            let (f, e) = topo.leaf_range(i);
+            e - f
+        };
+        let mut best = usize::MAX;
+        let mut best_span = 0u32;
+        for (k, &i) in ids.iter().enumerate() {
+            if !topo.is_leaf(i) && span(i) + 1 > best_span {
+                best = k;
+                best_span = span(i) + 1;
+            }
+        }
+        if best == usize::MAX {
+            break;
+        }
+        let (c0, c1) = topo.children(ids[best]);
+        ids[best] = c0;
+        ids.push(c1);
+    }
+    ids
+}
+
 /// Checks a cut: no node twice, none an ancestor of another (so every leaf is covered at
 /// most once), no empty node.
 pub fn check_cut(cut: &[u32], nodes: &[SstNode]) -> Result<(), String> {
+    check_cut_on(cut, nodes, Topology::perfect_of(nodes))
+}
+
+/// [`check_cut`] on either tree.
+pub fn check_cut_on(cut: &[u32], nodes: &[SstNode], topo: Topology<'_>) -> Result<(), String> {
     for (i, &a) in cut.iter().enumerate() {
         if a == 0 || a as usize >= nodes.len() {
             return Err(format!("slot {i}: node {a} out of range"));
@@ -253,10 +306,7 @@ pub fn check_cut(cut: &[u32], nodes: &[SstNode]) -> Result<(), String> {
             return Err(format!("slot {i}: node {a} is empty"));
         }
         for &b in &cut[i + 1..] {
-            let (hi, lo) = if a < b { (a, b) } else { (b, a) };
-            // hi is an ancestor of lo iff lo >> (depth difference) == hi.
-            let diff = lo.ilog2() - hi.ilog2();
-            if lo >> diff == hi {
+            if topo.contains(a, b) || topo.contains(b, a) {
                 return Err(format!("nodes {a} and {b}: one contains the other"));
             }
         }
@@ -267,19 +317,31 @@ pub fn check_cut(cut: &[u32], nodes: &[SstNode]) -> Result<(), String> {
 /// Nodes a cut could hold at most: the non-empty leaves reachable from the root through kept
 /// nodes (with culling: nodes of positive weight).
 pub fn reachable_leaves(nodes: &[SstNode], x: Vec3, n: Vec3, eps: f32, cull: bool) -> u32 {
-    let leaves = nodes.len() / 2;
+    reachable_leaves_on(nodes, Topology::perfect_of(nodes), x, n, eps, cull)
+}
+
+/// [`reachable_leaves`] on either tree.
+pub fn reachable_leaves_on(
+    nodes: &[SstNode],
+    topo: Topology<'_>,
+    x: Vec3,
+    n: Vec3,
+    eps: f32,
+    cull: bool,
+) -> u32 {
     let mut count = 0;
-    let mut stack = vec![1usize];
+    let mut stack = vec![1u32];
     while let Some(i) = stack.pop() {
-        let w = node_weight(&nodes[i], x, n, eps);
-        if !keep(&nodes[i], w, cull) {
+        let w = node_weight(&nodes[i as usize], x, n, eps);
+        if !keep(&nodes[i as usize], w, cull) {
             continue;
         }
-        if i >= leaves {
+        if topo.is_leaf(i) {
             count += 1;
         } else {
-            stack.push(2 * i);
-            stack.push(2 * i + 1);
+            let (c0, c1) = topo.children(i);
+            stack.push(c0);
+            stack.push(c1);
         }
     }
     count
@@ -289,11 +351,14 @@ pub fn reachable_leaves(nodes: &[SstNode], x: Vec3, n: Vec3, eps: f32, cull: boo
 /// their unoccluded contribution flux/pi x G (without the albedo/pi), with `vpl_g` giving
 /// G for a leaf (tests pass the VPL geometry term).
 pub fn subtree_sum(nodes: &[SstNode], node: u32, g: &dyn Fn(&SstNode) -> f32) -> Vec3 {
-    let leaves = (nodes.len() / 2) as u32;
-    let depth = leaves.trailing_zeros() - node.ilog2();
-    let first = node << depth;
-    (first..first + (1 << depth))
-        .map(|i| &nodes[i as usize])
+    subtree_sum_on(nodes, Topology::perfect_of(nodes), node, g)
+}
+
+/// [`subtree_sum`] on either tree.
+pub fn subtree_sum_on(nodes: &[SstNode], topo: Topology<'_>, node: u32, g: &dyn Fn(&SstNode) -> f32) -> Vec3 {
+    let (first, last) = topo.leaf_range(node);
+    (first..=last)
+        .map(|k| &nodes[(topo.leaves + k) as usize])
         .filter(|l| !l.is_empty())
         .map(|l| l.intensity / std::f32::consts::PI * g(l))
         .sum()

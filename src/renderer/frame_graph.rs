@@ -164,7 +164,9 @@ impl Renderer {
             .vpl
             .seed
             .wrapping_add(if s.vpl.animate { self.frames as u32 } else { 0 });
-        let frozen = self.freeze.is_some() && vpl_ok && self.tree.count == self.vpl_frame.count;
+        // The tree the method runs on: `tree.kind` where it follows links, else the perfect one.
+        let tree_kind = s.gi.method.tree_kind(s.tree.kind);
+        let frozen = self.freeze.is_some() && vpl_ok && self.tree.matches(self.vpl_frame.count, tree_kind);
         if frozen {
             // Frozen VPLs and tree (debugging): only the flags follow new thresholds.
             let th = (s.tree.v_min, s.tree.sigma_max);
@@ -212,9 +214,10 @@ impl Renderer {
                 &self.vpl_buffers.vpls,
                 &self.sort_buffers,
             );
-            // SST stage 10: the tree over the sorted VPLs, then its usable flags.
-            if self.tree.count != self.vpl_frame.count {
-                self.tree = TreeBuffers::new(&device, self.vpl_frame.count);
+            // SST stage 10: the tree over the sorted VPLs (the perfect tree or the radix tree,
+            // `tree.kind`), then its usable flags.
+            if !self.tree.matches(self.vpl_frame.count, tree_kind) {
+                self.tree = TreeBuffers::new(&device, self.vpl_frame.count, tree_kind);
             }
             self.sst_build.record(
                 &device,
@@ -227,6 +230,33 @@ impl Renderer {
                 s.tree.v_min,
                 s.tree.sigma_max,
             );
+            // The overlay's comparison: the other tree over the same keys, untimed.
+            let d = &s.display;
+            if d.tree_compare && d.tree_overlay != TreeOverlay::Off {
+                let other = match tree_kind {
+                    TreeKind::Perfect => TreeKind::Lbvh,
+                    TreeKind::Lbvh => TreeKind::Perfect,
+                };
+                let count = self.vpl_frame.count;
+                if !self.tree_other.as_ref().is_some_and(|t| t.matches(count, other)) {
+                    self.tree_other = Some(TreeBuffers::new(&device, count, other));
+                }
+                if let Some(t) = &self.tree_other {
+                    self.sst_build.record(
+                        &device,
+                        &queue,
+                        &mut enc,
+                        &mut self.quiet_timer,
+                        &self.vpl_buffers.vpls,
+                        &self.sort_buffers,
+                        t,
+                        s.tree.v_min,
+                        s.tree.sigma_max,
+                    );
+                }
+            } else {
+                self.tree_other = None;
+            }
             // The flux-pyramid tops (one float per light), read back on a later frame: a
             // readback, so in diagnostic frames only.
             let (per_layer, offsets) = passes::vpl_gen::pyramid_layout(self.vpl_buffers.res);
@@ -385,9 +415,10 @@ impl Renderer {
                 d.tree_level,
                 0.003 * self.scene.bounds.radius().max(1e-3),
                 &self.camera_buf,
-                &self.tree,
+                (&self.tree, self.tree_other.as_ref().filter(|_| d.tree_compare)),
                 &self.targets.gbuffer.position_view,
                 &self.targets.view.view,
+                self.targets.view.size,
             );
         }
     }

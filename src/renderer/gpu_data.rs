@@ -309,7 +309,9 @@ pub struct GpuSlcParams {
     /// (`reference::interleave::Interleave::offset_of`).
     pub interleave: u32,
     pub interleave_offset: u32,
-    pub _pad: [u32; 2],
+    /// 1: the radix tree (children from its links; `TreeKind::Lbvh`), 0: the perfect tree.
+    pub radix: u32,
+    pub _pad: u32,
 }
 
 /// Twin: `GtParams` in `shaders/methods/ground_truth/ground_truth.wgsl`.
@@ -871,9 +873,27 @@ mod tests {
                     offset_of!(GpuSlcParams, child_probability),
                     offset_of!(GpuSlcParams, interleave),
                     offset_of!(GpuSlcParams, interleave_offset),
+                    offset_of!(GpuSlcParams, radix),
                     offset_of!(GpuSlcParams, _pad),
-                    offset_of!(GpuSlcParams, _pad) + 4,
                 ],
+            ),
+            (
+                "sst_overlay.wgsl",
+                "OverlayParams",
+                size_of::<crate::renderer::passes::sst_overlay::GpuOverlayParams>(),
+                {
+                    use crate::renderer::passes::sst_overlay::GpuOverlayParams as P;
+                    vec![
+                        offset_of!(P, level),
+                        offset_of!(P, color_mode),
+                        offset_of!(P, min_radius),
+                        offset_of!(P, radix),
+                        offset_of!(P, leaves),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                        offset_of!(P, _pad) + 8,
+                    ]
+                },
             ),
             (
                 "sst_build.wgsl",

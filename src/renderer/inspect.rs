@@ -297,6 +297,14 @@ impl Renderer {
         Ok((nodes.iter().map(SstNode::decode).collect(), flags))
     }
 
+    /// The radix tree's links (`base::sst_node::Topology::radix`); empty for the perfect tree.
+    pub fn read_tree_links(&self) -> Result<Vec<[u32; 4]>, GpuError> {
+        match self.tree.kind {
+            crate::base::sst_node::TreeKind::Lbvh => passes::lbvh::read_links(&self.ctx, &self.tree),
+            crate::base::sst_node::TreeKind::Perfect => Ok(Vec::new()),
+        }
+    }
+
     /// Nodes `ids` of the frame's tree (one submission; ids past the tree read as empty)
     /// and the usable flags, without reading the whole tree back.
     pub fn read_tree_nodes(&self, ids: &[u32]) -> Result<(Vec<SstNode>, Vec<u32>), GpuError> {

@@ -53,7 +53,9 @@ use passes::{
 };
 use readback::ImageF32;
 use scene_gpu::SceneGpu;
-use settings::{RenderSettings, TemporalMode, TemporalSettings, TemporalView, TreeOverlay, ViewBuffer};
+use settings::{
+    RenderSettings, TemporalMode, TemporalSettings, TemporalView, TreeKind, TreeOverlay, ViewBuffer,
+};
 use timing::{GpuTimer, PassTimings};
 use views::{AbMode, AbSource, ViewSpec};
 
@@ -147,6 +149,11 @@ pub struct Renderer {
     sort_buffers: SortBuffers,
     sst_build: BuildPass,
     tree: TreeBuffers,
+    /// The other kind of tree over the same VPLs, for the overlay's side-by-side comparison
+    /// (`display.tree_compare`), built untimed (`quiet_timer`).
+    tree_other: Option<TreeBuffers>,
+    /// A timer never begun: passes recorded with it take no timestamps.
+    quiet_timer: GpuTimer,
     sst_overlay: SstOverlayPass,
     /// One GPU instance per method module (`methods::modules()`), by module name.
     methods: Vec<MethodInstance>,
@@ -269,7 +276,9 @@ impl Renderer {
             sst_sort: SortPass::new(device)?,
             sort_buffers: SortBuffers::new(device, settings.vpl.count),
             sst_build: BuildPass::new(device)?,
-            tree: TreeBuffers::new(device, settings.vpl.count),
+            tree: TreeBuffers::new(device, settings.vpl.count, settings.tree.kind),
+            tree_other: None,
+            quiet_timer: GpuTimer::new(device, &ctx.queue),
             sst_overlay: SstOverlayPass::new(device)?,
             methods: create_methods(device)?,
             selected_block: None,

@@ -253,6 +253,9 @@ pub struct TreeSettings {
     /// (strict: sigma_z < sigma_max, so 0 turns substitutes off and only leaves are sampled).
     /// Lower keeps only clusters lying on one plane.
     pub sigma_max: f32,
+    /// Which tree (`--tree`): the thesis's perfect binary tree or the SST paper's radix tree
+    /// (LBVH). The tree samplers run on either; the other tree methods need the perfect tree.
+    pub kind: TreeKind,
 }
 
 impl Default for TreeSettings {
@@ -261,10 +264,12 @@ impl Default for TreeSettings {
         Self {
             v_min: 0.7,
             sigma_max: 0.3,
+            kind: TreeKind::Perfect,
         }
     }
 }
 
+pub use crate::base::sst_node::TreeKind;
 pub use crate::methods::tree_samplers::settings::{
     ChildProbability, CutBlending, CutFallback, SamplingSettings,
 };
@@ -337,6 +342,9 @@ pub struct DisplaySettings {
     /// Tree level it draws (0 = the root; clamped to the leaves' level).
     pub tree_level: u32,
     pub tree_color: TreeColor,
+    /// Both trees side by side in the overlay: the perfect tree over the left half, the radix
+    /// tree over the right (the frame also builds the tree it does not sample).
+    pub tree_compare: bool,
     /// Position of the divider in the split comparison view (0 = left edge, 1 = right).
     pub split: f32,
 }
@@ -352,6 +360,7 @@ impl Default for DisplaySettings {
             tree_overlay: TreeOverlay::Off,
             tree_level: 6,
             tree_color: TreeColor::Intensity,
+            tree_compare: false,
             split: 0.5,
         }
     }

@@ -36,6 +36,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ),
     ("common/slc.wgsl", include_str!("../../shaders/common/slc.wgsl")),
     (
+        "common/tree_links.wgsl",
+        include_str!("../../shaders/common/tree_links.wgsl"),
+    ),
+    (
         "common/box_term.wgsl",
         include_str!("../../shaders/common/box_term.wgsl"),
     ),

@@ -21,6 +21,7 @@
 #include "common/vpl_visibility.wgsl"
 #include "common/sst_node.wgsl"
 #include "common/box_term.wgsl"
+#include "common/tree_links.wgsl"
 #include "common/slc.wgsl"
 #include "common/slc_params.wgsl"
 #include "common/stats64.wgsl"
@@ -62,6 +63,12 @@ override DIAGNOSTICS: bool = true;
 @group(0) @binding(14) var<uniform> ism: IsmParams;
 @group(0) @binding(15) var<storage, read> ism_depth: array<f32>;
 @group(0) @binding(16) var<storage, read_write> ism_lights: array<vec4<f32>>;
+// The radix tree's links (a dummy on the perfect tree): common/tree_links.wgsl.
+@group(0) @binding(17) var<storage, read> tree_links: array<vec4<u32>>;
+
+fn tree_radix() -> bool {
+    return sp.radix != 0u;
+}
 const TRACE_HEADER: u32 = 32u;
 const TRACE_RECORD: u32 = 64u;
 const TRACE_SAMPLES: u32 = 64u;
@@ -94,16 +101,17 @@ fn traverse(start: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb:
             && slc_far_enough(tree[node], x, sp.epsilon, sp.near_field)) {
             break;
         }
-        let pl = slc_child_prob(tree[2u * node], tree[2u * node + 1u], x, n, sp.epsilon,
-            sp.child_probability);
+        let c0 = tree_left(node);
+        let c1 = tree_right(node);
+        let pl = slc_child_prob(tree[c0], tree[c1], x, n, sp.epsilon, sp.child_probability);
         if pl < 0.0 {
             return Walk(0u, 0.0, steps);
         }
         var pc = pl;
         if rng_next(rng) < pl {
-            node = 2u * node;
+            node = c0;
         } else {
-            node = 2u * node + 1u;
+            node = c1;
             pc = 1.0 - pl;
         }
         prob *= pc;
@@ -151,13 +159,12 @@ fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: 
     let geo = vpl_geometry(pv, nv, x, n, sp.epsilon);
     var lit = geo > 0.0;
     if lit && sp.shadow_rays == 2u {
-        // The leaf's map; a substitute sample: a random leaf of the node's subtree
-        // (level l of the perfect tree: 2^(L - l) leaves from node << (L - l)).
+        // The leaf's map; a substitute sample: a random leaf of the node's subtree.
         var m = node - sp.leaves;
         if node < sp.leaves {
-            let down = firstLeadingBit(sp.leaves) - firstLeadingBit(node);
-            let span = 1u << down;
-            m = (node << down) - sp.leaves + min(u32(rng_next(rng) * f32(span)), span - 1u);
+            let r = tree_leaf_range(node, sp.leaves);
+            let span = r.y - r.x + 1u;
+            m = r.x + min(u32(rng_next(rng) * f32(span)), span - 1u);
         }
         let lv = sorted_vpls[m];
         lit = lv.id == VPL_NONE || ism_visible(m, lv.position.xyz, lv.normal, x);
@@ -383,7 +390,11 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
                 }
             }
             case 1u: {
-                if i < (1u << mock_level) {
+                // The perfect tree's level; the radix tree's mock cut after the blocks' cuts
+                // (slc_cuts.wgsl).
+                if tree_radix() {
+                    start = cuts[sp.grid_x * sp.grid_y * sp.cut_size + i];
+                } else if i < (1u << mock_level) {
                     start = (1u << mock_level) + i;
                 }
             }

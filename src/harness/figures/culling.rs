@@ -79,7 +79,14 @@ struct Row {
 }
 
 /// The light tree's build passes (shared frame work, not in any method's GI time).
-const TREE_BUILD: [&str; 4] = ["sst_keys", "sst_sort", "sst_build", "sst_classify"];
+const TREE_BUILD: [&str; 6] = [
+    "sst_keys",
+    "sst_sort",
+    "sst_build",
+    "lbvh_build",
+    "lbvh_nodes",
+    "sst_classify",
+];
 
 fn stat(m: &Measured, k: &str) -> f64 {
     m.method_stats

@@ -7,6 +7,7 @@ mod interpolation;
 mod resolution;
 mod sampling;
 mod temporal;
+mod trees;
 mod val;
 
 pub use culling::culling;
@@ -14,6 +15,7 @@ pub use interpolation::interpolation;
 pub use resolution::{scaling, upsampling};
 pub use sampling::{blending, blocks, steps};
 pub use temporal::temporal;
+pub use trees::trees;
 pub use val::val;
 
 use std::path::Path;

@@ -19,6 +19,7 @@ mod ui;
 use super::{
     FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
 };
+use crate::base::sst_node::TreeKind;
 use crate::reference::interleave::Interleave;
 use crate::renderer::{
     context::{GpuContext, GpuError},
@@ -100,7 +101,12 @@ const VIEWS: &[ViewInfo] = &[
         passes: &[],
     },
 ];
-const READS: &[Resource] = &[Resource::Gbuffer, Resource::Tree, Resource::Bvh];
+const READS: &[Resource] = &[
+    Resource::Gbuffer,
+    Resource::Tree,
+    Resource::AnyTree,
+    Resource::Bvh,
+];
 const TESTS: &[&str] = &[
     "slc::gpu_cuts_equal_the_cpu_cuts_and_are_valid",
     "slc::blending_picks_cuts_by_their_weights_and_falls_back_to_the_mock_cut",
@@ -523,7 +529,8 @@ impl Method for TreeSamplers {
             },
             interleave: il.n,
             interleave_offset: Interleave::offset_of(il.n, seed),
-            _pad: [0; 2],
+            radix: (cx.tree.kind == TreeKind::Lbvh) as u32,
+            _pad: 0,
         };
         // A timed frame leaves the last diagnostic frame's story (and statistics) in place.
         if cx.diagnostics {

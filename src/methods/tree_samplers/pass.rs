@@ -265,7 +265,8 @@ impl PixelTrace {
     }
 }
 
-/// Per-frame buffers: the cuts (cut_size node ids per block, 0 = empty slot), per-pixel
+/// Per-frame buffers: the cuts (cut_size node ids per block, 0 = empty slot; then the radix
+/// tree's mock cut, cut_size slots), per-pixel
 /// diagnostics (vec4: steps per traversal, fell back, samples evaluated, 1 + block of slot
 /// 0's cut) and the frame counters.
 pub struct SlcBuffers {
@@ -288,7 +289,7 @@ impl SlcBuffers {
     /// Bytes of the largest binding (the cuts or the diagnostics).
     pub fn largest_binding(size: (u32, u32), block: u32, cut_size: u32) -> u64 {
         let (gx, gy) = Self::grid(size, block);
-        (gx as u64 * gy as u64 * cut_size as u64 * 4).max(size.0 as u64 * size.1 as u64 * 16)
+        ((gx as u64 * gy as u64 + 1) * cut_size as u64 * 4).max(size.0 as u64 * size.1 as u64 * 16)
     }
 
     pub fn new(device: &wgpu::Device, size: (u32, u32), block: u32, cut_size: u32) -> Self {
@@ -304,7 +305,10 @@ impl SlcBuffers {
             })
         };
         Self {
-            cuts: buf("slc::cuts", grid.0 as u64 * grid.1 as u64 * cut_size as u64 * 4),
+            cuts: buf(
+                "slc::cuts",
+                (grid.0 as u64 * grid.1 as u64 + 1) * cut_size as u64 * 4,
+            ),
             diag: buf("slc::diag", size.0 as u64 * size.1 as u64 * 16),
             stats: buf("slc::stats", (STATS * 4) as u64),
             trace: buf("slc::trace", TRACE_WORDS as u64 * 4),
@@ -386,6 +390,7 @@ impl SlcPass {
                 float_texture_entry(2),
                 float_texture_entry(3),
                 storage_entry(4, c, false),
+                storage_entry(5, c, true),
             ],
         });
         let smod = shaders::create_module(device, "methods/tree_samplers/slc_sample.wgsl")?;
@@ -409,6 +414,7 @@ impl SlcPass {
                 uniform_entry(14, c),
                 storage_entry(15, c, true),
                 storage_entry(16, c, false),
+                storage_entry(17, c, true),
             ],
         });
         let vmod = shaders::create_module(device, "methods/tree_samplers/slc_views.wgsl")?;
@@ -501,6 +507,7 @@ impl SlcPass {
                 tv(&gbuffer.position_view),
                 tv(&gbuffer.normal_view),
                 out.cuts.as_entire_binding(),
+                tree.links().as_entire_binding(),
             ];
             let bind = bind_group_seq(device, "slc_cuts::bind_group", &self.cuts_layout, &entries);
             run_compute(
@@ -530,6 +537,7 @@ impl SlcPass {
             self.ism_params.as_entire_binding(),
             ism_depth.as_entire_binding(),
             ism_lights.as_entire_binding(),
+            tree.links().as_entire_binding(),
         ];
         let bind = bind_group_seq(device, "slc_sample::bind_group", &self.sample_layout, &entries);
         if let Some(m) = ism {

@@ -2,20 +2,20 @@
 //! the topology of issue 23's second light tree, one thread per internal node. Reads: the
 //! keys `sst_sort` sorted. Writes: internal nodes (children, leaf range) and parents. Timer:
 //! `lbvh_build`; then the SST node data bottom-up (`lbvh_nodes`: one thread per leaf, the
-//! second arrival at a node merges, as `sst_build`). Twins: `reference::lbvh::{build,
-//! node_data}`. The samplers on it are still to come; `bench tree` times both and checks the
-//! topology against the twin.
+//! second arrival at a node merges, as `sst_build`) into the frame's [`TreeBuffers`] (kind
+//! `Lbvh`), numbered as the samplers read both trees. Twins: `reference::lbvh::{build,
+//! sampler_layout}`. `sst_build::BuildPass` runs it when `tree.kind` is `lbvh`; `bench tree`
+//! times both trees and checks the topology against the twin.
 
 use bytemuck::{Pod, Zeroable};
 
 use super::{
-    WG_1D, bind_group_seq, compute_pipeline, run_compute, storage_buffer, storage_entry, uniform_buffer,
-    uniform_entry,
+    WG_1D, bind_group_seq, compute_pipeline, run_compute, storage_entry, uniform_buffer, uniform_entry,
 };
 use crate::reference::lbvh::{Child, Internal};
 use crate::renderer::{
     context::{GpuContext, GpuError},
-    passes::sst_sort::SortBuffers,
+    passes::{sst_build::TreeBuffers, sst_sort::SortBuffers},
     readback::read_storage_buffer,
     shaders,
     timing::GpuTimer,
@@ -29,75 +29,50 @@ pub struct GpuLbvhParams {
     pub _pad: [u32; 3],
 }
 
-/// Bit 31 of a stored child: a leaf.
-pub const LEAF_BIT: u32 = 0x8000_0000;
-
-/// The tree of `count` leaves: `count - 1` internal nodes (16 bytes each), the parents of
-/// every node (internal nodes, then leaves), and the SST node data of every node (64 bytes:
-/// internal node i at i, leaf k at count - 1 + k) with the build's arrival counters.
-pub struct LbvhBuffers {
-    pub count: u32,
-    pub nodes: wgpu::Buffer,
-    pub parents: wgpu::Buffer,
-    pub sst_nodes: wgpu::Buffer,
-    pub counters: wgpu::Buffer,
+/// The radix tree as the GPU stores it in a [`TreeBuffers`] of kind `Lbvh` (the samplers'
+/// numbering, `base::sst_node::Topology`): Karras's internal node i is node i + 1, leaf k is
+/// node n + k; `links[i + 1]` = (left, right, first, last leaf), `parents[node]`.
+/// The internal nodes in Karras's numbering, as the twin writes them.
+pub fn read_topology(ctx: &GpuContext, tree: &TreeBuffers) -> Result<Vec<Internal>, GpuError> {
+    let bytes = read_storage_buffer(ctx, &tree.links)?;
+    let raw: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
+    let n = tree.leaves;
+    let child = |c: u32| {
+        if c >= n {
+            Child::Leaf(c - n)
+        } else {
+            Child::Internal(c - 1)
+        }
+    };
+    Ok(raw
+        .iter()
+        .skip(1)
+        .take(tree.count.saturating_sub(1) as usize)
+        .map(|r| Internal {
+            left: child(r[0]),
+            right: child(r[1]),
+            first: r[2],
+            last: r[3],
+        })
+        .collect())
 }
 
-impl LbvhBuffers {
-    pub fn new(device: &wgpu::Device, count: u32) -> Self {
-        let n = count.max(2) as u64;
-        Self {
-            count,
-            nodes: storage_buffer(device, "lbvh::nodes", 16 * (n - 1)),
-            parents: storage_buffer(device, "lbvh::parents", 4 * (2 * n - 1)),
-            sst_nodes: storage_buffer(
-                device,
-                "lbvh::sst_nodes",
-                std::mem::size_of::<crate::base::gpu_layout::GpuSstNode>() as u64 * (2 * n - 1),
-            ),
-            counters: storage_buffer(device, "lbvh::counters", 4 * (n - 1)),
-        }
-    }
+/// The links (`links[0]` unused) for `base::sst_node::Topology::radix`.
+pub fn read_links(ctx: &GpuContext, tree: &TreeBuffers) -> Result<Vec<[u32; 4]>, GpuError> {
+    let bytes = read_storage_buffer(ctx, &tree.links)?;
+    let raw: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
+    Ok(raw[..(tree.leaves as usize).min(raw.len())].to_vec())
+}
 
-    /// The SST node data, decoded: internal nodes 0 .. count - 1, then the leaves.
-    pub fn read_node_data(&self, ctx: &GpuContext) -> Result<Vec<crate::base::sst_node::SstNode>, GpuError> {
-        let bytes = read_storage_buffer(ctx, &self.sst_nodes)?;
-        let all: Vec<crate::base::gpu_layout::GpuSstNode> = bytemuck::pod_collect_to_vec(&bytes);
-        Ok(all[..(2 * self.count.max(1) - 1) as usize]
-            .iter()
-            .map(crate::base::sst_node::SstNode::decode)
-            .collect())
-    }
-
-    /// The internal nodes as the twin writes them.
-    pub fn read(&self, ctx: &GpuContext) -> Result<Vec<Internal>, GpuError> {
-        let bytes = read_storage_buffer(ctx, &self.nodes)?;
-        let raw: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
-        let child = |c: u32| {
-            if c & LEAF_BIT != 0 {
-                Child::Leaf(c & !LEAF_BIT)
-            } else {
-                Child::Internal(c)
-            }
-        };
-        Ok(raw
-            .iter()
-            .take(self.count.saturating_sub(1) as usize)
-            .map(|r| Internal {
-                left: child(r[0]),
-                right: child(r[1]),
-                first: r[2],
-                last: r[3],
-            })
-            .collect())
-    }
-
-    /// The parents: internal nodes' (root: u32::MAX), then the leaves'.
-    pub fn read_parents(&self, ctx: &GpuContext) -> Result<Vec<u32>, GpuError> {
-        let bytes = read_storage_buffer(ctx, &self.parents)?;
-        let all: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-        Ok(all[..(2 * self.count.max(1) - 1) as usize].to_vec())
-    }
+/// The parents in Karras's numbering: internal nodes' (root: u32::MAX), then the leaves'.
+pub fn read_parents(ctx: &GpuContext, tree: &TreeBuffers) -> Result<Vec<u32>, GpuError> {
+    let bytes = read_storage_buffer(ctx, &tree.parents)?;
+    let all: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+    let n = tree.leaves as usize;
+    Ok(all[1..2 * n]
+        .iter()
+        .map(|&p| if p == u32::MAX { p } else { p - 1 })
+        .collect())
 }
 
 pub struct LbvhPass {
@@ -131,6 +106,7 @@ impl LbvhPass {
                 storage_entry(4, c, true),
                 storage_entry(5, c, false),
                 storage_entry(6, c, false),
+                storage_entry(7, c, false),
             ],
         });
         Ok(Self {
@@ -149,7 +125,7 @@ impl LbvhPass {
     }
 
     /// The leaf count (the first `out.count` of `keys`) into the uniform both passes read.
-    fn write_params(&self, queue: &wgpu::Queue, keys: &SortBuffers, out: &LbvhBuffers) -> GpuLbvhParams {
+    fn write_params(&self, queue: &wgpu::Queue, keys: &SortBuffers, out: &TreeBuffers) -> GpuLbvhParams {
         let p = GpuLbvhParams {
             count: out.count.min(keys.count),
             _pad: [0; 3],
@@ -158,7 +134,8 @@ impl LbvhPass {
         p
     }
 
-    /// Records the build over the first `out.count` keys of `keys` (sorted).
+    /// Records the build over the first `out.count` keys of `keys` (sorted) into `out` (of
+    /// kind `Lbvh`).
     pub fn record(
         &self,
         device: &wgpu::Device,
@@ -166,7 +143,7 @@ impl LbvhPass {
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
         keys: &SortBuffers,
-        out: &LbvhBuffers,
+        out: &TreeBuffers,
     ) {
         let p = self.write_params(queue, keys, out);
         let bind = bind_group_seq(
@@ -176,7 +153,7 @@ impl LbvhPass {
             &[
                 self.params.as_entire_binding(),
                 keys.keys.as_entire_binding(),
-                out.nodes.as_entire_binding(),
+                out.links.as_entire_binding(),
                 out.parents.as_entire_binding(),
             ],
         );
@@ -201,7 +178,7 @@ impl LbvhPass {
         timer: &mut GpuTimer,
         keys: &SortBuffers,
         vpls: &wgpu::Buffer,
-        out: &LbvhBuffers,
+        out: &TreeBuffers,
     ) {
         let p = self.write_params(queue, keys, out);
         encoder.clear_buffer(&out.counters, 0, None);
@@ -212,11 +189,12 @@ impl LbvhPass {
             &[
                 self.params.as_entire_binding(),
                 keys.keys.as_entire_binding(),
-                out.nodes.as_entire_binding(),
+                out.links.as_entire_binding(),
                 out.parents.as_entire_binding(),
                 vpls.as_entire_binding(),
-                out.sst_nodes.as_entire_binding(),
+                out.nodes.as_entire_binding(),
                 out.counters.as_entire_binding(),
+                out.sorted_vpls.as_entire_binding(),
             ],
         );
         run_compute(

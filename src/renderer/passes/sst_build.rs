@@ -6,7 +6,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::{
-    base::sst_node::{leaf_count, level_count},
+    base::sst_node::{TreeKind, leaf_count, level_count},
     renderer::{
         context::{GpuContext, GpuError},
         gpu_data::{GpuSstNode, GpuVpl},
@@ -16,7 +16,8 @@ use crate::{
 };
 
 use super::{
-    WG_1D, bind_group_seq, compute_pipeline, run_compute, sst_sort::SortBuffers, storage_entry, uniform_entry,
+    WG_1D, bind_group_seq, compute_pipeline, lbvh::LbvhPass, run_compute, sst_sort::SortBuffers,
+    storage_entry, uniform_entry,
 };
 
 /// Twin: `TreeParams` in `shaders/sst_build.wgsl`.
@@ -38,15 +39,24 @@ pub struct GpuClassifyParams {
     pub _pad: u32,
 }
 
-/// The tree of one frame: 2 x leaves nodes (node 0 unused), the usable bits, the per-node
-/// arrival counters of the build and the VPLs permuted into leaf order.
+/// The tree of one frame, either kind, numbered as the samplers read both
+/// (`base::sst_node::Topology`): node 1 the root, leaf k at `leaves + k`, 2 x leaves nodes
+/// (node 0 unused); the usable bits, the per-node arrival counters of the build and the VPLs
+/// permuted into leaf order. The perfect tree pads the leaves to a power of two; the radix
+/// tree has one leaf per VPL and its links (children, leaf ranges) and parents.
 pub struct TreeBuffers {
     pub nodes: wgpu::Buffer,
     pub flags: wgpu::Buffer,
     pub counters: wgpu::Buffer,
     pub sorted_vpls: wgpu::Buffer,
+    /// The radix tree's inner nodes (left, right, first leaf, last leaf), `links[0]` unused; a
+    /// 16-byte dummy for the perfect tree.
+    pub links: wgpu::Buffer,
+    /// The radix tree's parent of every node (the root's u32::MAX); a dummy for the perfect tree.
+    pub parents: wgpu::Buffer,
     pub count: u32,
     pub leaves: u32,
+    pub kind: TreeKind,
 }
 
 impl TreeBuffers {
@@ -55,12 +65,20 @@ impl TreeBuffers {
         2 * leaf_count(count) as u64 * std::mem::size_of::<GpuSstNode>() as u64
     }
 
-    pub fn new(device: &wgpu::Device, count: u32) -> Self {
-        let leaves = leaf_count(count);
+    /// Leaves of the tree of `count` VPLs.
+    pub fn leaves_of(count: u32, kind: TreeKind) -> u32 {
+        match kind {
+            TreeKind::Perfect => leaf_count(count),
+            TreeKind::Lbvh => count.max(1),
+        }
+    }
+
+    pub fn new(device: &wgpu::Device, count: u32, kind: TreeKind) -> Self {
+        let leaves = Self::leaves_of(count, kind);
         let buf = |label: &str, size: u64| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size,
+                size: size.max(16),
                 usage: wgpu::BufferUsages::STORAGE
                     | wgpu::BufferUsages::COPY_SRC
                     | wgpu::BufferUsages::COPY_DST,
@@ -68,6 +86,7 @@ impl TreeBuffers {
             })
         };
         let nodes = 2 * leaves as u64;
+        let radix = kind == TreeKind::Lbvh;
         Self {
             nodes: buf(
                 "sst_build::nodes",
@@ -79,17 +98,34 @@ impl TreeBuffers {
                 "sst_build::sorted_vpls",
                 leaves as u64 * std::mem::size_of::<GpuVpl>() as u64,
             ),
+            links: buf("lbvh::links", if radix { 16 * leaves as u64 } else { 16 }),
+            parents: buf("lbvh::parents", if radix { 4 * nodes } else { 16 }),
             count,
             leaves,
+            kind,
         }
     }
 
+    /// Levels of the perfect tree; the radix tree has no levels of equal nodes, and this is
+    /// the perfect tree's for as many VPLs (the mock cut's level bound, the steps view's
+    /// scale; its depth varies per leaf: `reference::lbvh::leaf_depths`).
     pub fn levels(&self) -> u32 {
-        level_count(self.leaves)
+        level_count(leaf_count(self.count))
+    }
+
+    /// The radix tree's links (a dummy for the perfect tree): bound by every sampler.
+    pub fn links(&self) -> &wgpu::Buffer {
+        &self.links
+    }
+
+    /// Whether it is the tree of `count` VPLs of `kind`.
+    pub fn matches(&self, count: u32, kind: TreeKind) -> bool {
+        self.count == count && self.kind == kind
     }
 }
 
 pub struct BuildPass {
+    lbvh: LbvhPass,
     build: wgpu::ComputePipeline,
     build_layout: wgpu::BindGroupLayout,
     classify: wgpu::ComputePipeline,
@@ -123,6 +159,7 @@ impl BuildPass {
             ],
         });
         Ok(Self {
+            lbvh: LbvhPass::new(device)?,
             build: compute_pipeline(device, "sst_build", &[Some(&build_layout)], &module, "build"),
             classify: compute_pipeline(
                 device,
@@ -138,7 +175,9 @@ impl BuildPass {
         })
     }
 
-    /// Records the build over `sort`'s first `tree.count` sorted pairs, then the flags.
+    /// Records the build of `tree`'s kind over `sort`'s first `tree.count` sorted pairs
+    /// (the perfect tree: `sst_build`; the radix tree: `lbvh_build` + `lbvh_nodes`), then the
+    /// flags.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -152,6 +191,13 @@ impl BuildPass {
         v_min: f32,
         sigma_max: f32,
     ) {
+        if tree.kind == TreeKind::Lbvh {
+            self.lbvh.record(device, queue, encoder, timer, sort, tree);
+            self.lbvh
+                .record_node_data(device, queue, encoder, timer, sort, vpls, tree);
+            self.record_classify(device, queue, encoder, timer, tree, v_min, sigma_max);
+            return;
+        }
         let p = GpuTreeParams {
             count: tree.count.min(sort.count),
             leaves: tree.leaves,
@@ -224,13 +270,15 @@ impl BuildPass {
 /// Reads every node back (2 x leaves, node 0 unused).
 pub fn read_nodes(ctx: &GpuContext, tree: &TreeBuffers) -> Result<Vec<GpuSstNode>, GpuError> {
     let bytes = readback::read_storage_buffer(ctx, &tree.nodes)?;
-    Ok(bytemuck::cast_slice(&bytes).to_vec())
+    let all: &[GpuSstNode] = bytemuck::cast_slice(&bytes);
+    Ok(all[..(2 * tree.leaves as usize).min(all.len())].to_vec())
 }
 
 /// Reads the usable bits back (word w holds nodes 32w .. 32w+31).
 pub fn read_flags(ctx: &GpuContext, tree: &TreeBuffers) -> Result<Vec<u32>, GpuError> {
     let bytes = readback::read_storage_buffer(ctx, &tree.flags)?;
-    Ok(bytemuck::cast_slice(&bytes).to_vec())
+    let all: &[u32] = bytemuck::cast_slice(&bytes);
+    Ok(all[..((2 * tree.leaves as usize).div_ceil(32)).min(all.len())].to_vec())
 }
 
 /// Reads the VPLs in leaf order back.

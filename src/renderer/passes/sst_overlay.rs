@@ -1,12 +1,14 @@
 //! Light-tree overlay: the nodes of one SST level over the camera view, as substitute
 //! distributions (ellipses in each node's plane at 1 and 2 sigma) or bounding boxes, coloured
-//! by flux, usable flag or node. Reads: the tree, its flags, camera, G-buffer positions (to
-//! dim what is hidden). Writes: the view texture (alpha-blended raster).
+//! by flux, usable flag or node; on the radix tree a level is the cut at that depth (its
+//! shallower leaves included). With `display.tree_compare`, both trees side by side (perfect
+//! left, radix right). Reads: the tree(s), flags, parents, camera, G-buffer positions (to dim
+//! what is hidden). Writes: the view texture (alpha-blended raster).
 
 use bytemuck::{Pod, Zeroable};
 
 use crate::renderer::{
-    settings::{TreeColor, TreeOverlay},
+    settings::{TreeColor, TreeKind, TreeOverlay},
     shaders,
     timing::GpuTimer,
 };
@@ -22,7 +24,9 @@ pub struct GpuOverlayParams {
     pub level: u32,
     pub color_mode: u32,
     pub min_radius: f32,
-    pub _pad: u32,
+    pub radix: u32,
+    pub leaves: u32,
+    pub _pad: [u32; 3],
 }
 
 pub struct SstOverlayPass {
@@ -30,6 +34,7 @@ pub struct SstOverlayPass {
     boxes: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
+    params_b: wgpu::Buffer,
 }
 
 impl SstOverlayPass {
@@ -49,6 +54,7 @@ impl SstOverlayPass {
                     wgpu::TextureSampleType::Float { filterable: false },
                     wgpu::TextureViewDimension::D2,
                 ),
+                storage_entry(5, wgpu::ShaderStages::VERTEX, true),
             ],
         });
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -102,12 +108,15 @@ impl SstOverlayPass {
                 wgpu::PrimitiveTopology::LineList,
             ),
             params: super::uniform_buffer::<GpuOverlayParams>(device, "sst_overlay::params"),
+            params_b: super::uniform_buffer::<GpuOverlayParams>(device, "sst_overlay::params_b"),
             layout,
         })
     }
 
     /// Draws level `level` (clamped to the leaves) of `tree` over `dst`. `min_radius`
-    /// (metres) is the smallest drawn semi-axis.
+    /// (metres) is the smallest drawn semi-axis. With `other` (the other kind of tree over the
+    /// same VPLs), the two side by side: the perfect tree in the left half of `dst`, the
+    /// radix tree in the right half (`size`: dst's).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -120,37 +129,66 @@ impl SstOverlayPass {
         level: u32,
         min_radius: f32,
         camera: &wgpu::Buffer,
-        tree: &TreeBuffers,
+        trees: (&TreeBuffers, Option<&TreeBuffers>),
         gb_position: &wgpu::TextureView,
         dst: &wgpu::TextureView,
+        size: (u32, u32),
     ) {
         let (pipeline, verts) = match mode {
             TreeOverlay::Off => return,
             TreeOverlay::Distributions => (&self.ellipses, 6),
             TreeOverlay::Boxes => (&self.boxes, 24),
         };
-        let level = level.min(tree.levels() - 1);
-        let p = GpuOverlayParams {
-            level,
-            color_mode: match color {
-                TreeColor::Intensity => 0,
-                TreeColor::Usable => 1,
-                TreeColor::Node => 2,
-            },
-            min_radius,
-            _pad: 0,
-        };
-        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        let entries = [
-            self.params.as_entire_binding(),
-            camera.as_entire_binding(),
-            tree.nodes.as_entire_binding(),
-            tree.flags.as_entire_binding(),
-            wgpu::BindingResource::TextureView(gb_position),
-        ];
-        let bind = bind_group_seq(device, "sst_overlay::bind_group", &self.layout, &entries);
+        let mut halves: Vec<(&TreeBuffers, Option<(u32, u32)>)> = vec![(trees.0, None)];
+        if let Some(other) = trees.1 {
+            let half = size.0 / 2;
+            halves = [trees.0, other]
+                .into_iter()
+                .map(|t| match t.kind {
+                    TreeKind::Perfect => (t, Some((0, half))),
+                    TreeKind::Lbvh => (t, Some((half, size.0 - half))),
+                })
+                .collect();
+        }
+        let params: Vec<GpuOverlayParams> = halves
+            .iter()
+            .map(|(tree, _)| {
+                let radix = tree.kind == TreeKind::Lbvh;
+                GpuOverlayParams {
+                    level: if radix {
+                        level
+                    } else {
+                        level.min(tree.levels() - 1)
+                    },
+                    color_mode: match color {
+                        TreeColor::Intensity => 0,
+                        TreeColor::Usable => 1,
+                        TreeColor::Node => 2,
+                    },
+                    min_radius,
+                    radix: radix as u32,
+                    leaves: tree.leaves,
+                    _pad: [0; 3],
+                }
+            })
+            .collect();
+        // One uniform slot per half (dynamic offsets would need another layout): the second
+        // half's parameters go to their own buffer.
+        let bufs = [&self.params, &self.params_b];
+        for (k, p) in params.iter().enumerate() {
+            queue.write_buffer(bufs[k], 0, bytemuck::bytes_of(p));
+        }
         encoder.push_debug_group("sst_overlay");
-        {
+        for (k, ((tree, scissor), p)) in halves.iter().zip(&params).enumerate() {
+            let entries = [
+                bufs[k].as_entire_binding(),
+                camera.as_entire_binding(),
+                tree.nodes.as_entire_binding(),
+                tree.flags.as_entire_binding(),
+                wgpu::BindingResource::TextureView(gb_position),
+                tree.parents.as_entire_binding(),
+            ];
+            let bind = bind_group_seq(device, "sst_overlay::bind_group", &self.layout, &entries);
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("sst_overlay"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -163,13 +201,24 @@ impl SstOverlayPass {
                     },
                 })],
                 depth_stencil_attachment: None,
-                timestamp_writes: timer.render_pass("sst_overlay"),
+                timestamp_writes: timer.render_pass(if k == 0 { "sst_overlay" } else { "sst_overlay_b" }),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bind, &[]);
-            pass.draw(0..verts, 0..(1u32 << level));
+            if let Some((x, w)) = scissor {
+                if *w == 0 || size.1 == 0 {
+                    continue;
+                }
+                pass.set_scissor_rect(*x, 0, *w, size.1);
+            }
+            let instances = if p.radix != 0 {
+                2 * tree.leaves - 1
+            } else {
+                1u32 << p.level
+            };
+            pass.draw(0..verts, 0..instances);
         }
         encoder.pop_debug_group();
     }

@@ -1,0 +1,160 @@
+//! Issue 23's tree comparison: the three tree samplers on the thesis's perfect binary tree and
+//! on the SST paper's radix tree (LBVH) over the same VPLs and keys. Per method and tree: the
+//! samples-per-pixel sweep's GPU time (the method's passes + the tree's build), RMSE, SSIM and
+//! traversal steps; the RMSE of each tree interpolated at equal GPU time (the perfect tree's
+//! time at the base spp). `bench tree` times the builds alone over 2^12 .. 2^20 VPLs and
+//! `bench lightcuts` measures the trees' far-paired clusters.
+
+use super::*;
+use crate::renderer::settings::TreeKind;
+
+/// The frame's tree build passes of either tree (GPU timestamps).
+const TREE_BUILD: [&str; 4] = ["sst_build", "lbvh_build", "lbvh_nodes", "sst_classify"];
+
+/// One tree's sweep: (total ms, RMSE) points, and at the base spp the steps per traversal,
+/// the build's ms and the total ms.
+struct TreeCurve {
+    points: Vec<(f64, f64)>,
+    steps: f64,
+    build: f64,
+    t_base: f64,
+}
+
+pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
+    let base_spp = b.base.sampling.cut_size;
+    let mut csv = Csv::new(&[
+        "scene",
+        "method",
+        "tree",
+        "spp",
+        "gi_gpu_ms",
+        "tree_build_gpu_ms",
+        "total_gpu_ms",
+        "rmse",
+        "rmse_std",
+        "ssim",
+        "mean_ratio",
+        "steps_per_traversal",
+        "steps_per_pixel",
+    ]);
+    let mut series = Vec::new();
+    let mut table = format!(
+        "perfect binary tree vs radix tree (LBVH), {} VPLs; time = the method's passes + the tree build (GPU timestamps):\n",
+        b.base.vpl.count
+    );
+    let mut matched = Csv::new(&[
+        "scene",
+        "method",
+        "matched_gpu_ms",
+        "rmse_perfect",
+        "rmse_lbvh",
+        "rmse_ratio_lbvh_over_perfect",
+        "extrapolated",
+        "steps_perfect",
+        "steps_lbvh",
+        "build_perfect_ms",
+        "build_lbvh_ms",
+    ]);
+    for (mi, (method, label)) in tree_methods(o).into_iter().enumerate() {
+        // Per tree: (total ms, RMSE) over the sweep, the base spp's steps and build time.
+        let mut curves: Vec<TreeCurve> = Vec::new();
+        for (ki, kind) in TreeKind::ALL.into_iter().enumerate() {
+            let mut pts = Vec::new();
+            let (mut steps, mut build, mut t_base) = (f64::NAN, f64::NAN, f64::NAN);
+            for v in o.sweep_values(method, base_spp) {
+                let spp = v.round().max(1.0) as u32;
+                let s = with(b, |s| {
+                    s.gi.method = method;
+                    s.tree.kind = kind;
+                    s.sampling.cut_size = spp;
+                });
+                let m = b.measure(&s, o.size, o.per_config(), true)?;
+                let gi = m.gi_ms().0;
+                let tb = m.pass_ms(&TREE_BUILD).0;
+                let (r, rs) = m.rmse();
+                csv.row(vec![
+                    b.scene.clone(),
+                    label.to_string(),
+                    kind.name().to_string(),
+                    spp.to_string(),
+                    num(gi),
+                    num(tb),
+                    num(gi + tb),
+                    num(r),
+                    num(rs),
+                    num(m.ssim().0),
+                    num(mean_std(&m.mean_ratio).0),
+                    num(m.steps_per_traversal()),
+                    num(m.steps_per_pixel()),
+                ]);
+                eprintln!(
+                    "[{}] {label} on the {} tree, {spp} spp: GI {gi:.3} + build {tb:.3} ms GPU, RMSE {r:.4e}, {:.2} steps per traversal",
+                    b.scene,
+                    kind.name(),
+                    m.steps_per_traversal()
+                );
+                if spp == base_spp {
+                    steps = m.steps_per_traversal();
+                    build = tb;
+                    t_base = gi + tb;
+                }
+                pts.push((gi + tb, r));
+            }
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            series.push(plot::Series {
+                name: format!("{label} {}", kind.name()),
+                color: 2 * mi + ki,
+                points: pts.clone(),
+            });
+            curves.push(TreeCurve {
+                points: pts,
+                steps,
+                build,
+                t_base,
+            });
+        }
+        let t = curves[0].t_base;
+        let (r_p, ex_p) = interp_loglog(&curves[0].points, t);
+        let (r_l, ex_l) = interp_loglog(&curves[1].points, t);
+        matched.row(vec![
+            b.scene.clone(),
+            label.to_string(),
+            num(t),
+            num(r_p),
+            num(r_l),
+            num(r_l / r_p),
+            (ex_p || ex_l).to_string(),
+            num(curves[0].steps),
+            num(curves[1].steps),
+            num(curves[0].build),
+            num(curves[1].build),
+        ]);
+        table.push_str(&format!(
+            "  {label:<6} at {t:.2} ms: RMSE perfect {r_p:.4e}, radix {r_l:.4e} ({:.2}x{}); steps per traversal {:.2} vs {:.2}; build {:.3} vs {:.3} ms\n",
+            r_l / r_p,
+            if ex_l { ", extrapolated" } else { "" },
+            curves[0].steps,
+            curves[1].steps,
+            curves[0].build,
+            curves[1].build
+        ));
+    }
+    csv.write(&dir.join("trees.csv"))?;
+    matched.write(&dir.join("trees_equal_time.csv"))?;
+    plot::lines(
+        &dir.join("trees_rmse.png"),
+        &format!(
+            "{}: RMSE vs GPU time (method + tree build), perfect vs radix tree",
+            b.scene
+        ),
+        "GPU time (ms: the method's passes + the tree build, timestamps)",
+        "RMSE of one frame's GI (W/(m² sr))",
+        &series,
+        true,
+        true,
+    )?;
+    Ok(Report {
+        table,
+        checks: Vec::new(),
+    })
+}
