@@ -139,13 +139,16 @@ fn bad_input_gives_one_clear_line() {
     let e = one_line_error(&[
         "render",
         "--method",
-        "lightcuts",
+        "light-culling-tree",
         "--tree",
         "lbvh",
         "--out",
         "/tmp/x",
     ]);
-    assert!(e.contains("--tree lbvh") && e.contains("Lightcuts"), "{e}");
+    assert!(
+        e.contains("--tree lbvh") && e.contains("perfect tree only"),
+        "{e}"
+    );
     let e = one_line_error(&[
         "render",
         "--method",

@@ -439,12 +439,34 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     ] {
         decodes(&d.join(p));
     }
+    // The tree comparison: every method that runs on either tree (the three samplers and
+    // Lightcuts, not Lightcut Interpolation) on both trees, and an equal-time row each.
+    let (_, rows) = common::read_csv(&d.join("trees.csv"));
+    for m in ["SLC", "RTSLC", "SST", "Lightcuts"] {
+        for t in ["perfect", "lbvh"] {
+            assert!(
+                rows.iter().any(|r| r["method"] == m && r["tree"] == t),
+                "{m} on {t}: {rows:?}"
+            );
+        }
+    }
+    assert!(rows.iter().all(|r| r["method"] != "LI"), "{rows:?}");
+    for r in &rows {
+        assert!(
+            r["rmse"].parse::<f64>().is_ok_and(|v| v.is_finite() && v > 0.0),
+            "{r:?}"
+        );
+        assert!(r["total_gpu_ms"].parse::<f64>().is_ok_and(|v| v > 0.0), "{r:?}");
+    }
+    let (_, rows) = common::read_csv(&d.join("trees_equal_time.csv"));
+    assert_eq!(rows.len(), 4, "{rows:?}");
+    decodes(&d.join("trees_rmse.png"));
     let run: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
     assert_eq!(run["width"], 64);
     // Each figure's wall time and the share of it outside rendering / GPU waits.
     let times = run["scenes"][0]["figure_times"].as_array().unwrap();
-    assert_eq!(times.len(), 11, "{times:?}");
+    assert_eq!(times.len(), 12, "{times:?}");
     for t in times {
         let share = t["share_outside_gpu"].as_f64().unwrap();
         assert!(

@@ -9,13 +9,13 @@ use common::Setup;
 
 use glam::Vec3;
 use lightcut::{
-    base::gpu_layout::GpuVpl,
+    base::{gpu_layout::GpuVpl, sst_node::Topology},
     methods::lightcuts::{self, Lightcuts, settings::LightcutsSettings},
     metrics,
     reference::{
         lightcuts::{
-            CONE_MARGIN, Cone, CutParams, LcTree, build, check_cut, cos_bound, geometry_bound, lightcut,
-            merge_cones, vpl_geometry,
+            CONE_MARGIN, Cone, CutParams, LcTree, build_on, check_cut_on, cos_bound, geometry_bound,
+            lightcut_on, merge_cones, vpl_geometry,
         },
         vpl::{pcg_hash, u01},
     },
@@ -23,7 +23,7 @@ use lightcut::{
         Buffer,
         context::GpuContext,
         readback::read_storage_buffer,
-        settings::{RenderSettings, Tonemap, ViewBuffer},
+        settings::{RenderSettings, Tonemap, TreeKind, ViewBuffer},
     },
     scene::bvh::Bvh,
 };
@@ -173,18 +173,38 @@ fn sorted_vpls(st: &Setup) -> Vec<GpuVpl> {
 #[test]
 fn gpu_lightcuts_equal_the_cpu_reference_and_cuts_are_valid() {
     let Some(ctx) = common::gpu() else { return };
+    check_lightcuts(&ctx, TreeKind::Perfect);
+}
+
+/// Issue 23: Lightcuts on the radix tree (its build bottom-up with arrival counters, the cut
+/// following the links) equals the CPU twin on the same tree, as on the perfect tree.
+#[test]
+fn gpu_lightcuts_on_the_radix_tree_equal_the_cpu_reference() {
+    let Some(ctx) = common::gpu() else { return };
+    check_lightcuts(&ctx, TreeKind::Lbvh);
+}
+
+fn check_lightcuts(ctx: &GpuContext, kind: TreeKind) {
+    let ctx = ctx.clone();
     // A max cut that some pixels reach, so that both stopping rules are exercised.
     let mut s = settings(0.05, 64);
     s.sampling.fixed_seed = true;
+    s.tree.kind = kind;
     let mut st = setup(&ctx, s.clone());
     let traced = (W / 2, H / 2);
     st.r.set_trace_pixel(Some(traced));
     st.frame();
+    assert_eq!(st.r.tree_buffers().1.kind, kind);
     let (nodes, _) = st.r.read_tree().unwrap();
+    let links = st.r.read_tree_links().unwrap();
+    let topo = match kind {
+        TreeKind::Perfect => Topology::perfect_of(&nodes),
+        TreeKind::Lbvh => Topology::radix(&links),
+    };
     let sorted = sorted_vpls(&st);
     let gpu_lc: LcTree = lc_of(&st).read_build(&ctx).unwrap();
     // The build: cones and representatives against the CPU's from the same tree and seed.
-    let cpu_lc = build(&nodes, &sorted, Lightcuts::seed(&s, 0));
+    let cpu_lc = build_on(&nodes, topo, &sorted, Lightcuts::seed(&s, 0));
     let same_reps = gpu_lc
         .reps
         .iter()
@@ -235,9 +255,9 @@ fn gpu_lightcuts_equal_the_cpu_reference_and_cuts_are_valid() {
             }
             let xp = Vec3::new(g[0], g[1], g[2]);
             let n = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
-            let cut = lightcut(&nodes, &gpu_lc, &sorted, &bvh, xp, n, &p);
+            let cut = lightcut_on(&nodes, topo, &gpu_lc, &sorted, &bvh, xp, n, &p);
             let ids: Vec<u32> = cut.cut.iter().map(|c| c.node).collect();
-            check_cut(&nodes, &ids).unwrap_or_else(|e| panic!("pixel ({x}, {y}): {e}"));
+            check_cut_on(&nodes, topo, &ids).unwrap_or_else(|e| panic!("pixel ({x}, {y}): {e}"));
             assert!(ids.len() as u32 <= p.max_cut);
             pixels += 1;
             at_max += cut.hit_max_cut(&p) as u32;
@@ -263,7 +283,7 @@ fn gpu_lightcuts_equal_the_cpu_reference_and_cuts_are_valid() {
     let tc = lc_of(&st).read_traced_cut(&ctx).unwrap().expect("a traced cut");
     assert_eq!(tc.pixel, traced.1 * W + traced.0);
     let mut gpu_ids: Vec<u32> = tc.nodes.iter().map(|n| n.node).collect();
-    check_cut(&nodes, &gpu_ids).unwrap();
+    check_cut_on(&nodes, topo, &gpu_ids).unwrap();
     let cpu = traced_cpu.expect("the traced pixel has geometry");
     let mut cpu_ids: Vec<u32> = cpu.cut.iter().map(|c| c.node).collect();
     gpu_ids.sort_unstable();
@@ -291,9 +311,20 @@ fn gpu_lightcuts_equal_the_cpu_reference_and_cuts_are_valid() {
 #[test]
 fn threshold_zero_and_unlimited_cut_equal_the_ground_truth() {
     let Some(ctx) = common::gpu() else { return };
-    // 256 VPLs: no cut can exceed 256 nodes, so a max cut of 1024 never binds.
-    let mut st = setup(&ctx, settings(0.0, 1024));
+    for kind in TreeKind::ALL {
+        threshold_zero(&ctx, kind);
+    }
+}
+
+fn threshold_zero(ctx: &GpuContext, kind: TreeKind) {
+    let ctx = ctx.clone();
+    // 256 VPLs: no cut can exceed 256 nodes, so a max cut of 1024 never binds (on the radix
+    // tree too: a cut holds at most one node per leaf).
+    let mut s = settings(0.0, 1024);
+    s.tree.kind = kind;
+    let mut st = setup(&ctx, s);
     st.frame();
+    assert_eq!(st.r.tree_buffers().1.kind, kind);
     let lc = st.indirect();
     let stats = st.r.method_stats_blocking();
     let gt = st.ground_truth_of_these_vpls();
@@ -306,7 +337,7 @@ fn threshold_zero_and_unlimited_cut_equal_the_ground_truth() {
             lit += 1;
         }
     }
-    eprintln!("threshold 0: worst relative difference {worst:e} over {lit} lit pixels; {stats:?}");
+    eprintln!("{kind:?}: threshold 0: worst relative difference {worst:e} over {lit} lit pixels; {stats:?}");
     assert!(lit > 500);
     assert!(worst < 1e-3, "worst relative difference {worst}");
     let frac = stats

@@ -40,6 +40,7 @@ const EXAMPLES: &[&str] = &[
     "-- render --scene default --width 320 --height 240 --method slc --temporal svgf --camera-path --path-frames 60 --compare-gt --out out/temporal",
     "-- results temporal --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
     "-- results interpolation --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
+    "-- results trees --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
     "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",
     "-- --view albedo --settings docs/settings-example.toml --tree-stats",
     "-- --compare-gt --views \"final;GI only;traversal steps;A/B comparison\" --pin 150,70",
@@ -639,6 +640,37 @@ fn cli_examples_write_what_they_promise() {
     let (_, rows) = common::read_csv(&tr.join("default").join("temporal_summary.csv"));
     assert_eq!(rows.len(), 3, "{rows:?}");
     let _ = std::fs::remove_dir_all(&tr);
+    // The tree comparison (the default scene, SLC, tiny): both trees, the equal-time table.
+    let trr = tmp("trees-results");
+    let out = run_cli(&args(
+        "-- results trees --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
+        &[("--scenes", "default"), ("--out", trr.to_str().unwrap())],
+        &[
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--frames",
+            "1",
+            "--timing-frames",
+            "2",
+            "--vpls",
+            "256",
+            "--spp",
+            "4,16",
+            "--methods",
+            "slc",
+        ],
+    ));
+    assert!(out.contains("RMSE perfect") && out.contains("radix"), "{out}");
+    let (_, rows) = common::read_csv(&trr.join("default").join("trees.csv"));
+    assert!(rows.iter().any(|r| r["tree"] == "perfect") && rows.iter().any(|r| r["tree"] == "lbvh"));
+    for r in &rows {
+        assert!(r["rmse"].parse::<f64>().is_ok_and(f64::is_finite), "{r:?}");
+    }
+    let (_, m) = common::read_csv(&trr.join("default").join("trees_equal_time.csv"));
+    assert_eq!(m.len(), 1, "{m:?}");
+    let _ = std::fs::remove_dir_all(&trr);
     // The tree's pairing and Lightcuts' cost per relative error (the default scene here).
     let out = run_cli(&args(
         "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",

@@ -10,7 +10,7 @@ use egui::accesskit::Role;
 use egui_kittest::{Harness, kittest::Queryable};
 use lightcut::{
     app::{AppOptions, WorkbenchApp},
-    renderer::settings::{ChildProbability, ViewBuffer},
+    renderer::settings::{ChildProbability, TreeKind, ViewBuffer},
 };
 
 fn setup() -> egui_wgpu::WgpuSetup {
@@ -128,6 +128,34 @@ fn light_tree_overlay_and_statistics_window() {
     // (get_by_* panics when no such node is shown.)
     h.get_by_label_contains("4096 VPLs in 4096 leaves, 13 levels; root flux");
     h.get_by_label_contains("usable = v ≥ 0.70");
+    // Issue 23: the tree combo switches the frame to the radix tree (the statistics walk it:
+    // deeper than 13 levels), and the overlay draws both trees side by side.
+    let overlay_one = shown_pixels(&h);
+    h.get_by_role_and_label(Role::ComboBox, "tree").click();
+    h.run_steps(2);
+    h.get_by_label(TreeKind::Lbvh.label()).click();
+    h.run_steps(4);
+    let r = h.state().renderer().expect("renderer");
+    assert_eq!(r.settings().tree.kind, TreeKind::Lbvh);
+    assert_eq!(r.tree_buffers().1.kind, TreeKind::Lbvh);
+    h.get_by_label_contains("4096 VPLs in 4096 leaves,");
+    assert!(
+        h.query_by_label_contains("4096 VPLs in 4096 leaves, 13 levels")
+            .is_none(),
+        "the statistics still show the perfect tree"
+    );
+    h.get_by_label("both trees side by side").click();
+    h.run_steps(4);
+    h.get_by_label_contains("left: perfect binary tree · right: radix tree (LBVH)");
+    assert!(
+        h.state()
+            .renderer()
+            .expect("renderer")
+            .settings()
+            .display
+            .tree_compare
+    );
+    assert_ne!(shown_pixels(&h), overlay_one, "the comparison drew nothing new");
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }
 

@@ -4,6 +4,7 @@
 //! level), the input cuts in colours, the pixel's own cut in white, and where the inputs
 //! disagree as a red band under the leaves. Data: `Renderer::read_cut_story`.
 
+use crate::base::sst_node::Topology;
 use crate::methods::CutStory;
 
 /// Colours of up to three input cuts.
@@ -42,7 +43,27 @@ pub fn contents(ui: &mut egui::Ui, story: &CutStory, leaves: u32) {
 
 fn tree_view(ui: &mut egui::Ui, story: &CutStory, leaves: u32) {
     let leaves = leaves.max(1);
-    let levels = leaves.ilog2() + 1;
+    // Either tree: a node spans its leaf range at its depth (the radix tree's leaves lie at
+    // many depths: as many rows as the deepest drawn node needs).
+    let topo = match story.links.is_empty() {
+        true => Topology { leaves, links: None },
+        false => Topology::radix(&story.links),
+    };
+    let valid = |n: u32| n != 0 && n < 2 * leaves;
+    let all = story
+        .inputs
+        .iter()
+        .chain(story.cut.iter())
+        .flat_map(|c| c.nodes.iter().copied());
+    let levels = match topo.links {
+        None => leaves.ilog2() + 1,
+        Some(_) => all
+            .filter(|&n| valid(n))
+            .map(|n| topo.depth(n) + 1)
+            .max()
+            .unwrap_or(1)
+            .min(96),
+    };
     let row = 14.0;
     let width = ui.available_width().clamp(240.0, 900.0);
     let height = row * levels as f32 + 14.0;
@@ -67,14 +88,12 @@ fn tree_view(ui: &mut egui::Ui, story: &CutStory, leaves: u32) {
         );
     }
     let span = |n: u32| {
-        let level = n.max(1).ilog2();
-        let w = leaves >> level.min(31);
-        let first = (n - (1 << level)) * w;
-        (level, first, first + w)
+        let (first, last) = topo.leaf_range(n);
+        (topo.depth(n), first, last + 1)
     };
     let draw = |nodes: &[u32], color: egui::Color32, offset: f32, thick: f32| {
         for &n in nodes {
-            if n == 0 || n >= 2 * leaves {
+            if !valid(n) {
                 continue;
             }
             let (level, a, b) = span(n);

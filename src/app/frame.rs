@@ -277,9 +277,18 @@ impl WorkbenchApp {
             let block = (py / b.block) * b.grid.0 + px / b.block;
             let (bx, by) = (px / b.block, py / b.block);
             renderer.select_block(Some(block));
-            match (renderer.read_cut(block), renderer.read_tree()) {
-                (Ok(cut), Ok((nodes, flags))) => {
+            match (
+                renderer.read_cut(block),
+                renderer.read_tree(),
+                renderer.read_tree_links(),
+            ) {
+                (Ok(cut), Ok((nodes, flags)), Ok(links)) => {
+                    let topo = match links.is_empty() {
+                        true => crate::base::sst_node::Topology::perfect_of(&nodes),
+                        false => crate::base::sst_node::Topology::radix(&links),
+                    };
                     self.cut_inspect = Some(CutInspect {
+                        depths: cut.iter().map(|&n| topo.depth(n.max(1))).collect(),
                         block: (bx, by),
                         rows: cut
                             .iter()
@@ -292,7 +301,9 @@ impl WorkbenchApp {
                         root_flux: nodes.get(1).map_or(0.0, |r| luminance(r.intensity)),
                     })
                 }
-                (Err(e), _) | (_, Err(e)) => self.errors.push(format!("reading the cut: {e}")),
+                (Err(e), _, _) | (_, Err(e), _) | (_, _, Err(e)) => {
+                    self.errors.push(format!("reading the cut: {e}"))
+                }
             }
         }
         if let Some(src) = events.snapshot {

@@ -247,6 +247,8 @@ struct CutInspect {
     /// (node id, node, usable).
     rows: Vec<(u32, SstNode, bool)>,
     leaves: u32,
+    /// Each row's depth (root 0: the perfect tree's level; the radix tree's depth).
+    depths: Vec<u32>,
     /// Luminance of the root's flux (every VPL).
     root_flux: f32,
 }

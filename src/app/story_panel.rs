@@ -8,7 +8,7 @@
 use glam::Vec3;
 
 use super::image_views::Prim;
-use crate::base::sst_node::{SstNode, basis, flag, luminance};
+use crate::base::sst_node::{SstNode, Topology, basis, flag, luminance};
 use crate::methods::tree_samplers::pass::{PixelTrace, SampleVisibility, StopReason};
 use crate::renderer::Renderer;
 
@@ -33,7 +33,9 @@ pub struct StoryPanel {
     nodes: std::collections::HashMap<u32, SstNode>,
     flags: Vec<u32>,
     leaves: u32,
-    /// (nodes, usable) per level.
+    /// The radix tree's links (empty on the perfect tree): levels are depths there.
+    links: Vec<[u32; 4]>,
+    /// (nodes, usable) per level (the radix tree: per depth, counts unknown: 0).
     levels: Vec<(u32, u32)>,
     read_at: f64,
     /// The sample whose path is detailed and drawn.
@@ -127,16 +129,25 @@ impl StoryPanel {
         ids.dedup();
         let (nodes, flags) = r.read_tree_nodes(&ids).map_err(|e| e.to_string())?;
         self.leaves = r.tree_buffers().1.leaves;
-        let levels = self.leaves.max(1).ilog2() + 1;
-        // Per level: its nodes (padding included) and how many are usable.
-        self.levels = (0..levels)
-            .map(|l| {
-                let usable = ((1u32 << l)..(2u32 << l))
-                    .filter(|&n| flag(&flags, n as usize))
-                    .count() as u32;
-                (1 << l, usable)
-            })
-            .collect();
+        self.links = r.read_tree_links().map_err(|e| e.to_string())?;
+        if self.links.is_empty() {
+            let levels = self.leaves.max(1).ilog2() + 1;
+            // Per level: its nodes (padding included) and how many are usable.
+            self.levels = (0..levels)
+                .map(|l| {
+                    let usable = ((1u32 << l)..(2u32 << l))
+                        .filter(|&n| flag(&flags, n as usize))
+                        .count() as u32;
+                    (1 << l, usable)
+                })
+                .collect();
+        } else {
+            // The radix tree: as many depths as the visited nodes reach (no per-depth counts
+            // without reading the whole tree).
+            let topo = Topology::radix(&self.links);
+            let deepest = ids.iter().map(|&n| topo.depth(n)).max().unwrap_or(0);
+            self.levels = vec![(0, 0); deepest as usize + 1];
+        }
         self.nodes = ids.into_iter().zip(nodes).collect();
         self.flags = flags;
         if let Some((x, y)) = pixel {
@@ -152,6 +163,17 @@ impl StoryPanel {
             self.gi = get("GI");
         }
         Ok(())
+    }
+
+    /// The frame's tree's shape (the radix tree's links, or the perfect tree's heap).
+    fn topo(&self) -> Topology<'_> {
+        match self.links.is_empty() {
+            true => Topology {
+                leaves: self.leaves.max(1),
+                links: None,
+            },
+            false => Topology::radix(&self.links),
+        }
     }
 
     fn node(&self, n: u32) -> SstNode {
@@ -304,7 +326,15 @@ impl StoryPanel {
         ))
         .on_hover_text("with accumulation on, the GI buffer is the mean over frames; the story is one frame");
         let leaves = self.leaves();
-        let level = |n: u32| n.max(1).ilog2();
+        let links = self.links.clone();
+        let topo = match links.is_empty() {
+            true => Topology {
+                leaves: leaves.max(1),
+                links: None,
+            },
+            false => Topology::radix(&links),
+        };
+        let level = |n: u32| topo.depth(n.max(1));
         egui::ScrollArea::vertical()
             .id_salt("story_samples")
             .max_height(220.0)
@@ -429,10 +459,14 @@ impl StoryPanel {
         let p = ui.painter_at(rect);
         let plot_w = rect.width() - 150.0;
         p.rect_filled(rect, 2.0, egui::Color32::from_gray(20));
+        // A node sits at its depth, over the middle of its leaf range (on the perfect tree:
+        // its position within its level).
+        let topo = self.topo();
         let pos = |n: u32| {
-            let l = n.max(1).ilog2();
-            let first = 1u32 << l;
-            let u = ((n - first) as f32 + 0.5) / first as f32;
+            let n = n.max(1);
+            let l = topo.depth(n);
+            let (a, b) = topo.leaf_range(n);
+            let u = (a + b + 1) as f32 * 0.5 / topo.leaves as f32;
             egui::pos2(
                 rect.left() + 4.0 + u * plot_w,
                 rect.top() + 4.0 + (l as f32 + 0.5) * row,
@@ -450,7 +484,11 @@ impl StoryPanel {
             p.text(
                 egui::pos2(rect.left() + plot_w + 12.0, y),
                 egui::Align2::LEFT_CENTER,
-                format!("L{l}: {usable}/{count} usable"),
+                if *count > 0 {
+                    format!("L{l}: {usable}/{count} usable")
+                } else {
+                    format!("depth {l}")
+                },
                 egui::FontId::monospace(10.0),
                 egui::Color32::from_gray(200),
             );

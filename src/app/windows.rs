@@ -67,7 +67,7 @@ impl WorkbenchApp {
             for (i, (n, node, usable)) in ci.rows.iter().enumerate() {
                 ui.label(i.to_string());
                 ui.label(n.to_string());
-                let level = n.ilog2();
+                let level = ci.depths.get(i).copied().unwrap_or(0);
                 let leaf = *n >= ci.leaves;
                 ui.label(if leaf {
                     format!("{level} (leaf)")

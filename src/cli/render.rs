@@ -148,8 +148,8 @@ pub struct SamplingArgs {
     /// filter). Its parameters: `--set temporal.<field>=..` (docs/temporal.md).
     #[arg(long, value_enum)]
     pub temporal: Option<TemporalArg>,
-    /// The light tree the tree samplers (SST, SLC, RTSLC) traverse: `perfect` (the thesis)
-    /// or `lbvh` (the SST paper's radix tree). Lightcuts, Lightcut Interpolation and the
+    /// The light tree the tree samplers (SST, SLC, RTSLC) and Lightcuts traverse: `perfect`
+    /// (the thesis) or `lbvh` (the SST paper's radix tree). Lightcut Interpolation and the
     /// light-culling tree need the perfect tree and refuse `lbvh`.
     #[arg(long, value_enum)]
     pub tree: Option<TreeArg>,

@@ -53,8 +53,8 @@ pub enum Figure {
     /// camera path, a sun sweep and a still view: per-frame RMSE / SSIM of raw and filtered GI
     /// against each frame's ground truth, flicker, and the stage's GPU time per pass.
     Temporal,
-    /// Issue 23: the tree samplers on the perfect binary tree and on the radix tree (LBVH):
-    /// RMSE over GPU time (method + tree build), steps, and RMSE at equal time.
+    /// Issue 23: the tree samplers and Lightcuts on the perfect binary tree and on the radix
+    /// tree (LBVH): RMSE over GPU time (method + tree build), steps, and RMSE at equal time.
     Trees,
 }
 

@@ -106,13 +106,14 @@ impl MethodId {
     pub fn any_tree(self) -> bool {
         self.info().reads.contains(&Resource::AnyTree)
     }
-    /// The tree a frame of this method builds when `wanted` is asked for: `wanted`, unless the
-    /// method needs the perfect tree (it reads the tree but not through its links).
+    /// The tree a frame of this method builds when `wanted` is asked for: `wanted` (the
+    /// overlay and the statistics show it), unless the method needs the perfect tree (it
+    /// reads the tree but not through its links).
     pub fn tree_kind(self, wanted: crate::base::sst_node::TreeKind) -> crate::base::sst_node::TreeKind {
-        if self.any_tree() {
-            wanted
-        } else {
+        if self.refuses_tree(wanted).is_some() {
             crate::base::sst_node::TreeKind::Perfect
+        } else {
+            wanted
         }
     }
     /// The refusal of `tree.kind = lbvh` for a method that reads the tree without its links
@@ -121,7 +122,7 @@ impl MethodId {
         let reads_tree = self.info().reads.contains(&Resource::Tree);
         (wanted != crate::base::sst_node::TreeKind::Perfect && reads_tree && !self.any_tree()).then(|| {
             format!(
-                "tree {}: {} runs on the perfect tree only (the radix tree serves SST, SLC and RTSLC)",
+                "tree {}: {} runs on the perfect tree only (the radix tree serves SST, SLC, RTSLC and Lightcuts)",
                 wanted.name(),
                 self.info().label
             )
@@ -340,6 +341,9 @@ pub struct CutStory {
     pub cut: Option<StoryCut>,
     /// Leaf intervals [start, end) where the inputs disagree.
     pub disagreements: Vec<(u32, u32)>,
+    /// The radix tree's links when the cuts are on it (`base::sst_node::Topology::radix`;
+    /// the renderer fills them in), empty on the perfect tree.
+    pub links: Vec<[u32; 4]>,
 }
 
 /// A heat-map view's colour scale, as the GUI draws its legend.

@@ -35,7 +35,7 @@ use glam::Vec3;
 use crate::base::{
     display::luminance,
     gpu_layout::{GpuVpl, VPL_NONE},
-    sst_node::{SstNode, basis},
+    sst_node::{SstNode, Topology, basis},
 };
 use crate::reference::vpl::{pcg_hash, u01};
 use crate::scene::bvh::{Bvh, Ray};
@@ -142,7 +142,14 @@ pub struct LcTree {
 /// Cones and representatives over the frame's tree (`nodes`: 2 x leaves decoded nodes, the
 /// sorted VPLs one per leaf). Twin: `lc_build.wgsl` (one dispatch per level, bottom-up).
 pub fn build(nodes: &[SstNode], sorted: &[GpuVpl], seed: u32) -> LcTree {
-    let leaves = nodes.len() / 2;
+    build_on(nodes, Topology::perfect_of(nodes), sorted, seed)
+}
+
+/// [`build`] on either tree: the radix tree's inner nodes in post-order (their children may
+/// have lower ids). Twin of the radix tree's: `lc_build_radix.wgsl` (one thread per leaf,
+/// arrival counters).
+pub fn build_on(nodes: &[SstNode], topo: Topology<'_>, sorted: &[GpuVpl], seed: u32) -> LcTree {
+    let leaves = topo.leaves as usize;
     let mut cones = vec![Cone::EMPTY; 2 * leaves];
     let mut reps = vec![VPL_NONE; 2 * leaves];
     for (i, v) in sorted.iter().enumerate().take(leaves) {
@@ -154,8 +161,25 @@ pub fn build(nodes: &[SstNode], sorted: &[GpuVpl], seed: u32) -> LcTree {
             reps[leaves + i] = i as u32;
         }
     }
-    for n in (1..leaves).rev() {
-        let (a, b) = (2 * n, 2 * n + 1);
+    // Inner nodes, children first.
+    let mut order = Vec::with_capacity(leaves);
+    let mut stack = vec![(1u32, false)];
+    while let Some((n, expanded)) = stack.pop() {
+        if topo.is_leaf(n) {
+            continue;
+        }
+        if expanded {
+            order.push(n);
+        } else {
+            let (a, b) = topo.children(n);
+            stack.push((n, true));
+            stack.push((b, false));
+            stack.push((a, false));
+        }
+    }
+    for n in order {
+        let (a, b) = topo.children(n);
+        let (a, b, n) = (a as usize, b as usize, n as usize);
         cones[n] = merge_cones(cones[a], cones[b]);
         reps[n] = pick_rep(
             reps[a],
@@ -384,7 +408,22 @@ pub fn lightcut(
     n: Vec3,
     p: &CutParams,
 ) -> PixelCut {
-    let leaves = (nodes.len() / 2) as u32;
+    lightcut_on(nodes, Topology::perfect_of(nodes), lc, sorted, bvh, x, n, p)
+}
+
+/// [`lightcut`] on either tree.
+#[allow(clippy::too_many_arguments)]
+pub fn lightcut_on(
+    nodes: &[SstNode],
+    topo: Topology<'_>,
+    lc: &LcTree,
+    sorted: &[GpuVpl],
+    bvh: &Bvh,
+    x: Vec3,
+    n: Vec3,
+    p: &CutParams,
+) -> PixelCut {
+    let leaves = topo.leaves;
     let estimate = |node: u32| cluster_estimate(nodes, lc, sorted, node, x, n, p.eps);
     let mut rays = 0u32;
     let mut visible = |node: u32, e: Vec3| -> bool {
@@ -440,7 +479,8 @@ pub fn lightcut(
         open.swap_remove(k);
         sum -= top.estimate;
         refinements += 1;
-        for child in [2 * top.node, 2 * top.node + 1] {
+        let (c0, c1) = topo.children(top.node);
+        for child in [c0, c1] {
             if nodes[child as usize].is_empty() {
                 continue;
             }
@@ -490,17 +530,19 @@ pub fn lightcut(
 /// Checks that `cut` (node ids) covers every non-empty leaf exactly once and no empty one:
 /// Ok, or the first problem found.
 pub fn check_cut(nodes: &[SstNode], cut: &[u32]) -> Result<(), String> {
-    let leaves = (nodes.len() / 2) as u32;
+    check_cut_on(nodes, Topology::perfect_of(nodes), cut)
+}
+
+/// [`check_cut`] on either tree.
+pub fn check_cut_on(nodes: &[SstNode], topo: Topology<'_>, cut: &[u32]) -> Result<(), String> {
+    let leaves = topo.leaves;
     let mut covered = vec![0u32; leaves as usize];
     for &c in cut {
         if c == 0 || c >= 2 * leaves {
             return Err(format!("node {c} is not a node of a tree of {leaves} leaves"));
         }
-        let depth = 31 - c.leading_zeros();
-        let levels = leaves.trailing_zeros();
-        let span = 1u32 << (levels - depth);
-        let first = (c << (levels - depth)) - leaves;
-        for l in first..first + span {
+        let (first, last) = topo.leaf_range(c);
+        for l in first..=last {
             covered[l as usize] += 1;
         }
     }

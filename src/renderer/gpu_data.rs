@@ -510,7 +510,7 @@ mod tests {
                         offset_of!(P, first),
                         offset_of!(P, last),
                         offset_of!(P, steps),
-                        offset_of!(P, _pad),
+                        offset_of!(P, radix),
                     ]
                 },
             ),

@@ -74,10 +74,14 @@ impl Renderer {
         if self.trace_pixel.is_none() {
             return Ok(None);
         }
-        match self.method_instance(self.settings.gi.method) {
-            Some(m) => m.read_cut_story(&self.ctx),
-            None => Ok(None),
+        let Some(m) = self.method_instance(self.settings.gi.method) else {
+            return Ok(None);
+        };
+        let mut story = m.read_cut_story(&self.ctx)?;
+        if let Some(s) = story.as_mut() {
+            s.links = self.read_tree_links()?;
         }
+        Ok(story)
     }
 
     /// The method's overlay for the pinned pixel (None without a pinned pixel, without

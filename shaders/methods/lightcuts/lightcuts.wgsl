@@ -29,6 +29,7 @@
 #include "common/sst_node.wgsl"
 #include "methods/lightcuts/lc_common.wgsl"
 #include "common/stats64.wgsl"
+#include "common/tree_links.wgsl"
 
 override DIAGNOSTICS: bool = true;
 override MODE: u32 = 0u;
@@ -58,7 +59,7 @@ struct LcParams {
     first: u32,       // 1: this dispatch starts the slice's cuts
     last: u32,        // 1: this dispatch finishes them and writes the outputs
     steps: u32,       // refinements per dispatch at most
-    _pad0: u32,
+    radix: u32,       // 1: the radix tree (children from tree_links; mode 0 only), 0: the perfect tree
 };
 
 // A pixel's refinement between dispatches.
@@ -94,6 +95,12 @@ struct LcState {
 @group(0) @binding(17) var<storage, read_write> record_cuts: array<u32>;
 // Word 0: records; word 8 + r: record r's cut length (li_common.wgsl).
 @group(0) @binding(18) var<storage, read_write> rec_meta: array<u32>;
+// The radix tree's links (a dummy on the perfect tree): common/tree_links.wgsl.
+@group(0) @binding(19) var<storage, read> tree_links: array<vec4<u32>>;
+
+fn tree_radix() -> bool {
+    return lp.radix != 0u;
+}
 
 var<private> rays: u32;
 
@@ -124,8 +131,10 @@ fn settle(lane: u32, settled: ptr<function, u32>, node: u32, vis: bool) {
 // First leaf under a node (the left-to-right order of a cut).
 fn first_leaf(e: u32) -> u32 {
     let node = e & ~LC_VISIBLE;
-    let levels = firstTrailingBit(lp.leaves);
-    return (node << (levels - firstLeadingBit(node))) - lp.leaves;
+    if node >= lp.leaves {
+        return node - lp.leaves;
+    }
+    return tree_leaf_range(node, lp.leaves).x;
 }
 
 fn sift_down(base: u32, start: u32, end: u32) {
@@ -364,7 +373,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         refinements += 1u;
         let rep = reps[node];
         for (var c = 0u; c < 2u; c++) {
-            let child = 2u * node + c;
+            let child = select(tree_right(node), tree_left(node), c == 0u);
             if !sst_is_empty(tree[child]) {
                 let b = error_bound(child, x, n);
                 var vis = false;

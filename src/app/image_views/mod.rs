@@ -346,6 +346,34 @@ fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
         egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
         egui::Color32::WHITE,
     );
+    // The tree overlay's two trees side by side: the divider and which half is which.
+    let d = cx.display;
+    if d.tree_compare
+        && d.tree_overlay != crate::renderer::settings::TreeOverlay::Off
+        && !pane.spec.buffer.is_rsm_space()
+        && pane.spec.effective_ab().is_none()
+    {
+        let x = disp.center().x;
+        painter.line_segment(
+            [egui::pos2(x, disp.top()), egui::pos2(x, disp.bottom())],
+            egui::Stroke::new(1.5, egui::Color32::from_white_alpha(200)),
+        );
+        let font = egui::FontId::proportional(14.0);
+        for (dx, align, text) in [
+            (-8.0, egui::Align2::RIGHT_TOP, "perfect binary tree"),
+            (8.0, egui::Align2::LEFT_TOP, "radix tree (LBVH)"),
+        ] {
+            let at = egui::pos2(x + dx, disp.top().max(rect.top()) + 6.0);
+            painter.text(
+                at + egui::vec2(1.0, 1.0),
+                align,
+                text,
+                font.clone(),
+                egui::Color32::BLACK,
+            );
+            painter.text(at, align, text, font.clone(), egui::Color32::WHITE);
+        }
+    }
 
     // Shared zoom (ctrl + wheel or pinch, about the pointer) and pan (ctrl/middle drag).
     let (fw, fh) = cx.renderer.size();

@@ -1,8 +1,9 @@
-//! Issue 23's tree comparison: the three tree samplers on the thesis's perfect binary tree and
-//! on the SST paper's radix tree (LBVH) over the same VPLs and keys. Per method and tree: the
-//! samples-per-pixel sweep's GPU time (the method's passes + the tree's build), RMSE, SSIM and
-//! traversal steps; the RMSE of each tree interpolated at equal GPU time (the perfect tree's
-//! time at the base spp). `bench tree` times the builds alone over 2^12 .. 2^20 VPLs and
+//! Issue 23's tree comparison: every method that runs on either tree (SST, SLC, RTSLC,
+//! Lightcuts) on the thesis's perfect binary tree and on the SST paper's radix tree (LBVH) over
+//! the same VPLs and keys. Per method and tree: its quality sweep (the samplers' spp,
+//! Lightcuts' relative error) with GPU time (the method's passes + the tree's build), RMSE,
+//! SSIM and traversal steps; the RMSE of each tree interpolated at equal GPU time (the perfect
+//! tree's time at the base value: the base spp, the middle relative error). `bench tree` times the builds alone over 2^12 .. 2^20 VPLs and
 //! `bench lightcuts` measures the trees' far-paired clusters.
 
 use super::*;
@@ -26,7 +27,8 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "scene",
         "method",
         "tree",
-        "spp",
+        "setting",
+        "value",
         "gi_gpu_ms",
         "tree_build_gpu_ms",
         "total_gpu_ms",
@@ -55,28 +57,43 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "build_perfect_ms",
         "build_lbvh_ms",
     ]);
-    for (mi, (method, label)) in tree_methods(o).into_iter().enumerate() {
-        // Per tree: (total ms, RMSE) over the sweep, the base spp's steps and build time.
+    let any: Vec<(MethodId, &str)> = methods(o)
+        .into_iter()
+        .filter(|(m, _)| m.any_tree() && m.per_frame())
+        .collect();
+    for (mi, (method, label)) in any.into_iter().enumerate() {
+        let Some(sweep) = method.info().sweep else {
+            continue;
+        };
+        let values = o.sweep_values(method, base_spp);
+        // The matched point: the base spp, else the sweep's middle value.
+        let base = if sweep.name == "spp" {
+            base_spp as f64
+        } else {
+            values[values.len() / 2]
+        };
+        // Per tree: (total ms, RMSE) over the sweep, the base value's steps and build time.
         let mut curves: Vec<TreeCurve> = Vec::new();
         for (ki, kind) in TreeKind::ALL.into_iter().enumerate() {
             let mut pts = Vec::new();
             let (mut steps, mut build, mut t_base) = (f64::NAN, f64::NAN, f64::NAN);
-            for v in o.sweep_values(method, base_spp) {
-                let spp = v.round().max(1.0) as u32;
+            for &v in &values {
                 let s = with(b, |s| {
                     s.gi.method = method;
                     s.tree.kind = kind;
-                    s.sampling.cut_size = spp;
+                    (sweep.apply)(s, v);
                 });
                 let m = b.measure(&s, o.size, o.per_config(), true)?;
                 let gi = m.gi_ms().0;
                 let tb = m.pass_ms(&TREE_BUILD).0;
                 let (r, rs) = m.rmse();
+                let value = knob(v, sweep.integer);
                 csv.row(vec![
                     b.scene.clone(),
                     label.to_string(),
                     kind.name().to_string(),
-                    spp.to_string(),
+                    sweep.name.to_string(),
+                    value.clone(),
                     num(gi),
                     num(tb),
                     num(gi + tb),
@@ -88,12 +105,13 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                     num(m.steps_per_pixel()),
                 ]);
                 eprintln!(
-                    "[{}] {label} on the {} tree, {spp} spp: GI {gi:.3} + build {tb:.3} ms GPU, RMSE {r:.4e}, {:.2} steps per traversal",
+                    "[{}] {label} on the {} tree, {} {value}: GI {gi:.3} + build {tb:.3} ms GPU, RMSE {r:.4e}, {:.2} steps per traversal",
                     b.scene,
                     kind.name(),
+                    sweep.name,
                     m.steps_per_traversal()
                 );
-                if spp == base_spp {
+                if v == base {
                     steps = m.steps_per_traversal();
                     build = tb;
                     t_base = gi + tb;

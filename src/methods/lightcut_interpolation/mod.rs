@@ -418,7 +418,7 @@ impl Method for LightcutInterpolation {
             first: 1,
             last: 1,
             steps: self.steps.0,
-            _pad: 0,
+            radix: 0,
         };
         if cx.diagnostics {
             self.traced = cx.trace_pixel.is_some();

@@ -42,11 +42,14 @@ pub static MODULE: Module = Module {
     shaders: &[
         shader!("lc_common.wgsl"),
         shader!("lc_build.wgsl"),
+        shader!("lc_merge.wgsl"),
+        shader!("lc_build_radix.wgsl"),
         shader!("lightcuts.wgsl"),
         shader!("lc_views.wgsl"),
     ],
     entry_shaders: &[
         "methods/lightcuts/lc_build.wgsl",
+        "methods/lightcuts/lc_build_radix.wgsl",
         "methods/lightcuts/lightcuts.wgsl",
         "methods/lightcuts/lc_views.wgsl",
     ],
@@ -108,7 +111,12 @@ pub static INFO: MethodInfo = MethodInfo {
     progress_unit: "",
     kind: Kind::PerFrame,
     module: &MODULE,
-    reads: &[Resource::Gbuffer, Resource::Tree, Resource::Bvh],
+    reads: &[
+        Resource::Gbuffer,
+        Resource::Tree,
+        Resource::AnyTree,
+        Resource::Bvh,
+    ],
     views: VIEWS,
     timed_passes: &["lightcuts_build", "lightcuts"],
     story: false,
@@ -253,7 +261,7 @@ impl Method for Lightcuts {
             first: 1,
             last: 1,
             steps: self.steps,
-            _pad: 0,
+            radix: (cx.tree.kind == crate::renderer::settings::TreeKind::Lbvh) as u32,
         };
         if cx.diagnostics {
             self.traced = cx.trace_pixel.is_some();
@@ -352,6 +360,7 @@ impl Method for Lightcuts {
                 nodes: t.nodes.iter().map(|n| n.node).collect(),
             }),
             disagreements: Vec::new(),
+            links: Vec::new(),
         }))
     }
 

@@ -55,7 +55,8 @@ pub struct GpuLcParams {
     pub last: u32,
     /// Refinements per dispatch at most ([`steps_per_dispatch`]).
     pub steps: u32,
-    pub _pad: u32,
+    /// 1: the radix tree (children from its links; Lightcuts only), 0: the perfect tree.
+    pub radix: u32,
 }
 
 /// Refinements per dispatch: all of them on a GPU; 16 on a CPU adapter, where lavapipe
@@ -288,6 +289,7 @@ impl CutKernel {
         entries.push(storage_entry(16, c, true));
         entries.push(storage_entry(17, c, false));
         entries.push(storage_entry(18, c, false));
+        entries.push(storage_entry(19, c, true));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lightcuts::layout"),
             entries: &entries,
@@ -329,7 +331,7 @@ impl CutKernel {
         b: &CutBindings<'_>,
     ) {
         let slices = items.div_ceil(slice).max(1);
-        let refine = dispatches_per_slice(p.max_cut, b.tree.levels(), p.steps);
+        let refine = dispatches_per_slice(p.max_cut, b.tree.depth_bound(), p.steps);
         let per_slice = refine + (self.mode == 1) as u32;
         let n = slices * per_slice;
         let mut all = Vec::with_capacity(n as usize);
@@ -369,6 +371,7 @@ impl CutKernel {
             b.lanes.as_entire_binding(),
             b.record_cuts.as_entire_binding(),
             b.rec_meta.as_entire_binding(),
+            b.tree.links().as_entire_binding(),
         ];
         let bind = bind_group_seq(device, "lightcuts::bind_group", &self.layout, &entries);
         encoder.push_debug_group(name);
@@ -387,10 +390,16 @@ impl CutKernel {
     }
 }
 
-/// The build kernel (`lc_build.wgsl`): normal cones and representatives, bottom-up.
+/// The build kernel (`lc_build.wgsl`): normal cones and representatives, bottom-up, one
+/// dispatch per level of the perfect tree; on the radix tree `lc_build_radix.wgsl`, one
+/// thread per leaf with arrival counters.
 pub struct BuildKernel {
     build: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    radix: wgpu::ComputePipeline,
+    radix_layout: wgpu::BindGroupLayout,
+    /// The radix build's arrival counters (one per node; grown on demand).
+    counters: Option<wgpu::Buffer>,
     /// One per level.
     params: StridedUniforms<GpuLcBuildParams>,
 }
@@ -399,20 +408,45 @@ impl BuildKernel {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let c = wgpu::ShaderStages::COMPUTE;
         let module = shaders::create_module(device, "methods/lightcuts/lc_build.wgsl")?;
+        let uniform = dynamic_uniform_entry(0, c, std::mem::size_of::<GpuLcBuildParams>() as u64);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lightcuts_build::layout"),
             entries: &[
-                dynamic_uniform_entry(0, c, std::mem::size_of::<GpuLcBuildParams>() as u64),
+                uniform,
                 storage_entry(1, c, true),
                 storage_entry(2, c, true),
                 storage_entry(3, c, false),
                 storage_entry(4, c, false),
             ],
         });
+        let rmodule = shaders::create_module(device, "methods/lightcuts/lc_build_radix.wgsl")?;
+        let radix_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lightcuts_build_radix::layout"),
+            entries: &[
+                uniform,
+                storage_entry(1, c, true),
+                storage_entry(2, c, true),
+                storage_entry(3, c, false),
+                storage_entry(4, c, false),
+                storage_entry(5, c, true),
+                storage_entry(6, c, true),
+                storage_entry(7, c, false),
+            ],
+        });
         Ok(Self {
             build: compute_pipeline_with(device, "lightcuts_build", &[Some(&layout)], &module, "main", &[]),
+            radix: compute_pipeline_with(
+                device,
+                "lightcuts_build_radix",
+                &[Some(&radix_layout)],
+                &rmodule,
+                "main",
+                &[],
+            ),
             params: StridedUniforms::new(device, "lightcuts_build::params", MAX_LEVELS),
             layout,
+            radix_layout,
+            counters: None,
         })
     }
 
@@ -430,6 +464,10 @@ impl BuildKernel {
         cones: &wgpu::Buffer,
         reps: &wgpu::Buffer,
     ) {
+        if tree.kind == crate::renderer::settings::TreeKind::Lbvh {
+            self.record_radix(device, queue, encoder, timer, name, seed, tree, cones, reps);
+            return;
+        }
         // Levels bottom-up: leaves (level L-1) first, the root last.
         let per_level: Vec<GpuLcBuildParams> = (0..tree.levels())
             .rev()
@@ -460,6 +498,69 @@ impl BuildKernel {
                 pass.set_bind_group(0, &bind, &[StridedUniforms::<GpuLcBuildParams>::offset(i as u32)]);
                 pass.dispatch_workgroups(bp.count.div_ceil(WG_1D), 1, 1);
             }
+        }
+        encoder.pop_debug_group();
+    }
+
+    /// The radix tree's build: one dispatch, one thread per leaf.
+    #[allow(clippy::too_many_arguments)]
+    fn record_radix(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        name: &str,
+        seed: u32,
+        tree: &TreeBuffers,
+        cones: &wgpu::Buffer,
+        reps: &wgpu::Buffer,
+    ) {
+        let need = 4 * tree.leaves.max(4) as u64;
+        if self.counters.as_ref().is_none_or(|c| c.size() < need) {
+            self.counters = Some(crate::renderer::passes::storage_buffer(
+                device,
+                "lightcuts_build_radix::counters",
+                need,
+            ));
+        }
+        let Some(counters) = &self.counters else { return };
+        self.params.write(
+            device,
+            queue,
+            &[GpuLcBuildParams {
+                first: 0,
+                count: tree.leaves,
+                leaves: tree.leaves,
+                seed,
+            }],
+        );
+        encoder.clear_buffer(counters, 0, None);
+        let entries = [
+            self.params.binding(),
+            tree.nodes.as_entire_binding(),
+            tree.sorted_vpls.as_entire_binding(),
+            cones.as_entire_binding(),
+            reps.as_entire_binding(),
+            tree.links.as_entire_binding(),
+            tree.parents.as_entire_binding(),
+            counters.as_entire_binding(),
+        ];
+        let bind = bind_group_seq(
+            device,
+            "lightcuts_build_radix::bind_group",
+            &self.radix_layout,
+            &entries,
+        );
+        encoder.push_debug_group(name);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(name),
+                timestamp_writes: timer.compute_pass(name),
+            });
+            pass.set_pipeline(&self.radix);
+            pass.set_bind_group(0, &bind, &[StridedUniforms::<GpuLcBuildParams>::offset(0)]);
+            pass.dispatch_workgroups(tree.leaves.div_ceil(WG_1D).max(1), 1, 1);
         }
         encoder.pop_debug_group();
     }

@@ -113,6 +113,16 @@ impl TreeBuffers {
         level_count(leaf_count(self.count))
     }
 
+    /// A bound on the depth (root 0) of any leaf: the perfect tree's leaf level; the radix
+    /// tree's prefixes of the 64-bit keys augmented with 32-bit indices grow by at least one
+    /// bit per level, so its depth is at most 96.
+    pub fn depth_bound(&self) -> u32 {
+        match self.kind {
+            TreeKind::Perfect => self.levels(),
+            TreeKind::Lbvh => 96,
+        }
+    }
+
     /// The radix tree's links (a dummy for the perfect tree): bound by every sampler.
     pub fn links(&self) -> &wgpu::Buffer {
         &self.links
