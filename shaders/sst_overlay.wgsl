@@ -9,6 +9,7 @@
 #include "common/camera.wgsl"
 #include "common/color.wgsl"
 #include "common/sst_node.wgsl"
+#include "common/tree_links.wgsl"
 
 struct OverlayParams {
     level: u32,      // tree level drawn (root = 0)
@@ -28,6 +29,12 @@ struct OverlayParams {
 @group(0) @binding(4) var gb_position: texture_2d<f32>;
 // The radix tree's parents (a dummy on the perfect tree).
 @group(0) @binding(5) var<storage, read> parents: array<u32>;
+// The radix tree's links (a dummy on the perfect tree): common/tree_links.wgsl.
+@group(0) @binding(6) var<storage, read> tree_links: array<vec4<u32>>;
+
+fn tree_radix() -> bool {
+    return op.radix != 0u;
+}
 
 // The node instance `ii` draws, or 0 when it is not in the level's cut.
 fn instance_node(ii: u32) -> u32 {
@@ -62,8 +69,15 @@ fn node_color(i: u32, node: SstNode) -> vec3<f32> {
     if op.color_mode == 2u {
         return id_color(i);
     }
-    let mean = luminance(tree[1].intensity) / f32(1u << op.level);
-    let t = (log2(max(luminance(node.intensity), 1e-30) / max(mean, 1e-30)) * 0.30103 + 2.0) / 4.0;
+    // Flux per leaf against the root's (on the perfect tree: the node's flux against its
+    // level's mean).
+    var span = 1.0;
+    if i < op.leaves {
+        let r = tree_leaf_range(i, op.leaves);
+        span = f32(r.y - r.x + 1u);
+    }
+    let mean = luminance(tree[1].intensity) / f32(op.leaves);
+    let t = (log2(max(luminance(node.intensity) / span, 1e-30) / max(mean, 1e-30)) * 0.30103 + 2.0) / 4.0;
     return false_color(t);
 }
 

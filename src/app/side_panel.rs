@@ -386,7 +386,15 @@ impl WorkbenchApp {
                 ui.checkbox(&mut v.animate, "new VPLs every frame");
             });
             ui.separator();
-            let levels = self.renderer.as_ref().map(|r| r.tree_buffers().1.levels());
+            // Rows of the level slider: the perfect tree's levels; the radix tree is deeper
+            // (its depth per leaf varies: the statistics window shows it), up to 48 here.
+            let levels = self.renderer.as_ref().map(|r| {
+                let t = r.tree_buffers().1;
+                match t.kind {
+                    crate::renderer::settings::TreeKind::Perfect => t.levels(),
+                    crate::renderer::settings::TreeKind::Lbvh => t.depth_bound().min(48),
+                }
+            });
             self.tree_panel.controls(ui, &mut self.settings, levels);
             ui.separator();
             ui.heading("Export");

@@ -93,12 +93,13 @@ impl TreePanel {
                 }
             });
         if d.tree_overlay != TreeOverlay::Off {
-            let max_level = levels.unwrap_or(21).saturating_sub(1).min(20);
+            let max_level = levels.unwrap_or(21).saturating_sub(1).min(47);
             d.tree_level = d.tree_level.min(max_level);
             ui.add(egui::Slider::new(&mut d.tree_level, 0..=max_level).text("tree level"))
                 .on_hover_text(format!(
-                    "0 = the root; {max_level} = the leaves (the VPLs). Level l has 2^l nodes. On the \
-                     radix tree, level l is the cut of the nodes at depth l and the leaves above it."
+                    "0 = the root. The perfect tree: {max_level} = the leaves (the VPLs); level l has 2^l \
+                     nodes. The radix tree: level l is the cut of the nodes at depth l and the leaves \
+                     above it (past its deepest leaf, the leaves)."
                 ));
             ui.checkbox(&mut d.tree_compare, "both trees side by side")
                 .on_hover_text(

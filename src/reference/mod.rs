@@ -25,6 +25,7 @@ pub mod lightcuts;
 pub mod slc;
 pub mod sst;
 pub mod sst_tree;
+pub mod surface;
 pub mod temporal;
 pub mod val;
 pub mod vpl;

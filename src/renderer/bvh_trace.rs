@@ -156,3 +156,123 @@ impl BvhTracer {
         Ok((bytemuck::cast_slice(&bytes).to_vec(), times))
     }
 }
+
+/// One ray's hit surface as `shaders/surface_rays.wgsl` writes it (twin: `Surface` in
+/// `shaders/common/surface.wgsl`, `reference::surface::Surface`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuSurface {
+    pub position: [f32; 3],
+    /// u32::MAX on a miss.
+    pub material: u32,
+    pub normal: [f32; 3],
+    /// 1 on a hit of a non-degenerate triangle.
+    pub valid: u32,
+    pub geometric_normal: [f32; 3],
+    pub _pad: u32,
+    pub albedo: [f32; 3],
+    pub _pad1: u32,
+    pub uv: [f32; 2],
+    pub _pad2: [u32; 2],
+}
+
+/// Traces rays and describes the surfaces they hit (`shaders/surface_rays.wgsl` over
+/// `common/surface.wgsl`): the GPU side of the light paths' hit surfaces, for the tests.
+pub struct SurfaceProbe {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl SurfaceProbe {
+    pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        use super::passes::{float_array_texture_entry, uniform_entry};
+        let module = shaders::create_module(device, "surface_rays.wgsl")?;
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("surface_rays::layout"),
+            entries: &[
+                storage_entry(0, c, true),
+                storage_entry(1, c, true),
+                storage_entry(2, c, true),
+                storage_entry(3, c, false),
+                storage_entry(4, c, true),
+                storage_entry(5, c, true),
+                storage_entry(6, c, true),
+                float_array_texture_entry(7),
+                uniform_entry(8, c),
+            ],
+        });
+        Ok(Self {
+            pipeline: compute_pipeline(device, "surface_rays", &[Some(&layout)], &module, "main"),
+            layout,
+        })
+    }
+
+    /// The surfaces `rays` hit in `scene`, albedo at mip level `lod`.
+    pub fn run(
+        &self,
+        ctx: &GpuContext,
+        scene: &super::scene_gpu::SceneGpu,
+        rays: &[GpuRay],
+        lod: u32,
+    ) -> Result<Vec<GpuSurface>, GpuError> {
+        let device = &ctx.device;
+        if rays.is_empty() {
+            return Ok(Vec::new());
+        }
+        if (rays.len() as u32).div_ceil(WG_1D) > MAX_GROUPS_X {
+            return Err(GpuError::Limit(format!(
+                "{} rays exceed one dispatch",
+                rays.len()
+            )));
+        }
+        let ray_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("surface_rays::rays"),
+            contents: bytemuck::cast_slice(rays),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let out = super::passes::storage_buffer(
+            device,
+            "surface_rays::out",
+            (rays.len() * std::mem::size_of::<GpuSurface>()) as u64,
+        );
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("surface_rays::params"),
+            contents: bytemuck::cast_slice(&[lod, 0, 0, 0]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let bind = super::passes::bind_group_seq(
+            device,
+            "surface_rays::bind_group",
+            &self.layout,
+            &[
+                scene.bvh_nodes.as_entire_binding(),
+                scene.bvh_triangles.as_entire_binding(),
+                ray_buf.as_entire_binding(),
+                out.as_entire_binding(),
+                scene.vertices.as_entire_binding(),
+                scene.indices.as_entire_binding(),
+                scene.materials.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&scene.textures_view),
+                params.as_entire_binding(),
+            ],
+        );
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("surface_rays::encoder"),
+        });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("surface_rays"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.dispatch_workgroups((rays.len() as u32).div_ceil(WG_1D), 1, 1);
+        }
+        ctx.queue.submit([enc.finish()]);
+        let bytes = readback::read_storage_buffer(ctx, &out)?;
+        Ok(bytemuck::pod_collect_to_vec(
+            &bytes[..rays.len() * std::mem::size_of::<GpuSurface>()],
+        ))
+    }
+}

@@ -775,9 +775,9 @@ impl RenderSettings {
                 self.display.split
             ));
         }
-        if self.display.tree_level > 20 {
+        if self.display.tree_level > 47 {
             return Err(format!(
-                "display.tree_level {} is out of range (0..=20)",
+                "display.tree_level {} is out of range (0..=47)",
                 self.display.tree_level
             ));
         }

@@ -36,6 +36,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ),
     ("common/slc.wgsl", include_str!("../../shaders/common/slc.wgsl")),
     (
+        "common/surface.wgsl",
+        include_str!("../../shaders/common/surface.wgsl"),
+    ),
+    (
         "common/tree_links.wgsl",
         include_str!("../../shaders/common/tree_links.wgsl"),
     ),
@@ -108,6 +112,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("temporal.wgsl", include_str!("../../shaders/temporal.wgsl")),
     ("lbvh.wgsl", include_str!("../../shaders/lbvh.wgsl")),
     (
+        "surface_rays.wgsl",
+        include_str!("../../shaders/surface_rays.wgsl"),
+    ),
+    (
         "common/sst_merge.wgsl",
         include_str!("../../shaders/common/sst_merge.wgsl"),
     ),
@@ -137,6 +145,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "val_cluster.wgsl",
     "temporal.wgsl",
     "lbvh.wgsl",
+    "surface_rays.wgsl",
 ];
 
 /// Every WGSL file: the shared ones and those the registered GI methods declare.

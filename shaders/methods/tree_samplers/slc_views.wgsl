@@ -7,6 +7,7 @@
 //   mode 3: each block tinted by its cut's mean node depth (false colour, root .. leaves).
 // CPU twin of the colour maps: src/reference/visualise.rs.
 #include "common/color.wgsl"
+#include "common/tree_links.wgsl"
 
 struct ViewParams {
     mode: u32,
@@ -19,8 +20,8 @@ struct ViewParams {
     levels: u32,
     selected: u32,   // 1 + selected block, 0 = none
     final_scale: u32, // full-resolution pixels per GI pixel (final image, G-buffer)
-    _pad1: u32,
-    _pad2: u32,
+    radix: u32,       // 1: the radix tree (depths walked along tree_links), 0: the perfect tree
+    leaves: u32,
 };
 
 @group(0) @binding(0) var<uniform> vp: ViewParams;
@@ -29,6 +30,39 @@ struct ViewParams {
 @group(0) @binding(3) var<storage, read> diag: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read> cuts: array<u32>;
 @group(0) @binding(5) var dst: texture_storage_2d<rgba8unorm, write>;
+// The radix tree's links (a dummy on the perfect tree): common/tree_links.wgsl.
+@group(0) @binding(6) var<storage, read> tree_links: array<vec4<u32>>;
+
+fn tree_radix() -> bool {
+    return vp.radix != 0u;
+}
+
+// Depth of node n (root 0): the perfect tree's level, or down the radix tree's links to the
+// child whose leaf range holds n's.
+fn node_depth(n: u32) -> u32 {
+    if !tree_radix() {
+        return firstLeadingBit(n);
+    }
+    var r = vec2<u32>(n - vp.leaves);
+    if n < vp.leaves {
+        r = tree_links[n].zw;
+    }
+    var node = 1u;
+    var d = 0u;
+    loop {
+        if node == n || node >= vp.leaves || d >= 128u {
+            break;
+        }
+        let l = tree_left(node);
+        var lr = vec2<u32>(l - vp.leaves);
+        if l < vp.leaves {
+            lr = tree_links[l].zw;
+        }
+        node = select(tree_right(node), l, lr.x <= r.x && r.y <= lr.y);
+        d += 1u;
+    }
+    return d;
+}
 
 fn grey_final(px: vec2<i32>) -> vec3<f32> {
     return vec3<f32>(display_grey(textureLoad(final_image, px, 0).rgb, vp.exposure, vp.tonemap));
@@ -69,7 +103,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                     break;
                 }
                 h = (h ^ n) * 16777619u;
-                depth += f32(firstLeadingBit(n));
+                depth += f32(node_depth(n));
                 count += 1u;
             }
             var tint = vec3<f32>(0.0);

@@ -203,7 +203,7 @@ pub(super) fn draw_legend(cx: &PaneContext<'_>, painter: &egui::Painter, rect: e
         legend_with(
             painter,
             rect,
-            "node flux / level mean (log)",
+            "node flux per VPL / mean per VPL (log)",
             -2.0,
             2.0,
             Scale::Log10,

@@ -66,9 +66,20 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             continue;
         };
         let values = o.sweep_values(method, base_spp);
-        // The matched point: the base spp, else the sweep's middle value.
+        if values.is_empty() {
+            continue;
+        }
+        // The matched point: the swept spp nearest the base spp, else the sweep's middle value.
         let base = if sweep.name == "spp" {
-            base_spp as f64
+            values
+                .iter()
+                .copied()
+                .min_by(|a, b| {
+                    (a - base_spp as f64)
+                        .abs()
+                        .total_cmp(&(b - base_spp as f64).abs())
+                })
+                .unwrap_or(values[0])
         } else {
             values[values.len() / 2]
         };

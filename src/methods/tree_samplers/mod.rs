@@ -635,7 +635,8 @@ impl Method for TreeSamplers {
             levels: cx.tree.levels(),
             selected: cx.selected_block.map_or(0, |b| b + 1),
             final_scale: scale,
-            _pad: [0; 2],
+            radix: (cx.tree.kind == TreeKind::Lbvh) as u32,
+            leaves: cx.tree.leaves,
         };
         self.pass.record_view(
             cx.device,
@@ -646,6 +647,7 @@ impl Method for TreeSamplers {
             &cx.targets.lighting.final_view,
             &cx.targets.gbuffer.position_view,
             b,
+            cx.tree.links(),
             cx.dst,
         );
     }

@@ -342,7 +342,9 @@ pub struct GpuSlcViewParams {
     pub selected: u32,
     /// Full-resolution pixels per GI pixel (2 with half-resolution GI).
     pub final_scale: u32,
-    pub _pad: [u32; 2],
+    /// 1: the radix tree (cut depths along its links).
+    pub radix: u32,
+    pub leaves: u32,
 }
 
 /// The leaves' maps of a frame with ISM visibility.
@@ -427,6 +429,7 @@ impl SlcPass {
                 storage_entry(3, c, true),
                 storage_entry(4, c, true),
                 storage_texture_entry(5, crate::renderer::passes::display::VIEW_FORMAT),
+                storage_entry(6, c, true),
             ],
         });
         Ok(Self {
@@ -593,6 +596,7 @@ impl SlcPass {
         final_image: &wgpu::TextureView,
         gb_position: &wgpu::TextureView,
         out: &SlcBuffers,
+        tree_links: &wgpu::Buffer,
         dst: &wgpu::TextureView,
     ) {
         queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
@@ -603,6 +607,7 @@ impl SlcPass {
             out.diag.as_entire_binding(),
             out.cuts.as_entire_binding(),
             wgpu::BindingResource::TextureView(dst),
+            tree_links.as_entire_binding(),
         ];
         let bind = bind_group_seq(device, "slc_views::bind_group", &self.views_layout, &entries);
         run_compute(

@@ -71,7 +71,8 @@ pub fn read_parents(ctx: &GpuContext, tree: &TreeBuffers) -> Result<Vec<u32>, Gp
     let n = tree.leaves as usize;
     Ok(all[1..2 * n]
         .iter()
-        .map(|&p| if p == u32::MAX { p } else { p - 1 })
+        // Unwritten (one leaf: the root is that leaf) or the root's: none.
+        .map(|&p| if p == u32::MAX || p == 0 { u32::MAX } else { p - 1 })
         .collect())
 }
 

@@ -54,6 +54,9 @@ pub struct TreeBuffers {
     pub links: wgpu::Buffer,
     /// The radix tree's parent of every node (the root's u32::MAX); a dummy for the perfect tree.
     pub parents: wgpu::Buffer,
+    /// This tree's classify uniform (one per tree: a frame may classify two trees, the
+    /// overlay's comparison, and queue writes land before either dispatch).
+    pub classify_params: wgpu::Buffer,
     pub count: u32,
     pub leaves: u32,
     pub kind: TreeKind,
@@ -100,6 +103,7 @@ impl TreeBuffers {
             ),
             links: buf("lbvh::links", if radix { 16 * leaves as u64 } else { 16 }),
             parents: buf("lbvh::parents", if radix { 4 * nodes } else { 16 }),
+            classify_params: super::uniform_buffer::<GpuClassifyParams>(device, "sst_classify::params"),
             count,
             leaves,
             kind,
@@ -141,7 +145,6 @@ pub struct BuildPass {
     classify: wgpu::ComputePipeline,
     classify_layout: wgpu::BindGroupLayout,
     build_params: wgpu::Buffer,
-    classify_params: wgpu::Buffer,
 }
 
 impl BuildPass {
@@ -179,7 +182,6 @@ impl BuildPass {
                 "classify",
             ),
             build_params: super::uniform_buffer::<GpuTreeParams>(device, "sst_build::params"),
-            classify_params: super::uniform_buffer::<GpuClassifyParams>(device, "sst_classify::params"),
             build_layout,
             classify_layout,
         })
@@ -254,9 +256,9 @@ impl BuildPass {
             sigma_max,
             _pad: 0,
         };
-        queue.write_buffer(&self.classify_params, 0, bytemuck::bytes_of(&p));
+        queue.write_buffer(&tree.classify_params, 0, bytemuck::bytes_of(&p));
         let entries = [
-            self.classify_params.as_entire_binding(),
+            tree.classify_params.as_entire_binding(),
             tree.nodes.as_entire_binding(),
             tree.flags.as_entire_binding(),
         ];

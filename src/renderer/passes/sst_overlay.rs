@@ -55,6 +55,7 @@ impl SstOverlayPass {
                     wgpu::TextureViewDimension::D2,
                 ),
                 storage_entry(5, wgpu::ShaderStages::VERTEX, true),
+                storage_entry(6, wgpu::ShaderStages::VERTEX, true),
             ],
         });
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -187,6 +188,7 @@ impl SstOverlayPass {
                 tree.flags.as_entire_binding(),
                 wgpu::BindingResource::TextureView(gb_position),
                 tree.parents.as_entire_binding(),
+                tree.links.as_entire_binding(),
             ];
             let bind = bind_group_seq(device, "sst_overlay::bind_group", &self.layout, &entries);
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
