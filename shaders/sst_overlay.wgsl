@@ -71,11 +71,8 @@ fn node_color(i: u32, node: SstNode) -> vec3<f32> {
     }
     // Flux per leaf against the root's (on the perfect tree: the node's flux against its
     // level's mean).
-    var span = 1.0;
-    if i < op.leaves {
-        let r = tree_leaf_range(i, op.leaves);
-        span = f32(r.y - r.x + 1u);
-    }
+    let r = tree_node_range(i, op.leaves);
+    let span = f32(r.y - r.x + 1u);
     let mean = luminance(tree[1].intensity) / f32(op.leaves);
     let t = (log2(max(luminance(node.intensity) / span, 1e-30) / max(mean, 1e-30)) * 0.30103 + 2.0) / 4.0;
     return false_color(t);

@@ -5,11 +5,6 @@
 #include "common/material.wgsl"
 #include "common/surface.wgsl"
 
-struct RayIn {
-    origin: vec4<f32>, // xyz origin, w tmin
-    dir: vec4<f32>,    // xyz direction, w tmax
-};
-
 struct ProbeParams {
     lod: u32,
     _pad0: u32,
@@ -19,7 +14,8 @@ struct ProbeParams {
 
 @group(0) @binding(0) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(1) var<storage, read> bvh_triangles: array<BvhTriangle>;
-@group(0) @binding(2) var<storage, read> rays: array<RayIn>;
+// (origin, tmin, dir, tmax): `GpuRay`'s layout, as bvh_rays.wgsl's RayIn.
+@group(0) @binding(2) var<storage, read> rays: array<BvhRay>;
 @group(0) @binding(3) var<storage, read_write> out: array<Surface>;
 @group(0) @binding(4) var<storage, read> scene_vertices: array<u32>;
 @group(0) @binding(5) var<storage, read> scene_indices: array<u32>;
@@ -36,12 +32,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let r = rays[i];
-    let h = bvh_closest_hit(r.origin.xyz, r.dir.xyz, r.origin.w, r.dir.w);
+    let h = bvh_closest_hit_ray(r);
     var s: Surface;
     s.material = 0xffffffffu;
     s.valid = 0u;
     if h.triangle != BVH_NO_HIT {
-        s = surface_at(h.triangle, h.u, h.v, r.dir.xyz, pp.lod);
+        s = surface_at(h.triangle, h.u, h.v, r.dir, pp.lod);
     }
     out[i] = s;
 }

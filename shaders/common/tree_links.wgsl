@@ -28,3 +28,31 @@ fn tree_leaf_range(i: u32, leaves: u32) -> vec2<u32> {
     let first = (i << down) - leaves;
     return vec2<u32>(first, first + (1u << down) - 1u);
 }
+
+// The leaves (indices) any node n covers, leaves included.
+fn tree_node_range(n: u32, leaves: u32) -> vec2<u32> {
+    if n >= leaves {
+        return vec2<u32>(n - leaves);
+    }
+    return tree_leaf_range(n, leaves);
+}
+
+// Depth of node n (root 0): the perfect tree's level, or down the radix tree's links to the
+// child whose leaf range holds n's. Twin: `Topology::depth`.
+fn tree_depth(n: u32, leaves: u32) -> u32 {
+    if !tree_radix() {
+        return firstLeadingBit(n);
+    }
+    let r = tree_node_range(n, leaves);
+    var node = 1u;
+    var d = 0u;
+    loop {
+        if node == n || node >= leaves || d >= 128u {
+            break;
+        }
+        let lr = tree_node_range(tree_left(node), leaves);
+        node = select(tree_right(node), tree_left(node), lr.x <= r.x && r.y <= lr.y);
+        d += 1u;
+    }
+    return d;
+}

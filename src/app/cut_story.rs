@@ -45,10 +45,7 @@ fn tree_view(ui: &mut egui::Ui, story: &CutStory, leaves: u32) {
     let leaves = leaves.max(1);
     // Either tree: a node spans its leaf range at its depth (the radix tree's leaves lie at
     // many depths: as many rows as the deepest drawn node needs).
-    let topo = match story.links.is_empty() {
-        true => Topology { leaves, links: None },
-        false => Topology::radix(&story.links),
-    };
+    let topo = Topology::of(leaves, &story.links);
     let valid = |n: u32| n != 0 && n < 2 * leaves;
     let all = story
         .inputs

@@ -283,10 +283,7 @@ impl WorkbenchApp {
                 renderer.read_tree_links(),
             ) {
                 (Ok(cut), Ok((nodes, flags)), Ok(links)) => {
-                    let topo = match links.is_empty() {
-                        true => crate::base::sst_node::Topology::perfect_of(&nodes),
-                        false => crate::base::sst_node::Topology::radix(&links),
-                    };
+                    let topo = crate::base::sst_node::Topology::of((nodes.len() / 2) as u32, &links);
                     self.cut_inspect = Some(CutInspect {
                         depths: cut.iter().map(|&n| topo.depth(n.max(1))).collect(),
                         block: (bx, by),

@@ -144,7 +144,7 @@ impl StoryPanel {
         } else {
             // The radix tree: as many depths as the visited nodes reach (no per-depth counts
             // without reading the whole tree).
-            let topo = Topology::radix(&self.links);
+            let topo = Topology::of(self.leaves, &self.links);
             let deepest = ids.iter().map(|&n| topo.depth(n)).max().unwrap_or(0);
             self.levels = vec![(0, 0); deepest as usize + 1];
         }
@@ -163,17 +163,6 @@ impl StoryPanel {
             self.gi = get("GI");
         }
         Ok(())
-    }
-
-    /// The frame's tree's shape (the radix tree's links, or the perfect tree's heap).
-    fn topo(&self) -> Topology<'_> {
-        match self.links.is_empty() {
-            true => Topology {
-                leaves: self.leaves.max(1),
-                links: None,
-            },
-            false => Topology::radix(&self.links),
-        }
     }
 
     fn node(&self, n: u32) -> SstNode {
@@ -327,13 +316,7 @@ impl StoryPanel {
         .on_hover_text("with accumulation on, the GI buffer is the mean over frames; the story is one frame");
         let leaves = self.leaves();
         let links = self.links.clone();
-        let topo = match links.is_empty() {
-            true => Topology {
-                leaves: leaves.max(1),
-                links: None,
-            },
-            false => Topology::radix(&links),
-        };
+        let topo = Topology::of(leaves, &links);
         let level = |n: u32| topo.depth(n.max(1));
         egui::ScrollArea::vertical()
             .id_salt("story_samples")
@@ -461,7 +444,7 @@ impl StoryPanel {
         p.rect_filled(rect, 2.0, egui::Color32::from_gray(20));
         // A node sits at its depth, over the middle of its leaf range (on the perfect tree:
         // its position within its level).
-        let topo = self.topo();
+        let topo = Topology::of(self.leaves, &self.links);
         let pos = |n: u32| {
             let n = n.max(1);
             let l = topo.depth(n);

@@ -141,10 +141,7 @@ impl TreePanel {
         self.last_refresh = now;
         let (nodes, flags) = renderer.read_tree().map_err(|e| e.to_string())?;
         let links = renderer.read_tree_links().map_err(|e| e.to_string())?;
-        let topo = match links.is_empty() {
-            true => Topology::perfect_of(&nodes),
-            false => Topology::radix(&links),
-        };
+        let topo = Topology::of((nodes.len() / 2) as u32, &links);
         self.stats = Some(stats_on(&nodes, &flags, topo));
         Ok(())
     }

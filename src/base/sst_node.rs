@@ -78,6 +78,18 @@ impl<'a> Topology<'a> {
         }
     }
 
+    /// The frame's tree of `leaves` leaves: the radix tree when `links` (as
+    /// `Renderer::read_tree_links` returns them) are given, else the perfect tree.
+    pub fn of(leaves: u32, links: &'a [[u32; 4]]) -> Self {
+        match links.is_empty() {
+            true => Topology {
+                leaves: leaves.max(1),
+                links: None,
+            },
+            false => Topology::radix(links),
+        }
+    }
+
     /// The radix tree of `links.len()` leaves (`links[0]` unused).
     pub fn radix(links: &'a [[u32; 4]]) -> Self {
         Topology {

@@ -34,6 +34,12 @@ use crate::{
     scene::{Camera, DirectionalLight},
 };
 
+/// The light tree's build passes, either tree (the perfect tree's `sst_build`, the radix
+/// tree's `lbvh_build` + `lbvh_nodes`), and the usable flags: shared frame work.
+pub const TREE_BUILD_PASSES: [&str; 4] = ["sst_build", "lbvh_build", "lbvh_nodes", "sst_classify"];
+/// The keys and the sort before either build.
+pub const SORT_PASSES: [&str; 2] = ["sst_keys", "sst_sort"];
+
 /// GPU passes grouped as the columns of thesis table 7.1.
 pub const PASS_GROUPS: [(&str, &[&str]); 8] = [
     ("G-buffer", &["gbuffer_depth", "gbuffer"]),
@@ -42,11 +48,8 @@ pub const PASS_GROUPS: [(&str, &[&str]); 8] = [
         "VPL generation",
         &["brsm_importance", "brsm_filter", "pdf_pyramid", "vpl_warp"],
     ),
-    ("sort VPLs", &["sst_keys", "sst_sort"]),
-    (
-        "build SST",
-        &["sst_build", "lbvh_build", "lbvh_nodes", "sst_classify"],
-    ),
+    ("sort VPLs", &SORT_PASSES),
+    ("build SST", &TREE_BUILD_PASSES),
     ("light cuts", &["slc_cuts"]),
     (
         "GI",

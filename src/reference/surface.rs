@@ -14,6 +14,7 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::base::display::srgb8_to_linear;
 use crate::scene::Scene;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,16 +25,6 @@ pub struct Surface {
     pub uv: Vec2,
     pub material: u32,
     pub albedo: Vec3,
-}
-
-/// sRGB 8-bit to linear (the decode of an `Rgba8UnormSrgb` read).
-pub fn srgb8_to_linear(c: u8) -> f32 {
-    let x = c as f32 / 255.0;
-    if x <= 0.04045 {
-        x / 12.92
-    } else {
-        ((x + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 /// Texel (nearest, repeat) of mip level `lod` of a chain whose level 0 is `size` x `size`

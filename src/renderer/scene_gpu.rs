@@ -67,15 +67,6 @@ pub fn build_vertices(scene: &Scene) -> (Vec<GpuVertex>, Vec<u32>) {
     (verts, indices)
 }
 
-fn srgb_to_linear(c: u8) -> f32 {
-    let x = c as f32 / 255.0;
-    if x <= 0.04045 {
-        x / 12.92
-    } else {
-        ((x + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 fn linear_to_srgb8(x: f32) -> u8 {
     let x = x.clamp(0.0, 1.0);
     let s = if x <= 0.0031308 {
@@ -101,7 +92,7 @@ pub fn texture_mips(tex: &TextureImage, size: u32) -> Vec<Vec<u8>> {
     };
     let mut levels = vec![base];
     let mut s = size;
-    let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
+    let lut: Vec<f32> = (0..=255u8).map(crate::base::display::srgb8_to_linear).collect();
     while s > 1 {
         let prev = levels.last().map(|v| v.as_slice()).unwrap_or(&[]);
         let n = s / 2;

@@ -10,13 +10,6 @@
 #include "methods/lightcuts/lc_common.wgsl"
 #include "methods/lightcuts/lc_merge.wgsl"
 
-struct LcBuildParams {
-    first: u32,  // first node id of the level
-    count: u32,  // nodes of the level
-    leaves: u32,
-    seed: u32,
-};
-
 @group(0) @binding(0) var<uniform> bp: LcBuildParams;
 @group(0) @binding(1) var<storage, read> nodes: array<SstNode>;
 @group(0) @binding(2) var<storage, read> sorted_vpls: array<Vpl>;

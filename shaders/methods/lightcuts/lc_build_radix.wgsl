@@ -13,14 +13,6 @@
 #include "methods/lightcuts/lc_common.wgsl"
 #include "methods/lightcuts/lc_merge.wgsl"
 
-// Twin: `GpuLcBuildParams` (first, count unused here).
-struct LcBuildParams {
-    first: u32,
-    count: u32,
-    leaves: u32,
-    seed: u32,
-};
-
 @group(0) @binding(0) var<uniform> bp: LcBuildParams;
 @group(0) @binding(1) var<storage, read> nodes: array<SstNode>;
 @group(0) @binding(2) var<storage, read> sorted_vpls: array<Vpl>;

@@ -3,6 +3,14 @@
 // cones and the representative pick. Contract: the includer includes common/math.wgsl,
 // common/random.wgsl, common/sst_node.wgsl and methods/lightcuts/lc_common.wgsl.
 
+// Both builds' uniform. Twin: `GpuLcBuildParams` (the radix build uses leaves and seed).
+struct LcBuildParams {
+    first: u32,  // the perfect tree's build: first node id of the level
+    count: u32,  // nodes of the level
+    leaves: u32,
+    seed: u32,
+};
+
 fn angle_between(a: vec3<f32>, b: vec3<f32>) -> f32 {
     return acos(clamp(dot(a, b), -1.0, 1.0));
 }

@@ -130,11 +130,7 @@ fn settle(lane: u32, settled: ptr<function, u32>, node: u32, vis: bool) {
 
 // First leaf under a node (the left-to-right order of a cut).
 fn first_leaf(e: u32) -> u32 {
-    let node = e & ~LC_VISIBLE;
-    if node >= lp.leaves {
-        return node - lp.leaves;
-    }
-    return tree_leaf_range(node, lp.leaves).x;
+    return tree_node_range(e & ~LC_VISIBLE, lp.leaves).x;
 }
 
 fn sift_down(base: u32, start: u32, end: u32) {

@@ -37,32 +37,6 @@ fn tree_radix() -> bool {
     return vp.radix != 0u;
 }
 
-// Depth of node n (root 0): the perfect tree's level, or down the radix tree's links to the
-// child whose leaf range holds n's.
-fn node_depth(n: u32) -> u32 {
-    if !tree_radix() {
-        return firstLeadingBit(n);
-    }
-    var r = vec2<u32>(n - vp.leaves);
-    if n < vp.leaves {
-        r = tree_links[n].zw;
-    }
-    var node = 1u;
-    var d = 0u;
-    loop {
-        if node == n || node >= vp.leaves || d >= 128u {
-            break;
-        }
-        let l = tree_left(node);
-        var lr = vec2<u32>(l - vp.leaves);
-        if l < vp.leaves {
-            lr = tree_links[l].zw;
-        }
-        node = select(tree_right(node), l, lr.x <= r.x && r.y <= lr.y);
-        d += 1u;
-    }
-    return d;
-}
 
 fn grey_final(px: vec2<i32>) -> vec3<f32> {
     return vec3<f32>(display_grey(textureLoad(final_image, px, 0).rgb, vp.exposure, vp.tonemap));
@@ -103,7 +77,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                     break;
                 }
                 h = (h ^ n) * 16777619u;
-                depth += f32(node_depth(n));
+                depth += f32(tree_depth(n, vp.leaves));
                 count += 1u;
             }
             var tint = vec3<f32>(0.0);

@@ -22,7 +22,10 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::{Bench, Csv, Frames, Measured, PASS_GROUPS, SAMPLE_PASSES, gi_passes, mean_std, num, plot};
+use super::{
+    Bench, Csv, Frames, Measured, PASS_GROUPS, SAMPLE_PASSES, SORT_PASSES, TREE_BUILD_PASSES, gi_passes,
+    mean_std, num, plot,
+};
 use crate::methods::{
     self as gi_methods, MethodId,
     tree_samplers::{RTSLC, SLC, SST},

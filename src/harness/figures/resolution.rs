@@ -128,10 +128,8 @@ pub fn scaling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             s.vpl.count = n;
         });
         let m = b.measure(&s, o.scaling_size, o.per_config(), true)?;
-        let sort = m.pass_ms(&["sst_keys", "sst_sort"]).0;
-        let build = m
-            .pass_ms(&["sst_build", "lbvh_build", "lbvh_nodes", "sst_classify"])
-            .0;
+        let sort = m.pass_ms(&SORT_PASSES).0;
+        let build = m.pass_ms(&TREE_BUILD_PASSES).0;
         let gi = m.pass_ms(&gi_passes()).0;
         let (r, rs) = m.rmse();
         csv.row(vec![

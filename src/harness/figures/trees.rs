@@ -9,9 +9,6 @@
 use super::*;
 use crate::renderer::settings::TreeKind;
 
-/// The frame's tree build passes of either tree (GPU timestamps).
-const TREE_BUILD: [&str; 4] = ["sst_build", "lbvh_build", "lbvh_nodes", "sst_classify"];
-
 /// One tree's sweep: (total ms, RMSE) points, and at the base spp the steps per traversal,
 /// the build's ms and the total ms.
 struct TreeCurve {
@@ -96,7 +93,7 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 });
                 let m = b.measure(&s, o.size, o.per_config(), true)?;
                 let gi = m.gi_ms().0;
-                let tb = m.pass_ms(&TREE_BUILD).0;
+                let tb = m.pass_ms(&TREE_BUILD_PASSES).0;
                 let (r, rs) = m.rmse();
                 let value = knob(v, sweep.integer);
                 csv.row(vec![

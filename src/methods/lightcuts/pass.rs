@@ -371,7 +371,7 @@ impl CutKernel {
             b.lanes.as_entire_binding(),
             b.record_cuts.as_entire_binding(),
             b.rec_meta.as_entire_binding(),
-            b.tree.links().as_entire_binding(),
+            b.tree.links.as_entire_binding(),
         ];
         let bind = bind_group_seq(device, "lightcuts::bind_group", &self.layout, &entries);
         encoder.push_debug_group(name);
@@ -450,7 +450,9 @@ impl BuildKernel {
         })
     }
 
-    /// Records the build (every level, one compute pass named `name`) into `cones`, `reps`.
+    /// Records the build (one compute pass named `name`) into `cones`, `reps`: the perfect
+    /// tree level by level (leaves first, the root last), the radix tree in one dispatch of a
+    /// thread per leaf with arrival counters.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
@@ -464,103 +466,67 @@ impl BuildKernel {
         cones: &wgpu::Buffer,
         reps: &wgpu::Buffer,
     ) {
-        if tree.kind == crate::renderer::settings::TreeKind::Lbvh {
-            self.record_radix(device, queue, encoder, timer, name, seed, tree, cones, reps);
-            return;
-        }
-        // Levels bottom-up: leaves (level L-1) first, the root last.
-        let per_level: Vec<GpuLcBuildParams> = (0..tree.levels())
-            .rev()
-            .map(|level| GpuLcBuildParams {
-                first: 1 << level,
-                count: 1 << level,
-                leaves: tree.leaves,
-                seed,
-            })
-            .collect();
-        self.params.write(device, queue, &per_level);
-        let entries = [
-            self.params.binding(),
-            tree.nodes.as_entire_binding(),
-            tree.sorted_vpls.as_entire_binding(),
-            cones.as_entire_binding(),
-            reps.as_entire_binding(),
-        ];
-        let bind = bind_group_seq(device, "lightcuts_build::bind_group", &self.layout, &entries);
-        encoder.push_debug_group(name);
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(name),
-                timestamp_writes: timer.compute_pass(name),
-            });
-            pass.set_pipeline(&self.build);
-            for (i, bp) in per_level.iter().enumerate() {
-                pass.set_bind_group(0, &bind, &[StridedUniforms::<GpuLcBuildParams>::offset(i as u32)]);
-                pass.dispatch_workgroups(bp.count.div_ceil(WG_1D), 1, 1);
-            }
-        }
-        encoder.pop_debug_group();
-    }
-
-    /// The radix tree's build: one dispatch, one thread per leaf.
-    #[allow(clippy::too_many_arguments)]
-    fn record_radix(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-        name: &str,
-        seed: u32,
-        tree: &TreeBuffers,
-        cones: &wgpu::Buffer,
-        reps: &wgpu::Buffer,
-    ) {
-        let need = 4 * tree.leaves.max(4) as u64;
-        if self.counters.as_ref().is_none_or(|c| c.size() < need) {
-            self.counters = Some(crate::renderer::passes::storage_buffer(
-                device,
-                "lightcuts_build_radix::counters",
-                need,
-            ));
-        }
-        let Some(counters) = &self.counters else { return };
-        self.params.write(
-            device,
-            queue,
-            &[GpuLcBuildParams {
+        let radix = tree.kind == crate::renderer::settings::TreeKind::Lbvh;
+        // Per dispatch: its uniforms (the radix build reads only leaves and seed).
+        let dispatches: Vec<GpuLcBuildParams> = if radix {
+            vec![GpuLcBuildParams {
                 first: 0,
                 count: tree.leaves,
                 leaves: tree.leaves,
                 seed,
-            }],
-        );
-        encoder.clear_buffer(counters, 0, None);
-        let entries = [
+            }]
+        } else {
+            (0..tree.levels())
+                .rev()
+                .map(|level| GpuLcBuildParams {
+                    first: 1 << level,
+                    count: 1 << level,
+                    leaves: tree.leaves,
+                    seed,
+                })
+                .collect()
+        };
+        self.params.write(device, queue, &dispatches);
+        let mut entries = vec![
             self.params.binding(),
             tree.nodes.as_entire_binding(),
             tree.sorted_vpls.as_entire_binding(),
             cones.as_entire_binding(),
             reps.as_entire_binding(),
-            tree.links.as_entire_binding(),
-            tree.parents.as_entire_binding(),
-            counters.as_entire_binding(),
         ];
-        let bind = bind_group_seq(
-            device,
-            "lightcuts_build_radix::bind_group",
-            &self.radix_layout,
-            &entries,
-        );
+        if radix {
+            let need = 4 * tree.leaves.max(4) as u64;
+            if self.counters.as_ref().is_none_or(|c| c.size() < need) {
+                self.counters = Some(crate::renderer::passes::storage_buffer(
+                    device,
+                    "lightcuts_build_radix::counters",
+                    need,
+                ));
+            }
+            let Some(counters) = &self.counters else { return };
+            encoder.clear_buffer(counters, 0, None);
+            entries.extend([
+                tree.links.as_entire_binding(),
+                tree.parents.as_entire_binding(),
+                counters.as_entire_binding(),
+            ]);
+        }
+        let (pipeline, layout) = match radix {
+            true => (&self.radix, &self.radix_layout),
+            false => (&self.build, &self.layout),
+        };
+        let bind = bind_group_seq(device, "lightcuts_build::bind_group", layout, &entries);
         encoder.push_debug_group(name);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(name),
                 timestamp_writes: timer.compute_pass(name),
             });
-            pass.set_pipeline(&self.radix);
-            pass.set_bind_group(0, &bind, &[StridedUniforms::<GpuLcBuildParams>::offset(0)]);
-            pass.dispatch_workgroups(tree.leaves.div_ceil(WG_1D).max(1), 1, 1);
+            pass.set_pipeline(pipeline);
+            for (i, bp) in dispatches.iter().enumerate() {
+                pass.set_bind_group(0, &bind, &[StridedUniforms::<GpuLcBuildParams>::offset(i as u32)]);
+                pass.dispatch_workgroups(bp.count.div_ceil(WG_1D).max(1), 1, 1);
+            }
         }
         encoder.pop_debug_group();
     }

@@ -647,7 +647,7 @@ impl Method for TreeSamplers {
             &cx.targets.lighting.final_view,
             &cx.targets.gbuffer.position_view,
             b,
-            cx.tree.links(),
+            &cx.tree.links,
             cx.dst,
         );
     }

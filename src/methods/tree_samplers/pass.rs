@@ -510,7 +510,7 @@ impl SlcPass {
                 tv(&gbuffer.position_view),
                 tv(&gbuffer.normal_view),
                 out.cuts.as_entire_binding(),
-                tree.links().as_entire_binding(),
+                tree.links.as_entire_binding(),
             ];
             let bind = bind_group_seq(device, "slc_cuts::bind_group", &self.cuts_layout, &entries);
             run_compute(
@@ -540,7 +540,7 @@ impl SlcPass {
             self.ism_params.as_entire_binding(),
             ism_depth.as_entire_binding(),
             ism_lights.as_entire_binding(),
-            tree.links().as_entire_binding(),
+            tree.links.as_entire_binding(),
         ];
         let bind = bind_group_seq(device, "slc_sample::bind_group", &self.sample_layout, &entries);
         if let Some(m) = ism {

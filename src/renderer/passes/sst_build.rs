@@ -127,11 +127,6 @@ impl TreeBuffers {
         }
     }
 
-    /// The radix tree's links (a dummy for the perfect tree): bound by every sampler.
-    pub fn links(&self) -> &wgpu::Buffer {
-        &self.links
-    }
-
     /// Whether it is the tree of `count` VPLs of `kind`.
     pub fn matches(&self, count: u32, kind: TreeKind) -> bool {
         self.count == count && self.kind == kind
