@@ -11,6 +11,7 @@
 
 #include "common/vpl.wgsl"
 #include "common/rsm_pyramid.wgsl"
+#include "common/rsm_warp.wgsl"
 
 
 struct LevelParams {
@@ -178,53 +179,6 @@ fn reduce(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ob = bounds_index(layer, l, gid.x, gid.y);
     bounds_pyramid[2u * ob] = lo;
     bounds_pyramid[2u * ob + 1u] = hi;
-}
-
-// Selection weight of a pyramid node: (1 - m) importance share + m flux share.
-fn node_weight(layer: u32, level: u32, x: u32, y: u32, wi: f32, wf: f32) -> f32 {
-    let k = pyr_index(layer, level, x, y);
-    return wi * importance_pyramid[k] + wf * flux_pyramid[k];
-}
-
-// Hierarchical warping of point `uv` through the pyramids of `layer`, top level down, each
-// level first vertically then horizontally. Returns (texel x, texel y, pmf bits).
-fn warp(layer: u32, uv_in: vec2<f32>, wi: f32, wf: f32) -> vec3<u32> {
-    var uv = uv_in;
-    var x = 0u;
-    var y = 0u;
-    let one_minus = 0.99999994;
-    for (var l = params.levels - 1u; l > 0u; l--) {
-        let cl = l - 1u;
-        let a = node_weight(layer, cl, 2u * x, 2u * y, wi, wf);
-        let b = node_weight(layer, cl, 2u * x + 1u, 2u * y, wi, wf);
-        let c = node_weight(layer, cl, 2u * x, 2u * y + 1u, wi, wf);
-        let d = node_weight(layer, cl, 2u * x + 1u, 2u * y + 1u, wi, wf);
-        let top = a + b;
-        let bottom = c + d;
-        let pt = top / (top + bottom);
-        var row = 0u;
-        if uv.y < pt {
-            uv.y = min(uv.y / pt, one_minus);
-        } else {
-            uv.y = min((uv.y - pt) / (1.0 - pt), one_minus);
-            row = 1u;
-        }
-        let left = select(a, c, row == 1u);
-        let right = select(b, d, row == 1u);
-        let pl = left / (left + right);
-        var col = 0u;
-        if uv.x < pl {
-            uv.x = min(uv.x / pl, one_minus);
-        } else {
-            uv.x = min((uv.x - pl) / (1.0 - pl), one_minus);
-            col = 1u;
-        }
-        x = 2u * x + col;
-        y = 2u * y + row;
-    }
-    let total = node_weight(layer, params.levels - 1u, 0u, 0u, wi, wf);
-    let pmf = node_weight(layer, 0u, x, y, wi, wf) / total;
-    return vec3<u32>(x, y, bitcast<u32>(pmf));
 }
 
 // One thread per VPL: pick a texel of its light's RSM and make the VPL.

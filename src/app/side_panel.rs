@@ -385,6 +385,34 @@ impl WorkbenchApp {
                 ui.add(egui::DragValue::new(&mut v.seed).prefix("seed "));
                 ui.checkbox(&mut v.animate, "new VPLs every frame");
             });
+            // Multi-bounce VPLs (instant radiosity): light paths from the RSM through the BVH.
+            let max_bounces = crate::renderer::passes::light_paths::MAX_BOUNCES;
+            ui.add(egui::Slider::new(&mut v.bounces, 1..=max_bounces).text("bounces"))
+                .on_hover_text(
+                    "1: the RSM's VPLs (one bounce, the thesis). N: light paths traced through the \
+                     BVH add VPLs at bounces 2..N, each bounce a 1/N share of the VPL budget",
+                );
+            if v.bounces > 1 {
+                let (first, paths) =
+                    crate::renderer::passes::light_paths::split_bounces(v.count, v.bounces);
+                ui.label(
+                    egui::RichText::new(format!(
+                        "bounce 1: {first} RSM VPLs · bounces 2..{}: {paths} light paths",
+                        v.bounces
+                    ))
+                    .small(),
+                );
+                ui.checkbox(&mut v.roulette, "Russian roulette")
+                    .on_hover_text("continue with probability max(albedo), flux / that (the SST paper)");
+                ui.add(egui::Slider::new(&mut v.path_flux_mix, 0.01..=1.0).text("path start flux mix"))
+                    .on_hover_text(
+                        "1: paths start at RSM texels drawn by flux (the SST paper); lower mixes in \
+                         bounce 1's BRSM importance, so fewer paths start where their light leaves unseen",
+                    );
+                if let Some(msg) = self.settings.gi.method.refuses_bounces(self.settings.vpl.bounces) {
+                    ui.colored_label(ui.visuals().warn_fg_color, msg);
+                }
+            }
             ui.separator();
             // Rows of the level slider: the perfect tree's levels; the radix tree is deeper
             // (its depth per leaf varies: the statistics window shows it), up to 48 here.

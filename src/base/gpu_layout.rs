@@ -11,13 +11,33 @@ pub struct GpuVpl {
     /// xyz = position, w = pmf of its texel.
     pub position: [f32; 4],
     pub normal: [f32; 3],
-    /// light layer << 24 | texel index, or `VPL_NONE`.
+    /// light layer << 24 | texel index, a light-path id ([`vpl_path_id`]), or `VPL_NONE`.
     pub id: u32,
     /// rgb = flux (W), w = 1 when valid.
     pub flux: [f32; 4],
 }
 
 pub const VPL_NONE: u32 = u32::MAX;
+/// The bit that marks a light-path VPL's id (bounce >= 2): `PATH_BIT | bounce << 24 | path`.
+/// Twin: `VPL_PATH_BIT` in `shaders/common/vpl.wgsl`.
+pub const VPL_PATH_BIT: u32 = 0x8000_0000;
+
+/// The id of light path `path`'s VPL at `bounce` (>= 2).
+pub fn vpl_path_id(bounce: u32, path: u32) -> u32 {
+    VPL_PATH_BIT | (bounce << 24) | path
+}
+
+/// The diffuse bounce a VPL's light has made: 1 for an RSM VPL (`layer << 24 | texel`), 2..
+/// for a light-path VPL, 0 for `VPL_NONE`.
+pub fn vpl_bounce(id: u32) -> u32 {
+    if id == VPL_NONE {
+        0
+    } else if id & VPL_PATH_BIT != 0 {
+        (id >> 24) & 0x7f
+    } else {
+        1
+    }
+}
 
 /// A node of the Stochastic Substitute Tree, 64 bytes (one cache line; the SST paper's node
 /// is 96 B, RTSLC's 32 B). Twin: `SstNode` in `shaders/common/sst_node.wgsl`; decoded by

@@ -153,6 +153,15 @@ pub struct SamplingArgs {
     /// light-culling tree need the perfect tree and refuse `lbvh`.
     #[arg(long, value_enum)]
     pub tree: Option<TreeArg>,
+    /// Diffuse bounces of indirect light: 1 = the RSM's VPLs (the thesis), N (2..=8) adds
+    /// VPLs at bounces 2..=N from light paths traced through the BVH, each bounce a
+    /// 1/N share of the VPL budget (`vpl.bounces`). The VAL methods refuse N > 1.
+    #[arg(long)]
+    pub bounces: Option<u32>,
+    /// Light paths without Russian roulette: every path runs to the last bounce, its flux
+    /// x albedo per bounce (`vpl.roulette = false`).
+    #[arg(long)]
+    pub no_roulette: bool,
     /// Least normal similarity of a usable SST node.
     #[arg(long)]
     pub v_min: Option<f32>,
@@ -284,6 +293,12 @@ impl SamplingArgs {
                 TemporalArg::Reproject => TemporalMode::Reproject,
                 TemporalArg::Svgf => TemporalMode::Svgf,
             };
+        }
+        if let Some(b) = self.bounces {
+            s.vpl.bounces = b;
+        }
+        if self.no_roulette {
+            s.vpl.roulette = false;
         }
         if let Some(t) = self.tree {
             use crate::renderer::settings::TreeKind;
@@ -524,6 +539,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     args.sampling.check_visibility(&[method])?;
     // `tree.kind = lbvh` from a settings file or --set: the same refusal as --tree's.
     if let Some(msg) = method.refuses_tree(settings.tree.kind) {
+        return Err(anyhow!("{msg}"));
+    }
+    if let Some(msg) = method.refuses_bounces(settings.vpl.bounces) {
         return Err(anyhow!("{msg}"));
     }
     if args.sampling.frames == 0 {

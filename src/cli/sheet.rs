@@ -73,6 +73,12 @@ pub fn run(args: &SheetArgs) -> anyhow::Result<()> {
         })
         .collect::<anyhow::Result<_>>()?;
     args.sampling.check_visibility(&methods)?;
+    if let Some(msg) = methods.iter().find_map(|m| {
+        m.refuses_tree(settings.tree.kind)
+            .or(m.refuses_bounces(settings.vpl.bounces))
+    }) {
+        return Err(anyhow!("{msg}"));
+    }
     let cam_name = args.camera.clone().or(opened.camera_name.clone());
     let camera = opened
         .scene

@@ -128,6 +128,16 @@ impl MethodId {
             )
         })
     }
+    /// The refusal of `vpl.bounces > 1` for a method that renders the RSM's first bounce only
+    /// (the CLI's message); None where the method shades the frame's VPLs of every bounce.
+    pub fn refuses_bounces(self, bounces: u32) -> Option<String> {
+        (bounces > 1 && self.info().one_bounce).then(|| {
+            format!(
+                "vpl.bounces {bounces}: {} lights the scene from the RSM's texels (one bounce); use vpl.bounces = 1",
+                self.info().label
+            )
+        })
+    }
     /// The method named `name` on the command line or in a settings file (case-insensitive;
     /// `-` and `_` ignored, so `ground-truth`, `GroundTruth` and `ground_truth` are one).
     pub fn parse(name: &str) -> Result<MethodId, String> {
@@ -440,6 +450,10 @@ pub struct MethodInfo {
     pub shadow_ray_switch: bool,
     /// True for the ground truth of the frame's own VPLs (the comparison's truth).
     pub truth_of_vpls: bool,
+    /// True when it lights the scene from the RSM itself (one bounce: Virtual Area Lights
+    /// cluster RSM texels), so it cannot follow `vpl.bounces > 1`: the CLI refuses, the GUI
+    /// says so.
+    pub one_bounce: bool,
     /// Checks its settings; the message names the field.
     pub validate: fn(&RenderSettings) -> Result<(), String>,
     /// Sets one of its settings out of range and returns that field's name (the registry test
@@ -473,6 +487,8 @@ pub struct FrameCx<'a> {
     pub camera: &'a wgpu::Buffer,
     pub vpl_buffers: &'a VplBuffers,
     pub vpl_frame: &'a VplFrame,
+    /// The frame's lights (one RSM layer each).
+    pub lights: &'a [crate::scene::DirectionalLight],
     /// The VPL generation's parameter buffer (the reference reads the RSM pyramids with it).
     pub vpl_params: &'a wgpu::Buffer,
     pub tree: &'a TreeBuffers,

@@ -20,6 +20,7 @@ pub mod interleave;
 pub mod ism;
 pub mod lbvh;
 pub mod light_culling;
+pub mod light_paths;
 pub mod lightcut_interpolation;
 pub mod lightcuts;
 pub mod slc;

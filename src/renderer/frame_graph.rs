@@ -24,6 +24,7 @@ macro_rules! frame_cx {
             camera: &$r.camera_buf,
             vpl_buffers: &$r.vpl_buffers,
             vpl_frame: &$r.vpl_frame,
+            lights: &$r.frame_lights,
             vpl_params: $r.vpl_gen.params_buffer(),
             tree: &$r.tree,
             gi_accum: $accum,
@@ -66,6 +67,7 @@ impl Renderer {
         let s = self.settings.clone();
 
         let lights = &input.lights[..input.lights.len().min(MAX_LIGHTS)];
+        self.frame_lights.clone_from(&lights.to_vec());
         let layers = lights.len().max(1) as u32;
         if layers != self.targets.shadow.layers() {
             self.targets.shadow = ShadowTargets::new(&device, s.shadow.resolution, layers);
@@ -202,6 +204,34 @@ impl Renderer {
                 &t.gbuffer,
                 &self.vpl_buffers,
             );
+            // Bounces 2..=N (`vpl.bounces`): light paths from RSM texels drawn by flux.
+            let vf = &self.vpl_frame;
+            if vf.paths > 0 {
+                let job = passes::light_paths::PathJob {
+                    paths: vf.paths,
+                    first: vf.first_bounce,
+                    bounces: vf.bounces,
+                    roulette: s.vpl.roulette,
+                    seed,
+                    ray_offset: s.gi.ray_offset,
+                    lod: 0,
+                    flux_scale: 1.0,
+                    flux_mix: s.vpl.path_flux_mix,
+                };
+                self.light_paths.record(
+                    &device,
+                    &queue,
+                    &mut enc,
+                    &mut self.timer,
+                    &job,
+                    lights,
+                    self.vpl_gen.params_buffer(),
+                    &self.targets.shadow,
+                    &self.vpl_buffers,
+                    &self.scene,
+                    &self.vpl_buffers.vpls,
+                );
+            }
             // SST stages 8-9: sort keys and the bitonic sort of (key, index) pairs.
             if self.sort_buffers.count != self.vpl_frame.count {
                 self.sort_buffers = SortBuffers::new(&device, self.vpl_frame.count);

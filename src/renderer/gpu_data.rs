@@ -464,6 +464,29 @@ mod tests {
                 ],
             ),
             (
+                "light_paths.wgsl",
+                "PathParams",
+                size_of::<crate::renderer::passes::light_paths::GpuPathParams>(),
+                {
+                    use crate::renderer::passes::light_paths::GpuPathParams as P;
+                    vec![
+                        offset_of!(P, paths),
+                        offset_of!(P, first),
+                        offset_of!(P, bounces),
+                        offset_of!(P, roulette),
+                        offset_of!(P, seed),
+                        offset_of!(P, ray_offset),
+                        offset_of!(P, lod),
+                        offset_of!(P, flux_scale),
+                        offset_of!(P, light_count),
+                        offset_of!(P, flux_mix),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                        offset_of!(P, ranges),
+                    ]
+                },
+            ),
+            (
                 "vpl_gen.wgsl",
                 "Vpl",
                 size_of::<GpuVpl>(),

@@ -283,6 +283,11 @@ impl Renderer {
         &self.vpl_frame
     }
 
+    /// The light-path pass (`vpl.bounces > 1`): its last starts.
+    pub fn light_paths(&self) -> &passes::light_paths::LightPathPass {
+        &self.light_paths
+    }
+
     pub fn vpl_buffers(&self) -> &VplBuffers {
         &self.vpl_buffers
     }

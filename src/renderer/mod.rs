@@ -143,6 +143,8 @@ pub struct Renderer {
     display: DisplayPass,
     visualise: VisualisePass,
     vpl_gen: VplGenPass,
+    /// Bounces 2..=N of `vpl.bounces` (light paths through the BVH).
+    light_paths: passes::light_paths::LightPathPass,
     composite: CompositePass,
     vpl_splat: VplSplatPass,
     sst_sort: SortPass,
@@ -169,6 +171,8 @@ pub struct Renderer {
     temporal: passes::temporal::TemporalPass,
     vpl_buffers: VplBuffers,
     vpl_frame: VplFrame,
+    /// The frame's lights (at most MAX_LIGHTS), for the methods.
+    frame_lights: Vec<crate::scene::DirectionalLight>,
     /// Luminance of light 0's irradiance and its shadow texel size, last frame (RSM flux view).
     light0_lum: f32,
     lights_texel: f32,
@@ -271,6 +275,7 @@ impl Renderer {
             display: DisplayPass::new(device)?,
             visualise: VisualisePass::new(device)?,
             vpl_gen: VplGenPass::new(device)?,
+            light_paths: passes::light_paths::LightPathPass::new(device)?,
             composite: CompositePass::new(device)?,
             vpl_splat: VplSplatPass::new(device)?,
             sst_sort: SortPass::new(device)?,
@@ -289,6 +294,7 @@ impl Renderer {
             temporal: passes::temporal::TemporalPass::new(device)?,
             vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
             vpl_frame: VplFrame::default(),
+            frame_lights: Vec::new(),
             light0_lum: 0.0,
             lights_texel: 0.0,
             rsm_raster: None,
@@ -342,13 +348,14 @@ impl Renderer {
             ),
             create_methods(device),
             passes::temporal::TemporalPass::new(device),
+            passes::light_paths::LightPathPass::new(device),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Pipeline(format!("shader reload failed: {e}")));
         }
-        let (g, s, d, disp, v, (vg, c, sp, so, b, ov, cv, cc), m, tp) = passes;
+        let (g, s, d, disp, v, (vg, c, sp, so, b, ov, cv, cc), m, tp, lp) = passes;
         let new = (
-            g?, s?, d?, disp?, v?, vg?, c?, sp?, so?, b?, ov?, cv?, cc?, m?, tp?,
+            g?, s?, d?, disp?, v?, vg?, c?, sp?, so?, b?, ov?, cv?, cc?, m?, tp?, lp?,
         );
         (
             self.gbuffer,
@@ -366,6 +373,7 @@ impl Renderer {
             self.compare_composite,
             self.methods,
             self.temporal,
+            self.light_paths,
         ) = new;
         // The comparison's truth restarts with new pipelines.
         self.compare = None;

@@ -171,6 +171,22 @@ pub struct VplSettings {
     pub seed: u32,
     /// New VPLs every frame (a fresh random rotation of the Hammersley set).
     pub animate: bool,
+    /// Diffuse bounces the indirect light makes (instant radiosity; the SST paper's VPL
+    /// generation, section 5). 1 = the RSM's VPLs only (the thesis; default). N > 1 adds
+    /// VPLs at bounces 2..=N from light paths traced through the BVH: every bounce gets
+    /// `count / N` of the budget (one slot per path), bounce 1 the rest. More bounces: light
+    /// in places the sun's first bounce cannot reach, fewer VPLs per bounce.
+    pub bounces: u32,
+    /// Russian roulette on the light paths (the SST paper, Keller): after each hit a path
+    /// continues with probability max(albedo) and its flux is divided by it, so a VPL's flux
+    /// stays near its path's start and dark surfaces end paths early. Off: every path runs
+    /// to `bounces` with its flux x albedo per bounce (no empty slots, smaller VPLs).
+    pub roulette: bool,
+    /// Share of the light paths' start PDF that follows the RSM texels' flux. 1 (default):
+    /// flux only, the SST paper's "sampling of the light sources according to their flux";
+    /// below 1 the rest follows bounce 1's BRSM importance, so fewer paths start where
+    /// their light leaves the scene unseen (a sunlit roof). Above 0 keeps it unbiased.
+    pub path_flux_mix: f32,
 }
 
 impl Default for VplSettings {
@@ -186,6 +202,9 @@ impl Default for VplSettings {
             flux_mix: 0.1,
             seed: 1,
             animate: false,
+            bounces: 1,
+            roulette: true,
+            path_flux_mix: 1.0,
         }
     }
 }
@@ -211,6 +230,10 @@ pub struct GiSettings {
     /// Must be above 0 (every texel that can contribute stays selectable, so the reference
     /// is unbiased); higher is more robust to a poor importance estimate, noisier otherwise.
     pub reference_flux_mix: f32,
+    /// Light paths the reference traces per sample per pixel when `vpl.bounces` > 1 (fresh
+    /// paths every frame; their bounce 2..=N VPLs are shaded at every pixel with shadow
+    /// rays, so the cost per pixel grows with it). More: less noise in the higher bounces.
+    pub reference_paths_per_sample: u32,
     /// Lower bound of the VPL-to-surface distance (metres) in the 1/d^2 term:
     /// 1 / max(d^2, epsilon^2) (the SST paper bounds d from below the same way). It removes
     /// the singularity next to VPLs at the price of darkening corners, where d < epsilon.
@@ -233,6 +256,7 @@ impl Default for GiSettings {
             reference_samples: 4096,
             reference_spp_per_frame: 1,
             reference_flux_mix: 0.25,
+            reference_paths_per_sample: 4,
             distance_epsilon: 0.05,
             ray_offset: 1e-3,
             shadow_rays: true,
@@ -745,6 +769,25 @@ impl RenderSettings {
         }
         if !(0.0..=1.0).contains(&v.flux_mix) {
             return Err(format!("vpl.flux_mix {} is out of range (0..=1)", v.flux_mix));
+        }
+        let max_bounces = crate::renderer::passes::light_paths::MAX_BOUNCES;
+        if !(1..=max_bounces).contains(&v.bounces) {
+            return Err(format!(
+                "vpl.bounces {} is out of range (1..={max_bounces})",
+                v.bounces
+            ));
+        }
+        if !(v.path_flux_mix > 0.0 && v.path_flux_mix <= 1.0) {
+            return Err(format!(
+                "vpl.path_flux_mix {} is out of range (0..=1, > 0: the paths stay unbiased)",
+                v.path_flux_mix
+            ));
+        }
+        if v.count < v.bounces {
+            return Err(format!(
+                "vpl.bounces {} needs at least as many VPLs (vpl.count {})",
+                v.bounces, v.count
+            ));
         }
         let g = &self.gi;
         if !(g.distance_epsilon > 0.0 && g.distance_epsilon <= 100.0) {

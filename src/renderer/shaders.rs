@@ -119,6 +119,11 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         "common/sst_merge.wgsl",
         include_str!("../../shaders/common/sst_merge.wgsl"),
     ),
+    (
+        "common/rsm_warp.wgsl",
+        include_str!("../../shaders/common/rsm_warp.wgsl"),
+    ),
+    ("light_paths.wgsl", include_str!("../../shaders/light_paths.wgsl")),
 ];
 
 /// The shared shaders that are entry points (not include-only files); [`entry_shaders`] adds
@@ -132,6 +137,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "visualise.wgsl",
     "bvh_rays.wgsl",
     "vpl_gen.wgsl",
+    "light_paths.wgsl",
     "composite.wgsl",
     "vpl_splat.wgsl",
     "sst_sort.wgsl",

@@ -28,6 +28,7 @@ pub static INFO: MethodInfo = MethodInfo {
     story: false,
     shadow_ray_switch: false,
     truth_of_vpls: false,
+    one_bounce: false,
     validate: |_: &RenderSettings| Ok(()),
     invalid_example: None,
     ui: |_, _, _| {},

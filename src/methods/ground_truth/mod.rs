@@ -39,6 +39,7 @@ pub static INFO: MethodInfo = MethodInfo {
     story: false,
     shadow_ray_switch: true,
     truth_of_vpls: true,
+    one_bounce: false,
     validate,
     invalid_example: Some(|s| {
         s.gi.rays_per_frame = 0;

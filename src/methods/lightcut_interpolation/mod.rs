@@ -143,6 +143,7 @@ pub static INFO: MethodInfo = MethodInfo {
     story: false,
     shadow_ray_switch: true,
     truth_of_vpls: false,
+    one_bounce: false,
     validate,
     invalid_example: Some(invalid_example),
     ui: ui::settings_ui,

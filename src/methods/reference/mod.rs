@@ -1,12 +1,23 @@
-//! Converged one-bounce reference (stage 19): every RSM texel as a VPL, estimated per pixel by
-//! Monte Carlo through the RSM pyramids and accumulated over frames until
-//! `gi.reference_samples` per pixel (checked against Mitsuba 3, docs/mitsuba_check.md).
+//! Converged reference (stage 19): every RSM texel as a VPL, estimated per pixel by Monte
+//! Carlo through the RSM pyramids and accumulated over frames until `gi.reference_samples`
+//! per pixel (checked against Mitsuba 3, docs/mitsuba_check.md). With `vpl.bounces` N > 1
+//! each frame also traces `gi.reference_paths_per_sample` fresh light paths per sample
+//! (`passes::light_paths`, new seeds every frame) and shades their bounce 2..=N VPLs at every
+//! pixel with shadow rays (the ground truth's kernel): the mean over frames converges to the
+//! N-bounce light, not to one frame's VPLs.
 
 pub mod pass;
 mod ui;
 
 use super::{FrameCx, Kind, Method, MethodId, MethodInfo, Module, Resource};
-use crate::renderer::{GiProgress, settings::RenderSettings, shaders::ShaderError};
+use crate::methods::ground_truth::pass::{GroundTruthPass, MAX_BATCHES};
+use crate::renderer::{
+    GiProgress,
+    gpu_data::{GpuGtParams, GpuVpl},
+    passes::light_paths::{LightPathPass, PathJob},
+    settings::RenderSettings,
+    shaders::ShaderError,
+};
 use pass::{GpuRefParams, ReferencePass};
 
 pub const ID: MethodId = MethodId::new("reference");
@@ -32,10 +43,11 @@ pub static INFO: MethodInfo = MethodInfo {
     module: &MODULE,
     reads: &[Resource::Gbuffer, Resource::ShadowMaps, Resource::Bvh],
     views: &[],
-    timed_passes: &["reference"],
+    timed_passes: &["reference", "light_path_starts", "light_paths", "ground_truth"],
     story: false,
     shadow_ray_switch: false,
     truth_of_vpls: false,
+    one_bounce: false,
     validate,
     invalid_example: Some(|s| {
         s.gi.reference_flux_mix = 0.0;
@@ -60,6 +72,12 @@ fn validate(s: &RenderSettings) -> Result<(), String> {
     if g.reference_samples == 0 {
         return Err("gi.reference_samples must be at least 1".into());
     }
+    if !(1..=256).contains(&g.reference_paths_per_sample) {
+        return Err(format!(
+            "gi.reference_paths_per_sample {} is out of range (1..=256)",
+            g.reference_paths_per_sample
+        ));
+    }
     if !(1..=4096).contains(&g.reference_spp_per_frame) {
         return Err(format!(
             "gi.reference_spp_per_frame {} is out of range (1..=4096)",
@@ -71,6 +89,12 @@ fn validate(s: &RenderSettings) -> Result<(), String> {
 
 pub struct Reference {
     pass: ReferencePass,
+    /// Bounces 2..=N: fresh light paths each frame ...
+    paths: LightPathPass,
+    /// ... their VPLs ...
+    path_vpls: Option<(u32, wgpu::Buffer)>,
+    /// ... shaded at every pixel with shadow rays.
+    shade: GroundTruthPass,
     /// (key, samples per pixel so far / target).
     state: Option<(u64, GiProgress)>,
 }
@@ -78,6 +102,9 @@ pub struct Reference {
 fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
     Ok(Box::new(Reference {
         pass: ReferencePass::new(device)?,
+        paths: LightPathPass::new(device)?,
+        path_vpls: None,
+        shade: GroundTruthPass::new(device)?,
         state: None,
     }))
 }
@@ -124,6 +151,74 @@ impl Method for Reference {
                 cx.scene,
                 cx.gi_accum,
             );
+            let bounces = cx.settings.vpl.bounces;
+            if bounces > 1 {
+                // This frame's n samples of bounce 1 come with n x paths_per_sample light
+                // paths, their flux x n: the sum over frames divided by the samples so far
+                // is the mean of the frames' path estimates.
+                let paths = n * g.reference_paths_per_sample;
+                let count = (bounces - 1) * paths;
+                if self.path_vpls.as_ref().is_none_or(|(c, _)| *c < count) {
+                    self.path_vpls = Some((
+                        count,
+                        cx.device.create_buffer(&wgpu::BufferDescriptor {
+                            label: Some("reference::path_vpls"),
+                            size: count as u64 * std::mem::size_of::<GpuVpl>() as u64,
+                            usage: wgpu::BufferUsages::STORAGE,
+                            mapped_at_creation: false,
+                        }),
+                    ));
+                }
+                if let Some((_, vpls)) = &self.path_vpls {
+                    let job = PathJob {
+                        paths,
+                        first: 0,
+                        bounces,
+                        roulette: cx.settings.vpl.roulette,
+                        seed: cx.settings.vpl.seed.wrapping_mul(0x9e37_79b9)
+                            ^ progress.done.wrapping_mul(0x85eb_ca6b).wrapping_add(0x27d4_eb2f),
+                        ray_offset: g.ray_offset,
+                        lod: 0,
+                        flux_scale: n as f32,
+                        flux_mix: g.reference_flux_mix,
+                    };
+                    self.paths.record(
+                        cx.device,
+                        cx.queue,
+                        enc,
+                        cx.timer,
+                        &job,
+                        cx.lights,
+                        cx.vpl_params,
+                        &cx.targets.shadow,
+                        cx.vpl_buffers,
+                        cx.scene,
+                        vpls,
+                    );
+                    let base = GpuGtParams {
+                        begin: 0,
+                        end: count,
+                        width: cx.size.0,
+                        height: cx.size.1,
+                        epsilon: g.distance_epsilon,
+                        ray_offset: g.ray_offset,
+                        shadow_rays: 1,
+                        _pad: 0,
+                    };
+                    self.shade.record(
+                        cx.device,
+                        cx.queue,
+                        enc,
+                        cx.timer,
+                        base,
+                        count.div_ceil(MAX_BATCHES).max(1),
+                        cx.scene,
+                        vpls,
+                        &cx.targets.gbuffer,
+                        cx.gi_accum,
+                    );
+                }
+            }
             progress.done += n;
         }
         if progress.done == 0 {

@@ -184,6 +184,7 @@ const fn info(
         story: false,
         shadow_ray_switch: true,
         truth_of_vpls: false,
+        one_bounce: true,
         validate,
         invalid_example: Some(invalid_example),
         ui: ui::settings_ui,

@@ -10,6 +10,7 @@ pub mod gbuffer;
 pub mod interleave_filter;
 pub mod ism;
 pub mod lbvh;
+pub mod light_paths;
 pub mod rsm;
 pub mod sst_build;
 pub mod sst_overlay;

@@ -137,9 +137,15 @@ impl VplBuffers {
 /// What one VPL frame produced.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct VplFrame {
-    /// (first, count) per light.
+    /// (first, count) of the bounce-1 VPLs per light.
     pub ranges: Vec<(u32, u32)>,
+    /// Every VPL slot: the bounce-1 VPLs, then (bounces - 1) x paths light-path slots.
     pub count: u32,
+    /// Bounce-1 (RSM) VPLs: slots `[0, first_bounce)`.
+    pub first_bounce: u32,
+    /// Light paths (bounce b's VPLs at `first_bounce + (b - 2) x paths ..`); 0 for one bounce.
+    pub paths: u32,
+    pub bounces: u32,
     pub seed: u32,
 }
 
@@ -235,14 +241,15 @@ impl VplGenPass {
     ) -> VplFrame {
         let lights = &lights[..lights.len().min(MAX_LIGHTS)];
         let count = settings.count.min(out.capacity);
-        let ranges = split_budget(lights, count);
+        let (first_bounce, paths) = super::light_paths::split_bounces(count, settings.bounces.max(1));
+        let ranges = split_budget(lights, first_bounce);
         let res = out.res;
         let (per_layer, offsets) = pyramid_layout(res);
         let mut p = GpuVplParams {
             res,
             levels: offsets.len() as u32,
             light_count: lights.len() as u32,
-            vpl_count: if lights.is_empty() { 0 } else { count },
+            vpl_count: if lights.is_empty() { 0 } else { first_bounce },
             samples: settings.samples_per_texel,
             filter_radius: settings.filter_radius,
             mode: match settings.mode {
@@ -379,7 +386,10 @@ impl VplGenPass {
         encoder.pop_debug_group();
         VplFrame {
             ranges,
-            count: p.vpl_count,
+            count: if lights.is_empty() { 0 } else { count },
+            first_bounce: p.vpl_count,
+            paths: if lights.is_empty() { 0 } else { paths },
+            bounces: settings.bounces.max(1),
             seed,
         }
     }
