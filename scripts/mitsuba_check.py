@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Independent check of lightcut-workbench's direct (and one-bounce indirect) light with Mitsuba 3.
+"""Independent check of lightcut-workbench's direct (and N-bounce indirect) light with Mitsuba 3.
 
 Inputs:
   --scene-dir  output of `lightcut-workbench export-scene` (scene.json, mesh_*.ply, textures/)
@@ -9,7 +9,8 @@ Mitsuba renders the same scene (two-sided diffuse BSDFs with the exported albedo
 textures, a `directional` emitter with the exported travel direction and irradiance, a
 `look_at` pinhole sensor, box pixel filter, `path` integrator):
   direct   = path(max_depth=2)
-  indirect = path(max_depth=3) - path(max_depth=2), same seed  (only with --indirect)
+  indirect = path(max_depth=N+2) - path(max_depth=2), same seed  (only with --indirect;
+             N = --bounces, default 1; ours rendered with `render --bounces N`)
 The image is rendered in --splits independent parts (different seeds, spp/splits each) whose
 spread gives the standard error of Mitsuba's image mean and region means.
 
@@ -42,7 +43,9 @@ def parse_args(argv=None):
     p.add_argument("--spp", type=int, default=256, help="samples per pixel for the direct render (total over splits)")
     p.add_argument("--indirect-spp", type=int, default=None,
                    help="samples per pixel for the two indirect renders (default: --spp)")
-    p.add_argument("--indirect", action="store_true", help="also compare one-bounce indirect (needs ours/indirect.exr)")
+    p.add_argument("--indirect", action="store_true", help="also compare the indirect light (needs ours/indirect.exr)")
+    p.add_argument("--bounces", type=int, default=1,
+                   help="diffuse bounces of the indirect part: path max_depth = bounces + 2 (ours: render --bounces)")
     p.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (scalar_rgb, llvm_ad_rgb, ...)")
     p.add_argument("--sampler", default="ldsampler", choices=["ldsampler", "independent", "stratified", "multijitter"])
     p.add_argument("--splits", type=int, default=4,
@@ -425,6 +428,8 @@ def main(argv=None) -> int:
     ours_ind_path = a.ours / "indirect.exr"
     if not ours_direct_path.exists():
         raise SystemExit(f"error: {ours_direct_path} not found (run `lightcut-workbench render --out {a.ours}`)")
+    if a.bounces < 1:
+        raise SystemExit("error: --bounces must be at least 1")
     if a.indirect and not ours_ind_path.exists():
         raise SystemExit(f"error: --indirect given but {ours_ind_path} does not exist (indirect not rendered yet)")
     if a.splits < 1 or a.spp < a.splits:
@@ -553,7 +558,9 @@ def main(argv=None) -> int:
             scene_i = mi.load_dict(build_scene_dict(mi, a.scene_dir, meta, a.width, a.height, a.sampler, per_i,
                                                     a.flip_v))
         t0 = time.time()
-        hit = cached("indirect", per_i * a.splits)
+        # One bounce keeps the part's old name (and its cached images); N bounces: indirectN.
+        part = "indirect" if a.bounces == 1 else f"indirect{a.bounces}"
+        hit = cached(part, per_i * a.splits)
         reused_ind = bool(hit)
         if hit:
             i_splits, t_ind = hit
@@ -562,18 +569,18 @@ def main(argv=None) -> int:
             for s in range(a.splits):
                 seed = a.seed + 7919 + 1000 * s
                 # Same seed for both depths so the direct part cancels in the difference.
-                i_splits.append(render(mi, scene_i, 3, per_i, seed) - render(mi, scene_i, 2, per_i, seed))
+                i_splits.append(render(mi, scene_i, a.bounces + 2, per_i, seed) - render(mi, scene_i, 2, per_i, seed))
             t_ind = time.time() - t0
-        save_splits("indirect", i_splits)
+        save_splits(part, i_splits)
         mts_ind = np.mean(i_splits, axis=0)
-        write_exr(mi, a.out / "mitsuba_indirect.exr", mts_ind)
+        write_exr(mi, a.out / f"mitsuba_{part}.exr", mts_ind)
         r = compare(ours_ind, i_splits, a.grid, ours_albedo, mat_id, mat_names)
-        r.update({"spp": per_i * a.splits, "render_s": t_ind, "max_depth": "3 minus 2", "reused": reused_ind})
-        report["parts"]["indirect"] = r
+        r.update({"spp": per_i * a.splits, "render_s": t_ind, "max_depth": f"{a.bounces + 2} minus 2", "bounces": a.bounces, "reused": reused_ind})
+        report["parts"][part] = r
         scale = 1.0 / max(float(np.percentile(mts_ind, 99.5)), 1e-30)
         strip = np.concatenate([tonemap(ours_ind, scale), tonemap(mts_ind, scale),
                                 diff_colour(ours_ind, mts_ind)], axis=1)
-        write_png(mi, a.out / "compare_indirect.png", strip)
+        write_png(mi, a.out / f"compare_{part}.png", strip)
 
     def clean(o):
         if isinstance(o, float) and not math.isfinite(o):

@@ -1,6 +1,6 @@
 // Draws the frame's VPLs as discs over the view texture (after display/visualise), coloured by
 // flux on a log scale relative to the mean VPL flux (false colour: 1/100 of the mean -> 0,
-// 100x the mean -> 1). Space 0: the camera view (projected; hidden VPLs drawn at half
+// 100x the mean -> 1) or by the bounce their light has made (`color_mode` 1). Space 0: the camera view (projected; hidden VPLs drawn at half
 // brightness); space 1: RSM texel space of light `layer` (views of the RSM and its maps).
 #include "common/camera.wgsl"
 #include "common/color.wgsl"
@@ -15,6 +15,10 @@ struct SplatParams {
     light_count: u32,
     per_layer: u32,    // floats per light layer of the flux pyramid
     top_offset: u32,   // offset of the pyramid's top level within a layer
+    color_mode: u32,   // 0 flux, 1 bounce
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 @group(0) @binding(0) var<uniform> sp: SplatParams;
@@ -72,7 +76,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let mean_flux = total / f32(sp.count);
     let lum = luminance(v.flux.rgb);
     let t = (log2(max(lum, 1e-30) / max(mean_flux, 1e-30)) * 0.30103 + 2.0) / 4.0;
-    let c = vec4<f32>(false_color(t) * shade, 1.0);
+    var rgb = false_color(t);
+    if sp.color_mode == 1u {
+        rgb = bounce_color(vpl_bounce(v.id));
+    }
+    let c = vec4<f32>(rgb * shade, 1.0);
     let r = i32(sp.radius);
     let ci = vec2<i32>(centre);
     for (var dy = -r; dy <= r; dy++) {

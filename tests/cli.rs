@@ -164,6 +164,40 @@ fn bad_input_gives_one_clear_line() {
 }
 
 #[test]
+fn bounces_out_of_range_and_one_bounce_methods_are_refused_in_one_line() {
+    // The VALs cluster the RSM's texels (one bounce): --bounces or vpl.bounces above 1 is
+    // refused, by `render` and by `sheet`.
+    let e = one_line_error(&["render", "--method", "val", "--bounces", "3", "--out", "/tmp/x"]);
+    assert!(e.contains("vpl.bounces 3") && e.contains("one bounce"), "{e}");
+    let e = one_line_error(&[
+        "render",
+        "--method",
+        "val-vpl",
+        "--set",
+        "vpl.bounces=2",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("vpl.bounces 2") && e.contains("one bounce"), "{e}");
+    let e = one_line_error(&[
+        "sheet",
+        "--methods",
+        "slc,val",
+        "--bounces",
+        "2",
+        "--out",
+        "/tmp/x.png",
+    ]);
+    assert!(e.contains("vpl.bounces 2"), "{e}");
+    let e = one_line_error(&["render", "--bounces", "9", "--out", "/tmp/x"]);
+    assert!(e.contains("vpl.bounces 9") && e.contains("1..=8"), "{e}");
+    let e = one_line_error(&["render", "--bounces", "0", "--out", "/tmp/x"]);
+    assert!(e.contains("vpl.bounces 0"), "{e}");
+    let e = one_line_error(&["render", "--set", "vpl.path_flux_mix=0", "--out", "/tmp/x"]);
+    assert!(e.contains("vpl.path_flux_mix"), "{e}");
+}
+
+#[test]
 fn bench_tree_prints_a_row_per_size_and_the_slopes() {
     if common::gpu().is_none() {
         return;

@@ -458,6 +458,32 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         );
         assert!(r["total_gpu_ms"].parse::<f64>().is_ok_and(|v| v > 0.0), "{r:?}");
     }
+    // The bounce-count figure: the five methods at 1 bounce and at 2..=4 bounces with paths
+    // by flux and mixed (7 configurations); light-path time only above one bounce.
+    let (_, rows) = common::read_csv(&d.join("bounces.csv"));
+    assert_eq!(rows.len(), 5 * 7, "{rows:?}");
+    for r in &rows {
+        let n: u32 = r["bounces"].parse().unwrap();
+        let paths: f64 = r["light_paths_gpu_ms"].parse().unwrap();
+        assert!(if n == 1 { paths == 0.0 } else { paths > 0.0 }, "{r:?}");
+        for c in [
+            "gi_gpu_ms",
+            "rmse",
+            "relative_rmse",
+            "gt_mean",
+            "gt_mean_over_one_bounce",
+        ] {
+            assert!(
+                r[c].parse::<f64>().is_ok_and(|v| v.is_finite() && v > 0.0),
+                "{c}: {r:?}"
+            );
+        }
+        if n > 1 {
+            assert!(r["path_vpls_alive"].parse::<u32>().unwrap() > 0, "{r:?}");
+        }
+    }
+    decodes(&d.join("bounces_rmse.png"));
+    decodes(&d.join("bounces_light.png"));
     let (_, rows) = common::read_csv(&d.join("trees_equal_time.csv"));
     assert_eq!(rows.len(), 4, "{rows:?}");
     decodes(&d.join("trees_rmse.png"));
@@ -466,7 +492,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     assert_eq!(run["width"], 64);
     // Each figure's wall time and the share of it outside rendering / GPU waits.
     let times = run["scenes"][0]["figure_times"].as_array().unwrap();
-    assert_eq!(times.len(), 12, "{times:?}");
+    assert_eq!(times.len(), 13, "{times:?}");
     for t in times {
         let share = t["share_outside_gpu"].as_f64().unwrap();
         assert!(

@@ -46,8 +46,12 @@ const EXAMPLES: &[&str] = &[
     "-- --compare-gt --views \"final;GI only;traversal steps;A/B comparison\" --pin 150,70",
     "-- sheet --methods slc,rtslc,sst --frames 16 --out screenshots/comparison_sheet.png",
     "-- results --out docs/results",
+    "-- render --scene default --width 320 --height 240 --method slc --bounces 3 --compare-gt --out out/slc3",
+    "-- render --scene default --width 320 --height 240 --method reference --samples 1024 --bounces 3 --out out/ref3",
+    "-- results bounces --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
     // Not `cargo run`: the independent check, run when Mitsuba 3 is importable.
     "python3 scripts/mitsuba_check.py --scene-dir out/scene --ours out/ref --width 320 --height 240 --indirect --out out/check",
+    "python3 scripts/mitsuba_check.py --scene-dir out/scene --ours out/ref3 --width 320 --height 240 --indirect --bounces 3 --out out/check3",
 ];
 
 fn repo() -> PathBuf {
@@ -315,6 +319,39 @@ fn cli_examples_write_what_they_promise() {
     ));
     assert!(out.contains("reference: 8 samples per pixel"), "{out}");
     assert!(mean(&rf.join("indirect.exr"))[1] > 0.0);
+    // Three bounces: the reference with light paths, SLC against its ground truth.
+    let rf3 = tmp("ref3");
+    let out = run_cli(&args(
+        "-- render --scene default --width 320 --height 240 --method reference --samples 1024 --bounces 3 --out out/ref3",
+        &[
+            ("--width", "40"),
+            ("--height", "30"),
+            ("--samples", "8"),
+            ("--out", rf3.to_str().unwrap()),
+        ],
+        &[],
+    ));
+    assert!(
+        out.contains("light_paths") && out.contains("reference: 8 samples per pixel"),
+        "{out}"
+    );
+    assert!(mean(&rf3.join("indirect.exr"))[1] > 0.0);
+    let slc3 = tmp("slc3");
+    let out = run_cli(&args(
+        "-- render --scene default --width 320 --height 240 --method slc --bounces 3 --compare-gt --out out/slc3",
+        &[
+            ("--width", "40"),
+            ("--height", "30"),
+            ("--out", slc3.to_str().unwrap()),
+        ],
+        &["--vpls", "384"],
+    ));
+    assert!(
+        out.contains("light_paths") && out.contains("ground truth (384 VPLs)"),
+        "{out}"
+    );
+    assert!(slc3.join("ground_truth_indirect.exr").is_file());
+    let _ = std::fs::remove_dir_all(&slc3);
 
     // The scene for an independent renderer.
     let sc = tmp("scene");
@@ -331,13 +368,25 @@ fn cli_examples_write_what_they_promise() {
         .args(["-c", "import mitsuba, numpy"])
         .output()
         .is_ok_and(|o| o.status.success());
-    if has_mitsuba {
+    for (ex, ours) in [
+        (
+            "python3 scripts/mitsuba_check.py --scene-dir out/scene --ours out/ref --width 320 --height 240 --indirect --out out/check",
+            &rf,
+        ),
+        (
+            "python3 scripts/mitsuba_check.py --scene-dir out/scene --ours out/ref3 --width 320 --height 240 --indirect --bounces 3 --out out/check3",
+            &rf3,
+        ),
+    ] {
+        if !has_mitsuba {
+            eprintln!("SKIPPED scripts/mitsuba_check.py: the mitsuba Python package is not installed");
+            break;
+        }
         let ck = tmp("check");
-        let ex = "python3 scripts/mitsuba_check.py --scene-dir out/scene --ours out/ref --width 320 --height 240 --indirect --out out/check";
         let mut w = words(ex);
         for (flag, value) in [
             ("--scene-dir", sc.to_str().unwrap()),
-            ("--ours", rf.to_str().unwrap()),
+            ("--ours", ours.to_str().unwrap()),
             ("--width", "40"),
             ("--height", "30"),
             ("--out", ck.to_str().unwrap()),
@@ -358,9 +407,8 @@ fn cli_examples_write_what_they_promise() {
             String::from_utf8_lossy(&o.stderr)
         );
         let _ = std::fs::remove_dir_all(ck);
-    } else {
-        eprintln!("SKIPPED scripts/mitsuba_check.py: the mitsuba Python package is not installed");
     }
+    let _ = std::fs::remove_dir_all(&rf3);
 
     // SLC with the ground truth of the same VPLs; then `compare` on its two EXRs.
     let slc = tmp("slc");
@@ -671,6 +719,30 @@ fn cli_examples_write_what_they_promise() {
     let (_, m) = common::read_csv(&trr.join("default").join("trees_equal_time.csv"));
     assert_eq!(m.len(), 1, "{m:?}");
     let _ = std::fs::remove_dir_all(&trr);
+    // The bounce-count figure (the default scene, SLC, tiny): 1..=4 bounces.
+    let br = tmp("bounces-results");
+    let out = run_cli(&args(
+        "-- results bounces --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
+        &[("--scenes", "default"), ("--out", br.to_str().unwrap())],
+        &[
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--frames",
+            "1",
+            "--timing-frames",
+            "2",
+            "--vpls",
+            "256",
+            "--methods",
+            "slc",
+        ],
+    ));
+    assert!(out.contains("bounce(s)") && out.contains("light paths"), "{out}");
+    let (_, rows) = common::read_csv(&br.join("default").join("bounces.csv"));
+    assert_eq!(rows.len(), 7, "{rows:?}");
+    let _ = std::fs::remove_dir_all(&br);
     // The tree's pairing and Lightcuts' cost per relative error (the default scene here).
     let out = run_cli(&args(
         "-- bench lightcuts --scene scenes/sponza.toml --width 160 --height 90",

@@ -674,3 +674,71 @@ fn the_temporal_switch_and_the_camera_path_reach_the_renderer() {
     );
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }
+
+#[test]
+fn bounce_controls_reach_the_renderer_and_the_overlay_colours_by_bounce() {
+    // Direct light only (the frame still makes VPLs, light paths and the tree), the VPL
+    // overlay on; tall, so that the VPL section is on screen.
+    let mut s = lightcut::renderer::settings::RenderSettings::default();
+    s.gi.method = lightcut::methods::direct_only::ID;
+    s.vpl.count = 1024;
+    s.display.vpl_overlay = true;
+    s.display.vpl_point_size = 2;
+    let options = AppOptions {
+        settings: Some(s),
+        ..Default::default()
+    };
+    let Some(mut h) = harness_with(egui::vec2(1100.0, 1700.0), options) else {
+        return;
+    };
+    h.run_steps(3);
+    let settings = |h: &Harness<'_, WorkbenchApp>| h.state().renderer().expect("renderer").settings().clone();
+    assert_eq!(settings(&h).vpl.bounces, 1);
+    h.get_by_role_and_label(Role::Slider, "bounces")
+        .set_value_accesskit(3.0);
+    h.run_steps(3);
+    assert_eq!(settings(&h).vpl.bounces, 3);
+    let r = h.state().renderer().expect("renderer");
+    assert_eq!((r.vpl_frame().bounces, r.vpl_frame().paths), (3, 341));
+    h.get_by_label_contains("bounce 1: 342 RSM VPLs · bounces 2..3: 341 light paths");
+    // Russian roulette and the path-start mix appear with more than one bounce.
+    assert!(settings(&h).vpl.roulette);
+    h.get_by_label("Russian roulette").click();
+    h.run_steps(2);
+    assert!(!settings(&h).vpl.roulette);
+    h.get_by_role_and_label(Role::Slider, "path start flux mix")
+        .set_value_accesskit(0.1);
+    h.run_steps(2);
+    assert!((settings(&h).vpl.path_flux_mix - 0.1).abs() < 1e-3);
+    // The overlay's colour: by bounce, with a legend swatch per bounce.
+    let by_flux = shown_pixels(&h);
+    h.get_by_role_and_label(Role::ComboBox, "VPL colour").click();
+    h.run_steps(2);
+    h.get_by_label("bounce").click();
+    h.run_steps(3);
+    assert_eq!(
+        settings(&h).display.vpl_color,
+        lightcut::renderer::settings::VplColor::Bounce
+    );
+    h.get_by_label("bounce 3");
+    assert_ne!(shown_pixels(&h), by_flux, "colouring by bounce changed nothing");
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+}
+
+#[test]
+fn a_one_bounce_method_says_so_under_the_bounces_slider() {
+    let mut s = lightcut::renderer::settings::RenderSettings::default();
+    s.gi.method = lightcut::methods::val::ID;
+    s.vpl.count = 256;
+    s.vpl.bounces = 2;
+    let options = AppOptions {
+        settings: Some(s),
+        view: Some(ViewBuffer::Albedo),
+        ..Default::default()
+    };
+    let Some(mut h) = harness_with(egui::vec2(700.0, 1700.0), options) else {
+        return;
+    };
+    h.run_steps(2);
+    h.get_by_label_contains("lights the scene from the RSM's texels (one bounce)");
+}

@@ -43,6 +43,15 @@ fn id_color(id: u32) -> vec3<f32> {
     return vec3<f32>(f32(h & 255u), f32((h >> 8u) & 255u), f32((h >> 16u) & 255u)) / 255.0 * 0.8 + 0.2;
 }
 
+// The VPL overlay's colour of diffuse bounce b (1 = RSM VPLs). Twin: base::colormap::bounce_color.
+fn bounce_color(b: u32) -> vec3<f32> {
+    var palette = array<vec3<f32>, 8>(
+        vec3<f32>(1.0, 0.6, 0.1), vec3<f32>(0.2, 0.8, 1.0), vec3<f32>(1.0, 0.3, 0.8),
+        vec3<f32>(0.4, 1.0, 0.3), vec3<f32>(1.0, 1.0, 0.3), vec3<f32>(0.6, 0.5, 1.0),
+        vec3<f32>(1.0, 1.0, 1.0), vec3<f32>(0.6, 0.6, 0.6));
+    return palette[clamp(b, 1u, 8u) - 1u];
+}
+
 // Viridis-like false colour for t in [0, 1].
 fn false_color(t: f32) -> vec3<f32> {
     let x = clamp(t, 0.0, 1.0);

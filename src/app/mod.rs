@@ -19,7 +19,7 @@ pub use tool_dock::Tool;
 mod windows;
 
 pub use exports::{export_view_files, preset_files, write_sheet};
-use windows::legend_with;
+use windows::{bounce_legend, legend_with};
 
 use std::{
     path::PathBuf,

@@ -184,6 +184,30 @@ impl WorkbenchApp {
                     egui::Slider::new(&mut self.settings.display.vpl_point_size, 0..=6).text("point size"),
                 );
             });
+            if self.settings.display.vpl_overlay {
+                ui.horizontal(|ui| {
+                    let d = &mut self.settings.display;
+                    egui::ComboBox::from_label("VPL colour")
+                        .selected_text(d.vpl_color.name())
+                        .show_ui(ui, |ui| {
+                            for c in crate::renderer::settings::VplColor::ALL {
+                                ui.selectable_value(&mut d.vpl_color, c, c.name());
+                            }
+                        });
+                    if d.vpl_color == crate::renderer::settings::VplColor::Bounce {
+                        // The legend: one swatch per bounce of the frame.
+                        for b in 1..=self.settings.vpl.bounces {
+                            let [r, g, bl] = crate::base::colormap::bounce_color(b);
+                            let c = egui::Color32::from_rgb((r * 255.0) as u8, (g * 255.0) as u8, (bl * 255.0) as u8);
+                            ui.label(
+                                egui::RichText::new(format!("bounce {b}"))
+                                    .background_color(c)
+                                    .color(egui::Color32::BLACK),
+                            );
+                        }
+                    }
+                });
+            }
             egui::ComboBox::from_label("tonemap")
                 .selected_text(self.settings.display.tonemap.name())
                 .show_ui(ui, |ui| {

@@ -119,6 +119,44 @@ pub(super) fn plain_text(s: &str) -> String {
 }
 
 /// A false-colour legend in the bottom-left corner of `rect`.
+/// The VPL overlay's legend when it colours by bounce: a swatch per bounce 1..=`bounces`.
+pub(super) fn bounce_legend(painter: &egui::Painter, rect: egui::Rect, bounces: u32) {
+    let n = bounces.clamp(1, 8);
+    let cell = 26.0;
+    let bar = egui::Rect::from_min_size(
+        rect.left_bottom() + egui::vec2(12.0, -34.0),
+        egui::vec2(cell * n as f32, 12.0),
+    );
+    painter.rect_filled(
+        bar.expand2(egui::vec2(6.0, 22.0))
+            .translate(egui::vec2(0.0, -8.0)),
+        4.0,
+        egui::Color32::from_black_alpha(170),
+    );
+    let font = egui::FontId::proportional(11.0);
+    let text = egui::Color32::from_gray(230);
+    painter.text(
+        bar.left_top() - egui::vec2(0.0, 3.0),
+        egui::Align2::LEFT_BOTTOM,
+        "VPL bounce",
+        font.clone(),
+        text,
+    );
+    for b in 1..=n {
+        let [r, g, bl] = crate::base::colormap::bounce_color(b).map(|v| (v * 255.0) as u8);
+        let x0 = bar.left() + cell * (b - 1) as f32;
+        let sw = egui::Rect::from_min_size(egui::pos2(x0, bar.top()), egui::vec2(cell - 4.0, 12.0));
+        painter.rect_filled(sw, 2.0, egui::Color32::from_rgb(r, g, bl));
+        painter.text(
+            sw.center_bottom() + egui::vec2(0.0, 2.0),
+            egui::Align2::CENTER_TOP,
+            b.to_string(),
+            font.clone(),
+            text,
+        );
+    }
+}
+
 pub(super) fn legend_with(
     painter: &egui::Painter,
     rect: egui::Rect,

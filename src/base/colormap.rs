@@ -8,6 +8,23 @@ pub fn id_color(id: u32) -> [f32; 3] {
     [h & 255, (h >> 8) & 255, (h >> 16) & 255].map(|v| v as f32 / 255.0 * 0.8 + 0.2)
 }
 
+/// The VPL overlay's colour of diffuse bounce `b` (1 = the RSM's VPLs): orange, cyan,
+/// magenta, green, yellow, violet, white, grey for 1..=8. Twin: `bounce_color` in
+/// `shaders/common/color.wgsl`.
+pub fn bounce_color(b: u32) -> [f32; 3] {
+    const PALETTE: [[f32; 3]; 8] = [
+        [1.0, 0.6, 0.1],
+        [0.2, 0.8, 1.0],
+        [1.0, 0.3, 0.8],
+        [0.4, 1.0, 0.3],
+        [1.0, 1.0, 0.3],
+        [0.6, 0.5, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.6, 0.6, 0.6],
+    ];
+    PALETTE[(b.clamp(1, 8) - 1) as usize]
+}
+
 /// Viridis-like polynomial false colour of t in [0, 1].
 pub fn false_color(t: f32) -> [f32; 3] {
     let x = t.clamp(0.0, 1.0);

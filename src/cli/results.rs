@@ -56,9 +56,12 @@ pub enum Figure {
     /// Issue 23: the tree samplers and Lightcuts on the perfect binary tree and on the radix
     /// tree (LBVH): RMSE over GPU time (method + tree build), steps, and RMSE at equal time.
     Trees,
+    /// Issue 23: multi-bounce VPLs at 1..=4 bounces: the light the ground truth gathers, the
+    /// light paths' GPU time, every per-frame method's time and relative error.
+    Bounces,
 }
 
-const ORDER: [Figure; 12] = [
+const ORDER: [Figure; 13] = [
     Figure::Timings,
     Figure::Steps,
     Figure::EqualTime,
@@ -67,6 +70,7 @@ const ORDER: [Figure; 12] = [
     Figure::Val,
     Figure::Temporal,
     Figure::Trees,
+    Figure::Bounces,
     Figure::Blocks,
     Figure::Blending,
     Figure::Upsampling,
@@ -312,6 +316,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
                 Figure::Val => figures::val(&mut b, &o, &dir)?,
                 Figure::Temporal => figures::temporal(&mut b, &o, &dir)?,
                 Figure::Trees => figures::trees(&mut b, &o, &dir)?,
+                Figure::Bounces => figures::bounces(&mut b, &o, &dir)?,
                 Figure::Steps => figures::steps(&mut b, &o, &dir)?,
                 Figure::Blocks => figures::blocks(&mut b, &o, &dir)?,
                 Figure::Blending => figures::blending(&mut b, &o, &dir)?,

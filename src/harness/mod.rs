@@ -37,6 +37,8 @@ use crate::{
 /// The light tree's build passes, either tree (the perfect tree's `sst_build`, the radix
 /// tree's `lbvh_build` + `lbvh_nodes`), and the usable flags: shared frame work.
 pub const TREE_BUILD_PASSES: [&str; 4] = ["sst_build", "lbvh_build", "lbvh_nodes", "sst_classify"];
+/// The light paths of `vpl.bounces > 1` (starts, then the paths' VPLs).
+pub const LIGHT_PATH_PASSES: [&str; 2] = ["light_path_starts", "light_paths"];
 /// The keys and the sort before either build.
 pub const SORT_PASSES: [&str; 2] = ["sst_keys", "sst_sort"];
 
@@ -46,7 +48,14 @@ pub const PASS_GROUPS: [(&str, &[&str]); 8] = [
     ("shadow map", &["rsm"]),
     (
         "VPL generation",
-        &["brsm_importance", "brsm_filter", "pdf_pyramid", "vpl_warp"],
+        &[
+            "brsm_importance",
+            "brsm_filter",
+            "pdf_pyramid",
+            "vpl_warp",
+            "light_path_starts",
+            "light_paths",
+        ],
     ),
     ("sort VPLs", &SORT_PASSES),
     ("build SST", &TREE_BUILD_PASSES),
@@ -211,7 +220,10 @@ pub struct Bench {
     pub gi_exposure: f32,
     pub adapter: String,
     /// Ground truths by (VPL count, seed, width | height << 16, shadow rays).
-    gt: HashMap<(u32, u32, u32, bool), (ImageF32, u64)>,
+    /// Ground truths by ((VPL count, seed, size, shadow rays), (bounces, roulette, path
+    /// start flux mix)).
+    #[allow(clippy::type_complexity)]
+    gt: HashMap<((u32, u32, u32, bool), (u32, bool, u32)), (ImageF32, u64)>,
     /// Progress lines to stderr.
     pub verbose: bool,
     /// Wall clock spent rendering and waiting for the GPU (the rest of a figure's wall time
@@ -313,7 +325,11 @@ impl Bench {
         s: &RenderSettings,
         size: (u32, u32),
     ) -> anyhow::Result<(ImageF32, u64)> {
-        let key = (s.vpl.count, s.vpl.seed, size.0 | size.1 << 16, s.gi.shadow_rays);
+        let v = &s.vpl;
+        let key = (
+            (v.count, v.seed, size.0 | size.1 << 16, s.gi.shadow_rays),
+            (v.bounces, v.roulette, v.path_flux_mix.to_bits()),
+        );
         if let Some(cached) = self.gt.get(&key) {
             return Ok(cached.clone());
         }

@@ -256,7 +256,7 @@ impl Default for GiSettings {
             reference_samples: 4096,
             reference_spp_per_frame: 1,
             reference_flux_mix: 0.25,
-            reference_paths_per_sample: 4,
+            reference_paths_per_sample: 16,
             distance_epsilon: 0.05,
             ray_offset: 1e-3,
             shadow_rays: true,
@@ -321,6 +321,27 @@ impl TreeOverlay {
     }
 }
 
+/// Colouring of the VPL overlay (`display.vpl_overlay`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum VplColor {
+    /// Log-scale false colour of the VPL's flux around the mean VPL flux.
+    #[default]
+    Flux,
+    /// The diffuse bounce its light has made (`vpl.bounces`): a fixed colour per bounce
+    /// (`base::colormap::bounce_color`).
+    Bounce,
+}
+
+impl VplColor {
+    pub const ALL: [VplColor; 2] = [VplColor::Flux, VplColor::Bounce];
+    pub fn name(self) -> &'static str {
+        match self {
+            VplColor::Flux => "flux",
+            VplColor::Bounce => "bounce",
+        }
+    }
+}
+
 /// Colouring of the light-tree overlay.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum TreeColor {
@@ -357,6 +378,8 @@ pub struct DisplaySettings {
     /// Draw the frame's VPLs over the view (in the camera view, or in RSM texel space over
     /// RSM-space views), coloured by flux on a log scale around the mean VPL flux.
     pub vpl_overlay: bool,
+    /// What the VPL discs' colour shows: flux, or the bounce (multi-bounce VPLs).
+    pub vpl_color: VplColor,
     /// Radius of the VPL discs in view pixels (0 = one pixel).
     pub vpl_point_size: u32,
     /// Level shown by the PDF-pyramid view (0 = full resolution).
@@ -379,6 +402,7 @@ impl Default for DisplaySettings {
             exposure_ev: 0.0,
             tonemap: Tonemap::Aces,
             vpl_overlay: false,
+            vpl_color: VplColor::Flux,
             vpl_point_size: 1,
             pyramid_level: 0,
             tree_overlay: TreeOverlay::Off,

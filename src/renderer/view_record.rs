@@ -19,6 +19,8 @@ impl Renderer {
             light_count: self.vpl_frame.ranges.len() as u32,
             per_layer,
             top_offset: *offsets.last().unwrap_or(&0),
+            color_mode: (self.settings.display.vpl_color == settings::VplColor::Bounce) as u32,
+            _pad: [0; 3],
         };
         self.vpl_splat.record(
             &device,

@@ -2,6 +2,7 @@
 //! `<figure>.csv`, PNG plots and images into the scene's results folder, and returns a
 //! [`Report`]: a short text table and the ratio checks of issue 7 it covers.
 
+mod bounces;
 mod culling;
 mod interpolation;
 mod resolution;
@@ -10,6 +11,7 @@ mod temporal;
 mod trees;
 mod val;
 
+pub use bounces::bounces;
 pub use culling::culling;
 pub use interpolation::interpolation;
 pub use resolution::{scaling, upsampling};

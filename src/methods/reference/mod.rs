@@ -57,6 +57,7 @@ pub static INFO: MethodInfo = MethodInfo {
     tests: &[
         "vpl::converged_reference_converges_to_the_exact_sum_over_all_texels",
         "vpl::raising_the_reference_target_continues_and_a_view_change_restarts",
+        "light_paths::the_n_bounce_reference_converges_to_the_mean_ground_truth_of_fresh_vpls",
     ],
     sweep: None,
 };

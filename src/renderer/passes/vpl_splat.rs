@@ -23,6 +23,9 @@ pub struct GpuSplatParams {
     pub light_count: u32,
     pub per_layer: u32,
     pub top_offset: u32,
+    /// 0 = flux, 1 = bounce.
+    pub color_mode: u32,
+    pub _pad: [u32; 3],
 }
 
 pub struct VplSplatPass {
