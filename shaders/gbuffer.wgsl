@@ -1,8 +1,9 @@
 // G-buffer pass: rasterise the scene from the camera.
 // Outputs (see src/renderer/frame.rs):
 //   0 position: Rgba32Float, xyz world position, w = material id + 1 (0 = no geometry)
-//   1 normal:   Rgba16Float, xyz unit shading normal facing the camera, w = 1
-//   2 albedo:   Rgba16Float, rgb linear diffuse albedo = baseColorFactor x texture, a = alpha
+//   1 normal:   Rgba16Float, xyz unit shading normal facing the camera, w = roughness (glTF)
+//   2 albedo:   Rgba16Float, rgb linear base colour = baseColorFactor x texture, a = metallic
+// (roughness and metallic: the GGX BRDF's, `common/brdf.wgsl`; Lambert reads rgb only)
 #include "common/camera.wgsl"
 #include "common/material.wgsl"
 #include "common/vertex.wgsl"
@@ -35,7 +36,8 @@ fn fs_main(i: VertexOut, @builtin(front_facing) front: bool) -> GbufferOut {
     }
     var o: GbufferOut;
     o.position = vec4<f32>(i.world, f32(i.material + 1u));
-    o.normal = vec4<f32>(n, 1.0);
-    o.albedo = albedo;
+    let params = materials[i.material].params;
+    o.normal = vec4<f32>(n, params.y);
+    o.albedo = vec4<f32>(albedo.rgb, params.x);
     return o;
 }

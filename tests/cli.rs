@@ -198,6 +198,42 @@ fn bounces_out_of_range_and_one_bounce_methods_are_refused_in_one_line() {
 }
 
 #[test]
+fn ggx_is_refused_by_methods_that_shade_with_lambert_only() {
+    let e = one_line_error(&[
+        "render",
+        "--method",
+        "lightcuts",
+        "--brdf",
+        "ggx",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("brdf GGX") && e.contains("Lambert only"), "{e}");
+    let e = one_line_error(&[
+        "render",
+        "--method",
+        "slc",
+        "--set",
+        "gi.brdf=\"Ggx\"",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("Lambert only"), "{e}");
+    let e = one_line_error(&[
+        "sheet",
+        "--methods",
+        "slc",
+        "--brdf",
+        "ggx",
+        "--out",
+        "/tmp/x.png",
+    ]);
+    assert!(e.contains("Lambert only"), "{e}");
+    let e = one_line_error(&["render", "--brdf", "phong", "--out", "/tmp/x"]);
+    assert!(e.contains("phong"), "{e}");
+}
+
+#[test]
 fn bench_tree_prints_a_row_per_size_and_the_slopes() {
     if common::gpu().is_none() {
         return;

@@ -41,11 +41,13 @@ fn test_scene(rho: [f32; 3], sun: &DirectionalLight) -> Scene {
         name: "ground".into(),
         base_color_factor: [rho[0], rho[1], rho[2], 1.0],
         base_color_texture: None,
+        ..Default::default()
     });
     s.materials.push(Material {
         name: "blocker".into(),
         base_color_factor: [0.2, 0.2, 0.2, 1.0],
         base_color_texture: None,
+        ..Default::default()
     });
     // CCW seen from +Y.
     quad(

@@ -94,6 +94,7 @@ fn stacked_quads(n: usize, back_to_front: bool) -> Scene {
         name: "grey".into(),
         base_color_factor: [0.5, 0.5, 0.5, 1.0],
         base_color_texture: None,
+        ..Default::default()
     });
     let mut order: Vec<usize> = (0..n).collect();
     if back_to_front {

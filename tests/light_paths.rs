@@ -47,6 +47,7 @@ fn closed_box(albedo: [f32; 3]) -> Scene {
         name: "box".into(),
         base_color_factor: [albedo[0], albedo[1], albedo[2], 1.0],
         base_color_texture: None,
+        ..Default::default()
     }];
     for axis in 0..3 {
         for side in [0.0f32, 1.0] {

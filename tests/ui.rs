@@ -742,3 +742,41 @@ fn a_one_bounce_method_says_so_under_the_bounces_slider() {
     h.run_steps(2);
     h.get_by_label_contains("lights the scene from the RSM's texels (one bounce)");
 }
+
+#[test]
+fn the_brdf_combo_reaches_the_renderer_and_lambert_only_methods_say_so() {
+    // Direct light only (GGX-capable): the combo switches the frame's BRDF, the direct light
+    // changes.
+    let Some(mut h) = harness_with(egui::vec2(1100.0, 1700.0), AppOptions::default()) else {
+        return;
+    };
+    h.run_steps(3);
+    let lambert = shown_pixels(&h);
+    h.get_by_role_and_label(Role::ComboBox, "BRDF").click();
+    h.run_steps(2);
+    h.get_by_label("GGX (metallic-roughness)").click();
+    h.run_steps(3);
+    let r = h.state().renderer().expect("renderer");
+    assert_eq!(r.settings().gi.brdf, lightcut::renderer::settings::Brdf::Ggx);
+    assert_ne!(
+        shown_pixels(&h),
+        lambert,
+        "GGX changed nothing in the direct light"
+    );
+    assert!(h.query_by_label_contains("Lambert only").is_none());
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+    drop(h);
+    // A Lambert-only method: the note under the combo.
+    let mut s = slc_settings();
+    s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
+    let options = AppOptions {
+        settings: Some(s),
+        view: Some(ViewBuffer::Albedo),
+        ..Default::default()
+    };
+    let Some(mut h) = harness_with(egui::vec2(700.0, 1700.0), options) else {
+        return;
+    };
+    h.run_steps(2);
+    h.get_by_label_contains("shades with Lambert only so far");
+}

@@ -307,16 +307,35 @@ fn ground_truth_against_cpu(shadow_rays: bool) -> Option<Vec<Vec3>> {
 
 #[test]
 fn converged_reference_converges_to_the_exact_sum_over_all_texels() {
+    converged_reference_against_exact(
+        default_scene::build(),
+        lightcut::renderer::settings::Brdf::Lambert,
+    );
+}
+
+#[test]
+fn converged_reference_with_ggx_converges_to_the_exact_brdf_sum() {
+    // The default room made glossy (rough dielectrics, a satin metal); the exact sum with the
+    // BRDF twin at every pixel.
+    let mut scene = default_scene::build();
+    for (i, m) in scene.materials.iter_mut().enumerate() {
+        (m.metallic, m.roughness) = if i % 2 == 0 { (0.0, 0.4) } else { (1.0, 0.5) };
+    }
+    converged_reference_against_exact(scene, lightcut::renderer::settings::Brdf::Ggx);
+}
+
+fn converged_reference_against_exact(scene: Scene, brdf: lightcut::renderer::settings::Brdf) {
     // A small RSM (64 x 64 texels) so that the exact CPU sum is affordable.
     let mut settings = RenderSettings::default();
     settings.shadow.resolution = 64;
     settings.gi.method = lightcut::methods::reference::ID;
     settings.gi.reference_samples = 256;
     settings.gi.reference_spp_per_frame = 64;
+    settings.gi.brdf = brdf;
     let (w, h) = (48u32, 32u32);
-    let Some((mut r, scene)) = setup(settings.clone(), (w, h)) else {
-        return;
-    };
+    let Some(ctx) = common::gpu() else { return };
+    let mut r = Renderer::new(ctx, &scene, (w, h), settings.clone()).expect("renderer");
+    let cam = scene.camera_or_default(None).unwrap();
     // Independent estimates: different seeds (the importance changes too; the estimator is
     // unbiased for any importance because the PDF keeps a flux share).
     let seeds = 6;
@@ -364,11 +383,23 @@ fn converged_reference_converges_to_the_exact_sum_over_all_texels() {
         if p[3] == 0.0 {
             continue;
         }
-        let e = reference::gi::exact_indirect(
+        let x = Vec3::from_slice(&p[..3]);
+        let surface = reference::brdf::Surface {
+            base: Vec3::from_slice(&alb.pixels[k][..3]),
+            metallic: alb.pixels[k][3],
+            roughness: nrm.pixels[k][3],
+        };
+        let model = match brdf {
+            lightcut::renderer::settings::Brdf::Lambert => reference::brdf::Model::Lambert,
+            lightcut::renderer::settings::Brdf::Ggx => reference::brdf::Model::Ggx,
+        };
+        let e = reference::gi::exact_indirect_brdf(
             &bvh,
-            Vec3::from_slice(&p[..3]),
+            x,
             Vec3::from_slice(&nrm.pixels[k][..3]).normalize(),
-            Vec3::from_slice(&alb.pixels[k][..3]),
+            (cam.position - x).normalize(),
+            model,
+            &surface,
             &texels,
             settings.gi.distance_epsilon,
             Some(settings.gi.ray_offset),
@@ -376,7 +407,7 @@ fn converged_reference_converges_to_the_exact_sum_over_all_texels() {
         exact_sum += lum(e.to_array());
     }
     let exact = exact_sum / (w * h) as f64;
-    eprintln!("reference image mean {mean:.6} +- {se:.6} (6 x 256 spp), exact {exact:.6}");
+    eprintln!("{brdf:?}: reference image mean {mean:.6} +- {se:.6} (6 x 256 spp), exact {exact:.6}");
     assert!(exact > 0.0);
     assert!(
         (mean - exact).abs() < 4.0 * se + 1e-3 * exact,
@@ -472,4 +503,101 @@ fn raising_the_reference_target_continues_and_a_view_change_restarts() {
         view: ViewBuffer::Final,
     });
     assert_eq!(r.gi_progress().map(|p| p.done), Some(32));
+}
+
+#[test]
+fn ground_truth_with_ggx_equals_a_cpu_evaluation_with_the_brdf() {
+    // The default room made glossy (a rough floor, a polished metal sphere, satin walls) and
+    // shaded with gi.brdf = ggx: every checked pixel equals the CPU sum with the BRDF twin.
+    let Some(ctx) = common::gpu() else { return };
+    let mut scene = default_scene::build();
+    for (i, m) in scene.materials.iter_mut().enumerate() {
+        (m.metallic, m.roughness) = match i % 4 {
+            0 => (0.0, 0.3),
+            1 => (1.0, 0.2),
+            2 => (0.5, 0.6),
+            _ => (0.0, 0.05),
+        };
+    }
+    let mut settings = RenderSettings::default();
+    settings.vpl.count = 256;
+    settings.shadow.resolution = 256;
+    settings.gi.method = lightcut::methods::ground_truth::ID;
+    settings.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
+    let (w, h) = (64u32, 40u32);
+    let mut r = Renderer::new(ctx, &scene, (w, h), settings.clone()).expect("renderer");
+    for _ in 0..4 {
+        frame(&mut r, &scene);
+        if r.gi_progress().is_some_and(|p| p.finished()) {
+            break;
+        }
+    }
+    assert!(r.gi_progress().unwrap().finished());
+    let cam = scene.camera_or_default(None).unwrap();
+    let ind = r.read(Buffer::Indirect).unwrap();
+    let pos = r.read(Buffer::Position).unwrap();
+    let nrm = r.read(Buffer::Normal).unwrap();
+    let alb = r.read(Buffer::Albedo).unwrap();
+    let vpls = r.read_vpls().unwrap();
+    let bvh = Bvh::build(&scene.positions, &scene.indices);
+    let emitters: Vec<reference::gi::Texel> = vpls
+        .iter()
+        .filter(|v| v.id != VPL_NONE)
+        .map(|v| reference::gi::Texel {
+            position: Vec3::from_slice(&v.position[..3]),
+            normal: Vec3::from_array(v.normal),
+            flux: Vec3::from_slice(&v.flux[..3]),
+        })
+        .collect();
+    let (mut checked, mut glossy) = (0, 0);
+    for k in (0..(w * h) as usize).step_by(7) {
+        let p = pos.pixels[k];
+        if p[3] == 0.0 {
+            continue;
+        }
+        let x = Vec3::new(p[0], p[1], p[2]);
+        // The G-buffer's w channels: roughness (normal.w), metallic (albedo.a), f16.
+        let s = reference::brdf::Surface {
+            base: Vec3::from_slice(&alb.pixels[k][..3]),
+            metallic: alb.pixels[k][3],
+            roughness: nrm.pixels[k][3],
+        };
+        let want = reference::gi::exact_indirect_brdf(
+            &bvh,
+            x,
+            Vec3::from_slice(&nrm.pixels[k][..3]).normalize(),
+            (cam.position - x).normalize(),
+            reference::brdf::Model::Ggx,
+            &s,
+            &emitters,
+            settings.gi.distance_epsilon,
+            Some(settings.gi.ray_offset),
+        );
+        let got = Vec3::from_slice(&ind.pixels[k][..3]);
+        let tol = 2e-3 * want.max_element().max(1e-6);
+        assert!(
+            (got - want).abs().max_element() <= tol,
+            "pixel {k} ({s:?}): GPU {got} CPU {want}"
+        );
+        checked += 1;
+        glossy += (s.roughness < 0.5) as usize;
+    }
+    assert!(checked > 100 && glossy > 20, "checked {checked}, glossy {glossy}");
+    // Lambert on the same scene differs (the BRDF is in use).
+    let lambert_mean: f64 = {
+        let mut s = settings.clone();
+        s.gi.brdf = lightcut::renderer::settings::Brdf::Lambert;
+        r.set_settings(s).unwrap();
+        for _ in 0..4 {
+            frame(&mut r, &scene);
+        }
+        let l = r.read(Buffer::Indirect).unwrap();
+        l.pixels.iter().map(|p| lum([p[0], p[1], p[2]])).sum::<f64>()
+    };
+    let ggx_mean: f64 = ind.pixels.iter().map(|p| lum([p[0], p[1], p[2]])).sum();
+    assert!(
+        (ggx_mean / lambert_mean - 1.0).abs() > 0.01,
+        "{ggx_mean} vs {lambert_mean}"
+    );
+    assert!(r.ctx.errors.take().is_empty());
 }

@@ -58,15 +58,3 @@ fn shadow_visibility(i: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     return lit / total;
 }
 
-// Direct diffuse radiance at p: sum over lights of rho/pi * E * max(0, n.l) * visibility.
-fn direct_radiance(p: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
-    var sum = vec3<f32>(0.0);
-    for (var i = 0u; i < lights.count.x; i++) {
-        let l = lights.lights[i];
-        let cos_t = max(dot(n, -l.direction.xyz), 0.0);
-        if cos_t > 0.0 {
-            sum += albedo / PI * l.irradiance.rgb * cos_t * shadow_visibility(i, p, n);
-        }
-    }
-    return sum;
-}

@@ -7,6 +7,7 @@
 struct MaterialGpu {
     base_color: vec4<f32>,
     texture: vec4<i32>, // x = layer in `textures` or -1
+    params: vec4<f32>,  // x = metallic, y = roughness (glTF factors)
 };
 
 // Implicit-derivative sampling: fragment shaders only.

@@ -371,6 +371,19 @@ impl WorkbenchApp {
                 ui.label(line);
             }
             let g = &mut self.settings.gi;
+            egui::ComboBox::from_label("BRDF")
+                .selected_text(g.brdf.name())
+                .show_ui(ui, |ui| {
+                    for b in crate::renderer::settings::Brdf::ALL {
+                        ui.selectable_value(&mut g.brdf, b, b.name());
+                    }
+                })
+                .response
+                .on_hover_text("the BRDF of every shading point; the VPLs stay diffuse emitters (docs/brdf.md)");
+            if let Some(msg) = g.method.refuses_brdf(g.brdf) {
+                ui.colored_label(ui.visuals().warn_fg_color, msg);
+            }
+            let g = &mut self.settings.gi;
             ui.add(
                 egui::Slider::new(&mut g.distance_epsilon, 0.001..=1.0)
                     .logarithmic(true)

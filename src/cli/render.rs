@@ -97,6 +97,15 @@ pub enum TreeArg {
     Lbvh,
 }
 
+/// The BRDF for `--brdf`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BrdfArg {
+    /// base colour / pi (default).
+    Lambert,
+    /// Cook-Torrance GGX over glTF's metallic and roughness factors.
+    Ggx,
+}
+
 /// Settings of the tree samplers (override `--settings`).
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct SamplingArgs {
@@ -162,6 +171,11 @@ pub struct SamplingArgs {
     /// x albedo per bounce (`vpl.roulette = false`).
     #[arg(long)]
     pub no_roulette: bool,
+    /// The BRDF of every shading point: `lambert` (default) or `ggx` (Cook-Torrance GGX over
+    /// glTF's metallic-roughness factors; `gi.brdf`). Methods that shade with Lambert only
+    /// refuse `ggx`.
+    #[arg(long, value_enum)]
+    pub brdf: Option<BrdfArg>,
     /// Least normal similarity of a usable SST node.
     #[arg(long)]
     pub v_min: Option<f32>,
@@ -299,6 +313,12 @@ impl SamplingArgs {
         }
         if self.no_roulette {
             s.vpl.roulette = false;
+        }
+        if let Some(b) = self.brdf {
+            s.gi.brdf = match b {
+                BrdfArg::Lambert => crate::renderer::settings::Brdf::Lambert,
+                BrdfArg::Ggx => crate::renderer::settings::Brdf::Ggx,
+            };
         }
         if let Some(t) = self.tree {
             use crate::renderer::settings::TreeKind;
@@ -541,7 +561,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if let Some(msg) = method.refuses_tree(settings.tree.kind) {
         return Err(anyhow!("{msg}"));
     }
-    if let Some(msg) = method.refuses_bounces(settings.vpl.bounces) {
+    if let Some(msg) = method
+        .refuses_bounces(settings.vpl.bounces)
+        .or(method.refuses_brdf(settings.gi.brdf))
+    {
         return Err(anyhow!("{msg}"));
     }
     if args.sampling.frames == 0 {

@@ -76,6 +76,7 @@ pub fn run(args: &SheetArgs) -> anyhow::Result<()> {
     if let Some(msg) = methods.iter().find_map(|m| {
         m.refuses_tree(settings.tree.kind)
             .or(m.refuses_bounces(settings.vpl.bounces))
+            .or(m.refuses_brdf(settings.gi.brdf))
     }) {
         return Err(anyhow!("{msg}"));
     }

@@ -138,6 +138,25 @@ impl MethodId {
             )
         })
     }
+    /// The BRDF a frame of this method shades with: `wanted`, or Lambert where it refuses
+    /// it (the GUI says so; the direct light and the comparison's truth follow).
+    pub fn brdf(self, wanted: crate::renderer::settings::Brdf) -> crate::renderer::settings::Brdf {
+        if self.refuses_brdf(wanted).is_some() {
+            crate::renderer::settings::Brdf::Lambert
+        } else {
+            wanted
+        }
+    }
+    /// The refusal of `gi.brdf = ggx` for a method that shades with Lambert only.
+    pub fn refuses_brdf(self, brdf: crate::renderer::settings::Brdf) -> Option<String> {
+        (brdf != crate::renderer::settings::Brdf::Lambert && !self.info().glossy).then(|| {
+            format!(
+                "brdf {}: {} shades with Lambert only so far (GGX: the ground truth, the reference and the direct light)",
+                brdf.name(),
+                self.info().label
+            )
+        })
+    }
     /// The method named `name` on the command line or in a settings file (case-insensitive;
     /// `-` and `_` ignored, so `ground-truth`, `GroundTruth` and `ground_truth` are one).
     pub fn parse(name: &str) -> Result<MethodId, String> {
@@ -454,6 +473,9 @@ pub struct MethodInfo {
     /// cluster RSM texels), so it cannot follow `vpl.bounces > 1`: the CLI refuses, the GUI
     /// says so.
     pub one_bounce: bool,
+    /// True when its shading follows `gi.brdf` (GGX included); the others refuse
+    /// `gi.brdf = ggx` (CLI in one line, GUI below the BRDF combo).
+    pub glossy: bool,
     /// Checks its settings; the message names the field.
     pub validate: fn(&RenderSettings) -> Result<(), String>,
     /// Sets one of its settings out of range and returns that field's name (the registry test
@@ -489,6 +511,10 @@ pub struct FrameCx<'a> {
     pub vpl_frame: &'a VplFrame,
     /// The frame's lights (one RSM layer each).
     pub lights: &'a [crate::scene::DirectionalLight],
+    /// The BRDF of this frame (`gi.brdf`, Lambert where the frame's method refuses GGX).
+    pub brdf: crate::renderer::settings::Brdf,
+    /// The camera's position (glossy shading's view direction).
+    pub eye: glam::Vec3,
     /// The VPL generation's parameter buffer (the reference reads the RSM pyramids with it).
     pub vpl_params: &'a wgpu::Buffer,
     pub tree: &'a TreeBuffers,

@@ -25,6 +25,39 @@ pub fn exact_indirect(
     eps: f32,
     shadow_rays: Option<f32>,
 ) -> Vec3 {
+    albedo / std::f32::consts::PI * emitted_sum(bvh, x, n, texels, eps, shadow_rays, |_| Vec3::ONE)
+}
+
+/// The same sum shaded with a BRDF (the ground truth's glossy path): sum over texels of
+/// f(v, l) x flux/pi x cos_x x cos_t / max(d^2, eps^2) x V, l towards the texel, `v` the unit
+/// direction to the eye.
+#[allow(clippy::too_many_arguments)]
+pub fn exact_indirect_brdf(
+    bvh: &Bvh,
+    x: Vec3,
+    n: Vec3,
+    v: Vec3,
+    model: crate::reference::brdf::Model,
+    surface: &crate::reference::brdf::Surface,
+    texels: &[Texel],
+    eps: f32,
+    shadow_rays: Option<f32>,
+) -> Vec3 {
+    emitted_sum(bvh, x, n, texels, eps, shadow_rays, |l| {
+        crate::reference::brdf::eval(model, n, v, l, surface)
+    })
+}
+
+/// Sum over texels of weight(l) x flux/pi x cos_x x cos_t / max(d^2, eps^2) x V.
+fn emitted_sum(
+    bvh: &Bvh,
+    x: Vec3,
+    n: Vec3,
+    texels: &[Texel],
+    eps: f32,
+    shadow_rays: Option<f32>,
+    weight: impl Fn(Vec3) -> Vec3,
+) -> Vec3 {
     let pi = std::f32::consts::PI;
     let mut sum = Vec3::ZERO;
     for t in texels {
@@ -50,7 +83,7 @@ pub fn exact_indirect(
                 continue;
             }
         }
-        sum += t.flux / pi * (cx * ct / dist2.max(eps * eps));
+        sum += weight(w) * t.flux / pi * (cx * ct / dist2.max(eps * eps));
     }
-    albedo / pi * sum
+    sum
 }

@@ -13,6 +13,7 @@
 //! | `methods/lightcuts/{lc_build, lightcuts}.wgsl` | [`lightcuts::build`], [`lightcuts::lightcut`] (and the error bound) |
 //! | `common/bvh.wgsl` | `scene::bvh::Bvh::{closest_hit, any_hit}` (and brute force) |
 
+pub mod brdf;
 pub mod direct;
 pub mod gbuffer;
 pub mod gi;

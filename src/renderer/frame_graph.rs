@@ -25,6 +25,8 @@ macro_rules! frame_cx {
             vpl_buffers: &$r.vpl_buffers,
             vpl_frame: &$r.vpl_frame,
             lights: &$r.frame_lights,
+            brdf: $r.frame_brdf,
+            eye: $r.frame_eye,
             vpl_params: $r.vpl_gen.params_buffer(),
             tree: &$r.tree,
             gi_accum: $accum,
@@ -68,6 +70,8 @@ impl Renderer {
 
         let lights = &input.lights[..input.lights.len().min(MAX_LIGHTS)];
         self.frame_lights.clone_from(&lights.to_vec());
+        self.frame_brdf = s.gi.method.brdf(s.gi.brdf);
+        self.frame_eye = input.camera.position;
         let layers = lights.len().max(1) as u32;
         if layers != self.targets.shadow.layers() {
             self.targets.shadow = ShadowTargets::new(&device, s.shadow.resolution, layers);
@@ -134,6 +138,8 @@ impl Renderer {
         );
         self.direct.record(
             &device,
+            &queue,
+            self.frame_brdf.gpu(),
             &mut enc,
             &mut self.timer,
             &self.camera_buf,

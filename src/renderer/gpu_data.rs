@@ -204,6 +204,8 @@ pub struct GpuMaterial {
     pub base_color: [f32; 4],
     /// x = texture layer or -1 (as i32 bits), yzw unused.
     pub texture: [i32; 4],
+    /// x = metallic, y = roughness (glTF factors), zw unused.
+    pub params: [f32; 4],
 }
 
 /// Twin: `Vertex` inputs of `shaders/gbuffer.wgsl` (vertex buffer, not a uniform).
@@ -326,7 +328,10 @@ pub struct GpuGtParams {
     pub ray_offset: f32,
     /// 1: shadow rays, 0: every VPL visible (`GiSettings::shadow_rays`).
     pub shadow_rays: u32,
-    pub _pad: u32,
+    /// The BRDF model (`Brdf::gpu`).
+    pub brdf: u32,
+    /// xyz the camera's position (the view direction of glossy shading).
+    pub eye: [f32; 4],
 }
 
 #[cfg(test)]
@@ -436,6 +441,7 @@ mod tests {
                 vec![
                     offset_of!(GpuMaterial, base_color),
                     offset_of!(GpuMaterial, texture),
+                    offset_of!(GpuMaterial, params),
                 ],
             ),
             (
@@ -862,7 +868,8 @@ mod tests {
                     offset_of!(GpuGtParams, epsilon),
                     offset_of!(GpuGtParams, ray_offset),
                     offset_of!(GpuGtParams, shadow_rays),
-                    offset_of!(GpuGtParams, _pad),
+                    offset_of!(GpuGtParams, brdf),
+                    offset_of!(GpuGtParams, eye),
                 ],
             ),
             (

@@ -3,6 +3,7 @@
 //!
 //! Frame order (see ARCHITECTURE.md): shadow_map -> gbuffer -> direct -> display | visualise.
 
+pub mod brdf_probe;
 pub mod bvh_trace;
 pub mod context;
 pub mod frame;
@@ -173,6 +174,10 @@ pub struct Renderer {
     vpl_frame: VplFrame,
     /// The frame's lights (at most MAX_LIGHTS), for the methods.
     frame_lights: Vec<crate::scene::DirectionalLight>,
+    /// The frame's BRDF (`MethodId::brdf`: Lambert where the method refuses GGX).
+    frame_brdf: settings::Brdf,
+    /// The frame's camera position.
+    frame_eye: Vec3,
     /// Luminance of light 0's irradiance and its shadow texel size, last frame (RSM flux view).
     light0_lum: f32,
     lights_texel: f32,
@@ -295,6 +300,8 @@ impl Renderer {
             vpl_buffers: VplBuffers::new(device, settings.shadow.resolution, lights, settings.vpl.count),
             vpl_frame: VplFrame::default(),
             frame_lights: Vec::new(),
+            frame_brdf: settings::Brdf::Lambert,
+            frame_eye: Vec3::ZERO,
             light0_lum: 0.0,
             lights_texel: 0.0,
             rsm_raster: None,

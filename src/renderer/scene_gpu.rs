@@ -266,12 +266,14 @@ impl SceneGpu {
                     0,
                     0,
                 ],
+                params: [m.metallic, m.roughness, 0.0, 0.0],
             })
             .collect();
         if mats.is_empty() {
             mats.push(GpuMaterial {
                 base_color: [0.8, 0.8, 0.8, 1.0],
                 texture: [-1, 0, 0, 0],
+                params: [0.0, 1.0, 0.0, 0.0],
             });
         }
         let materials = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

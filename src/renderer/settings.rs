@@ -212,6 +212,33 @@ impl Default for VplSettings {
 pub use super::temporal_settings::{MAX_ATROUS_ITERATIONS, TemporalMode, TemporalSettings, TemporalView};
 pub use crate::methods::{MethodId, MethodView};
 
+/// The BRDF every method shades with (`shaders/common/brdf.wgsl`, docs/brdf.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Brdf {
+    /// base colour / pi (the thesis; the references against Mitsuba are diffuse).
+    #[default]
+    Lambert,
+    /// Cook-Torrance GGX over glTF's metallic and roughness factors.
+    Ggx,
+}
+
+impl Brdf {
+    pub const ALL: [Brdf; 2] = [Brdf::Lambert, Brdf::Ggx];
+    pub fn name(self) -> &'static str {
+        match self {
+            Brdf::Lambert => "Lambert",
+            Brdf::Ggx => "GGX (metallic-roughness)",
+        }
+    }
+    /// The shader's model constant (`BRDF_LAMBERT` / `BRDF_GGX`).
+    pub fn gpu(self) -> u32 {
+        match self {
+            Brdf::Lambert => 0,
+            Brdf::Ggx => 1,
+        }
+    }
+}
+
 /// Shading of VPLs (shared by every GI method and the references).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -246,6 +273,9 @@ pub struct GiSettings {
     /// remove (light through walls) and what they cost (the GI pass without them is the
     /// cost of traversal and evaluation alone). The converged reference always traces.
     pub shadow_rays: bool,
+    /// The BRDF of every shading point: Lambert (default) or GGX (metallic-roughness). The
+    /// VPLs themselves stay diffuse emitters (their flux is the RSM's diffuse reflection).
+    pub brdf: Brdf,
 }
 
 impl Default for GiSettings {
@@ -260,6 +290,7 @@ impl Default for GiSettings {
             distance_epsilon: 0.05,
             ray_offset: 1e-3,
             shadow_rays: true,
+            brdf: Brdf::Lambert,
         }
     }
 }

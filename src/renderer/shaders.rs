@@ -124,6 +124,8 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         include_str!("../../shaders/common/rsm_warp.wgsl"),
     ),
     ("light_paths.wgsl", include_str!("../../shaders/light_paths.wgsl")),
+    ("common/brdf.wgsl", include_str!("../../shaders/common/brdf.wgsl")),
+    ("brdf_eval.wgsl", include_str!("../../shaders/brdf_eval.wgsl")),
 ];
 
 /// The shared shaders that are entry points (not include-only files); [`entry_shaders`] adds
@@ -138,6 +140,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "bvh_rays.wgsl",
     "vpl_gen.wgsl",
     "light_paths.wgsl",
+    "brdf_eval.wgsl",
     "composite.wgsl",
     "vpl_splat.wgsl",
     "sst_sort.wgsl",

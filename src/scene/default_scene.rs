@@ -49,6 +49,7 @@ pub fn build() -> Scene {
         name: name.into(),
         base_color_factor: [c[0], c[1], c[2], 1.0],
         base_color_texture: tex,
+        ..Default::default()
     };
     s.materials = vec![
         mat("white wall", [0.73, 0.73, 0.70], None),

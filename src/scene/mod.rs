@@ -72,7 +72,9 @@ impl Aabb {
     }
 }
 
-/// A diffuse material: albedo = `base_color_factor` x texture(uv) (texture sRGB-decoded).
+/// A material: base colour = `base_color_factor` x texture(uv) (texture sRGB-decoded); with
+/// `gi.brdf = ggx` also glTF's metallic and (perceptual) roughness factors
+/// (`shaders/common/brdf.wgsl`). Lambert shading reads the base colour only.
 #[derive(Clone, Debug)]
 pub struct Material {
     pub name: String,
@@ -80,6 +82,10 @@ pub struct Material {
     pub base_color_factor: [f32; 4],
     /// Index into [`Scene::textures`], if the material has a base colour texture that loaded.
     pub base_color_texture: Option<usize>,
+    /// glTF `metallicFactor` (0 dielectric .. 1 metal).
+    pub metallic: f32,
+    /// glTF `roughnessFactor` (perceptual roughness; the GGX alpha is its square).
+    pub roughness: f32,
 }
 
 impl Default for Material {
@@ -88,6 +94,8 @@ impl Default for Material {
             name: "default".into(),
             base_color_factor: [0.8, 0.8, 0.8, 1.0],
             base_color_texture: None,
+            metallic: 0.0,
+            roughness: 1.0,
         }
     }
 }

@@ -1,11 +1,13 @@
 // Ground truth (the thesis's reference, chapter 7): every VPL of the frame evaluated at every
 // pixel with a BVH shadow ray, accumulated batch by batch (VPLs [begin, end) per dispatch) so
 // that no dispatch runs long:
-//   L(x) = rho_x / pi x sum_v flux_v / pi x cos_x x cos_v / max(d^2, eps^2) x V(x, v)
+//   L(x) = sum_v f(v_x, l_v) x flux_v / pi x cos_x x cos_v / max(d^2, eps^2) x V(x, v)
+// with f the frame's BRDF (common/brdf.wgsl; Lambert: rho_x / pi, factored out of the sum).
 // CPU twin: src/reference/gi.rs.
 #include "common/math.wgsl"
 #include "common/vpl.wgsl"
 #include "common/vpl_visibility.wgsl"
+#include "common/brdf.wgsl"
 
 struct GtParams {
     begin: u32,
@@ -15,7 +17,8 @@ struct GtParams {
     epsilon: f32,
     ray_offset: f32,
     shadow_rays: u32, // 1 trace shadow rays, 0 every VPL visible
-    _pad1: u32,
+    brdf: u32,        // BRDF_LAMBERT / BRDF_GGX
+    eye: vec4<f32>,   // xyz camera position
 };
 
 @group(0) @binding(0) var<uniform> params: GtParams;
@@ -49,12 +52,28 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if g.w == 0.0 {
         return;
     }
-    let nx = normalize(textureLoad(gb_normal, px, 0).xyz);
-    let albedo = textureLoad(gb_albedo, px, 0).rgb;
+    let nr = textureLoad(gb_normal, px, 0);
+    let nx = normalize(nr.xyz);
+    let albedo = textureLoad(gb_albedo, px, 0);
+    let k = gid.y * params.width + gid.x;
+    if params.brdf == BRDF_LAMBERT {
+        var sum = vec3<f32>(0.0);
+        for (var i = params.begin; i < params.end; i++) {
+            sum += vpl_irradiance_term(vpls[i], g.xyz, nx);
+        }
+        accum[k] += vec4<f32>(albedo.rgb / PI * sum, 0.0);
+        return;
+    }
+    // Glossy: the BRDF per VPL direction.
+    let v = normalize(params.eye.xyz - g.xyz);
     var sum = vec3<f32>(0.0);
     for (var i = params.begin; i < params.end; i++) {
-        sum += vpl_irradiance_term(vpls[i], g.xyz, nx);
+        let vp = vpls[i];
+        let t = vpl_irradiance_term(vp, g.xyz, nx);
+        if any(t > vec3<f32>(0.0)) {
+            let l = normalize(vp.position.xyz - g.xyz);
+            sum += brdf_eval(params.brdf, nx, v, l, albedo.rgb, albedo.a, nr.w) * t;
+        }
     }
-    let k = gid.y * params.width + gid.x;
-    accum[k] += vec4<f32>(albedo / PI * sum, 0.0);
+    accum[k] += vec4<f32>(sum, 0.0);
 }

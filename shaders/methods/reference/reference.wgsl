@@ -16,6 +16,7 @@
 #include "common/vpl.wgsl"
 #include "common/rsm_pyramid.wgsl"
 #include "common/box_term.wgsl"
+#include "common/brdf.wgsl"
 
 struct RefParams {
     width: u32,
@@ -26,6 +27,19 @@ struct RefParams {
     ray_offset: f32,
     flux_mix: f32,      // m above (> 0)
     seed: u32,
+    brdf: u32,          // BRDF_LAMBERT (rho / pi, factored out) or BRDF_GGX (per sample)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+    eye: vec4<f32>,     // xyz camera position
+};
+
+// The shading point's view direction and material (glossy shading).
+struct Shading {
+    v: vec3<f32>,
+    metallic: f32,
+    base: vec3<f32>,
+    roughness: f32,
 };
 
 @group(0) @binding(0) var<uniform> params: VplParams;
@@ -74,7 +88,7 @@ fn node_w(layer: u32, level: u32, x: u32, y: u32, wi: f32, wf: f32, p: vec3<f32>
 }
 
 // One sample: returns f / pmf (rgb, without rho/pi).
-fn sample_once(rng: ptr<function, Rng>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+fn sample_once(rng: ptr<function, Rng>, p: vec3<f32>, n: vec3<f32>, sh: Shading) -> vec3<f32> {
     // Light choice in proportion to its flux.
     var total = 0.0;
     for (var l = 0u; l < params.light_count; l++) {
@@ -148,7 +162,11 @@ fn sample_once(rng: ptr<function, Rng>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32>
     if g <= 0.0 || !vpl_visible(tp.xyz, tn, p, n, rp.ray_offset) {
         return vec3<f32>(0.0);
     }
-    return flux / PI * g / pmf;
+    if rp.brdf == BRDF_LAMBERT {
+        return flux / PI * g / pmf;
+    }
+    let l = normalize(tp.xyz - p);
+    return brdf_eval(rp.brdf, n, sh.v, l, sh.base, sh.metallic, sh.roughness) * flux / PI * g / pmf;
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -161,13 +179,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if g.w == 0.0 {
         return;
     }
-    let n = normalize(textureLoad(gb_normal, px, 0).xyz);
-    let albedo = textureLoad(gb_albedo, px, 0).rgb;
+    let nr = textureLoad(gb_normal, px, 0);
+    let n = normalize(nr.xyz);
+    let albedo = textureLoad(gb_albedo, px, 0);
+    let sh = Shading(normalize(rp.eye.xyz - g.xyz), albedo.a, albedo.rgb, nr.w);
     let k = gid.y * rp.width + gid.x;
     var sum = vec3<f32>(0.0);
     for (var s = 0u; s < rp.samples; s++) {
         var rng = rng_new(k, rp.first_sample + s, rp.seed ^ 0x5bd1e995u);
-        sum += sample_once(&rng, g.xyz, n);
+        sum += sample_once(&rng, g.xyz, n, sh);
     }
-    accum[k] += vec4<f32>(albedo / PI * sum, 0.0);
+    if rp.brdf == BRDF_LAMBERT {
+        sum *= albedo.rgb / PI;
+    }
+    accum[k] += vec4<f32>(sum, 0.0);
 }

@@ -29,6 +29,7 @@ pub static INFO: MethodInfo = MethodInfo {
     shadow_ray_switch: false,
     truth_of_vpls: false,
     one_bounce: false,
+    glossy: true,
     validate: |_: &RenderSettings| Ok(()),
     invalid_example: None,
     ui: |_, _, _| {},

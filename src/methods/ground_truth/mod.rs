@@ -40,6 +40,7 @@ pub static INFO: MethodInfo = MethodInfo {
     shadow_ray_switch: true,
     truth_of_vpls: true,
     one_bounce: false,
+    glossy: true,
     validate,
     invalid_example: Some(|s| {
         s.gi.rays_per_frame = 0;
@@ -123,7 +124,8 @@ impl Method for GroundTruth {
             epsilon: g.distance_epsilon,
             ray_offset: g.ray_offset,
             shadow_rays: g.shadow_rays as u32,
-            _pad: 0,
+            brdf: cx.brdf.gpu(),
+            eye: cx.eye.extend(0.0).to_array(),
         };
         gt.progress.done = self.pass.record(
             cx.device,

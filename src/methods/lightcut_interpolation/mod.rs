@@ -144,6 +144,7 @@ pub static INFO: MethodInfo = MethodInfo {
     shadow_ray_switch: true,
     truth_of_vpls: false,
     one_bounce: false,
+    glossy: false,
     validate,
     invalid_example: Some(invalid_example),
     ui: ui::settings_ui,

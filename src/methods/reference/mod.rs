@@ -48,6 +48,7 @@ pub static INFO: MethodInfo = MethodInfo {
     shadow_ray_switch: false,
     truth_of_vpls: false,
     one_bounce: false,
+    glossy: true,
     validate,
     invalid_example: Some(|s| {
         s.gi.reference_flux_mix = 0.0;
@@ -138,6 +139,9 @@ impl Method for Reference {
                 ray_offset: g.ray_offset,
                 flux_mix: g.reference_flux_mix,
                 seed: cx.settings.vpl.seed,
+                brdf: cx.brdf.gpu(),
+                _pad: [0; 3],
+                eye: cx.eye.extend(0.0).to_array(),
             };
             self.pass.record(
                 cx.device,
@@ -204,7 +208,8 @@ impl Method for Reference {
                         epsilon: g.distance_epsilon,
                         ray_offset: g.ray_offset,
                         shadow_rays: 1,
-                        _pad: 0,
+                        brdf: cx.brdf.gpu(),
+                        eye: cx.eye.extend(0.0).to_array(),
                     };
                     self.shade.record(
                         cx.device,

@@ -28,6 +28,11 @@ pub struct GpuRefParams {
     pub ray_offset: f32,
     pub flux_mix: f32,
     pub seed: u32,
+    /// The BRDF model (`Brdf::gpu`).
+    pub brdf: u32,
+    pub _pad: [u32; 3],
+    /// xyz the camera's position.
+    pub eye: [f32; 4],
 }
 
 pub struct ReferencePass {

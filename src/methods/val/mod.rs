@@ -185,6 +185,7 @@ const fn info(
         shadow_ray_switch: true,
         truth_of_vpls: false,
         one_bounce: true,
+        glossy: false,
         validate,
         invalid_example: Some(invalid_example),
         ui: ui::settings_ui,

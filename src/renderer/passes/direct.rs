@@ -17,6 +17,8 @@ pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Floa
 pub struct DirectPass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    /// `DirectParams`: x = the BRDF model (`Brdf::gpu`).
+    params: wgpu::Buffer,
 }
 
 impl DirectPass {
@@ -38,16 +40,29 @@ impl DirectPass {
                 float_texture_entry(4),
                 float_texture_entry(5),
                 storage_texture_entry(6, RADIANCE_FORMAT),
+                uniform_entry(7, c),
             ],
         });
         let pipeline = compute_pipeline(device, "direct::pipeline", &[Some(&layout)], &module, "main");
-        Ok(Self { pipeline, layout })
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("direct::params"),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            pipeline,
+            layout,
+            params,
+        })
     }
 
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        brdf: u32,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
         camera: &wgpu::Buffer,
@@ -57,6 +72,7 @@ impl DirectPass {
         out: &wgpu::TextureView,
         size: (u32, u32),
     ) {
+        queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&[brdf, 0u32, 0, 0]));
         let tv = wgpu::BindingResource::TextureView;
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("direct::bind_group"),
@@ -89,6 +105,10 @@ impl DirectPass {
                 wgpu::BindGroupEntry {
                     binding: 6,
                     resource: tv(out),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: self.params.as_entire_binding(),
                 },
             ],
         });

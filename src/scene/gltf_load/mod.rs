@@ -284,6 +284,10 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                 .unwrap_or_else(|| format!("material{i}")),
             base_color_factor: factor,
             base_color_texture: tex,
+            // glTF's defaults are 1 and 1; out-of-range or non-finite factors are clamped to
+            // the nearest valid value (NaN: the default).
+            metallic: clamp_factor(pbr.metallic_factor()),
+            roughness: clamp_factor(pbr.roughness_factor()),
         });
         material_uv_set.push(set);
     }
@@ -676,4 +680,9 @@ fn make_camera(name: &str, world: &Mat4, yfov: f32, znear: f32, warnings: &mut W
 fn finite_far(cam: &Camera, bounds: &Aabb) -> f32 {
     let d = (cam.position - bounds.center()).length() + bounds.radius();
     (2.0 * d).max(cam.znear * 1000.0).max(1.0)
+}
+
+/// A glTF factor in [0, 1]: clamped, NaN to the default 1.
+fn clamp_factor(v: f32) -> f32 {
+    if v.is_nan() { 1.0 } else { v.clamp(0.0, 1.0) }
 }
