@@ -212,7 +212,7 @@ fn ggx_is_refused_by_methods_that_shade_with_lambert_only() {
     let e = one_line_error(&[
         "render",
         "--method",
-        "slc",
+        "light-culling",
         "--set",
         "gi.brdf=\"Ggx\"",
         "--out",
@@ -222,13 +222,25 @@ fn ggx_is_refused_by_methods_that_shade_with_lambert_only() {
     let e = one_line_error(&[
         "sheet",
         "--methods",
-        "slc",
+        "slc,val",
         "--brdf",
         "ggx",
         "--out",
         "/tmp/x.png",
     ]);
     assert!(e.contains("Lambert only"), "{e}");
+    // The tree samplers shade with GGX, but not through their albedo-demodulated paths.
+    let e = one_line_error(&[
+        "render",
+        "--method",
+        "slc",
+        "--brdf",
+        "ggx",
+        "--half-res",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("gi.brdf = Ggx with sampling.half_resolution"), "{e}");
     let e = one_line_error(&["render", "--brdf", "phong", "--out", "/tmp/x"]);
     assert!(e.contains("phong"), "{e}");
 }

@@ -1143,3 +1143,91 @@ fn ism_visibility_looks_samples_up_in_the_leaves_maps_as_the_cpu_does() {
     );
     assert!(m.mean_ratio > 0.8 && m.mean_ratio < 1.3, "{m:?}");
 }
+
+/// The default room with every material set to (metallic, roughness).
+fn glossy_room(metallic: f32, roughness: f32) -> lightcut::scene::Scene {
+    let mut scene = lightcut::scene::default_scene::build();
+    for m in &mut scene.materials {
+        (m.metallic, m.roughness) = (metallic, roughness);
+    }
+    scene
+}
+
+/// Means over 8 -> 128 accumulated frames against `gt`: (frames, RMSE, block error, mean ratio).
+fn converge(st: &mut Setup, gt: &lightcut::renderer::readback::ImageF32) -> Vec<(u32, f64, f64, f64)> {
+    st.frame();
+    assert_eq!(st.r.sampling_frames(), 1, "the average restarts");
+    let mut errs = Vec::new();
+    for target in [8u32, 32, 128] {
+        while st.r.sampling_frames() < target {
+            st.frame();
+        }
+        let img = st.indirect();
+        let m = metrics::compare(&img, gt, 3.0, lightcut::renderer::settings::Tonemap::Aces);
+        errs.push((target, m.rmse, block_error(&img, gt), m.mean_ratio));
+    }
+    errs
+}
+
+#[test]
+fn with_ggx_glossy_samples_walk_to_leaves_so_the_samplers_converge_on_metal() {
+    // SST paper section 4.3: a sample of the glossy part ignores substitutes and walks to a
+    // leaf VPL. On an all-metal room (no diffuse part) every sample is glossy, so SLC and SST
+    // become unbiased for the frame's VPLs; RTSLC shades leaves with the whole BRDF on a
+    // mixed room. Each mean over frames converges to the GGX ground truth at 1/sqrt(frames).
+    let Some(ctx) = common::gpu() else { return };
+    let ggx = lightcut::renderer::settings::Brdf::Ggx;
+    for (method, scene) in [
+        (SLC, glossy_room(1.0, 0.6)),
+        (SST, glossy_room(1.0, 0.6)),
+        (RTSLC, glossy_room(0.5, 0.4)),
+    ] {
+        let mut s = settings(method);
+        s.gi.brdf = ggx;
+        let mut st = Setup::with_scene(&ctx, scene, s, (W, H));
+        let gt = st.ground_truth_of_these_vpls();
+        st.set(|s| {
+            s.gi.method = method;
+            s.sampling.block_size = 1;
+            s.sampling.accumulate = true;
+        });
+        let errs = converge(&mut st, &gt);
+        eprintln!("{method} with GGX vs ground truth (frames, RMSE, block error, mean ratio): {errs:?}");
+        let (_, r8, b8, _) = errs[0];
+        let (_, r128, b128, m128) = errs[2];
+        assert!(
+            r8 / r128 > 2.5 && r8 / r128 < 7.5,
+            "{method}: RMSE ratio {}",
+            r8 / r128
+        );
+        assert!(b8 / b128 > 2.5, "{method}: block error ratio {}", b8 / b128);
+        assert!(
+            (m128 - 1.0).abs() < 0.02,
+            "{method}: mean ratio after 128 frames {m128}"
+        );
+        assert!(ctx.errors.take().is_empty());
+    }
+}
+
+#[test]
+fn with_ggx_diffuse_samples_keep_their_substitutes() {
+    // A rough dielectric room: most samples take the diffuse part and stop at substitutes as
+    // with Lambert, so SLC's steps per traversal stay below RTSLC's (which walks to leaves).
+    let Some(ctx) = common::gpu() else { return };
+    let mut steps = Vec::new();
+    for method in [SLC, RTSLC] {
+        let mut s = settings(method);
+        s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
+        let mut st = Setup::with_scene(&ctx, glossy_room(0.0, 0.8), s, (W, H));
+        st.frame();
+        st.frame();
+        let stats = st.r.sampling_stats_blocking().expect("stats");
+        steps.push(stats.steps_per_traversal());
+        assert!(ctx.errors.take().is_empty());
+    }
+    eprintln!(
+        "steps per traversal with GGX: SLC {:.2}, RTSLC {:.2}",
+        steps[0], steps[1]
+    );
+    assert!(steps[0] < 0.8 * steps[1], "{steps:?}");
+}

@@ -768,15 +768,17 @@ fn the_brdf_combo_reaches_the_renderer_and_lambert_only_methods_say_so() {
     drop(h);
     // A Lambert-only method: the note under the combo.
     let mut s = slc_settings();
+    s.gi.method = lightcut::methods::lightcuts::ID;
+    s.vpl.count = 64;
     s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
     let options = AppOptions {
         settings: Some(s),
         view: Some(ViewBuffer::Albedo),
         ..Default::default()
     };
-    let Some(mut h) = harness_with(egui::vec2(700.0, 1700.0), options) else {
+    let Some(mut h) = harness_with(egui::vec2(500.0, 1700.0), options) else {
         return;
     };
-    h.run_steps(2);
+    h.run_steps(1);
     h.get_by_label_contains("shades with Lambert only so far");
 }

@@ -28,7 +28,8 @@ struct SlcParams {
     interleave: u32,        // n of the n x n slot interleaving (1 = off)
     interleave_offset: u32, // the frame's subset offset
     radix: u32,             // 1: the radix tree (children from tree_links), 0: the perfect tree
-    _pad1: u32,
+    brdf: u32,              // BRDF_LAMBERT / BRDF_GGX (common/brdf.wgsl)
+    eye: vec4<f32>,         // xyz camera position (glossy shading's view direction)
 };
 
 // The pixel whose G-buffer sample builds block b's cut.

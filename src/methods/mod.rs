@@ -147,11 +147,12 @@ impl MethodId {
             wanted
         }
     }
-    /// The refusal of `gi.brdf = ggx` for a method that shades with Lambert only.
+    /// The refusal of `gi.brdf = ggx` for a method that shades with Lambert only (the tree
+    /// samplers' own limits, half resolution and interleaving, are in their `validate`).
     pub fn refuses_brdf(self, brdf: crate::renderer::settings::Brdf) -> Option<String> {
         (brdf != crate::renderer::settings::Brdf::Lambert && !self.info().glossy).then(|| {
             format!(
-                "brdf {}: {} shades with Lambert only so far (GGX: the ground truth, the reference and the direct light)",
+                "brdf {}: {} shades with Lambert only so far (GGX: the ground truth, the reference, SLC, SST, RTSLC and the direct light)",
                 brdf.name(),
                 self.info().label
             )

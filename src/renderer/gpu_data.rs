@@ -313,7 +313,10 @@ pub struct GpuSlcParams {
     pub interleave_offset: u32,
     /// 1: the radix tree (children from its links; `TreeKind::Lbvh`), 0: the perfect tree.
     pub radix: u32,
-    pub _pad: u32,
+    /// The BRDF model (`Brdf::gpu`).
+    pub brdf: u32,
+    /// xyz the camera's position.
+    pub eye: [f32; 4],
 }
 
 /// Twin: `GtParams` in `shaders/methods/ground_truth/ground_truth.wgsl`.
@@ -904,7 +907,8 @@ mod tests {
                     offset_of!(GpuSlcParams, interleave),
                     offset_of!(GpuSlcParams, interleave_offset),
                     offset_of!(GpuSlcParams, radix),
-                    offset_of!(GpuSlcParams, _pad),
+                    offset_of!(GpuSlcParams, brdf),
+                    offset_of!(GpuSlcParams, eye),
                 ],
             ),
             (

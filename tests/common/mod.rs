@@ -80,7 +80,11 @@ pub struct Setup {
 
 impl Setup {
     pub fn new(ctx: &GpuContext, s: RenderSettings, size: (u32, u32)) -> Setup {
-        let scene = default_scene::build();
+        Setup::with_scene(ctx, default_scene::build(), s, size)
+    }
+    /// The fixture on `scene` (the default scene's materials changed, say).
+    #[allow(dead_code)]
+    pub fn with_scene(ctx: &GpuContext, scene: Scene, s: RenderSettings, size: (u32, u32)) -> Setup {
         let cam = scene.camera_or_default(None).unwrap();
         let r = Renderer::new(ctx.clone(), &scene, size, s).unwrap();
         Setup { r, scene, cam }

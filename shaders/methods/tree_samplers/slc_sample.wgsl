@@ -26,6 +26,7 @@
 #include "common/slc_params.wgsl"
 #include "common/stats64.wgsl"
 #include "common/ism.wgsl"
+#include "common/brdf.wgsl"
 
 @group(0) @binding(0) var<uniform> sp: SlcParams;
 @group(0) @binding(1) var<storage, read> tree: array<SstNode>;
@@ -91,13 +92,15 @@ struct Walk {
     steps: u32,
 };
 
-// Descends from `start`; node 0 = dead branch (both children weigh 0).
-fn traverse(start: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: u32) -> Walk {
+// Descends from `start`; node 0 = dead branch (both children weigh 0). `leaves_only`: the
+// glossy samples' walk, which ignores substitutes (SST paper, section 4.3).
+fn traverse(start: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: u32,
+    leaves_only: bool) -> Walk {
     var node = start;
     var prob = 1.0;
     var steps = 0u;
     loop {
-        if node >= sp.leaves || (sp.method != 2u && is_usable(node)
+        if node >= sp.leaves || (!leaves_only && sp.method != 2u && is_usable(node)
             && slc_far_enough(tree[node], x, sp.epsilon, sp.near_field)) {
             break;
         }
@@ -132,9 +135,10 @@ fn gauss2(rng: ptr<function, Rng>) -> vec2<f32> {
     return r * vec2<f32>(cos(TAU * u2), sin(TAU * u2));
 }
 
-// Flux/pi x G x V of cluster `node` at x (without rho/pi).
+// Flux/pi x G x V of cluster `node` at x (without the BRDF); `point` receives the light
+// point (the VPL or the substitute sample).
 fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: u32,
-    rays: ptr<function, u32>) -> vec3<f32> {
+    rays: ptr<function, u32>, point: ptr<function, vec3<f32>>) -> vec3<f32> {
     var pv: vec3<f32>;
     var nv: vec3<f32>;
     var flux: vec3<f32>;
@@ -156,6 +160,7 @@ fn evaluate(node: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: 
             c.bbox_min, c.bbox_max);
         flux = c.intensity;
     }
+    *point = pv;
     let geo = vpl_geometry(pv, nv, x, n, sp.epsilon);
     var lit = geo > 0.0;
     if lit && sp.shadow_rays == 2u {
@@ -250,8 +255,25 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
 
 fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
     let k = px.y * sp.width + px.x;
-    let n = normalize(textureLoad(gb_normal, vec2<i32>(px), 0).xyz);
-    let albedo = textureLoad(gb_albedo, vec2<i32>(px), 0).rgb;
+    let nr = textureLoad(gb_normal, vec2<i32>(px), 0);
+    let n = normalize(nr.xyz);
+    let albedo4 = textureLoad(gb_albedo, vec2<i32>(px), 0);
+    let albedo = albedo4.rgb;
+    // Glossy shading (gi.brdf = GGX; SST paper section 4.3): each sample picks the diffuse or
+    // the glossy part of the BRDF by the size of its material term (p_glossy); diffuse samples
+    // walk as the method does (substitutes allowed), glossy ones walk to leaf VPLs. RTSLC
+    // always ends at leaves and shades with the whole BRDF.
+    let glossy_brdf = sp.brdf != BRDF_LAMBERT;
+    let v = normalize(sp.eye.xyz - x);
+    let metallic = albedo4.a;
+    let roughness = nr.w;
+    var p_glossy = 0.0;
+    if glossy_brdf && sp.method != 2u {
+        let f0 = brdf_f0(albedo, metallic);
+        let spec_term = luminance(brdf_schlick(f0, max(dot(n, v), 0.0)));
+        let diff_term = (1.0 - metallic) * luminance(albedo);
+        p_glossy = select(1.0, spec_term / (spec_term + diff_term), spec_term + diff_term > 0.0);
+    }
     var rng = rng_new(k, sp.seed, 0x51c5u);
 
     // Blending weights of the 4 surrounding blocks (Algorithm 1).
@@ -415,7 +437,12 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
         if start == 0u {
             continue;
         }
-        let walk = traverse(start, x, n, &rng, tb);
+        // The lobe of this sample (a glossy BRDF only; RTSLC takes the whole BRDF).
+        var glossy_sample = false;
+        if glossy_brdf && sp.method != 2u {
+            glossy_sample = rng_next(&rng) < p_glossy;
+        }
+        let walk = traverse(start, x, n, &rng, tb, glossy_sample);
         steps += walk.steps;
         walks += 1u;
         if tb != NO_TRACE {
@@ -430,7 +457,18 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
             continue;
         }
         evaluated += 1u;
-        let c = evaluate(walk.node, x, n, &rng, tb, &rays) / walk.prob;
+        var point = vec3<f32>(0.0);
+        var c = evaluate(walk.node, x, n, &rng, tb, &rays, &point) / walk.prob;
+        if glossy_brdf {
+            let l = normalize(point - x);
+            if sp.method == 2u {
+                c *= brdf_eval(sp.brdf, n, v, l, albedo, metallic, roughness);
+            } else if glossy_sample {
+                c *= brdf_specular(sp.brdf, n, v, l, albedo, metallic, roughness) / p_glossy;
+            } else {
+                c *= brdf_diffuse(sp.brdf, n, v, l, albedo, metallic) / (1.0 - p_glossy);
+            }
+        }
         if tb != NO_TRACE {
             trace[tb + 10u] = bitcast<u32>(c.x);
             trace[tb + 11u] = bitcast<u32>(c.y);
@@ -463,7 +501,10 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
     // Demodulated (half-resolution GI, interleaving): without the albedo, which the upsampler
     // or the interleaving's filter applies.
     var radiance = albedo / PI * sum;
-    if sp.demodulate != 0u {
+    if glossy_brdf {
+        // The BRDF is in every sample (validation keeps demodulation off with it).
+        radiance = sum;
+    } else if sp.demodulate != 0u {
         radiance = sum / PI;
     }
     if sp.accumulate == 0u {

@@ -50,6 +50,7 @@ pub static INFO: MethodInfo = MethodInfo {
     tests: &[
         "vpl::ground_truth_on_the_gpu_equals_a_cpu_evaluation_of_the_same_vpls",
         "slc::the_comparison_ground_truth_equals_the_ground_truth_method",
+        "vpl::ground_truth_with_ggx_equals_a_cpu_evaluation_with_the_brdf",
     ],
     sweep: None,
 };

@@ -59,6 +59,7 @@ pub static INFO: MethodInfo = MethodInfo {
         "vpl::converged_reference_converges_to_the_exact_sum_over_all_texels",
         "vpl::raising_the_reference_target_continues_and_a_view_change_restarts",
         "light_paths::the_n_bounce_reference_converges_to_the_mean_ground_truth_of_fresh_vpls",
+        "vpl::converged_reference_with_ggx_converges_to_the_exact_brdf_sum",
     ],
     sweep: None,
 };

@@ -109,6 +109,7 @@ const READS: &[Resource] = &[
 ];
 const TESTS: &[&str] = &[
     "slc::gpu_cuts_equal_the_cpu_cuts_and_are_valid",
+    "slc::with_ggx_glossy_samples_walk_to_leaves_so_the_samplers_converge_on_metal",
     "slc::blending_picks_cuts_by_their_weights_and_falls_back_to_the_mock_cut",
     "slc::rtslc_averaged_over_frames_converges_to_the_ground_truth",
     "slc::slc_without_usable_inner_nodes_equals_rtslc_and_steps_order_as_the_thesis_says",
@@ -156,7 +157,7 @@ pub static SLC_INFO: MethodInfo = MethodInfo {
     shadow_ray_switch: true,
     truth_of_vpls: false,
     one_bounce: false,
-    glossy: false,
+    glossy: true,
     validate,
     invalid_example: Some(invalid_cut_size),
     ui: ui::settings_ui,
@@ -188,7 +189,7 @@ pub static SST_INFO: MethodInfo = MethodInfo {
     shadow_ray_switch: true,
     truth_of_vpls: false,
     one_bounce: false,
-    glossy: false,
+    glossy: true,
     validate,
     invalid_example: Some(invalid_cut_size),
     ui: ui::settings_ui,
@@ -221,7 +222,7 @@ pub static RTSLC_INFO: MethodInfo = MethodInfo {
     shadow_ray_switch: true,
     truth_of_vpls: false,
     one_bounce: false,
-    glossy: false,
+    glossy: true,
     validate,
     invalid_example: Some(invalid_cut_size),
     ui: ui::settings_ui,
@@ -233,6 +234,21 @@ pub static RTSLC_INFO: MethodInfo = MethodInfo {
 fn validate(s: &RenderSettings) -> Result<(), String> {
     let sm = &s.sampling;
     sm.ism.validate("sampling")?;
+    // Half-resolution GI and the interleaving's filter work on the GI without the albedo
+    // (Lambert's rho / pi factored out), which a glossy BRDF does not allow.
+    if s.gi.method.samples_tree()
+        && s.gi.brdf == crate::renderer::settings::Brdf::Ggx
+        && (sm.half_resolution || sm.interleave.filters())
+    {
+        return Err(format!(
+            "gi.brdf = Ggx with {}: the tree samplers' half-resolution GI and interleaving filter divide out Lambert's albedo / pi; use gi.brdf = Lambert or turn them off",
+            if sm.half_resolution {
+                "sampling.half_resolution"
+            } else {
+                "sampling.interleave (n > 1 or a filter radius)"
+            }
+        ));
+    }
     if !(1..=64).contains(&sm.block_size) {
         return Err(format!(
             "sampling.block_size {} is out of range (1..=64)",
@@ -536,7 +552,8 @@ impl Method for TreeSamplers {
             interleave: il.n,
             interleave_offset: Interleave::offset_of(il.n, seed),
             radix: (cx.tree.kind == TreeKind::Lbvh) as u32,
-            _pad: 0,
+            brdf: cx.brdf.gpu(),
+            eye: cx.eye.extend(0.0).to_array(),
         };
         // A timed frame leaves the last diagnostic frame's story (and statistics) in place.
         if cx.diagnostics {
