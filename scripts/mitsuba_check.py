@@ -44,6 +44,9 @@ def parse_args(argv=None):
     p.add_argument("--indirect-spp", type=int, default=None,
                    help="samples per pixel for the two indirect renders (default: --spp)")
     p.add_argument("--indirect", action="store_true", help="also compare the indirect light (needs ours/indirect.exr)")
+    p.add_argument("--brdf", choices=["lambert", "ggx"], default="lambert",
+                   help="ggx: the workbench's GGX BRDF (as a Python BSDF) with the exported metallic / roughness; "
+                        "ours rendered with `render --brdf ggx`")
     p.add_argument("--bounces", type=int, default=1,
                    help="diffuse bounces of the indirect part: path max_depth = bounces + 2 (ours: render --bounces)")
     p.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (scalar_rgb, llvm_ad_rgb, ...)")
@@ -88,8 +91,108 @@ def load_texture(mi, path: Path, factor, flip_v: bool):
     return mi.Bitmap(np.ascontiguousarray(rgb.astype(np.float32)), mi.Bitmap.PixelFormat.RGB)
 
 
+def register_lightcut_ggx(mi):
+    """Registers `lightcut_ggx`: the workbench's GGX BRDF (shaders/common/brdf.wgsl) as a
+    Mitsuba BSDF, so that `--brdf ggx` compares the same BRDF (Mitsuba's roughconductor /
+    principled differ in their Fresnel and diffuse terms). Sampling: half cosine, half GGX
+    half-vectors (the pdf is the mixture's); eval / pdf in the local shading frame."""
+    import drjit as dr
+
+    class LightcutGgx(mi.BSDF):
+        def __init__(self, props):
+            mi.BSDF.__init__(self, props)
+            self.base = props.get_texture("base")
+            self.metallic = props["metallic"]
+            self.roughness = props["roughness"]
+            flags = (mi.BSDFFlags.DiffuseReflection | mi.BSDFFlags.GlossyReflection
+                     | mi.BSDFFlags.FrontSide)
+            self.m_components = [flags]
+            self.m_flags = flags
+
+        def _alpha(self):
+            return max(self.roughness * self.roughness, 0.002)
+
+        def _f(self, si, wi, wo, active):
+            nv = mi.Frame3f.cos_theta(wi)
+            nl = mi.Frame3f.cos_theta(wo)
+            active = active & (nv > 0) & (nl > 0)
+            base = self.base.eval(si, active)
+            f0 = dr.lerp(mi.Color3f(0.04), base, self.metallic)
+
+            def schlick(u):
+                m = 1.0 - dr.clip(u, 0.0, 1.0)
+                m2 = m * m
+                return f0 + (1.0 - f0) * (m2 * m2 * m)
+
+            h = dr.normalize(wi + wo)
+            nh = dr.maximum(mi.Frame3f.cos_theta(h), 0.0)
+            a = self._alpha()
+            a2 = a * a
+            q = nh * nh * (a2 - 1.0) + 1.0
+            d = a2 / (dr.pi * q * q)
+            vis = 0.5 / (nl * dr.sqrt(nv * nv * (1.0 - a2) + a2) + nv * dr.sqrt(nl * nl * (1.0 - a2) + a2))
+            spec = schlick(dr.dot(wi, h)) * (d * vis)
+            diff = (1.0 - self.metallic) * base * (1.0 - schlick(nv)) * (1.0 - schlick(nl)) / dr.pi
+            return dr.select(active, diff + spec, 0.0), active
+
+        def _pdf(self, wi, wo, active):
+            nl = mi.Frame3f.cos_theta(wo)
+            h = dr.normalize(wi + wo)
+            nh = dr.maximum(mi.Frame3f.cos_theta(h), 0.0)
+            a = self._alpha()
+            a2 = a * a
+            q = nh * nh * (a2 - 1.0) + 1.0
+            d = a2 / (dr.pi * q * q)
+            pdf_s = d * nh / (4.0 * dr.maximum(dr.abs(dr.dot(wi, h)), 1e-8))
+            pdf = 0.5 * pdf_s + 0.5 * dr.maximum(nl, 0.0) / dr.pi
+            return dr.select(active & (nl > 0), pdf, 0.0)
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            wi = si.wi
+            active = active & (mi.Frame3f.cos_theta(wi) > 0)
+            a = self._alpha()
+            a2 = a * a
+            u1, u2 = sample2.x, sample2.y
+            # GGX half-vector by inverting D's cdf in cos(theta_h).
+            c = dr.sqrt(dr.maximum((1.0 - u1) / (1.0 + (a2 - 1.0) * u1), 0.0))
+            st = dr.sqrt(dr.maximum(1.0 - c * c, 0.0))
+            phi = 2.0 * dr.pi * u2
+            h = mi.Vector3f(st * dr.cos(phi), st * dr.sin(phi), c)
+            wo_s = 2.0 * dr.dot(wi, h) * h - wi
+            wo_d = mi.warp.square_to_cosine_hemisphere(sample2)
+            wo = dr.select(sample1 < 0.5, wo_s, wo_d)
+            f, ok = self._f(si, wi, wo, active)
+            pdf = self._pdf(wi, wo, ok)
+            bs = mi.BSDFSample3f()
+            bs.wo = wo
+            bs.pdf = pdf
+            bs.eta = 1.0
+            bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
+            bs.sampled_component = 0
+            w = dr.select(ok & (pdf > 0), f * mi.Frame3f.cos_theta(wo) / dr.maximum(pdf, 1e-20), 0.0)
+            return bs, w
+
+        def eval(self, ctx, si, wo, active=True):
+            f, ok = self._f(si, si.wi, wo, active)
+            return dr.select(ok, f * mi.Frame3f.cos_theta(wo), 0.0)
+
+        def pdf(self, ctx, si, wo, active=True):
+            return self._pdf(si.wi, wo, active & (mi.Frame3f.cos_theta(si.wi) > 0))
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+
+        def traverse(self, callback):
+            callback.put_parameter("metallic", self.metallic, mi.ParamFlags.NonDifferentiable)
+
+        def to_string(self):
+            return f"LightcutGgx[metallic={self.metallic}, roughness={self.roughness}]"
+
+    mi.register_bsdf("lightcut_ggx", lambda props: LightcutGgx(props))
+
+
 def build_scene_dict(mi, scene_dir: Path, meta: dict, width: int, height: int, sampler: str, spp: int,
-                     flip_v: bool) -> dict:
+                     flip_v: bool, brdf: str = "lambert") -> dict:
     cam = meta["camera"]
     eye = np.asarray(cam["position"], dtype=float)
     fwd = np.asarray(cam["forward"], dtype=float)
@@ -137,7 +240,10 @@ def build_scene_dict(mi, scene_dir: Path, meta: dict, width: int, height: int, s
             "type": "ply",
             "filename": str(scene_dir / m["mesh"]),
             "face_normals": False,  # use the exported vertex normals as shading normals
-            "bsdf": {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": refl}},
+            "bsdf": {"type": "twosided", "bsdf": (
+                {"type": "diffuse", "reflectance": refl} if brdf == "lambert" else
+                {"type": "lightcut_ggx", "base": refl, "metallic": float(m.get("metallic", 1.0)),
+                 "roughness": float(m.get("roughness", 1.0))})},
         }
         n_mesh += 1
     if n_mesh == 0:
@@ -483,7 +589,10 @@ def main(argv=None) -> int:
 
     t0 = time.time()
     per = spp_split(a.spp)
-    scene = mi.load_dict(build_scene_dict(mi, a.scene_dir, meta, a.width, a.height, a.sampler, per, a.flip_v))
+    if a.brdf == "ggx":
+        register_lightcut_ggx(mi)
+    scene = mi.load_dict(build_scene_dict(mi, a.scene_dir, meta, a.width, a.height, a.sampler, per, a.flip_v,
+                                          a.brdf))
     t_load = time.time() - t0
 
     report = {
@@ -498,6 +607,7 @@ def main(argv=None) -> int:
         "camera": meta["camera"],
         "sun": meta.get("sun", []),
         "flip_v": a.flip_v,
+        "brdf": a.brdf,
         "seed": a.seed,
         "ours_supersampling": ours_ss,
         "scene_load_s": t_load,
@@ -516,7 +626,7 @@ def main(argv=None) -> int:
                 and old.get("splits") == a.splits and old.get("seed") == a.seed
                 and old.get("width") == a.width and old.get("height") == a.height
                 and old.get("camera") == meta["camera"] and old.get("sun") == meta.get("sun", [])
-                and old.get("flip_v") == a.flip_v
+                and old.get("flip_v") == a.flip_v and old.get("brdf", "lambert") == a.brdf
                 and old.get("parts", {}).get(part, {}).get("spp") == spp_total)
         files = [a.reuse_mitsuba / f"mitsuba_{part}_split{k}.exr" for k in range(a.splits)]
         if not same or not all(f.exists() for f in files):
@@ -556,7 +666,7 @@ def main(argv=None) -> int:
         scene_i = scene
         if per_i != per:
             scene_i = mi.load_dict(build_scene_dict(mi, a.scene_dir, meta, a.width, a.height, a.sampler, per_i,
-                                                    a.flip_v))
+                                                    a.flip_v, a.brdf))
         t0 = time.time()
         # One bounce keeps the part's old name (and its cached images); N bounces: indirectN.
         part = "indirect" if a.bounces == 1 else f"indirect{a.bounces}"

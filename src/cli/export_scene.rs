@@ -168,6 +168,9 @@ fn jstr(s: &str) -> String {
 struct MaterialEntry {
     name: String,
     albedo: [f32; 3],
+    /// glTF metallic and roughness factors (`gi.brdf = ggx`).
+    metallic: f32,
+    roughness: f32,
     texture: Option<String>,
     mesh: Option<String>,
     triangles: usize,
@@ -176,7 +179,8 @@ struct MaterialEntry {
 /// The JSON document:
 /// `{ "format", "scene", "camera": {name, position, forward, up, yfov_deg},
 ///    "sun": [{name, direction (travel), irradiance [r,g,b] W/m^2}],
-///    "materials": [{name, albedo, texture, mesh, triangles}], "bounds": {min, max},
+///    "materials": [{name, albedo, metallic, roughness, texture, mesh, triangles}],
+///    "bounds": {min, max},
 ///    "uv_origin": "top-left" }`.
 fn scene_json(scene: &Scene, cam: &Camera, materials: &[MaterialEntry]) -> String {
     let mut j = String::new();
@@ -217,10 +221,12 @@ fn scene_json(scene: &Scene, cam: &Camera, materials: &[MaterialEntry]) -> Strin
         let opt = |s: &Option<String>| s.as_deref().map(jstr).unwrap_or_else(|| "null".into());
         let _ = write!(
             j,
-            "{}\n    {{\"name\": {}, \"albedo\": {}, \"texture\": {}, \"mesh\": {}, \"triangles\": {}}}",
+            "{}\n    {{\"name\": {}, \"albedo\": {}, \"metallic\": {}, \"roughness\": {}, \"texture\": {}, \"mesh\": {}, \"triangles\": {}}}",
             if i == 0 { "" } else { "," },
             jstr(&m.name),
             vec3(m.albedo),
+            num(m.metallic),
+            num(m.roughness),
             opt(&m.texture),
             opt(&m.mesh),
             m.triangles
@@ -337,6 +343,8 @@ pub fn run(args: &ExportSceneArgs) -> anyhow::Result<()> {
         entries.push(MaterialEntry {
             name: m.name.clone(),
             albedo,
+            metallic: m.metallic,
+            roughness: m.roughness,
             texture,
             mesh,
             triangles: part.faces.len(),

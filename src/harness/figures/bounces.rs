@@ -95,7 +95,12 @@ pub fn bounces(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 });
                 let m = b.measure(&s, o.size, o.per_config(), true)?;
                 let gi = m.gi_ms().0;
-                let paths = m.pass_ms(&LIGHT_PATH_PASSES).0;
+                // One bounce runs no light-path pass.
+                let paths = if n > 1 {
+                    m.pass_ms(&LIGHT_PATH_PASSES).0
+                } else {
+                    0.0
+                };
                 let (r, rs) = m.rmse();
                 let rel = r / gt_mean.max(1e-30);
                 csv.row(vec![
