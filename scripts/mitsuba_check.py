@@ -112,6 +112,13 @@ def register_lightcut_ggx(mi):
         def _alpha(self):
             return max(self.roughness * self.roughness, 0.002)
 
+        def _d(self, h):
+            """GGX's D(h) and cos(theta_h) (h in the local frame)."""
+            nh = dr.maximum(mi.Frame3f.cos_theta(h), 0.0)
+            a2 = self._alpha() ** 2
+            q = nh * nh * (a2 - 1.0) + 1.0
+            return a2 / (dr.pi * q * q), nh
+
         def _f(self, si, wi, wo, active):
             nv = mi.Frame3f.cos_theta(wi)
             nl = mi.Frame3f.cos_theta(wo)
@@ -125,11 +132,8 @@ def register_lightcut_ggx(mi):
                 return f0 + (1.0 - f0) * (m2 * m2 * m)
 
             h = dr.normalize(wi + wo)
-            nh = dr.maximum(mi.Frame3f.cos_theta(h), 0.0)
-            a = self._alpha()
-            a2 = a * a
-            q = nh * nh * (a2 - 1.0) + 1.0
-            d = a2 / (dr.pi * q * q)
+            d, _ = self._d(h)
+            a2 = self._alpha() ** 2
             vis = 0.5 / (nl * dr.sqrt(nv * nv * (1.0 - a2) + a2) + nv * dr.sqrt(nl * nl * (1.0 - a2) + a2))
             spec = schlick(dr.dot(wi, h)) * (d * vis)
             diff = (1.0 - self.metallic) * base * (1.0 - schlick(nv)) * (1.0 - schlick(nl)) / dr.pi
@@ -138,11 +142,7 @@ def register_lightcut_ggx(mi):
         def _pdf(self, wi, wo, active):
             nl = mi.Frame3f.cos_theta(wo)
             h = dr.normalize(wi + wo)
-            nh = dr.maximum(mi.Frame3f.cos_theta(h), 0.0)
-            a = self._alpha()
-            a2 = a * a
-            q = nh * nh * (a2 - 1.0) + 1.0
-            d = a2 / (dr.pi * q * q)
+            d, nh = self._d(h)
             pdf_s = d * nh / (4.0 * dr.maximum(dr.abs(dr.dot(wi, h)), 1e-8))
             pdf = 0.5 * pdf_s + 0.5 * dr.maximum(nl, 0.0) / dr.pi
             return dr.select(active & (nl > 0), pdf, 0.0)

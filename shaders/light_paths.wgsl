@@ -87,35 +87,20 @@ fn path_starts(@builtin(global_invocation_id) gid: vec3<u32>) {
     if p >= pp.paths {
         return;
     }
-    var layer = 0u;
-    for (var l = 0u; l < pp.light_count; l++) {
-        let rg = pp.ranges[l];
-        if p >= rg.x && p < rg.x + rg.y {
-            layer = l;
-        }
-    }
+    let layer = range_layer(p, pp.ranges, pp.light_count);
     let rg = pp.ranges[layer];
     let n = max(rg.y, 1u);
-    let total = flux_pyramid[pyr_index(layer, params.levels - 1u, 0u, 0u)];
-    let total_imp = importance_pyramid[pyr_index(layer, params.levels - 1u, 0u, 0u)];
     var v = empty_vpl();
-    if total > 0.0 {
-        // As the bounce-1 warp mixes them: flux share m, importance share 1 - m.
-        var m = pp.flux_mix;
-        if !(total_imp > 0.0) {
-            m = 1.0;
-        }
-        let wi = select(0.0, (1.0 - m) / total_imp, total_imp > 0.0);
-        let w = warp(layer, hammersley(p - rg.x, n, path_rotation(layer)), wi, m / total);
-        let pmf = bitcast<f32>(w.z);
-        let t = vec2<i32>(w.xy);
-        let pos = textureLoad(rsm_position, t, i32(layer), 0);
-        if pos.w > 0.0 && pmf > 0.0 {
-            v.position = vec4<f32>(pos.xyz, pmf);
-            v.normal = normalize(textureLoad(rsm_normal, t, i32(layer), 0).xyz);
-            v.id = (layer << 24u) | (w.y * params.res + w.x);
-            v.flux = vec4<f32>(textureLoad(rsm_flux, t, i32(layer), 0).rgb / (f32(n) * pmf), 1.0);
-        }
+    // As the bounce-1 warp mixes them (flux share pp.flux_mix); pmf 0 without flux.
+    let w = warp_mixed(layer, hammersley(p - rg.x, n, path_rotation(layer)), pp.flux_mix);
+    let pmf = bitcast<f32>(w.z);
+    let t = vec2<i32>(w.xy);
+    let pos = textureLoad(rsm_position, t, i32(layer), 0);
+    if pos.w > 0.0 && pmf > 0.0 {
+        v.position = vec4<f32>(pos.xyz, pmf);
+        v.normal = normalize(textureLoad(rsm_normal, t, i32(layer), 0).xyz);
+        v.id = (layer << 24u) | (w.y * params.res + w.x);
+        v.flux = vec4<f32>(textureLoad(rsm_flux, t, i32(layer), 0).rgb / (f32(n) * pmf), 1.0);
     }
     starts[p] = v;
 }

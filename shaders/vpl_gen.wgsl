@@ -188,13 +188,7 @@ fn warp_vpls(@builtin(global_invocation_id) gid: vec3<u32>) {
     if i >= params.vpl_count {
         return;
     }
-    var layer = 0u;
-    for (var l = 0u; l < params.light_count; l++) {
-        let rg = params.ranges[l];
-        if i >= rg.x && i < rg.x + rg.y {
-            layer = l;
-        }
-    }
+    let layer = range_layer(i, params.ranges, params.light_count);
     let rg = params.ranges[layer];
     let j = i - rg.x;
     let n = max(rg.y, 1u);
@@ -202,20 +196,11 @@ fn warp_vpls(@builtin(global_invocation_id) gid: vec3<u32>) {
     let uv = hammersley(j, n, rot);
     var texel = vec2<u32>(0u);
     var pmf = 0.0;
-    let total_flux = flux_pyramid[pyr_index(layer, params.levels - 1u, 0u, 0u)];
-    let total_imp = importance_pyramid[pyr_index(layer, params.levels - 1u, 0u, 0u)];
     if params.mode == 1u {
         texel = min(vec2<u32>(uv * f32(params.res)), vec2<u32>(params.res - 1u));
         pmf = 1.0 / f32(params.res * params.res);
-    } else if total_flux > 0.0 {
-        // Shares: weights normalised by each pyramid's total; no importance -> flux only.
-        var m = params.flux_mix;
-        if !(total_imp > 0.0) {
-            m = 1.0;
-        }
-        let wi = select(0.0, (1.0 - m) / total_imp, total_imp > 0.0);
-        let wf = m / total_flux;
-        let w = warp(layer, uv, wi, wf);
+    } else {
+        let w = warp_mixed(layer, uv, params.flux_mix);
         texel = w.xy;
         pmf = bitcast<f32>(w.z);
     }

@@ -5,7 +5,7 @@ mod common;
 
 use glam::Vec3;
 use lightcut::{
-    reference::brdf::{self, Model, Surface},
+    reference::brdf::{self, Brdf, Surface},
     renderer::brdf_probe::{BrdfProbe, GpuBrdfCase},
 };
 
@@ -33,7 +33,7 @@ fn gpu_brdf_equals_the_cpu_twin() {
             v = if v.dot(n) < 0.0 { v - 2.0 * v.dot(n) * n } else { v };
             l = if l.dot(n) < 0.0 { l - 2.0 * l.dot(n) * n } else { l };
         }
-        let model = if k % 4 == 0 { Model::Lambert } else { Model::Ggx };
+        let model = if k % 4 == 0 { Brdf::Lambert } else { Brdf::Ggx };
         let s = Surface {
             base: Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()),
             metallic: if k % 3 == 0 { 1.0 } else { rng.next_f32() },

@@ -193,3 +193,44 @@ fn irradiance_scales_linearly_and_back_faces_of_the_sun_are_dark() {
     let below = DirectionalLight::from_angles("sun", 0.0, -30.0, Vec3::splat(2.0));
     assert_eq!(mean(&mut r, &[below]), 0.0);
 }
+
+#[test]
+fn a_method_without_ggx_keeps_the_whole_frame_lambert() {
+    // The default room made glossy. With gi.brdf = Ggx the direct light changes under a method
+    // that shades with GGX ("off" here), and stays Lambert's under one that refuses GGX
+    // (Lightcuts): the frame's BRDF is the method's (`MethodId::brdf`).
+    let Some(ctx) = common::gpu() else { return };
+    let mut scene = lightcut::scene::default_scene::build();
+    for m in &mut scene.materials {
+        (m.metallic, m.roughness) = (0.5, 0.3);
+    }
+    let cam = scene.camera_or_default(None).unwrap();
+    let mut s = RenderSettings::default();
+    s.vpl.count = 64;
+    let mut r = Renderer::new(ctx, &scene, (32, 24), s.clone()).expect("renderer");
+    let mut direct = |method, brdf| {
+        let mut s = s.clone();
+        s.gi.method = method;
+        s.gi.brdf = brdf;
+        r.set_settings(s).expect("settings");
+        r.render(&FrameInput {
+            camera: &cam,
+            lights: &scene.lights,
+            view: ViewBuffer::Final,
+        });
+        r.read(Buffer::Direct).expect("direct").pixels
+    };
+    use lightcut::renderer::settings::Brdf;
+    let (off, lc) = (
+        lightcut::methods::direct_only::ID,
+        lightcut::methods::lightcuts::ID,
+    );
+    let lambert = direct(off, Brdf::Lambert);
+    assert_ne!(direct(off, Brdf::Ggx), lambert, "GGX changed nothing");
+    assert_eq!(
+        direct(lc, Brdf::Ggx),
+        lambert,
+        "a Lambert-only method's frame shaded with GGX"
+    );
+    assert_eq!(direct(lc, Brdf::Lambert), lambert);
+}

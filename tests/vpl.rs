@@ -245,13 +245,40 @@ fn ground_truth_on_the_gpu_equals_a_cpu_evaluation_of_the_same_vpls() {
 /// the GPU's checked pixels (None without a GPU).
 fn ground_truth_against_cpu(shadow_rays: bool) -> Option<Vec<Vec3>> {
     let mut settings = RenderSettings::default();
+    settings.gi.shadow_rays = shadow_rays;
+    let c = ground_truth_vs_cpu(default_scene::build(), settings, 1e-3)?;
+    assert!(
+        c.checked > 100 && c.lit > 50,
+        "checked {}, lit {}",
+        c.checked,
+        c.lit
+    );
+    Some(c.got)
+}
+
+/// What [`ground_truth_vs_cpu`] compared.
+struct GtCheck {
+    r: Renderer,
+    scene: Scene,
+    settings: RenderSettings,
+    /// The GPU's checked pixels.
+    got: Vec<Vec3>,
+    checked: usize,
+    lit: usize,
+    /// Checked pixels with roughness below 0.5.
+    glossy: usize,
+}
+
+/// The ground truth of 256 VPLs (`settings.gi.brdf`, `settings.gi.shadow_rays`) on `scene`,
+/// 64 x 40, against the CPU sum at every 7th pixel (Lambert: `exact_indirect`; GGX:
+/// `exact_indirect_brdf` with the G-buffer's material): each within `tol` x the CPU value.
+fn ground_truth_vs_cpu(scene: Scene, mut settings: RenderSettings, tol: f32) -> Option<GtCheck> {
+    let ctx = common::gpu()?;
     settings.vpl.count = 256;
     settings.shadow.resolution = 256;
     settings.gi.method = lightcut::methods::ground_truth::ID;
-    settings.gi.shadow_rays = shadow_rays;
     let (w, h) = (64u32, 40u32);
-    let (mut r, scene) = setup(settings.clone(), (w, h))?;
-    let mut out = Vec::new();
+    let mut r = Renderer::new(ctx, &scene, (w, h), settings.clone()).expect("renderer");
     for _ in 0..4 {
         frame(&mut r, &scene);
         if r.gi_progress().is_some_and(|p| p.finished()) {
@@ -259,6 +286,7 @@ fn ground_truth_against_cpu(shadow_rays: bool) -> Option<Vec<Vec3>> {
         }
     }
     assert!(r.gi_progress().unwrap().finished());
+    let cam = scene.camera_or_default(None).unwrap();
     let ind = r.read(Buffer::Indirect).unwrap();
     let pos = r.read(Buffer::Position).unwrap();
     let nrm = r.read(Buffer::Normal).unwrap();
@@ -275,34 +303,58 @@ fn ground_truth_against_cpu(shadow_rays: bool) -> Option<Vec<Vec3>> {
             flux: Vec3::from_slice(&v.flux[..3]),
         })
         .collect();
-    let (mut checked, mut lit) = (0, 0);
+    let g = &settings.gi;
+    let shadow = g.shadow_rays.then_some(g.ray_offset);
+    let (mut got, mut checked, mut lit, mut glossy) = (Vec::new(), 0, 0, 0);
     for k in (0..(w * h) as usize).step_by(7) {
         let p = pos.pixels[k];
         if p[3] == 0.0 {
             continue;
         }
-        let want = reference::gi::exact_indirect(
-            &bvh,
-            Vec3::new(p[0], p[1], p[2]),
-            Vec3::from_slice(&nrm.pixels[k][..3]).normalize(),
-            Vec3::from_slice(&alb.pixels[k][..3]),
-            &emitters,
-            settings.gi.distance_epsilon,
-            settings.gi.shadow_rays.then_some(settings.gi.ray_offset),
-        );
-        let got = Vec3::from_slice(&ind.pixels[k][..3]);
-        out.push(got);
-        let tol = 1e-3 * want.max_element().max(1e-6);
+        let x = Vec3::new(p[0], p[1], p[2]);
+        let n = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
+        // The G-buffer's w channels: roughness (normal.w), metallic (albedo.a), f16.
+        let s = reference::brdf::Surface {
+            base: Vec3::from_slice(&alb.pixels[k][..3]),
+            metallic: alb.pixels[k][3],
+            roughness: nrm.pixels[k][3],
+        };
+        let want = match g.brdf {
+            reference::brdf::Brdf::Lambert => {
+                reference::gi::exact_indirect(&bvh, x, n, s.base, &emitters, g.distance_epsilon, shadow)
+            }
+            brdf => reference::gi::exact_indirect_brdf(
+                &bvh,
+                x,
+                n,
+                (cam.position - x).normalize(),
+                brdf,
+                &s,
+                &emitters,
+                g.distance_epsilon,
+                shadow,
+            ),
+        };
+        let v = Vec3::from_slice(&ind.pixels[k][..3]);
         assert!(
-            (got - want).abs().max_element() <= tol,
-            "pixel {k}: GPU {got} CPU {want}"
+            (v - want).abs().max_element() <= tol * want.max_element().max(1e-6),
+            "pixel {k} ({s:?}): GPU {v} CPU {want}"
         );
+        got.push(v);
         checked += 1;
         lit += (want.max_element() > 0.0) as usize;
+        glossy += (s.roughness < 0.5) as usize;
     }
-    assert!(checked > 100 && lit > 50, "checked {checked}, lit {lit}");
     assert!(r.ctx.errors.take().is_empty());
-    Some(out)
+    Some(GtCheck {
+        r,
+        scene,
+        settings,
+        got,
+        checked,
+        lit,
+        glossy,
+    })
 }
 
 #[test]
@@ -389,16 +441,12 @@ fn converged_reference_against_exact(scene: Scene, brdf: lightcut::renderer::set
             metallic: alb.pixels[k][3],
             roughness: nrm.pixels[k][3],
         };
-        let model = match brdf {
-            lightcut::renderer::settings::Brdf::Lambert => reference::brdf::Model::Lambert,
-            lightcut::renderer::settings::Brdf::Ggx => reference::brdf::Model::Ggx,
-        };
         let e = reference::gi::exact_indirect_brdf(
             &bvh,
             x,
             Vec3::from_slice(&nrm.pixels[k][..3]).normalize(),
             (cam.position - x).normalize(),
-            model,
+            brdf,
             &surface,
             &texels,
             settings.gi.distance_epsilon,
@@ -509,7 +557,6 @@ fn raising_the_reference_target_continues_and_a_view_change_restarts() {
 fn ground_truth_with_ggx_equals_a_cpu_evaluation_with_the_brdf() {
     // The default room made glossy (a rough floor, a polished metal sphere, satin walls) and
     // shaded with gi.brdf = ggx: every checked pixel equals the CPU sum with the BRDF twin.
-    let Some(ctx) = common::gpu() else { return };
     let mut scene = default_scene::build();
     for (i, m) in scene.materials.iter_mut().enumerate() {
         (m.metallic, m.roughness) = match i % 4 {
@@ -520,84 +567,32 @@ fn ground_truth_with_ggx_equals_a_cpu_evaluation_with_the_brdf() {
         };
     }
     let mut settings = RenderSettings::default();
-    settings.vpl.count = 256;
-    settings.shadow.resolution = 256;
-    settings.gi.method = lightcut::methods::ground_truth::ID;
     settings.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
-    let (w, h) = (64u32, 40u32);
-    let mut r = Renderer::new(ctx, &scene, (w, h), settings.clone()).expect("renderer");
-    for _ in 0..4 {
-        frame(&mut r, &scene);
-        if r.gi_progress().is_some_and(|p| p.finished()) {
-            break;
-        }
-    }
-    assert!(r.gi_progress().unwrap().finished());
-    let cam = scene.camera_or_default(None).unwrap();
-    let ind = r.read(Buffer::Indirect).unwrap();
-    let pos = r.read(Buffer::Position).unwrap();
-    let nrm = r.read(Buffer::Normal).unwrap();
-    let alb = r.read(Buffer::Albedo).unwrap();
-    let vpls = r.read_vpls().unwrap();
-    let bvh = Bvh::build(&scene.positions, &scene.indices);
-    let emitters: Vec<reference::gi::Texel> = vpls
-        .iter()
-        .filter(|v| v.id != VPL_NONE)
-        .map(|v| reference::gi::Texel {
-            position: Vec3::from_slice(&v.position[..3]),
-            normal: Vec3::from_array(v.normal),
-            flux: Vec3::from_slice(&v.flux[..3]),
-        })
-        .collect();
-    let (mut checked, mut glossy) = (0, 0);
-    for k in (0..(w * h) as usize).step_by(7) {
-        let p = pos.pixels[k];
-        if p[3] == 0.0 {
-            continue;
-        }
-        let x = Vec3::new(p[0], p[1], p[2]);
-        // The G-buffer's w channels: roughness (normal.w), metallic (albedo.a), f16.
-        let s = reference::brdf::Surface {
-            base: Vec3::from_slice(&alb.pixels[k][..3]),
-            metallic: alb.pixels[k][3],
-            roughness: nrm.pixels[k][3],
-        };
-        let want = reference::gi::exact_indirect_brdf(
-            &bvh,
-            x,
-            Vec3::from_slice(&nrm.pixels[k][..3]).normalize(),
-            (cam.position - x).normalize(),
-            reference::brdf::Model::Ggx,
-            &s,
-            &emitters,
-            settings.gi.distance_epsilon,
-            Some(settings.gi.ray_offset),
-        );
-        let got = Vec3::from_slice(&ind.pixels[k][..3]);
-        let tol = 2e-3 * want.max_element().max(1e-6);
-        assert!(
-            (got - want).abs().max_element() <= tol,
-            "pixel {k} ({s:?}): GPU {got} CPU {want}"
-        );
-        checked += 1;
-        glossy += (s.roughness < 0.5) as usize;
-    }
-    assert!(checked > 100 && glossy > 20, "checked {checked}, glossy {glossy}");
+    let Some(mut c) = ground_truth_vs_cpu(scene, settings, 2e-3) else {
+        return;
+    };
+    assert!(
+        c.checked > 100 && c.glossy > 20,
+        "checked {}, glossy {}",
+        c.checked,
+        c.glossy
+    );
     // Lambert on the same scene differs (the BRDF is in use).
+    let ind = c.r.read(Buffer::Indirect).unwrap();
+    let ggx_mean: f64 = ind.pixels.iter().map(|p| lum([p[0], p[1], p[2]])).sum();
     let lambert_mean: f64 = {
-        let mut s = settings.clone();
+        let mut s = c.settings.clone();
         s.gi.brdf = lightcut::renderer::settings::Brdf::Lambert;
-        r.set_settings(s).unwrap();
+        c.r.set_settings(s).unwrap();
         for _ in 0..4 {
-            frame(&mut r, &scene);
+            frame(&mut c.r, &c.scene);
         }
-        let l = r.read(Buffer::Indirect).unwrap();
+        let l = c.r.read(Buffer::Indirect).unwrap();
         l.pixels.iter().map(|p| lum([p[0], p[1], p[2]])).sum::<f64>()
     };
-    let ggx_mean: f64 = ind.pixels.iter().map(|p| lum([p[0], p[1], p[2]])).sum();
     assert!(
         (ggx_mean / lambert_mean - 1.0).abs() > 0.01,
         "{ggx_mean} vs {lambert_mean}"
     );
-    assert!(r.ctx.errors.take().is_empty());
+    assert!(c.r.ctx.errors.take().is_empty());
 }

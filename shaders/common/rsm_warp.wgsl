@@ -50,3 +50,32 @@ fn warp(layer: u32, uv_in: vec2<f32>, wi: f32, wf: f32) -> vec3<u32> {
     let pmf = node_weight(layer, 0u, x, y, wi, wf) / total;
     return vec3<u32>(x, y, bitcast<u32>(pmf));
 }
+
+// The light whose budget range (x = first index, y = count) holds index i: the VPLs' and the
+// light paths' split between the lights.
+fn range_layer(i: u32, ranges: array<vec4<u32>, 4>, count: u32) -> u32 {
+    var layer = 0u;
+    for (var l = 0u; l < count; l++) {
+        if i >= ranges[l].x && i < ranges[l].x + ranges[l].y {
+            layer = l;
+        }
+    }
+    return layer;
+}
+
+// Warps `uv` through light `layer`'s mixed PDF: (1 - m) importance share + m flux share,
+// each normalised by its pyramid's total (flux only where the layer has no importance).
+// Returns (texel x, texel y, pmf bits); pmf 0 where the layer reflects no flux.
+fn warp_mixed(layer: u32, uv: vec2<f32>, flux_mix: f32) -> vec3<u32> {
+    let total_flux = flux_pyramid[pyr_index(layer, params.levels - 1u, 0u, 0u)];
+    if !(total_flux > 0.0) {
+        return vec3<u32>(0u, 0u, bitcast<u32>(0.0));
+    }
+    let total_imp = importance_pyramid[pyr_index(layer, params.levels - 1u, 0u, 0u)];
+    var m = flux_mix;
+    if !(total_imp > 0.0) {
+        m = 1.0;
+    }
+    let wi = select(0.0, (1.0 - m) / total_imp, total_imp > 0.0);
+    return warp(layer, uv, wi, m / total_flux);
+}

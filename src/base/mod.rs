@@ -5,6 +5,7 @@
 //! `metrics`, `export`, `harness`, `sheet` and `app` import from here; nothing here imports
 //! from them.
 
+pub mod brdf;
 pub mod colormap;
 pub mod display;
 pub mod gpu_layout;

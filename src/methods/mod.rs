@@ -151,10 +151,16 @@ impl MethodId {
     /// samplers' own limits, half resolution and interleaving, are in their `validate`).
     pub fn refuses_brdf(self, brdf: crate::renderer::settings::Brdf) -> Option<String> {
         (brdf != crate::renderer::settings::Brdf::Lambert && !self.info().glossy).then(|| {
+            let glossy: Vec<&str> = REGISTRY
+                .iter()
+                .filter(|m| m.glossy && m.kind != Kind::DirectOnly)
+                .map(|m| m.short)
+                .collect();
             format!(
-                "brdf {}: {} shades with Lambert only so far (GGX: the ground truth, the reference, SLC, SST, RTSLC and the direct light)",
+                "brdf {}: {} shades with Lambert only so far (GGX: {} and the direct light)",
                 brdf.name(),
-                self.info().label
+                self.info().label,
+                glossy.join(", ")
             )
         })
     }

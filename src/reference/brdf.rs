@@ -6,21 +6,7 @@
 
 use glam::Vec3;
 
-/// The BRDF model (`gi.brdf` selects it; the shader's `BRDF_LAMBERT` / `BRDF_GGX`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Model {
-    Lambert,
-    Ggx,
-}
-
-impl Model {
-    pub fn gpu(self) -> u32 {
-        match self {
-            Model::Lambert => 0,
-            Model::Ggx => 1,
-        }
-    }
-}
+pub use crate::base::brdf::Brdf;
 
 pub const MIN_ALPHA: f32 = 0.002;
 const INV_PI: f32 = 1.0 / std::f32::consts::PI;
@@ -37,6 +23,12 @@ pub fn alpha(roughness: f32) -> f32 {
     (roughness * roughness).max(MIN_ALPHA)
 }
 
+/// GGX's distribution D at cos(theta_h) = `nh` for alpha^2 = `a2`.
+pub fn ggx_d(nh: f32, a2: f32) -> f32 {
+    let q = nh * nh * (a2 - 1.0) + 1.0;
+    a2 / (std::f32::consts::PI * q * q)
+}
+
 pub fn f0(base: Vec3, metallic: f32) -> Vec3 {
     Vec3::splat(0.04).lerp(base, metallic)
 }
@@ -48,8 +40,8 @@ pub fn schlick(f0: Vec3, u: f32) -> Vec3 {
 }
 
 /// The diffuse part (the whole BRDF for Lambert).
-pub fn diffuse(model: Model, n: Vec3, v: Vec3, l: Vec3, s: &Surface) -> Vec3 {
-    if model == Model::Lambert {
+pub fn diffuse(model: Brdf, n: Vec3, v: Vec3, l: Vec3, s: &Surface) -> Vec3 {
+    if model == Brdf::Lambert {
         return s.base * INV_PI;
     }
     let (nl, nv) = (n.dot(l), n.dot(v));
@@ -62,8 +54,8 @@ pub fn diffuse(model: Model, n: Vec3, v: Vec3, l: Vec3, s: &Surface) -> Vec3 {
 }
 
 /// The specular (GGX) part; zero for Lambert.
-pub fn specular(model: Model, n: Vec3, v: Vec3, l: Vec3, s: &Surface) -> Vec3 {
-    if model == Model::Lambert {
+pub fn specular(model: Brdf, n: Vec3, v: Vec3, l: Vec3, s: &Surface) -> Vec3 {
+    if model == Brdf::Lambert {
         return Vec3::ZERO;
     }
     let (nl, nv) = (n.dot(l), n.dot(v));
@@ -74,21 +66,20 @@ pub fn specular(model: Model, n: Vec3, v: Vec3, l: Vec3, s: &Surface) -> Vec3 {
     let nh = n.dot(h).max(0.0);
     let a = alpha(s.roughness);
     let a2 = a * a;
-    let q = nh * nh * (a2 - 1.0) + 1.0;
-    let d = a2 / (std::f32::consts::PI * q * q);
+    let d = ggx_d(nh, a2);
     let vis = 0.5 / (nl * (nv * nv * (1.0 - a2) + a2).sqrt() + nv * (nl * nl * (1.0 - a2) + a2).sqrt());
     schlick(f0(s.base, s.metallic), v.dot(h)) * (d * vis)
 }
 
 /// f(v, l), per unit solid angle of l.
-pub fn eval(model: Model, n: Vec3, v: Vec3, l: Vec3, s: &Surface) -> Vec3 {
+pub fn eval(model: Brdf, n: Vec3, v: Vec3, l: Vec3, s: &Surface) -> Vec3 {
     diffuse(model, n, v, l, s) + specular(model, n, v, l, s)
 }
 
 /// The directional albedo E(v) = integral of f(v, l) (n.l) dl over the hemisphere, by Monte
 /// Carlo with `samples` directions drawn half from the cosine density and half as GGX
 /// reflections (one-sample MIS, the mixture's pdf): the white furnace's measurement.
-pub fn albedo(model: Model, v: Vec3, s: &Surface, samples: u32, seed: u32) -> (f64, f64) {
+pub fn albedo(model: Brdf, v: Vec3, s: &Surface, samples: u32, seed: u32) -> (f64, f64) {
     albedo_of(
         |v, l| eval(model, Vec3::Z, v, l, s),
         v,
@@ -127,9 +118,7 @@ pub fn albedo_of(
         if nl > 0.0 {
             let h = (l + v).normalize();
             let nh = h.z.max(0.0);
-            let q = nh * nh * (a2 - 1.0) + 1.0;
-            let d = a2 / (std::f32::consts::PI * q * q);
-            let pdf_s = d * nh / (4.0 * v.dot(h).abs().max(1e-8));
+            let pdf_s = ggx_d(nh, a2) * nh / (4.0 * v.dot(h).abs().max(1e-8));
             let pdf = 0.5 * pdf_s + 0.5 * nl * INV_PI;
             let f = f(v, l);
             // The luminance-free white furnace: the largest channel.
@@ -165,7 +154,7 @@ mod tests {
                         metallic,
                         roughness,
                     };
-                    let (e, se) = albedo(Model::Ggx, dir(theta, 0.0), &s, 100_000, 7);
+                    let (e, se) = albedo(Brdf::Ggx, dir(theta, 0.0), &s, 100_000, 7);
                     worst = worst.max(e);
                     assert!(
                         e <= 1.0 + 4.0 * se + 1e-3,
@@ -177,7 +166,7 @@ mod tests {
         // A rough white dielectric still reflects most of the light (no gross energy loss:
         // the Fresnel-weighted diffuse keeps about (1 - F0)^2 = 0.92 of it).
         let (e, _) = albedo(
-            Model::Ggx,
+            Brdf::Ggx,
             dir(30.0, 0.0),
             &Surface {
                 base: Vec3::ONE,
@@ -190,7 +179,7 @@ mod tests {
         assert!(e > 0.85, "{e}");
         // Lambert with a white base: exactly 1.
         let (e, se) = albedo(
-            Model::Lambert,
+            Brdf::Lambert,
             dir(45.0, 0.0),
             &Surface {
                 base: Vec3::ONE,
@@ -220,11 +209,11 @@ mod tests {
             }
             let h = (v + l).normalize();
             (Vec3::ONE - schlick(f0(s.base, s.metallic), v.dot(h))) * s.base * INV_PI
-                + specular(Model::Ggx, n, v, l, &s)
+                + specular(Brdf::Ggx, n, v, l, &s)
         };
         let (e, se) = albedo_of(gltf, dir(85.0, 0.0), s.roughness, 100_000, 9);
         assert!(e > 1.2, "{e} +- {se}");
-        let (ours, _) = albedo(Model::Ggx, dir(85.0, 0.0), &s, 100_000, 9);
+        let (ours, _) = albedo(Brdf::Ggx, dir(85.0, 0.0), &s, 100_000, 9);
         assert!(ours <= 1.0, "{ours}");
     }
 
@@ -243,7 +232,7 @@ mod tests {
                 ((80.0, 0.0), (5.0, 90.0)),
             ] {
                 let (v, l) = (dir(a.0, a.1), dir(b.0, b.1));
-                let (f, g) = (eval(Model::Ggx, n, v, l, &s), eval(Model::Ggx, n, l, v, &s));
+                let (f, g) = (eval(Brdf::Ggx, n, v, l, &s), eval(Brdf::Ggx, n, l, v, &s));
                 assert!(
                     (f - g).abs().max_element() <= 1e-5 * f.max_element().max(1e-3),
                     "{f} vs {g}"
@@ -261,12 +250,12 @@ mod tests {
             roughness: 0.5,
         };
         let (n, v, l) = (Vec3::Z, dir(20.0, 0.0), dir(50.0, 180.0));
-        assert_eq!(eval(Model::Lambert, n, v, l, &s), s.base * INV_PI);
-        assert_eq!(eval(Model::Ggx, n, v, -l, &s), Vec3::ZERO);
-        assert_eq!(eval(Model::Ggx, n, -v, l, &s), Vec3::ZERO);
+        assert_eq!(eval(Brdf::Lambert, n, v, l, &s), s.base * INV_PI);
+        assert_eq!(eval(Brdf::Ggx, n, v, -l, &s), Vec3::ZERO);
+        assert_eq!(eval(Brdf::Ggx, n, -v, l, &s), Vec3::ZERO);
         // A rough dielectric is close to Lambert away from grazing; a smooth metal's peak is
         // in the mirror direction.
-        let rough = eval(Model::Ggx, n, v, l, &Surface { roughness: 1.0, ..s });
+        let rough = eval(Brdf::Ggx, n, v, l, &Surface { roughness: 1.0, ..s });
         assert!(
             ((rough / (s.base * INV_PI)) - Vec3::ONE).abs().max_element() < 0.2,
             "{rough}"
@@ -277,6 +266,6 @@ mod tests {
             roughness: 0.2,
         };
         let mirror = dir(20.0, 180.0);
-        assert!(eval(Model::Ggx, n, v, mirror, &metal).x > 10.0 * eval(Model::Ggx, n, v, l, &metal).x);
+        assert!(eval(Brdf::Ggx, n, v, mirror, &metal).x > 10.0 * eval(Brdf::Ggx, n, v, l, &metal).x);
     }
 }

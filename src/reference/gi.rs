@@ -37,7 +37,7 @@ pub fn exact_indirect_brdf(
     x: Vec3,
     n: Vec3,
     v: Vec3,
-    model: crate::reference::brdf::Model,
+    model: crate::base::brdf::Brdf,
     surface: &crate::reference::brdf::Surface,
     texels: &[Texel],
     eps: f32,

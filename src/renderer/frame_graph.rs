@@ -69,7 +69,8 @@ impl Renderer {
         let s = self.settings.clone();
 
         let lights = &input.lights[..input.lights.len().min(MAX_LIGHTS)];
-        self.frame_lights.clone_from(&lights.to_vec());
+        self.frame_lights.clear();
+        self.frame_lights.extend_from_slice(lights);
         self.frame_brdf = s.gi.method.brdf(s.gi.brdf);
         self.frame_eye = input.camera.position;
         let layers = lights.len().max(1) as u32;

@@ -212,32 +212,7 @@ impl Default for VplSettings {
 pub use super::temporal_settings::{MAX_ATROUS_ITERATIONS, TemporalMode, TemporalSettings, TemporalView};
 pub use crate::methods::{MethodId, MethodView};
 
-/// The BRDF every method shades with (`shaders/common/brdf.wgsl`, docs/brdf.md).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Brdf {
-    /// base colour / pi (the thesis; the references against Mitsuba are diffuse).
-    #[default]
-    Lambert,
-    /// Cook-Torrance GGX over glTF's metallic and roughness factors.
-    Ggx,
-}
-
-impl Brdf {
-    pub const ALL: [Brdf; 2] = [Brdf::Lambert, Brdf::Ggx];
-    pub fn name(self) -> &'static str {
-        match self {
-            Brdf::Lambert => "Lambert",
-            Brdf::Ggx => "GGX (metallic-roughness)",
-        }
-    }
-    /// The shader's model constant (`BRDF_LAMBERT` / `BRDF_GGX`).
-    pub fn gpu(self) -> u32 {
-        match self {
-            Brdf::Lambert => 0,
-            Brdf::Ggx => 1,
-        }
-    }
-}
+pub use crate::base::brdf::Brdf;
 
 /// Shading of VPLs (shared by every GI method and the references).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
