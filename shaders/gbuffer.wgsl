@@ -1,8 +1,8 @@
 // G-buffer pass: rasterise the scene from the camera.
 // Outputs (see src/renderer/frame.rs):
 //   0 position: Rgba32Float, xyz world position, w = material id + 1 (0 = no geometry)
-//   1 normal:   Rgba16Float, xyz unit shading normal facing the camera, w = roughness (glTF)
-//   2 albedo:   Rgba16Float, rgb linear base colour = baseColorFactor x texture, a = metallic
+//   1 normal:   Rgba16Float, xyz unit shading normal facing the camera, w = roughness (glTF factor x texture G)
+//   2 albedo:   Rgba16Float, rgb linear base colour = baseColorFactor x texture, a = metallic (factor x texture B)
 // (roughness and metallic: the GGX BRDF's, `common/brdf.wgsl`; Lambert reads rgb only)
 #include "common/camera.wgsl"
 #include "common/material.wgsl"
@@ -36,8 +36,8 @@ fn fs_main(i: VertexOut, @builtin(front_facing) front: bool) -> GbufferOut {
     }
     var o: GbufferOut;
     o.position = vec4<f32>(i.world, f32(i.material + 1u));
-    let params = materials[i.material].params;
-    o.normal = vec4<f32>(n, params.y);
-    o.albedo = vec4<f32>(albedo.rgb, params.x);
+    let mr = material_metal_rough(i.material, i.uv);
+    o.normal = vec4<f32>(n, mr.y);
+    o.albedo = vec4<f32>(albedo.rgb, mr.x);
     return o;
 }

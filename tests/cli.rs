@@ -202,13 +202,17 @@ fn ggx_is_refused_by_methods_that_shade_with_lambert_only() {
     let e = one_line_error(&[
         "render",
         "--method",
-        "lightcuts",
+        "lightcut-interpolation",
         "--brdf",
         "ggx",
         "--out",
         "/tmp/x",
     ]);
     assert!(e.contains("brdf GGX") && e.contains("Lambert only"), "{e}");
+    assert!(
+        e.contains("Lightcuts"),
+        "the message names the glossy methods: {e}"
+    );
     let e = one_line_error(&[
         "render",
         "--method",
@@ -243,6 +247,16 @@ fn ggx_is_refused_by_methods_that_shade_with_lambert_only() {
     assert!(e.contains("gi.brdf = Ggx with sampling.half_resolution"), "{e}");
     let e = one_line_error(&["render", "--brdf", "phong", "--out", "/tmp/x"]);
     assert!(e.contains("phong"), "{e}");
+    let e = one_line_error(&[
+        "render",
+        "--brdf",
+        "ggx",
+        "--glossy-weights",
+        "mirror",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("mirror"), "{e}");
 }
 
 #[test]

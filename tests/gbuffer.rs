@@ -142,3 +142,57 @@ fn fragment_counts_of_stacked_quads() {
     }
     assert!(ctx.errors.take().is_empty());
 }
+
+/// Metallic and roughness in the G-buffer are glTF's factors times the metallic-roughness
+/// texture's B and G (stored sRGB-encoded, sampled back to linear), beside an untextured
+/// material that keeps its factors.
+#[test]
+fn metallic_roughness_textures_reach_the_gbuffer() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut scene = stacked_quads(1, true);
+    let (g_byte, b_byte) = (140u8, 60u8);
+    let mut tex = lightcut::scene::TextureImage {
+        name: "mr".into(),
+        width: 4,
+        height: 4,
+        rgba8: [255, g_byte, b_byte, 255].repeat(16),
+    };
+    tex.encode_linear_as_srgb();
+    scene.textures.push(tex);
+    let size = (32, 32);
+    let cam = Camera {
+        position: Vec3::new(0.0, 0.0, 0.0),
+        forward: Vec3::NEG_Z,
+        up: Vec3::Y,
+        ..scene.camera_or_default(None).unwrap()
+    };
+    let camera = camera_buffer(&ctx, &cam, size);
+    for textured in [true, false] {
+        let m = &mut scene.materials[0];
+        (m.metallic, m.roughness) = (0.5, 0.8);
+        (m.roughness_texture, m.metallic_texture) = if textured {
+            (Some(0), Some(0))
+        } else {
+            (None, None)
+        };
+        let g = gpu_scene(&ctx, &scene);
+        let out = gbuffer(&ctx, &g, &camera, size, false);
+        let (want_r, want_m) = if textured {
+            (0.8 * g_byte as f32 / 255.0, 0.5 * b_byte as f32 / 255.0)
+        } else {
+            (0.8, 0.5)
+        };
+        let mut covered = 0;
+        for (p, (n, a)) in out[0].iter().zip(out[1].iter().zip(&out[2])) {
+            if p[3] <= 0.0 {
+                continue;
+            }
+            covered += 1;
+            assert!((n[3] - want_r).abs() < 4e-3, "roughness {} vs {want_r}", n[3]);
+            assert!((a[3] - want_m).abs() < 4e-3, "metallic {} vs {want_m}", a[3]);
+            assert!((a[0] - 0.5).abs() < 1e-3, "albedo unchanged");
+        }
+        assert_eq!(covered, size.0 * size.1, "the quad fills the view");
+    }
+    assert!(ctx.errors.take().is_empty());
+}

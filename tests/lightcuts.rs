@@ -380,3 +380,193 @@ fn the_mean_over_builds_of_a_fixed_cut_converges_to_the_ground_truth() {
     );
     assert!(ctx.errors.take().is_empty());
 }
+
+/// The default room made glossy: rough dielectrics and satin metals alternating by material.
+fn mixed_glossy_room() -> lightcut::scene::Scene {
+    let mut scene = lightcut::scene::default_scene::build();
+    for (i, m) in scene.materials.iter_mut().enumerate() {
+        (m.metallic, m.roughness) = if i % 2 == 0 { (0.0, 0.35) } else { (1.0, 0.5) };
+    }
+    scene
+}
+
+/// Lightcuts' material bound for GGX (`ggx_cos_bound`) is never below the true
+/// luminance(f(v, l)) x G of a VPL in the box and the cone, over random boxes, receivers,
+/// views and materials (roughness 0.05..1, metallic 0..1), with a quarter of the views set up
+/// so that the box lies on the mirror direction (the lobe's peak).
+#[test]
+fn the_ggx_error_bound_is_never_below_the_true_glossy_term() {
+    use lightcut::reference::brdf::{self, Brdf, Surface};
+    use lightcut::reference::lightcuts::{Shading, geometry_brdf_bound};
+    let mut k = 7u32;
+    let mut rnd = || {
+        k += 1;
+        u01(pcg_hash(k.wrapping_mul(0x9e37_79b9)))
+    };
+    let (cases, mut checked, mut tight) = (3000, 0, 0);
+    let mut ratios = Vec::new();
+    for case in 0..cases {
+        let centre = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 6.0;
+        let half = Vec3::new(rnd(), rnd(), rnd()) * if case % 3 == 0 { 0.05 } else { 0.6 };
+        let (lo, hi) = (centre - half, centre + half);
+        let x = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 8.0;
+        let n = sphere(rnd(), rnd());
+        let d = (centre - x).normalize_or_zero();
+        let v = if case % 4 == 0 {
+            // The box on the mirror direction of v.
+            (2.0 * n.dot(d) * n - d).normalize_or_zero()
+        } else {
+            sphere(rnd(), rnd())
+        };
+        let surface = Surface {
+            base: Vec3::new(rnd(), rnd(), rnd()),
+            metallic: if case % 5 == 0 { 1.0 } else { rnd() },
+            roughness: 0.05 + 0.95 * rnd() * rnd(),
+        };
+        let sh = Shading { v, surface };
+        let cone = Cone {
+            axis: sphere(rnd(), rnd()),
+            half_angle: rnd() * rnd() * std::f32::consts::PI,
+        };
+        let eps = 0.05;
+        let bound = geometry_brdf_bound(x, n, lo, hi, cone, eps, &sh);
+        let mut largest = 0.0f32;
+        for _ in 0..64 {
+            let p = lo + (hi - lo) * Vec3::new(rnd(), rnd(), rnd());
+            let m = in_cone(cone.axis, cone.half_angle, rnd(), rnd());
+            let g = vpl_geometry(p, m, x, n, eps);
+            if g <= 0.0 {
+                continue;
+            }
+            let l = (p - x).normalize();
+            let f = lightcut::base::display::luminance(brdf::eval(Brdf::Ggx, n, v, l, &surface));
+            let t = f * g;
+            assert!(
+                t <= bound * (1.0 + 1e-4) + 1e-6,
+                "case {case}: lum(f) G {t} above the bound {bound} (box {lo}..{hi}, x {x}, n {n}, v {v}, {surface:?}, cone {cone:?})"
+            );
+            largest = largest.max(t);
+            checked += 1;
+        }
+        if largest > 0.0 {
+            ratios.push(bound / largest);
+            tight += (bound < 20.0 * largest) as u32;
+        }
+    }
+    ratios.sort_by(f32::total_cmp);
+    let median = ratios[ratios.len() / 2];
+    eprintln!(
+        "{checked} VPLs checked; bound / largest sampled term: median {median:.2}, {tight} of {} within 20x",
+        ratios.len()
+    );
+    assert!(checked > cases * 10, "{checked} VPLs checked");
+    // Not vacuous: the bound follows the lobe (the median within a few times the largest
+    // sampled term).
+    assert!(median < 10.0, "median ratio {median}");
+}
+
+/// With `gi.brdf = "Ggx"` every pixel's lightcut (its cut size and radiance) is the CPU's
+/// (`lightcut_shaded_on` with the G-buffer's material and the camera's view direction).
+#[test]
+fn gpu_lightcuts_with_ggx_equal_the_cpu_reference() {
+    use lightcut::reference::brdf::Surface;
+    use lightcut::reference::lightcuts::{Shading, lightcut_shaded_on};
+    let Some(ctx) = common::gpu() else { return };
+    let mut s = settings(0.05, 64);
+    s.sampling.fixed_seed = true;
+    s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
+    let mut st = Setup::with_scene(&ctx, mixed_glossy_room(), s.clone(), (W, H));
+    st.frame();
+    let (nodes, _) = st.r.read_tree().unwrap();
+    let topo = Topology::perfect_of(&nodes);
+    let sorted = sorted_vpls(&st);
+    let gpu_lc: LcTree = lc_of(&st).read_build(&ctx).unwrap();
+    let bvh = Bvh::build(&st.scene.positions, &st.scene.indices);
+    let ind = st.indirect();
+    let pos = st.r.read(Buffer::Position).unwrap();
+    let nrm = st.r.read(Buffer::Normal).unwrap();
+    let alb = st.r.read(Buffer::Albedo).unwrap();
+    let diag =
+        st.r.read_view_buffer(ViewBuffer::Method(lightcuts::CUT_SIZE))
+            .unwrap()
+            .expect("the lightcut diagnostics");
+    let p = CutParams {
+        relative_error: 0.05,
+        max_cut: 64,
+        eps: s.gi.distance_epsilon,
+        shadow_rays: Some(s.gi.ray_offset),
+        trace_every_node: false,
+    };
+    let eye = st.cam.position;
+    let (mut pixels, mut same_size, mut close, mut metal) = (0, 0, 0, 0);
+    let (mut ggx_nodes, mut lambert_nodes) = (0usize, 0usize);
+    for y in 0..H {
+        for x in 0..W {
+            let k = (y * W + x) as usize;
+            let g = pos.pixels[k];
+            if g[3] == 0.0 {
+                continue;
+            }
+            let xp = Vec3::new(g[0], g[1], g[2]);
+            let n = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
+            let sh = Shading {
+                v: (eye - xp).normalize(),
+                surface: Surface {
+                    base: Vec3::from_slice(&alb.pixels[k][..3]),
+                    metallic: alb.pixels[k][3],
+                    roughness: nrm.pixels[k][3],
+                },
+            };
+            metal += (sh.surface.metallic > 0.5) as u32;
+            let cut = lightcut_shaded_on(&nodes, topo, &gpu_lc, &sorted, &bvh, xp, n, &p, Some(&sh));
+            let ids: Vec<u32> = cut.cut.iter().map(|c| c.node).collect();
+            check_cut_on(&nodes, topo, &ids).unwrap_or_else(|e| panic!("pixel ({x}, {y}): {e}"));
+            let lambert = lightcut_on(&nodes, topo, &gpu_lc, &sorted, &bvh, xp, n, &p);
+            (ggx_nodes, lambert_nodes) = (ggx_nodes + ids.len(), lambert_nodes + lambert.cut.len());
+            pixels += 1;
+            same_size += (diag.pixels[k][0] as usize == ids.len()) as u32;
+            let want = cut.radiance(Vec3::ZERO);
+            let got = Vec3::from_slice(&ind.pixels[k][..3]);
+            close += ((got - want).abs().max_element() <= 1e-3 * want.max_element() + 1e-7) as u32;
+        }
+    }
+    eprintln!(
+        "GGX: {pixels} pixels ({metal} metal): {same_size} same cut size, {close} same radiance; mean cut {:.1} nodes (Lambert's {:.1})",
+        ggx_nodes as f64 / pixels as f64,
+        lambert_nodes as f64 / pixels as f64
+    );
+    assert!(pixels > 500 && metal > 50, "{pixels} pixels, {metal} metal");
+    assert!(
+        same_size >= pixels * 97 / 100,
+        "cut sizes: {same_size} of {pixels} equal"
+    );
+    assert!(close >= pixels * 97 / 100, "radiance: {close} of {pixels} equal");
+    assert!(ctx.errors.take().is_empty());
+}
+
+/// With GGX, threshold 0 and an unlimited cut refine to every leaf: the image equals the GGX
+/// ground truth of the same VPLs.
+#[test]
+fn with_ggx_threshold_zero_equals_the_ggx_ground_truth() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut s = settings(0.0, 1024);
+    s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
+    let mut st = Setup::with_scene(&ctx, mixed_glossy_room(), s, (W, H));
+    st.frame();
+    let errs = ctx.errors.take();
+    assert!(errs.is_empty(), "{errs:?}");
+    let lc = st.indirect();
+    let gt = st.ground_truth_of_these_vpls();
+    let (mut worst, mut lit) = (0.0f32, 0);
+    for (a, b) in lc.pixels.iter().zip(&gt.pixels) {
+        let (a, b) = (Vec3::from_slice(&a[..3]), Vec3::from_slice(&b[..3]));
+        if b.max_element() > 1e-6 {
+            worst = worst.max((a - b).abs().max_element() / b.max_element());
+            lit += 1;
+        }
+    }
+    eprintln!("GGX threshold 0: worst relative difference {worst:e} over {lit} lit pixels");
+    assert!(lit > 500);
+    assert!(worst < 1e-3, "worst relative difference {worst}");
+    assert!(ctx.errors.take().is_empty());
+}

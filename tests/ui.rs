@@ -768,7 +768,7 @@ fn the_brdf_combo_reaches_the_renderer_and_lambert_only_methods_say_so() {
     drop(h);
     // A Lambert-only method: the note under the combo.
     let mut s = slc_settings();
-    s.gi.method = lightcut::methods::lightcuts::ID;
+    s.gi.method = lightcut::methods::lightcut_interpolation::ID;
     s.vpl.count = 64;
     s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
     let options = AppOptions {
@@ -781,4 +781,29 @@ fn the_brdf_combo_reaches_the_renderer_and_lambert_only_methods_say_so() {
     };
     h.run_steps(1);
     h.get_by_label_contains("shades with Lambert only so far");
+    drop(h);
+    // SLC with GGX: the glossy walk's weights (the SST paper's material term) are a setting.
+    let mut s = slc_settings();
+    s.vpl.count = 64;
+    s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
+    let options = AppOptions {
+        settings: Some(s),
+        view: Some(ViewBuffer::Albedo),
+        ..Default::default()
+    };
+    let Some(mut h) = harness_with(egui::vec2(500.0, 1700.0), options) else {
+        return;
+    };
+    h.run_steps(1);
+    h.get_by_role_and_label(Role::ComboBox, "glossy walk weights")
+        .click();
+    h.run_steps(2);
+    h.get_by_label("material term (SST paper)").click();
+    h.run_steps(2);
+    let r = h.state().renderer().expect("renderer");
+    assert_eq!(
+        r.settings().sampling.glossy_weights,
+        lightcut::base::sampling::GlossyWeights::Material
+    );
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }

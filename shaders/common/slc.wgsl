@@ -31,14 +31,21 @@ const SLC_DEFENSIVE: f32 = 0.2;
 // normalisation. All have the support of box_cos (lum(I) x box_cos = 0 <=> w = 0), so each
 // is unbiased wherever eq. 5.5 is.
 fn slc_child_prob(l: SstNode, r: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32, mode: u32) -> f32 {
+    return slc_child_prob_m(l, r, x, n, eps, mode, 1.0, 1.0);
+}
+
+// slc_child_prob with each child's weight times a material term (ml, mr >= 0; the glossy
+// walk's slc_glossy_term, 1 otherwise): the SST paper's eq. 5 weight M_j x G_j x I_j.
+fn slc_child_prob_m(l: SstNode, r: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32, mode: u32,
+    ml: f32, mr: f32) -> f32 {
     if mode == 0u {
-        let wl = slc_node_weight(l, x, n, eps);
-        let wr = slc_node_weight(r, x, n, eps);
+        let wl = slc_node_weight(l, x, n, eps) * ml;
+        let wr = slc_node_weight(r, x, n, eps) * mr;
         let s = wl + wr;
         return select(-1.0, wl / s, s > 0.0);
     }
-    let gl = select(luminance(l.intensity) * box_cos(l.bbox_min, l.bbox_max, x, n), 0.0, sst_is_empty(l));
-    let gr = select(luminance(r.intensity) * box_cos(r.bbox_min, r.bbox_max, x, n), 0.0, sst_is_empty(r));
+    let gl = select(luminance(l.intensity) * box_cos(l.bbox_min, l.bbox_max, x, n), 0.0, sst_is_empty(l)) * ml;
+    let gr = select(luminance(r.intensity) * box_cos(r.bbox_min, r.bbox_max, x, n), 0.0, sst_is_empty(r)) * mr;
     if !(gl + gr > 0.0) {
         return -1.0;
     }
@@ -61,6 +68,64 @@ fn slc_child_prob(l: SstNode, r: SstNode, x: vec3<f32>, n: vec3<f32>, eps: f32, 
     let xl = gl / max(dot(fl, fl), e2);
     let xr = gr / max(dot(fr, fr), e2);
     return 0.5 * (nl / (nl + nr) + xl / (xl + xr));
+}
+
+// The SST paper's glossy material term (section 4.1: "For the glossy part of the BRDF ... We
+// compute the perfect reflection R of the view vector along the surface normal at x ... test
+// if the ray x + t R intersects with the cluster's bounding box. If so, we use R for the glossy
+// BRDF computation. Otherwise, the BRDF is evaluated with a direction vector R' that actually
+// does intersect the bounding box and minimizes the difference to R"). R' here: towards the
+// point of the box nearest the reflected ray's point level with the box centre,
+// clamp(x + R max((c - x).R, 0), lo, hi) (an approximation of the minimising direction).
+// Returns luminance(F(v.h)) D(n.h) Vis(n.l, n.v) at l = R' with n.l at least 1e-3, so the
+// term is positive wherever n.v > 0 and the walk keeps the support of the geometric weights
+// (unbiased). 0 when n.v <= 0, where the glossy part is 0 for every light. The cosine is the
+// weight's box_cos. f0 = F0, a2 = alpha^2 (common/brdf.wgsl). Twin: `reference::slc::glossy_term`.
+// The geometric share of the defensive glossy weights (sampling.glossy_weights; twin:
+// `base::sampling::GLOSSY_DEFENSIVE`).
+const SLC_GLOSSY_DEFENSIVE: f32 = 0.25;
+
+fn slc_mirror_toward(lo: vec3<f32>, hi: vec3<f32>, x: vec3<f32>, r: vec3<f32>) -> vec3<f32> {
+    let rs = select(vec3<f32>(1e-8), r, abs(r) >= vec3<f32>(1e-8));
+    let inv = vec3<f32>(1.0) / rs;
+    let t0 = (lo - x) * inv;
+    let t1 = (hi - x) * inv;
+    let tn = min(t0, t1);
+    let tf = max(t0, t1);
+    let t_in = max(max(tn.x, tn.y), max(tn.z, 0.0));
+    let t_out = min(min(tf.x, tf.y), tf.z);
+    if t_in <= t_out {
+        return r;
+    }
+    let c = 0.5 * (lo + hi);
+    let p = clamp(x + r * max(dot(c - x, r), 0.0), lo, hi);
+    let d = p - x;
+    let l2 = dot(d, d);
+    if !(l2 > 1e-20) {
+        return r;
+    }
+    return d / sqrt(l2);
+}
+
+fn slc_glossy_term(lo: vec3<f32>, hi: vec3<f32>, x: vec3<f32>, n: vec3<f32>, v: vec3<f32>,
+    f0: vec3<f32>, a2: f32) -> f32 {
+    let nv = dot(n, v);
+    if !(nv > 0.0) {
+        return 0.0;
+    }
+    let r = 2.0 * nv * n - v;
+    let l = slc_mirror_toward(lo, hi, x, r);
+    let nl = max(dot(n, l), 1e-3);
+    let hs = v + l;
+    let h = select(n, normalize(hs), dot(hs, hs) > 1e-12);
+    let nh = max(dot(n, h), 0.0);
+    let q = nh * nh * (a2 - 1.0) + 1.0;
+    let d = a2 / (3.14159265358979 * q * q);
+    let vis = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));
+    let m = 1.0 - clamp(dot(v, h), 0.0, 1.0);
+    let m2 = m * m;
+    let f = f0 + (vec3<f32>(1.0) - f0) * (m2 * m2 * m);
+    return luminance(f) * d * vis;
 }
 
 // Near-field refinement (ours; theta = 0 turns it off, the thesis's rule): a usable node is

@@ -29,6 +29,10 @@ struct SlcParams {
     interleave_offset: u32, // the frame's subset offset
     radix: u32,             // 1: the radix tree (children from tree_links), 0: the perfect tree
     brdf: u32,              // BRDF_LAMBERT / BRDF_GGX (common/brdf.wgsl)
+    glossy_material: u32,   // glossy walks: 0 geometric, 1 x slc_glossy_term (SST paper 4.1), 2 defensive mix
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
     eye: vec4<f32>,         // xyz camera position (glossy shading's view direction)
 };
 

@@ -7,7 +7,7 @@ pub enum Brdf {
     /// base colour / pi (the thesis; the references against Mitsuba are diffuse).
     #[default]
     Lambert,
-    /// Cook-Torrance GGX over glTF's metallic and roughness factors.
+    /// Cook-Torrance GGX over glTF's metallic and roughness (factors x textures).
     Ggx,
 }
 

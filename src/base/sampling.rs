@@ -38,3 +38,48 @@ impl ChildProbability {
         }
     }
 }
+
+/// How a glossy sample's walk (SLC, SST with `gi.brdf = "Ggx"`; SST paper section 4.3:
+/// glossy samples walk to leaf VPLs) weighs the two children of a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum GlossyWeights {
+    /// The geometric weights alone (`ChildProbability`), as a diffuse sample walks.
+    Geometric,
+    /// The SST paper's material term (section 4.1): each child's weight times the specular
+    /// BRDF towards the reflected view direction where it meets the child's box, else
+    /// towards the box's point nearest it (`reference::slc::glossy_term`).
+    Material,
+    /// Ours (the default): (1 - [`GLOSSY_DEFENSIVE`]) x the material term's probability +
+    /// [`GLOSSY_DEFENSIVE`] x the geometric one (a defensive mixture): the paper's single
+    /// direction per box underrates children whose VPLs lie in the lobe off that direction,
+    /// a firefly when drawn. Measured in `tests/slc.rs` and docs/brdf.md.
+    #[default]
+    Defensive,
+}
+
+/// The geometric share of [`GlossyWeights::Defensive`] (`SLC_GLOSSY_DEFENSIVE` in
+/// `common/slc.wgsl`).
+pub const GLOSSY_DEFENSIVE: f32 = 0.25;
+
+impl GlossyWeights {
+    pub const ALL: [GlossyWeights; 3] = [
+        GlossyWeights::Geometric,
+        GlossyWeights::Material,
+        GlossyWeights::Defensive,
+    ];
+    pub fn name(self) -> &'static str {
+        match self {
+            GlossyWeights::Geometric => "geometric only",
+            GlossyWeights::Material => "material term (SST paper)",
+            GlossyWeights::Defensive => "material + 25% geometric (defensive)",
+        }
+    }
+    /// `SlcParams.glossy_material`.
+    pub fn gpu(self) -> u32 {
+        match self {
+            GlossyWeights::Geometric => 0,
+            GlossyWeights::Material => 1,
+            GlossyWeights::Defensive => 2,
+        }
+    }
+}

@@ -26,6 +26,11 @@ pub fn run() -> anyhow::Result<()> {
         if m.story {
             println!("{:<14} pixel story: yes", "");
         }
+        if m.kind != crate::methods::Kind::DirectOnly {
+            let brdf = if m.glossy { "Lambert, GGX" } else { "Lambert only" };
+            let bounces = if m.one_bounce { "1 (RSM texels)" } else { "1..=8" };
+            println!("{:<14} BRDF: {brdf}; VPL bounces: {bounces}", "");
+        }
         if !m.tests.is_empty() {
             println!("{:<14} checked by: {}", "", m.tests.join(", "));
         }

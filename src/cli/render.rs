@@ -41,6 +41,14 @@ pub enum FallbackArg {
     Recompute,
 }
 
+/// Glossy walk weights for `--glossy-weights`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum GlossyWeightsArg {
+    Geometric,
+    Material,
+    Defensive,
+}
+
 /// Child probability for `--child-probability`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ChildProbabilityArg {
@@ -102,7 +110,7 @@ pub enum TreeArg {
 pub enum BrdfArg {
     /// base colour / pi (default).
     Lambert,
-    /// Cook-Torrance GGX over glTF's metallic and roughness factors.
+    /// Cook-Torrance GGX over glTF's metallic and roughness (factors x textures).
     Ggx,
 }
 
@@ -172,10 +180,15 @@ pub struct SamplingArgs {
     #[arg(long)]
     pub no_roulette: bool,
     /// The BRDF of every shading point: `lambert` (default) or `ggx` (Cook-Torrance GGX over
-    /// glTF's metallic-roughness factors; `gi.brdf`). Methods that shade with Lambert only
+    /// glTF's metallic-roughness factors and textures; `gi.brdf`). Methods that shade with Lambert only
     /// refuse `ggx`.
     #[arg(long, value_enum)]
     pub brdf: Option<BrdfArg>,
+    /// With `--brdf ggx`, how SLC's and SST's glossy samples weigh the children of a step:
+    /// `geometric` (the diffuse weights), `material` (the SST paper's material term, section
+    /// 4.1) or `defensive` (default: the material term mixed with 25% geometric).
+    #[arg(long, value_enum)]
+    pub glossy_weights: Option<GlossyWeightsArg>,
     /// Least normal similarity of a usable SST node.
     #[arg(long)]
     pub v_min: Option<f32>,
@@ -313,6 +326,14 @@ impl SamplingArgs {
         }
         if self.no_roulette {
             s.vpl.roulette = false;
+        }
+        if let Some(g) = self.glossy_weights {
+            use crate::base::sampling::GlossyWeights;
+            s.sampling.glossy_weights = match g {
+                GlossyWeightsArg::Geometric => GlossyWeights::Geometric,
+                GlossyWeightsArg::Material => GlossyWeights::Material,
+                GlossyWeightsArg::Defensive => GlossyWeights::Defensive,
+            };
         }
         if let Some(b) = self.brdf {
             s.gi.brdf = match b {

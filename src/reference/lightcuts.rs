@@ -37,6 +37,7 @@ use crate::base::{
     gpu_layout::{GpuVpl, VPL_NONE},
     sst_node::{SstNode, Topology, basis},
 };
+use crate::reference::brdf;
 use crate::reference::vpl::{pcg_hash, u01};
 use crate::scene::bvh::{Bvh, Ray};
 
@@ -255,31 +256,104 @@ pub fn geometry_bound(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cone: Cone, eps: f32
     if cx <= 0.0 {
         return 0.0;
     }
-    // The emitter's cosine: the angle between its normal m and x - p is at least the angle
-    // between the cone's axis and x - p minus the cone's half-angle.
+    let cv = emitter_cos_bound(x, lo, hi, cone);
+    cx * cv / box_distance2(x, lo, hi).max(eps * eps)
+}
+
+/// Upper bound of the emitter's cosine over VPLs in the box with normals in the cone: the
+/// angle between a normal m and x - p is at least the angle between the cone's axis and
+/// x - p minus the cone's half-angle. Twin: `lc_emitter_cos_bound`.
+pub fn emitter_cos_bound(x: Vec3, lo: Vec3, hi: Vec3, cone: Cone) -> f32 {
     let c_axis = cos_bound(-cone.axis, x, lo, hi);
     let phi = c_axis.clamp(0.0, 1.0).acos();
     let theta = cone.half_angle + CONE_MARGIN;
-    let cv = if phi <= theta {
+    if phi <= theta {
         1.0
     } else if phi - theta >= std::f32::consts::FRAC_PI_2 {
         0.0
     } else {
         (phi - theta).cos()
-    };
-    cx * cv / box_distance2(x, lo, hi).max(eps * eps)
+    }
+}
+
+/// The receiver's view direction and material for the glossy BRDF (`gi.brdf = "Ggx"`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shading {
+    pub v: Vec3,
+    pub surface: brdf::Surface,
+}
+
+/// Upper bound of luminance(f(v, l)) x n.l over the directions l from x into the box, with
+/// `cx` >= n.l (> 0) from [`cos_bound`]: Lightcuts' material bound (Walter et al. 4.1 bound
+/// Lambert, Phong and Ward alike) for the GGX BRDF. Derivation in
+/// `shaders/methods/lightcuts/lc_brdf_bound.wgsl` (its twin `lc_ggx_cos_bound`): the diffuse
+/// part by (1 - metallic) lum(base) / pi x cx; D by its value at n.h = cos(theta_lr / 2), theta_lr
+/// the least angle between the mirror direction and the box; Schlick's F at the least v.h;
+/// Vis x n.l by min(0.5 / (n.v alpha) x cx, 0.5 / (A + n.v)).
+pub fn ggx_cos_bound(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cx: f32, sh: &Shading) -> f32 {
+    let (v, s) = (sh.v, &sh.surface);
+    let nv = n.dot(v);
+    if nv.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return 0.0;
+    }
+    let pi = std::f32::consts::PI;
+    let diffuse = (1.0 - s.metallic) * luminance(s.base) / pi * cx;
+    let a = brdf::alpha(s.roughness);
+    let a2 = a * a;
+    let r = 2.0 * nv * n - v;
+    let t_lr = cos_bound(r, x, lo, hi).clamp(0.0, 1.0).acos();
+    let d = brdf::ggx_d((0.5 * t_lr).cos(), a2);
+    let t_back = cos_bound(-v, x, lo, hi).clamp(0.0, 1.0).acos();
+    let vh = (0.5 * (pi - t_back)).cos();
+    let f = luminance(brdf::schlick(brdf::f0(s.base, s.metallic), vh));
+    let big_a = (nv * nv * (1.0 - a2) + a2).sqrt();
+    let vis_cos = (0.5 / (nv * a) * cx).min(0.5 / (big_a + nv));
+    diffuse + f * d * vis_cos
+}
+
+/// [`geometry_bound`] with the glossy BRDF: an upper bound of luminance(f(v, l)) x cos_x x
+/// cos_v / max(d^2, eps^2) over the box and the cone. Twin: `lc_geometry_brdf_bound`.
+pub fn geometry_brdf_bound(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cone: Cone, eps: f32, sh: &Shading) -> f32 {
+    if cone.is_empty() {
+        return 0.0;
+    }
+    let cx = cos_bound(n, x, lo, hi);
+    if cx <= 0.0 {
+        return 0.0;
+    }
+    let cv = emitter_cos_bound(x, lo, hi, cone);
+    let m = ggx_cos_bound(x, n, lo, hi, cx, sh);
+    m * cv / box_distance2(x, lo, hi).max(eps * eps)
 }
 
 /// The error bound of node `node` at (x, n): 0 for leaves (exact) and empty nodes.
 /// Twin: `lc_error_bound`.
 pub fn error_bound(nodes: &[SstNode], lc: &LcTree, node: u32, x: Vec3, n: Vec3, eps: f32) -> f32 {
+    error_bound_shaded(nodes, lc, node, x, n, eps, None)
+}
+
+/// [`error_bound`], with the glossy BRDF's bound where `sh` is given. Twin: `error_bound` in
+/// `lightcuts.wgsl`.
+pub fn error_bound_shaded(
+    nodes: &[SstNode],
+    lc: &LcTree,
+    node: u32,
+    x: Vec3,
+    n: Vec3,
+    eps: f32,
+    sh: Option<&Shading>,
+) -> f32 {
     let leaves = (nodes.len() / 2) as u32;
     let c = &nodes[node as usize];
     if node >= leaves || c.is_empty() {
         return 0.0;
     }
-    luminance(c.intensity) / std::f32::consts::PI
-        * geometry_bound(x, n, c.bbox_min, c.bbox_max, lc.cones[node as usize], eps)
+    let cone = lc.cones[node as usize];
+    let g = match sh {
+        Some(sh) => geometry_brdf_bound(x, n, c.bbox_min, c.bbox_max, cone, eps, sh),
+        None => geometry_bound(x, n, c.bbox_min, c.bbox_max, cone, eps),
+    };
+    luminance(c.intensity) / std::f32::consts::PI * g
 }
 
 /// The exact (unbounded) geometric term of `vpl_geometry` in `common/vpl.wgsl`.
@@ -323,6 +397,31 @@ pub fn cluster_estimate(
         return Vec3::ZERO;
     }
     flux * (luminance(nodes[node as usize].intensity) / lf) / std::f32::consts::PI * g
+}
+
+/// [`cluster_estimate`] times the glossy BRDF f(v, l) towards the representative where `sh`
+/// is given (radiance; Lambert leaves the albedo / pi to [`PixelCut::radiance`]). Twin:
+/// `estimate` in `lightcuts.wgsl`.
+#[allow(clippy::too_many_arguments)]
+pub fn cluster_estimate_shaded(
+    nodes: &[SstNode],
+    lc: &LcTree,
+    sorted: &[GpuVpl],
+    node: u32,
+    x: Vec3,
+    n: Vec3,
+    eps: f32,
+    sh: Option<&Shading>,
+) -> Vec3 {
+    let e = cluster_estimate(nodes, lc, sorted, node, x, n, eps);
+    match sh {
+        Some(sh) if e != Vec3::ZERO => {
+            let v = &sorted[lc.reps[node as usize] as usize];
+            let l = (Vec3::from_slice(&v.position[..3]) - x).normalize();
+            e * brdf::eval(brdf::Brdf::Ggx, n, sh.v, l, &sh.surface)
+        }
+        _ => e,
+    }
 }
 
 /// Whether the node's representative is visible from (x, n): one BVH shadow ray between the
@@ -382,11 +481,16 @@ pub struct PixelCut {
     /// The largest bound left in the cut over lum(sum) (0 when every node is exact).
     pub relative_bound: f32,
     pub shadow_rays: u32,
+    /// Shaded with the glossy BRDF: `sum` is radiance already.
+    pub glossy: bool,
 }
 
 impl PixelCut {
     /// Radiance at a receiver of albedo `albedo`.
     pub fn radiance(&self, albedo: Vec3) -> Vec3 {
+        if self.glossy {
+            return self.sum;
+        }
         albedo / std::f32::consts::PI * self.sum
     }
     /// Whether refinement stopped at the size limit with a bound above the threshold.
@@ -423,8 +527,25 @@ pub fn lightcut_on(
     n: Vec3,
     p: &CutParams,
 ) -> PixelCut {
+    lightcut_shaded_on(nodes, topo, lc, sorted, bvh, x, n, p, None)
+}
+
+/// [`lightcut_on`] with the glossy BRDF where `sh` is given: its bounds
+/// ([`error_bound_shaded`]) and estimates ([`cluster_estimate_shaded`]; the sum is radiance).
+#[allow(clippy::too_many_arguments)]
+pub fn lightcut_shaded_on(
+    nodes: &[SstNode],
+    topo: Topology<'_>,
+    lc: &LcTree,
+    sorted: &[GpuVpl],
+    bvh: &Bvh,
+    x: Vec3,
+    n: Vec3,
+    p: &CutParams,
+    sh: Option<&Shading>,
+) -> PixelCut {
     let leaves = topo.leaves;
-    let estimate = |node: u32| cluster_estimate(nodes, lc, sorted, node, x, n, p.eps);
+    let estimate = |node: u32| cluster_estimate_shaded(nodes, lc, sorted, node, x, n, p.eps, sh);
     let mut rays = 0u32;
     let mut visible = |node: u32, e: Vec3| -> bool {
         if e == Vec3::ZERO && !p.trace_every_node {
@@ -442,7 +563,7 @@ pub fn lightcut_on(
     let mut sum = Vec3::ZERO;
     let mut refinements = 0;
     if !nodes[1].is_empty() {
-        let bound = error_bound(nodes, lc, 1, x, n, p.eps);
+        let bound = error_bound_shaded(nodes, lc, 1, x, n, p.eps, sh);
         if bound > 0.0 {
             let e = estimate(1);
             let vis = visible(1, e);
@@ -484,7 +605,7 @@ pub fn lightcut_on(
             if nodes[child as usize].is_empty() {
                 continue;
             }
-            let bound = error_bound(nodes, lc, child, x, n, p.eps);
+            let bound = error_bound_shaded(nodes, lc, child, x, n, p.eps, sh);
             let (e, vis) = if lc.reps[child as usize] == lc.reps[top.node as usize] {
                 (estimate(child), top_vis)
             } else if bound > 0.0 || child >= leaves || p.trace_every_node {
@@ -524,6 +645,7 @@ pub fn lightcut_on(
         refinements,
         relative_bound,
         shadow_rays: rays,
+        glossy: sh.is_some(),
     }
 }
 

@@ -13,8 +13,9 @@
 
 use glam::Vec3;
 
+use super::brdf;
 use super::sst_tree::{SstNode, luminance};
-use crate::base::sampling::ChildProbability;
+use crate::base::sampling::{ChildProbability, GLOSSY_DEFENSIVE, GlossyWeights};
 use crate::base::sst_node::Topology;
 
 /// Largest cut (samples per pixel) the GPU kernels hold in registers.
@@ -83,8 +84,22 @@ pub fn child_probability(
     eps: f32,
     mode: ChildProbability,
 ) -> Option<f32> {
+    child_probability_m(l, r, x, n, eps, mode, (1.0, 1.0))
+}
+
+/// [`child_probability`] with each child's weight times a material term `m` = (left,
+/// right), both >= 0 (the glossy walk's [`glossy_term`]): `slc_child_prob_m`.
+pub fn child_probability_m(
+    l: &SstNode,
+    r: &SstNode,
+    x: Vec3,
+    n: Vec3,
+    eps: f32,
+    mode: ChildProbability,
+    m: (f32, f32),
+) -> Option<f32> {
     if mode == ChildProbability::Mean {
-        let (wl, wr) = (node_weight(l, x, n, eps), node_weight(r, x, n, eps));
+        let (wl, wr) = (node_weight(l, x, n, eps) * m.0, node_weight(r, x, n, eps) * m.1);
         let s = wl + wr;
         return (s > 0.0).then(|| wl / s);
     }
@@ -95,7 +110,7 @@ pub fn child_probability(
             luminance(c.intensity) * box_cos(c.bbox_min, c.bbox_max, x, n)
         }
     };
-    let (gl, gr) = (g(l), g(r));
+    let (gl, gr) = (g(l) * m.0, g(r) * m.1);
     // (Also None for NaN.)
     if (gl + gr).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return None;
@@ -120,6 +135,89 @@ pub fn child_probability(
     };
     let (xl, xr) = (gl / far(l), gr / far(r));
     Some(0.5 * (nl / (nl + nr) + xl / (xl + xr)))
+}
+
+/// The direction from x towards the box [lo, hi] for the glossy material term: `r` when
+/// the ray x + t r (t >= 0) meets the box, else towards the box point nearest the ray's
+/// point level with the box centre, clamp(x + r max((c - x).r, 0), lo, hi) (an approximation
+/// of the SST paper's R', the direction into the box closest to R): `slc_mirror_toward`.
+pub fn mirror_toward(lo: Vec3, hi: Vec3, x: Vec3, r: Vec3) -> Vec3 {
+    let safe = |c: f32| if c.abs() >= 1e-8 { c } else { 1e-8 };
+    let inv = Vec3::ONE / Vec3::new(safe(r.x), safe(r.y), safe(r.z));
+    let (t0, t1) = ((lo - x) * inv, (hi - x) * inv);
+    let (tn, tf) = (t0.min(t1), t0.max(t1));
+    let t_in = tn.x.max(tn.y).max(tn.z.max(0.0));
+    let t_out = tf.x.min(tf.y).min(tf.z);
+    if t_in <= t_out {
+        return r;
+    }
+    let c = 0.5 * (lo + hi);
+    let p = (x + r * (c - x).dot(r).max(0.0)).clamp(lo, hi);
+    let d = p - x;
+    let l2 = d.dot(d);
+    if l2.partial_cmp(&1e-20) != Some(std::cmp::Ordering::Greater) {
+        return r;
+    }
+    d / l2.sqrt()
+}
+
+/// The SST paper's glossy material term of a node's box (section 4.1): the specular BRDF's
+/// luminance(F(v.h)) D(n.h) Vis at l = [`mirror_toward`] of the reflected view direction, with
+/// n.l at least 1e-3 (positive wherever n.v > 0, so the glossy walk keeps the support of
+/// the geometric weights); 0 when n.v <= 0. `slc_glossy_term` in `common/slc.wgsl`.
+pub fn glossy_term(lo: Vec3, hi: Vec3, x: Vec3, n: Vec3, v: Vec3, s: &brdf::Surface) -> f32 {
+    let nv = n.dot(v);
+    if nv.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return 0.0;
+    }
+    let a = brdf::alpha(s.roughness);
+    let a2 = a * a;
+    let r = 2.0 * nv * n - v;
+    let l = mirror_toward(lo, hi, x, r);
+    let nl = n.dot(l).max(1e-3);
+    let hs = v + l;
+    let h = if hs.dot(hs) > 1e-12 { hs.normalize() } else { n };
+    let nh = n.dot(h).max(0.0);
+    let vis = 0.5 / (nl * (nv * nv * (1.0 - a2) + a2).sqrt() + nv * (nl * nl * (1.0 - a2) + a2).sqrt());
+    let f = brdf::schlick(brdf::f0(s.base, s.metallic), v.dot(h));
+    luminance(f) * brdf::ggx_d(nh, a2) * vis
+}
+
+/// A glossy walk's probability of the left child (`traverse` in `slc_sample.wgsl`): the
+/// geometric [`child_probability`], with `weights` times the children's [`glossy_term`]s
+/// (`Material`), or those mixed with [`GLOSSY_DEFENSIVE`] of the geometric one
+/// (`Defensive`; the geometric one alone where the material terms are both 0).
+#[allow(clippy::too_many_arguments)]
+pub fn glossy_child_probability(
+    l: &SstNode,
+    r: &SstNode,
+    x: Vec3,
+    n: Vec3,
+    v: Vec3,
+    s: &brdf::Surface,
+    eps: f32,
+    mode: ChildProbability,
+    weights: GlossyWeights,
+) -> Option<f32> {
+    if weights == GlossyWeights::Geometric {
+        return child_probability(l, r, x, n, eps, mode);
+    }
+    let m = |c: &SstNode| {
+        if c.is_empty() {
+            0.0
+        } else {
+            glossy_term(c.bbox_min, c.bbox_max, x, n, v, s)
+        }
+    };
+    let pm = child_probability_m(l, r, x, n, eps, mode, (m(l), m(r)));
+    if weights == GlossyWeights::Material {
+        return pm;
+    }
+    let pg = child_probability(l, r, x, n, eps, mode)?;
+    Some(match pm {
+        Some(pm) => pm + (pg - pm) * GLOSSY_DEFENSIVE,
+        None => pg,
+    })
 }
 
 /// Whether a node may enter a cut (as a split's child): not empty, and (with culling) not
@@ -417,6 +515,75 @@ mod tests {
     use super::*;
     use crate::base::gpu_layout::GpuVpl;
     use crate::reference::sst_tree::{build, sort_vpls};
+
+    #[test]
+    fn glossy_term_follows_the_mirror_direction_and_keeps_the_support() {
+        use super::super::brdf::Surface;
+        let (x, n) = (Vec3::ZERO, Vec3::Z);
+        let v = Vec3::new(-1.0, 0.0, 1.0).normalize();
+        let r = 2.0 * n.dot(v) * n - v;
+        let s = Surface {
+            base: Vec3::splat(0.9),
+            metallic: 1.0,
+            roughness: 0.3,
+        };
+        // A box on the mirror ray: R itself.
+        let on = (Vec3::new(1.8, -0.2, 1.8), Vec3::new(2.2, 0.2, 2.2));
+        assert_eq!(mirror_toward(on.0, on.1, x, r), r);
+        // A box beside it: a direction into the box (its point level with the centre).
+        let off = (Vec3::new(1.8, 1.0, 1.8), Vec3::new(2.2, 1.4, 2.2));
+        let d = mirror_toward(off.0, off.1, x, r);
+        assert!((d.length() - 1.0).abs() < 1e-5);
+        let t = ((off.0 + off.1) * 0.5).dot(d);
+        let p = x + d * t;
+        assert!(
+            p.y >= off.0.y - 1e-4 && p.y <= off.1.y + 1e-4,
+            "{d} does not point into the box"
+        );
+        assert!(d.dot(r) < 1.0 - 1e-4);
+        let (g_on, g_off) = (
+            glossy_term(on.0, on.1, x, n, v, &s),
+            glossy_term(off.0, off.1, x, n, v, &s),
+        );
+        // On the mirror direction the term is the specular BRDF at the lobe's peak (n.h = 1).
+        let a2 = brdf::alpha(0.3).powi(2);
+        let nv = n.dot(v);
+        let peak = luminance(brdf::schlick(brdf::f0(s.base, 1.0), nv)) * brdf::ggx_d(1.0, a2) * 0.5
+            / (2.0 * nv * (nv * nv * (1.0 - a2) + a2).sqrt());
+        assert!((g_on - peak).abs() < 1e-4 * peak, "{g_on} vs {peak}");
+        assert!(g_off > 0.0 && g_off < 0.5 * g_on, "{g_off} vs {g_on}");
+        // Farther from the lobe, smaller.
+        let far = (Vec3::new(1.8, 3.0, 1.8), Vec3::new(2.2, 3.4, 2.2));
+        assert!(glossy_term(far.0, far.1, x, n, v, &s) < g_off);
+        // A box behind the view (below the tangent plane too): still positive, so no branch
+        // the geometric weights keep is cut off.
+        let below = (Vec3::new(-3.0, -0.5, -1.0), Vec3::new(-2.0, 0.5, 0.05));
+        assert!(glossy_term(below.0, below.1, x, n, v, &s) > 0.0);
+        // A view from below the surface: no glossy light at all.
+        assert_eq!(glossy_term(on.0, on.1, x, n, -v, &s), 0.0);
+        // The multipliers scale the weights: equal terms change nothing.
+        let patch = |lo: Vec3, hi: Vec3| SstNode {
+            position: 0.5 * (lo + hi),
+            intensity: Vec3::ONE,
+            bbox_min: lo,
+            bbox_max: hi,
+            ..SstNode::EMPTY
+        };
+        let l = patch(Vec3::new(-1.0, -1.0, 1.0), Vec3::new(0.0, 1.0, 1.2));
+        let rr = patch(Vec3::new(1.0, -1.0, 1.0), Vec3::new(2.0, 1.0, 1.2));
+        let eps = 0.01;
+        for mode in [
+            ChildProbability::Mean,
+            ChildProbability::MinMax,
+            ChildProbability::Defensive,
+        ] {
+            let p1 = child_probability(&l, &rr, x, n, eps, mode).unwrap();
+            let p2 = child_probability_m(&l, &rr, x, n, eps, mode, (0.5, 0.5)).unwrap();
+            assert!((p1 - p2).abs() < 1e-6);
+            let p3 = child_probability_m(&l, &rr, x, n, eps, mode, (2.0, 0.5)).unwrap();
+            assert!(p3 > p1, "{mode:?}: a larger term takes more probability");
+        }
+    }
 
     #[test]
     fn child_probabilities_by_hand() {

@@ -202,7 +202,7 @@ pub struct VisParams {
 pub struct GpuMaterial {
     /// Linear RGBA base colour factor.
     pub base_color: [f32; 4],
-    /// x = texture layer or -1 (as i32 bits), yzw unused.
+    /// Texture layers or -1: x base colour, y roughness (its G), z metallic (its B); w unused.
     pub texture: [i32; 4],
     /// x = metallic, y = roughness (glTF factors), zw unused.
     pub params: [f32; 4],
@@ -315,6 +315,10 @@ pub struct GpuSlcParams {
     pub radix: u32,
     /// The BRDF model (`Brdf::gpu`).
     pub brdf: u32,
+    /// How glossy walks weigh the children: 0 geometric, 1 the SST paper's material term,
+    /// 2 defensive (`GlossyWeights::gpu`).
+    pub glossy_material: u32,
+    pub _pad: [u32; 3],
     /// xyz the camera's position.
     pub eye: [f32; 4],
 }
@@ -543,6 +547,11 @@ mod tests {
                         offset_of!(P, last),
                         offset_of!(P, steps),
                         offset_of!(P, radix),
+                        offset_of!(P, brdf),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                        offset_of!(P, _pad) + 8,
+                        offset_of!(P, eye),
                     ]
                 },
             ),
@@ -908,6 +917,10 @@ mod tests {
                     offset_of!(GpuSlcParams, interleave_offset),
                     offset_of!(GpuSlcParams, radix),
                     offset_of!(GpuSlcParams, brdf),
+                    offset_of!(GpuSlcParams, glossy_material),
+                    offset_of!(GpuSlcParams, _pad),
+                    offset_of!(GpuSlcParams, _pad) + 4,
+                    offset_of!(GpuSlcParams, _pad) + 8,
                     offset_of!(GpuSlcParams, eye),
                 ],
             ),

@@ -1,4 +1,5 @@
-//! The scene on the GPU: vertices, materials, the base-colour texture array, the BVH.
+//! The scene on the GPU: vertices, materials, the texture array (base colour and
+//! metallic-roughness layers), the BVH.
 
 use glam::Vec3;
 use wgpu::util::DeviceExt;
@@ -252,18 +253,20 @@ impl SceneGpu {
         });
         let sampler = texture_sampler(device, anisotropy);
 
+        let layer = |t: Option<usize>| {
+            t.filter(|&t| t < scene.textures.len())
+                .map(|t| t as i32)
+                .unwrap_or(-1)
+        };
         let mut mats: Vec<GpuMaterial> = scene
             .materials
             .iter()
             .map(|m| GpuMaterial {
                 base_color: m.base_color_factor,
                 texture: [
-                    m.base_color_texture
-                        .filter(|&t| t < scene.textures.len())
-                        .map(|t| t as i32)
-                        .unwrap_or(-1),
-                    0,
-                    0,
+                    layer(m.base_color_texture),
+                    layer(m.roughness_texture),
+                    layer(m.metallic_texture),
                     0,
                 ],
                 params: [m.metallic, m.roughness, 0.0, 0.0],
@@ -272,7 +275,7 @@ impl SceneGpu {
         if mats.is_empty() {
             mats.push(GpuMaterial {
                 base_color: [0.8, 0.8, 0.8, 1.0],
-                texture: [-1, 0, 0, 0],
+                texture: [-1, -1, -1, 0],
                 params: [0.0, 1.0, 0.0, 0.0],
             });
         }

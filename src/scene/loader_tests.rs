@@ -648,6 +648,89 @@ fn uv_set_follows_material_texcoord() {
     assert_eq!(&s.textures[0].rgba8[..4], &[10, 20, 30, 255]);
 }
 
+#[test]
+fn metallic_roughness_textures_are_read_as_linear_data() {
+    let dir = temp_dir("mrtex");
+    // G = roughness, B = metallic (glTF); two texels.
+    let img = image::RgbImage::from_fn(2, 1, |x, _| {
+        image::Rgb(if x == 0 { [0, 64, 200] } else { [255, 255, 0] })
+    });
+    img.save(dir.join("mr.png")).unwrap();
+    let mut gb = Gb::default();
+    gb.vec3(&TRI);
+    gb.indices(&[0, 1, 2]);
+    gb.vec2(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+    let rest = r#""meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":2},"indices":1,"material":0}]}],
+"materials":[{"name":"Rough","pbrMetallicRoughness":{"metallicFactor":0.5,"roughnessFactor":0.8,"metallicRoughnessTexture":{"index":0}}}],
+"textures":[{"source":0}],
+"images":[{"uri":"mr.png"}],
+"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]"#;
+    let s = load_gltf(&gb.write(&dir, "m", rest)).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let m = &s.materials[0];
+    assert_eq!((m.metallic, m.roughness), (0.5, 0.8), "the factors stay");
+    assert_eq!(m.roughness_texture, Some(0));
+    assert_eq!(m.metallic_texture, Some(0));
+    assert_eq!(m.base_color_texture, None);
+    // Stored sRGB-encoded: decoding gives the linear data back within half an sRGB step.
+    let t = &s.textures[0];
+    let dec = |i: usize| crate::base::display::srgb8_to_linear(t.rgba8[i]);
+    for (i, want) in [
+        (0usize, 0.0f32),
+        (1, 64.0 / 255.0),
+        (2, 200.0 / 255.0),
+        (5, 1.0),
+        (6, 0.0),
+    ] {
+        assert!((dec(i) - want).abs() < 0.0025, "byte {i}: {} vs {want}", dec(i));
+    }
+    // The same image as base colour too: two textures (colour and data).
+    let rest2 = rest.replace(
+        r#""metallicRoughnessTexture""#,
+        r#""baseColorTexture":{"index":0},"metallicRoughnessTexture""#,
+    );
+    let s = load_gltf(&gb.write(&dir, "m2", &rest2)).unwrap();
+    assert_eq!(s.textures.len(), 2);
+    let m = &s.materials[0];
+    assert!(m.base_color_texture.is_some() && m.roughness_texture.is_some());
+    assert_ne!(m.base_color_texture, m.roughness_texture);
+    assert_eq!(
+        s.textures[m.base_color_texture.unwrap()].rgba8[1],
+        64,
+        "colour bytes unchanged"
+    );
+}
+
+#[test]
+fn split_roughness_metallic_textures_find_the_image_beside_their_dds() {
+    // Sponza's AMD_split_roughnessMetallic textures are DDS-only; the glTF metallic-roughness
+    // PNG they were split from lies beside them under the DDS's base name.
+    let dir = temp_dir("splitmr");
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 51, 102]))
+        .save(dir.join("arch_rough.png"))
+        .unwrap();
+    let mut gb = Gb::default();
+    gb.vec3(&TRI);
+    gb.indices(&[0, 1, 2]);
+    gb.vec2(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+    let rest = r#""extensionsUsed":["AMD_split_roughnessMetallic","MSFT_texture_dds"],
+"meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":2},"indices":1,"material":0},{"attributes":{"POSITION":0,"TEXCOORD_0":2},"indices":1,"material":1}]}],
+"materials":[{"name":"Arch","pbrMetallicRoughness":{"metallicFactor":0.1},"extensions":{"AMD_split_roughnessMetallic":{"roughnessTexture":{"index":0},"metallicTexture":{"index":1}}}},
+             {"name":"Lost","extensions":{"AMD_split_roughnessMetallic":{"roughnessTexture":{"index":2}}}}],
+"textures":[{"extensions":{"MSFT_texture_dds":{"source":0}}},{"extensions":{"MSFT_texture_dds":{"source":1}}},{"extensions":{"MSFT_texture_dds":{"source":2}}}],
+"images":[{"uri":"arch_rough.roughness.dds"},{"uri":"arch_rough.metallic.dds"},{"uri":"gone.roughness.dds"}],
+"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]"#;
+    let s = load_gltf(&gb.write(&dir, "s", rest)).unwrap();
+    let arch = &s.materials[0];
+    assert_eq!(arch.roughness_texture, Some(0), "{:?}", s.warnings);
+    assert_eq!(arch.metallic_texture, Some(0), "one image, one data texture");
+    assert_eq!(s.textures.len(), 1);
+    let lost = &s.materials[1];
+    assert_eq!(lost.roughness_texture, None);
+    assert!(has_warning(&s, "nor one beside its DDS"), "{:?}", s.warnings);
+    assert!(!has_warning(&s, "Arch"), "{:?}", s.warnings);
+}
+
 // ---------------------------------------------------------------------------------------
 // Default scene
 // ---------------------------------------------------------------------------------------
@@ -942,6 +1025,21 @@ fn sponza_loads() {
     assert!(s.textures.len() >= 20, "{} textures", s.textures.len());
     // the three 16x16 curtain stand-ins are decoded
     assert!(s.textures.iter().any(|t| t.width == 16 && t.height == 16));
+    // the split roughness / metallic textures come from the PNGs beside their DDS files
+    let with = |f: fn(&crate::scene::Material) -> Option<usize>| {
+        s.materials.iter().filter(|m| f(m).is_some()).count()
+    };
+    assert!(
+        with(|m| m.roughness_texture) >= 15,
+        "{} roughness textures",
+        with(|m| m.roughness_texture)
+    );
+    assert!(
+        with(|m| m.metallic_texture) >= 6,
+        "{} metallic textures",
+        with(|m| m.metallic_texture)
+    );
+    assert!(!has_warning(&s, "beside its DDS"), "{:?}", s.warnings);
 }
 
 #[test]

@@ -86,6 +86,12 @@ pub struct Material {
     pub metallic: f32,
     /// glTF `roughnessFactor` (perceptual roughness; the GGX alpha is its square).
     pub roughness: f32,
+    /// Index into [`Scene::textures`] of the texture whose G channel multiplies `roughness`
+    /// (glTF `metallicRoughnessTexture`, or AMD_split_roughnessMetallic's roughness texture).
+    /// Data textures are stored sRGB-encoded so that sampling decodes them to linear.
+    pub roughness_texture: Option<usize>,
+    /// Likewise, the texture whose B channel multiplies `metallic`.
+    pub metallic_texture: Option<usize>,
 }
 
 impl Default for Material {
@@ -96,6 +102,8 @@ impl Default for Material {
             base_color_texture: None,
             metallic: 0.0,
             roughness: 1.0,
+            roughness_texture: None,
+            metallic_texture: None,
         }
     }
 }
@@ -108,6 +116,30 @@ pub struct TextureImage {
     pub height: u32,
     /// `width * height * 4` bytes, row-major, top row first.
     pub rgba8: Vec<u8>,
+}
+
+impl TextureImage {
+    /// Re-encodes linear 8-bit data (a metallic-roughness texture) as the sRGB bytes whose
+    /// decode gives it back, to within half an sRGB step (at most 0.0023, at 1.0); alpha is
+    /// kept. The renderer's texture array is sRGB: its sampler then returns the linear data.
+    pub fn encode_linear_as_srgb(&mut self) {
+        let lut: Vec<u8> = (0..=255u32)
+            .map(|v| {
+                let x = v as f32 / 255.0;
+                let s = if x <= 0.0031308 {
+                    12.92 * x
+                } else {
+                    1.055 * x.powf(1.0 / 2.4) - 0.055
+                };
+                (s * 255.0 + 0.5).clamp(0.0, 255.0) as u8
+            })
+            .collect();
+        for px in self.rgba8.chunks_exact_mut(4) {
+            for c in &mut px[..3] {
+                *c = lut[*c as usize];
+            }
+        }
+    }
 }
 
 /// A directional light (sun).

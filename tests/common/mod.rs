@@ -129,3 +129,13 @@ impl Setup {
         gt
     }
 }
+
+/// The default room with every material set to (metallic, roughness) (the GGX tests).
+#[allow(dead_code)]
+pub fn glossy_room(metallic: f32, roughness: f32) -> Scene {
+    let mut scene = default_scene::build();
+    for m in &mut scene.materials {
+        (m.metallic, m.roughness) = (metallic, roughness);
+    }
+    scene
+}

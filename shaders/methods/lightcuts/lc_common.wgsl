@@ -51,6 +51,14 @@ fn lc_geometry_bound(x: vec3<f32>, n: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>, c
     if cx <= 0.0 {
         return 0.0;
     }
+    let cv = lc_emitter_cos_bound(x, lo, hi, cone);
+    return cx * cv / max(lc_box_distance2(x, lo, hi), eps * eps);
+}
+
+// Upper bound of the emitter's cosine (its normal m against x - p) over VPLs in [lo, hi] with
+// normals in the cone: the angle is at least the angle between the cone's axis and x - p
+// minus the half-angle.
+fn lc_emitter_cos_bound(x: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>, cone: vec4<f32>) -> f32 {
     let c_axis = lc_cos_bound(-cone.xyz, x, lo, hi);
     let phi = acos(clamp(c_axis, 0.0, 1.0));
     let theta = cone.w + LC_CONE_MARGIN;
@@ -62,7 +70,7 @@ fn lc_geometry_bound(x: vec3<f32>, n: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>, c
             cv = cos(phi - theta);
         }
     }
-    return cx * cv / max(lc_box_distance2(x, lo, hi), eps * eps);
+    return cv;
 }
 
 // A cluster's unshadowed estimate at (x, n) from its representative `v` (flux / pi x G with

@@ -28,6 +28,8 @@
 #include "common/vpl_visibility.wgsl"
 #include "common/sst_node.wgsl"
 #include "methods/lightcuts/lc_common.wgsl"
+#include "common/brdf.wgsl"
+#include "methods/lightcuts/lc_brdf_bound.wgsl"
 #include "common/stats64.wgsl"
 #include "common/tree_links.wgsl"
 
@@ -60,7 +62,19 @@ struct LcParams {
     last: u32,        // 1: this dispatch finishes them and writes the outputs
     steps: u32,       // refinements per dispatch at most
     radix: u32,       // 1: the radix tree (children from tree_links; mode 0 only), 0: the perfect tree
+    brdf: u32,        // BRDF_LAMBERT / BRDF_GGX (mode 0 only; Lightcut Interpolation is Lambert)
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+    eye: vec4<f32>,   // xyz the camera's position (the glossy BRDF's view direction)
 };
+
+// The shading point's material (gi.brdf = GGX): set per pixel before the refinement.
+var<private> glossy: bool;
+var<private> sh_v: vec3<f32>;
+var<private> sh_base: vec3<f32>;
+var<private> sh_metallic: f32;
+var<private> sh_roughness: f32;
 
 // A pixel's refinement between dispatches.
 struct LcState {
@@ -233,17 +247,28 @@ fn error_bound(node: u32, x: vec3<f32>, n: vec3<f32>) -> f32 {
     if node >= lp.leaves || sst_is_empty(c) {
         return 0.0;
     }
+    if glossy {
+        return luminance(c.intensity) / PI * lc_geometry_brdf_bound(x, n, sh_v, c.bbox_min, c.bbox_max,
+            cones[node], lp.epsilon, sh_base, sh_metallic, sh_roughness);
+    }
     return luminance(c.intensity) / PI * lc_geometry_bound(x, n, c.bbox_min, c.bbox_max, cones[node], lp.epsilon);
 }
 
 // The cluster's unshadowed estimate: its representative's flux / pi x G with the cluster's
-// luminance.
+// luminance (Lambert: irradiance-like, the albedo / pi applied at the end); with the glossy
+// BRDF times f(v, l) towards the representative (radiance).
 fn estimate(node: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let rep = reps[node];
     if rep == LC_NONE {
         return vec3<f32>(0.0);
     }
-    return lc_estimate(sorted_vpls[rep], luminance(tree[node].intensity), x, n, lp.epsilon);
+    let v = sorted_vpls[rep];
+    let e = lc_estimate(v, luminance(tree[node].intensity), x, n, lp.epsilon);
+    if glossy && any(e != vec3<f32>(0.0)) {
+        let l = normalize(v.position.xyz - x);
+        return e * brdf_eval(lp.brdf, n, sh_v, l, sh_base, sh_metallic, sh_roughness);
+    }
+    return e;
 }
 
 // Whether the node's representative is visible from x (one shadow ray when the estimate is
@@ -314,7 +339,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let x = g.xyz;
-    let n = normalize(textureLoad(gb_normal, px, 0).xyz);
+    let nr = textureLoad(gb_normal, px, 0);
+    let n = normalize(nr.xyz);
+    glossy = MODE == 0u && lp.brdf != BRDF_LAMBERT;
+    if glossy {
+        let a = textureLoad(gb_albedo, px, 0);
+        sh_v = normalize(lp.eye.xyz - x);
+        sh_base = a.rgb;
+        sh_metallic = a.a;
+        sh_roughness = nr.w;
+    }
     let traced = DIAGNOSTICS && MODE == 0u && (u32(px.x) | (u32(px.y) << 16u)) == lp.trace_pixel;
     var size = 0u;     // heap entries
     var settled = 0u;  // final nodes outside the heap
@@ -418,7 +452,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let albedo = textureLoad(gb_albedo, px, 0).rgb;
-    let radiance = albedo / PI * sum;
+    // With the glossy BRDF the estimates carry it already.
+    let radiance = select(albedo / PI * sum, sum, glossy);
     if lp.accumulate != 0u {
         accum[k] += vec4<f32>(radiance, 0.0);
     } else {

@@ -92,10 +92,19 @@ struct Walk {
     steps: u32,
 };
 
+// The shading point's glossy lobe for the glossy walk's material term (slc_glossy_term).
+struct Lobe {
+    v: vec3<f32>,
+    f0: vec3<f32>,
+    a2: f32,
+};
+
 // Descends from `start`; node 0 = dead branch (both children weigh 0). `leaves_only`: the
-// glossy samples' walk, which ignores substitutes (SST paper, section 4.3).
+// glossy samples' walk, which ignores substitutes (SST paper, section 4.3) and, with
+// sampling.glossy_weights, weighs each child by the glossy material term towards its box
+// (section 4.1; twin: `reference::slc::glossy_child_probability`).
 fn traverse(start: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb: u32,
-    leaves_only: bool) -> Walk {
+    leaves_only: bool, lobe: Lobe) -> Walk {
     var node = start;
     var prob = 1.0;
     var steps = 0u;
@@ -106,7 +115,21 @@ fn traverse(start: u32, x: vec3<f32>, n: vec3<f32>, rng: ptr<function, Rng>, tb:
         }
         let c0 = tree_left(node);
         let c1 = tree_right(node);
-        let pl = slc_child_prob(tree[c0], tree[c1], x, n, sp.epsilon, sp.child_probability);
+        var ml = 1.0;
+        var mr = 1.0;
+        if leaves_only && sp.glossy_material != 0u {
+            let l = tree[c0];
+            let r = tree[c1];
+            ml = select(slc_glossy_term(l.bbox_min, l.bbox_max, x, n, lobe.v, lobe.f0, lobe.a2), 0.0, sst_is_empty(l));
+            mr = select(slc_glossy_term(r.bbox_min, r.bbox_max, x, n, lobe.v, lobe.f0, lobe.a2), 0.0, sst_is_empty(r));
+        }
+        var pl = slc_child_prob_m(tree[c0], tree[c1], x, n, sp.epsilon, sp.child_probability, ml, mr);
+        if leaves_only && sp.glossy_material == 2u {
+            // Defensive: a share of the geometric probability, so a child the material
+            // term underrates keeps part of its geometric share.
+            let pg = slc_child_prob(tree[c0], tree[c1], x, n, sp.epsilon, sp.child_probability);
+            pl = select(mix(pl, pg, SLC_GLOSSY_DEFENSIVE), pg, pl < 0.0);
+        }
         if pl < 0.0 {
             return Walk(0u, 0.0, steps);
         }
@@ -274,6 +297,8 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
         let diff_term = (1.0 - metallic) * luminance(albedo);
         p_glossy = select(1.0, spec_term / (spec_term + diff_term), spec_term + diff_term > 0.0);
     }
+    let a = brdf_alpha(roughness);
+    let lobe = Lobe(v, brdf_f0(albedo, metallic), a * a);
     var rng = rng_new(k, sp.seed, 0x51c5u);
 
     // Blending weights of the 4 surrounding blocks (Algorithm 1).
@@ -442,7 +467,7 @@ fn shade_pixel(px: vec2<u32>, x: vec3<f32>) {
         if glossy_brdf && sp.method != 2u {
             glossy_sample = rng_next(&rng) < p_glossy;
         }
-        let walk = traverse(start, x, n, &rng, tb, glossy_sample);
+        let walk = traverse(start, x, n, &rng, tb, glossy_sample, lobe);
         steps += walk.steps;
         walks += 1u;
         if tb != NO_TRACE {

@@ -421,6 +421,9 @@ impl Method for LightcutInterpolation {
             last: 1,
             steps: self.steps.0,
             radix: 0,
+            brdf: 0,
+            _pad: [0; 3],
+            eye: [0.0; 4],
         };
         if cx.diagnostics {
             self.traced = cx.trace_pixel.is_some();

@@ -41,6 +41,7 @@ pub static MODULE: Module = Module {
     create,
     shaders: &[
         shader!("lc_common.wgsl"),
+        shader!("lc_brdf_bound.wgsl"),
         shader!("lc_build.wgsl"),
         shader!("lc_merge.wgsl"),
         shader!("lc_build_radix.wgsl"),
@@ -123,7 +124,7 @@ pub static INFO: MethodInfo = MethodInfo {
     shadow_ray_switch: true,
     truth_of_vpls: false,
     one_bounce: false,
-    glossy: false,
+    glossy: true,
     validate,
     invalid_example: Some(invalid_example),
     ui: ui::settings_ui,
@@ -132,6 +133,9 @@ pub static INFO: MethodInfo = MethodInfo {
         "lightcuts::gpu_lightcuts_equal_the_cpu_reference_and_cuts_are_valid",
         "lightcuts::threshold_zero_and_unlimited_cut_equal_the_ground_truth",
         "lightcuts::the_mean_over_builds_of_a_fixed_cut_converges_to_the_ground_truth",
+        "lightcuts::the_ggx_error_bound_is_never_below_the_true_glossy_term",
+        "lightcuts::gpu_lightcuts_with_ggx_equal_the_cpu_reference",
+        "lightcuts::with_ggx_threshold_zero_equals_the_ggx_ground_truth",
     ],
     sweep: Some(&SWEEP),
 };
@@ -264,6 +268,9 @@ impl Method for Lightcuts {
             last: 1,
             steps: self.steps,
             radix: (cx.tree.kind == crate::renderer::settings::TreeKind::Lbvh) as u32,
+            brdf: cx.brdf.gpu(),
+            _pad: [0; 3],
+            eye: cx.eye.extend(0.0).to_array(),
         };
         if cx.diagnostics {
             self.traced = cx.trace_pixel.is_some();

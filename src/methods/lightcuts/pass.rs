@@ -57,6 +57,11 @@ pub struct GpuLcParams {
     pub steps: u32,
     /// 1: the radix tree (children from its links; Lightcuts only), 0: the perfect tree.
     pub radix: u32,
+    /// The BRDF (`Brdf::gpu`; Lightcuts only, Lightcut Interpolation shades Lambert).
+    pub brdf: u32,
+    pub _pad: [u32; 3],
+    /// xyz the camera's position (the glossy BRDF's view direction).
+    pub eye: [f32; 4],
 }
 
 /// Refinements per dispatch: all of them on a GPU; 16 on a CPU adapter, where lavapipe

@@ -110,6 +110,8 @@ const READS: &[Resource] = &[
 const TESTS: &[&str] = &[
     "slc::gpu_cuts_equal_the_cpu_cuts_and_are_valid",
     "slc::with_ggx_glossy_samples_walk_to_leaves_so_the_samplers_converge_on_metal",
+    "slc::glossy_walks_weigh_children_by_the_material_term_as_the_cpu_does",
+    "slc::the_defensive_glossy_weights_lower_the_error_on_polished_metal",
     "slc::blending_picks_cuts_by_their_weights_and_falls_back_to_the_mock_cut",
     "slc::rtslc_averaged_over_frames_converges_to_the_ground_truth",
     "slc::slc_without_usable_inner_nodes_equals_rtslc_and_steps_order_as_the_thesis_says",
@@ -553,6 +555,8 @@ impl Method for TreeSamplers {
             interleave_offset: Interleave::offset_of(il.n, seed),
             radix: (cx.tree.kind == TreeKind::Lbvh) as u32,
             brdf: cx.brdf.gpu(),
+            glossy_material: sm.glossy_weights.gpu(),
+            _pad: [0; 3],
             eye: cx.eye.extend(0.0).to_array(),
         };
         // A timed frame leaves the last diagnostic frame's story (and statistics) in place.

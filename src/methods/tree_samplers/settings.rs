@@ -70,7 +70,7 @@ impl CutFallback {
     }
 }
 
-pub use crate::base::sampling::ChildProbability;
+pub use crate::base::sampling::{ChildProbability, GlossyWeights};
 pub use crate::renderer::settings::InterleaveSettings;
 
 /// Largest interleaving pattern of the tree samplers: 8 x 8 = 64 subsets of at most 64 cut
@@ -110,6 +110,11 @@ pub struct SamplingSettings {
     /// How a traversal step splits its probability between the children (all three
     /// samplers; the cuts are built the same either way).
     pub child_probability: ChildProbability,
+    /// With a glossy BRDF (`gi.brdf = "Ggx"`), how the glossy samples' walks (SLC, SST)
+    /// weigh the children: geometric weights alone, the SST paper's glossy material term
+    /// (section 4.1), or (default) that mixed with 25% of the geometric probability. All
+    /// are unbiased; see docs/brdf.md for the measurements.
+    pub glossy_weights: GlossyWeights,
     pub blending: CutBlending,
     pub fallback: CutFallback,
     /// Average successive frames while the view, lights and settings stay (progressive);
@@ -149,6 +154,7 @@ impl Default for SamplingSettings {
             // SLC from 0.915x to 0.98x in the Breakfast Room; 0.1 m overshoots (light leaks).
             substitute_offset: 0.05,
             child_probability: ChildProbability::Defensive,
+            glossy_weights: GlossyWeights::Defensive,
             blending: CutBlending::Stochastic,
             fallback: CutFallback::MockCut,
             accumulate: false,

@@ -1,7 +1,7 @@
 //! The tree samplers' settings in the GUI (SST hides the cut and blending controls it does
 //! not use; RTSLC hides the substitute controls).
 
-use super::settings::{ChildProbability, CutBlending, CutFallback, SamplerVisibility};
+use super::settings::{ChildProbability, CutBlending, CutFallback, GlossyWeights, SamplerVisibility};
 use super::{RTSLC, SST};
 use crate::methods::MethodId;
 use crate::renderer::settings::RenderSettings;
@@ -67,6 +67,24 @@ pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) 
              of the closest-point one, which keeps VPLs next to the point from being \
              drawn rarely (fireflies)",
         );
+    if method != RTSLC && s.gi.brdf != crate::renderer::settings::Brdf::Lambert {
+        egui::ComboBox::from_label("glossy walk weights")
+            .selected_text(sm.glossy_weights.name())
+            .show_ui(ui, |ui| {
+                for g in GlossyWeights::ALL {
+                    ui.selectable_value(&mut sm.glossy_weights, g, g.name());
+                }
+            })
+            .response
+            .on_hover_text(
+                "how a glossy sample's walk to a leaf picks a child: the geometric \
+                 weights alone; the SST paper's material term (4.1: the specular BRDF \
+                 towards the reflected view direction where it meets the child's box, \
+                 else towards its nearest point); or (default) that mixed with 25% of \
+                 the geometric choice, so a child the single direction underrates is \
+                 still drawn (fewer fireflies)",
+            );
+    }
     ui.checkbox(
         &mut sm.half_resolution,
         "half-resolution GI (bilateral upsampling)",

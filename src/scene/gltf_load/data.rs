@@ -111,32 +111,81 @@ pub(super) fn load_buffers(
     Ok(out)
 }
 
-/// Decodes every image used as a base colour texture (each once, in parallel). Returns the
-/// decoded textures and a map image index -> texture index (`None` when it failed).
-pub(super) fn load_base_color_images(
+/// A material's texture requests: (source, TEXCOORD set) of its base colour, roughness and
+/// metallic textures.
+#[derive(Default)]
+pub(super) struct MaterialTextures {
+    pub(super) base: Option<(TexSource, u32)>,
+    pub(super) roughness: Option<(TexSource, u32)>,
+    pub(super) metallic: Option<(TexSource, u32)>,
+}
+
+/// Where a texture's pixels come from: a glTF image, or an image file found beside a
+/// DDS-only texture's `.dds` (see [`dds_sibling`]).
+#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub(super) enum TexSource {
+    Image(usize),
+    File(PathBuf),
+}
+
+/// What a texture holds: colour (sRGB-encoded, base colour) or data (linear: glTF's
+/// metallic-roughness, roughness in G and metallic in B). Data textures are stored
+/// sRGB-encoded ([`TextureImage::encode_linear_as_srgb`]) so that they share the base colour array, whose
+/// sampler decodes them back to linear.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub(super) enum TexKind {
+    Color,
+    Data,
+}
+
+impl TexKind {
+    fn what(self) -> &'static str {
+        match self {
+            TexKind::Color => "base colour",
+            TexKind::Data => "metallic-roughness",
+        }
+    }
+    fn fallback(self) -> &'static str {
+        match self {
+            TexKind::Color => "their colour factor only",
+            TexKind::Data => "their metallic / roughness factors only",
+        }
+    }
+}
+
+/// The image file beside a DDS-only texture's `.dds`: `name[.roughness|.metallic].dds` ->
+/// `name.png` / `.jpg` / `.jpeg`, if it exists. Sponza's `AMD_split_roughnessMetallic`
+/// textures are DDS-only (`sponza_arch_rough.roughness.dds`), split from the glTF
+/// metallic-roughness PNGs shipped beside them (`sponza_arch_rough.png`: roughness in G,
+/// metallic in B).
+pub(super) fn dds_sibling(base_dir: &Path, dds_uri: &str) -> Option<PathBuf> {
+    let lower = dds_uri.to_ascii_lowercase();
+    let stem_len = lower.strip_suffix(".dds")?.len();
+    let mut stem = &dds_uri[..stem_len];
+    for part in [".roughness", ".metallic"] {
+        if stem.to_ascii_lowercase().ends_with(part) {
+            stem = &stem[..stem.len() - part.len()];
+        }
+    }
+    ["png", "jpg", "jpeg"]
+        .iter()
+        .filter_map(|ext| resolve_uri(base_dir, &format!("{stem}.{ext}")).ok())
+        .find(|p| p.is_file())
+}
+
+/// Decodes every texture the materials use (each source and kind once, in parallel).
+/// `users`: (source, kind) -> names of the materials using it. Returns the textures and a
+/// map (source, kind) -> texture index (`None` when it failed, with a warning).
+#[allow(clippy::type_complexity)]
+pub(super) fn load_textures(
     doc: &gltf::Document,
     buffers: &[Vec<u8>],
     base_dir: &Path,
-    sourceless: &HashSet<usize>,
+    users: &BTreeMap<(TexSource, TexKind), Vec<String>>,
     warnings: &mut Warnings,
-) -> (Vec<TextureImage>, HashMap<usize, Option<usize>>) {
-    // image index -> names of materials using it
-    let mut users: BTreeMap<usize, Vec<String>> = BTreeMap::new();
-    for (i, m) in doc.materials().enumerate() {
-        if let Some(info) = m.pbr_metallic_roughness().base_color_texture() {
-            if sourceless.contains(&info.texture().index()) {
-                continue;
-            }
-            let img = info.texture().source().index();
-            users.entry(img).or_default().push(
-                m.name()
-                    .map(str::to_string)
-                    .unwrap_or_else(|| format!("material{i}")),
-            );
-        }
-    }
+) -> (Vec<TextureImage>, HashMap<(TexSource, TexKind), Option<usize>>) {
     let images: Vec<gltf::Image> = doc.images().collect();
-    let jobs: Vec<usize> = users.keys().copied().collect();
+    let jobs: Vec<&(TexSource, TexKind)> = users.keys().collect();
     let results: Mutex<Vec<Option<DecodeResult>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
     let next = AtomicUsize::new(0);
     let threads = std::thread::available_parallelism()
@@ -148,11 +197,21 @@ pub(super) fn load_base_color_images(
     let work = || {
         loop {
             let j = next.fetch_add(1, Ordering::Relaxed);
-            let Some(&img_index) = jobs.get(j) else { break };
-            let Some(img) = images.get(img_index) else {
-                continue;
+            let Some(&(source, kind)) = jobs.get(j) else { break };
+            let (label, mut res) = match source {
+                TexSource::Image(i) => {
+                    let Some(img) = images.get(*i) else {
+                        continue;
+                    };
+                    decode_image(img, buffers, base_dir)
+                }
+                TexSource::File(p) => decode_file(p),
             };
-            let (label, res) = decode_image(img, buffers, base_dir);
+            if *kind == TexKind::Data
+                && let Ok(t) = &mut res
+            {
+                t.encode_linear_as_srgb();
+            }
             if let Ok(mut r) = results.lock() {
                 r[j] = Some((label, res));
             }
@@ -169,28 +228,57 @@ pub(super) fn load_base_color_images(
 
     let mut textures = Vec::new();
     let mut map = HashMap::new();
-    for (j, &img_index) in jobs.iter().enumerate() {
-        let user_list = users.get(&img_index).map(|u| u.join("', '")).unwrap_or_default();
+    for (j, &key) in jobs.iter().enumerate() {
+        let user_list = users.get(key).map(|u| u.join("', '")).unwrap_or_default();
+        let (what, fallback) = (key.1.what(), key.1.fallback());
         match results.get(j).cloned().flatten() {
             Some((_, Ok(t))) => {
-                map.insert(img_index, Some(textures.len()));
+                map.insert(key.clone(), Some(textures.len()));
                 textures.push(t);
             }
             Some((label, Err(e))) => {
                 warnings.push(format!(
-                    "base colour image {label} not loaded ({e}); material(s) '{user_list}' use their colour factor only"
+                    "{what} image {label} not loaded ({e}); material(s) '{user_list}' use {fallback}"
                 ));
-                map.insert(img_index, None);
+                map.insert(key.clone(), None);
             }
             None => {
+                let name = match &key.0 {
+                    TexSource::Image(i) => i.to_string(),
+                    TexSource::File(p) => format!("'{}'", p.display()),
+                };
                 warnings.push(format!(
-                    "base colour image {img_index} not loaded (decoder failure); material(s) '{user_list}' use their colour factor only"
+                    "{what} image {name} not loaded (decoder failure); material(s) '{user_list}' use {fallback}"
                 ));
-                map.insert(img_index, None);
+                map.insert(key.clone(), None);
             }
         }
     }
     (textures, map)
+}
+
+/// Decodes an image file found beside a DDS-only texture.
+fn decode_file(p: &Path) -> (String, Result<TextureImage, String>) {
+    let label = format!("'{}'", p.display());
+    let name = p
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "image".into());
+    let res = std::fs::read(p)
+        .map_err(|e| e.to_string())
+        .and_then(|b| decode_bytes(&b, name));
+    (label, res)
+}
+
+fn decode_bytes(b: &[u8], name: String) -> Result<TextureImage, String> {
+    let decoded = image::load_from_memory(b).map_err(|e| one_line(&e.to_string()))?;
+    let rgba = decoded.into_rgba8();
+    Ok(TextureImage {
+        name,
+        width: rgba.width(),
+        height: rgba.height(),
+        rgba8: rgba.into_raw(),
+    })
 }
 
 pub(super) fn decode_image(
@@ -219,16 +307,7 @@ pub(super) fn decode_image(
         .name()
         .map(str::to_string)
         .unwrap_or_else(|| format!("image{}", img.index()));
-    let res = bytes.and_then(|b| {
-        let decoded = image::load_from_memory(&b).map_err(|e| one_line(&e.to_string()))?;
-        let rgba = decoded.into_rgba8();
-        Ok(TextureImage {
-            name,
-            width: rgba.width(),
-            height: rgba.height(),
-            rgba8: rgba.into_raw(),
-        })
-    });
+    let res = bytes.and_then(|b| decode_bytes(&b, name));
     (label, res)
 }
 

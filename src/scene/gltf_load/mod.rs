@@ -196,6 +196,24 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
     // a plain `source`) are pointed at a placeholder image so validation passes, and are
     // treated as "no texture" below.
     let mut sourceless: HashSet<usize> = HashSet::new();
+    // Their DDS image's URI (MSFT_texture_dds), where the file gives one.
+    let mut dds_uris: HashMap<usize, String> = HashMap::new();
+    for (i, t) in root.textures.iter().enumerate() {
+        if t.source.value() != u32::MAX as usize {
+            continue;
+        }
+        let uri = t
+            .extensions
+            .as_ref()
+            .and_then(|e| e.others.get("MSFT_texture_dds"))
+            .and_then(|v| v.get("source"))
+            .and_then(|v| v.as_u64())
+            .and_then(|k| root.images.get(k as usize))
+            .and_then(|img| img.uri.clone());
+        if let Some(uri) = uri {
+            dds_uris.insert(i, uri);
+        }
+    }
     if root
         .textures
         .iter()
@@ -243,12 +261,116 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
 
     let buffers = load_buffers(&doc, path, &base_dir, blob)?;
 
-    // Materials and their base colour images.
-    let (textures, image_to_texture) =
-        load_base_color_images(&doc, &buffers, &base_dir, &sourceless, &mut warnings);
+    // Materials and their textures: base colour, and metallic-roughness (glTF's
+    // `metallicRoughnessTexture`, or AMD_split_roughnessMetallic's separate roughness and
+    // metallic textures; roughness is read from G and metallic from B either way, which also
+    // reads a grey image right).
+    let mut requests: Vec<MaterialTextures> = Vec::new();
+    let mut users: BTreeMap<(TexSource, TexKind), Vec<String>> = BTreeMap::new();
+    for (i, m) in doc.materials().enumerate() {
+        let name = m
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("material{i}"));
+        let pbr = m.pbr_metallic_roughness();
+        let mut req = MaterialTextures::default();
+        // A texture's source: its image, or for a DDS-only data texture the image beside it.
+        let source = |tex: usize, kind: TexKind, what: &str, warnings: &mut Warnings| -> Option<TexSource> {
+            if !sourceless.contains(&tex) {
+                return doc
+                    .textures()
+                    .nth(tex)
+                    .map(|t| TexSource::Image(t.source().index()));
+            }
+            let sibling = (kind == TexKind::Data)
+                .then(|| dds_uris.get(&tex).and_then(|u| dds_sibling(&base_dir, u)))
+                .flatten();
+            if sibling.is_none() {
+                let fallback = match kind {
+                    TexKind::Color => "the colour factor only",
+                    TexKind::Data => "the factor only",
+                };
+                let beside = if kind == TexKind::Data {
+                    " (nor one beside its DDS)"
+                } else {
+                    ""
+                };
+                warnings.push(format!(
+                    "material '{name}': {what} texture {tex} has no PNG/JPG source{beside}; using {fallback}"
+                ));
+            }
+            sibling.map(TexSource::File)
+        };
+        if let Some(info) = pbr.base_color_texture() {
+            req.base = source(
+                info.texture().index(),
+                TexKind::Color,
+                "base colour",
+                &mut warnings,
+            )
+            .map(|src| (src, info.tex_coord()));
+        }
+        if let Some(info) = pbr.metallic_roughness_texture() {
+            let src = source(
+                info.texture().index(),
+                TexKind::Data,
+                "metallic-roughness",
+                &mut warnings,
+            );
+            req.roughness = src.clone().map(|s| (s, info.tex_coord()));
+            req.metallic = src.map(|s| (s, info.tex_coord()));
+        }
+        if let Some(split) = m.extension_value("AMD_split_roughnessMetallic") {
+            for (key, what) in [("roughnessTexture", "roughness"), ("metallicTexture", "metallic")] {
+                let Some(tex) = split
+                    .get(key)
+                    .and_then(|t| t.get("index"))
+                    .and_then(|v| v.as_u64())
+                else {
+                    continue;
+                };
+                let set = split
+                    .get(key)
+                    .and_then(|t| t.get("texCoord"))
+                    .and_then(|v| v.as_u64())
+                    .unwrap_or(0) as u32;
+                let found = if (tex as usize) < doc.textures().len() {
+                    source(tex as usize, TexKind::Data, what, &mut warnings)
+                } else {
+                    warnings.push(format!(
+                        "material '{name}': AMD_split_roughnessMetallic names missing texture {tex}; using the factor only"
+                    ));
+                    None
+                };
+                let slot = if key == "roughnessTexture" {
+                    &mut req.roughness
+                } else {
+                    &mut req.metallic
+                };
+                // glTF's own metallicRoughnessTexture takes precedence.
+                if slot.is_none() {
+                    *slot = found.map(|s| (s, set));
+                }
+            }
+        }
+        for (src, kind) in [
+            (&req.base, TexKind::Color),
+            (&req.roughness, TexKind::Data),
+            (&req.metallic, TexKind::Data),
+        ] {
+            if let Some((src, _)) = src {
+                let u = users.entry((src.clone(), kind)).or_default();
+                if !u.contains(&name) {
+                    u.push(name.clone());
+                }
+            }
+        }
+        requests.push(req);
+    }
+    let (textures, texture_of) = load_textures(&doc, &buffers, &base_dir, &users, &mut warnings);
     let mut materials: Vec<Material> = Vec::new();
     let mut material_uv_set: Vec<u32> = Vec::new();
-    for (i, m) in doc.materials().enumerate() {
+    for ((i, m), req) in doc.materials().enumerate().zip(requests) {
         let pbr = m.pbr_metallic_roughness();
         let factor = pbr.base_color_factor();
         let factor = if factor.iter().all(|c| c.is_finite()) {
@@ -259,35 +381,49 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
             ));
             [1.0; 4]
         };
-        let (tex, set) = match pbr.base_color_texture() {
-            Some(info) if sourceless.contains(&info.texture().index()) => {
-                warnings.push(format!(
-                    "material '{}': base colour texture {} has no PNG/JPG source; using the colour factor only",
-                    m.name().unwrap_or(""),
-                    info.texture().index()
-                ));
-                (None, info.tex_coord())
-            }
-            Some(info) => (
-                image_to_texture
-                    .get(&info.texture().source().index())
-                    .copied()
-                    .flatten(),
-                info.tex_coord(),
-            ),
-            None => (None, 0),
+        let name = m
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("material{i}"));
+        let texture = |t: &Option<(TexSource, u32)>, kind: TexKind| {
+            t.as_ref()
+                .and_then(|(src, _)| texture_of.get(&(src.clone(), kind)).copied().flatten())
         };
+        let (base, roughness_tex, metallic_tex) = (
+            texture(&req.base, TexKind::Color),
+            texture(&req.roughness, TexKind::Data),
+            texture(&req.metallic, TexKind::Data),
+        );
+        // One UV set per material (the vertices carry one): the base colour's, else the
+        // metallic-roughness texture's.
+        let sets: Vec<u32> = [
+            (base, &req.base),
+            (roughness_tex, &req.roughness),
+            (metallic_tex, &req.metallic),
+        ]
+        .iter()
+        .filter(|(t, _)| t.is_some())
+        .filter_map(|(_, r)| r.as_ref().map(|(_, set)| *set))
+        .collect();
+        let set = sets
+            .first()
+            .copied()
+            .unwrap_or_else(|| pbr.base_color_texture().map(|t| t.tex_coord()).unwrap_or(0));
+        if sets.iter().any(|&s| s != set) {
+            warnings.push(format!(
+                "material '{name}': its textures use different TEXCOORD sets; all read set {set}"
+            ));
+        }
         materials.push(Material {
-            name: m
-                .name()
-                .map(str::to_string)
-                .unwrap_or_else(|| format!("material{i}")),
+            name,
             base_color_factor: factor,
-            base_color_texture: tex,
+            base_color_texture: base,
             // glTF's defaults are 1 and 1; out-of-range or non-finite factors are clamped to
             // the nearest valid value (NaN: the default).
             metallic: clamp_factor(pbr.metallic_factor()),
             roughness: clamp_factor(pbr.roughness_factor()),
+            roughness_texture: roughness_tex,
+            metallic_texture: metallic_tex,
         });
         material_uv_set.push(set);
     }
