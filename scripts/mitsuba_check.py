@@ -10,7 +10,9 @@ textures, a `directional` emitter with the exported travel direction and irradia
 `look_at` pinhole sensor, box pixel filter, `path` integrator):
   direct   = path(max_depth=2)
   indirect = path(max_depth=N+2) - path(max_depth=2), same seed  (only with --indirect;
-             N = --bounces, default 1; ours rendered with `render --bounces N`)
+             N = --bounces, default 1; ours rendered with `render --bounces N`); with
+             --brdf ggx the `lightcut_first_glossy` integrator instead: GGX at the camera's
+             hit, N diffuse (Lambert, base colour) bounces to the sun beyond, as our VPLs
 The image is rendered in --splits independent parts (different seeds, spp/splits each) whose
 spread gives the standard error of Mitsuba's image mean and region means.
 
@@ -61,6 +63,9 @@ def parse_args(argv=None):
     p.add_argument("--reuse-mitsuba", type=Path, default=None,
                    help="take Mitsuba's split renders from an earlier --out folder (same scene, size, spp, "
                         "splits, seed, variant, sampler) instead of rendering again")
+    p.add_argument("--self-check", action="store_true",
+                   help="check `lightcut_first_glossy` itself: with --brdf lambert its one-bounce image equals "
+                        "path(max_depth=3) - path(max_depth=2) (same scene, --spp); prints both means and exits")
     p.add_argument("--out", required=True, type=Path)
     return p.parse_args(argv)
 
@@ -182,6 +187,10 @@ def register_lightcut_ggx(mi):
         def eval_pdf(self, ctx, si, wo, active=True):
             return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
 
+        def eval_diffuse_reflectance(self, si, active=True):
+            # The base colour: what the RSM's Lambert VPLs reflect (`lightcut_first_glossy`).
+            return self.base.eval(si, active)
+
         def traverse(self, callback):
             callback.put_parameter("metallic", self.metallic, mi.ParamFlags.NonDifferentiable)
 
@@ -267,6 +276,62 @@ def render(mi, scene, max_depth: int, spp: int, seed: int) -> np.ndarray:
     so two calls with the same seed and spp use the same samples)."""
     integ = mi.load_dict({"type": "path", "max_depth": max_depth, "rr_depth": max_depth + 100,
                           "hide_emitters": False})
+    passes = max(1, -(-spp // MAX_PASS_SPP))
+    per = spp // passes
+    acc = None
+    for k in range(passes):
+        img = np.array(mi.render(scene, integrator=integ, spp=per, seed=seed * 1009 + k), dtype=np.float64)[:, :, :3]
+        acc = img if acc is None else acc + img
+    return acc / passes
+
+
+def register_first_glossy(mi, bounces: int):
+    """Registers `lightcut_first_glossy`: the indirect light as the workbench's VPLs carry it with
+    `gi.brdf = ggx`. The camera's hit reflects with the scene's BSDF (`lightcut_ggx`), sampled by
+    its own importance sampling; every later vertex is a Lambertian reflector of its base colour
+    (the BSDF's `eval_diffuse_reflectance`), lit by the sun with a shadow ray, and continues by a
+    cosine-weighted bounce: light paths are diffuse emitters, as the RSM's and the light paths'
+    VPLs are. No emission at the camera's hit and no direct sun there: the indirect part of
+    N = `bounces` diffuse bounces before the glossy receiver (Mitsuba's `path` would also carry
+    glossy reflections of the sun into the scene, which no VPL does)."""
+    import drjit as dr
+
+    class FirstGlossy(mi.SamplingIntegrator):
+        def __init__(self, props):
+            mi.SamplingIntegrator.__init__(self, props)
+
+        def sample(self, scene, sampler, ray, medium=None, active=True):
+            ctx = mi.BSDFContext()
+            si = scene.ray_intersect(ray, active)
+            valid = si.is_valid()
+            act = mi.Bool(active) & valid
+            bsdf = si.bsdf(ray)
+            bs, w = bsdf.sample(ctx, si, sampler.next_1d(act), sampler.next_2d(act), act)
+            act &= (bs.pdf > 0) & dr.any(w > 0)
+            throughput = mi.Spectrum(w)
+            ray = si.spawn_ray(si.to_world(bs.wo))
+            result = mi.Spectrum(0.0)
+            for depth in range(bounces):
+                si = scene.ray_intersect(ray, act)
+                act &= si.is_valid()
+                albedo = si.bsdf(ray).eval_diffuse_reflectance(si, act)
+                n = si.sh_frame.n
+                n = dr.select(dr.dot(n, -ray.d) < 0, -n, n)  # two-sided: the side the ray arrives at
+                ds, em = scene.sample_emitter_direction(si, sampler.next_2d(act), True, act)
+                cos = dr.maximum(dr.dot(n, ds.d), 0.0)
+                result += dr.select(act, throughput * albedo / dr.pi * em * cos, 0.0)
+                if depth + 1 < bounces:
+                    wo = mi.Frame3f(n).to_world(mi.warp.square_to_cosine_hemisphere(sampler.next_2d(act)))
+                    throughput *= albedo
+                    ray = si.spawn_ray(wo)
+            return result, valid, []
+
+    mi.register_integrator("lightcut_first_glossy", lambda props: FirstGlossy(props))
+
+
+def render_first_glossy(mi, scene, spp: int, seed: int) -> np.ndarray:
+    """`render` with `lightcut_first_glossy` (registered by `register_first_glossy`)."""
+    integ = mi.load_dict({"type": "lightcut_first_glossy"})
     passes = max(1, -(-spp // MAX_PASS_SPP))
     per = spp // passes
     acc = None
@@ -591,9 +656,22 @@ def main(argv=None) -> int:
     per = spp_split(a.spp)
     if a.brdf == "ggx":
         register_lightcut_ggx(mi)
+        register_first_glossy(mi, a.bounces)
     scene = mi.load_dict(build_scene_dict(mi, a.scene_dir, meta, a.width, a.height, a.sampler, per, a.flip_v,
                                           a.brdf))
     t_load = time.time() - t0
+    if a.self_check:
+        if a.brdf != "lambert" or a.bounces != 1:
+            raise SystemExit("error: --self-check compares with `path` and needs --brdf lambert --bounces 1")
+        register_first_glossy(mi, 1)
+        fg = [render_first_glossy(mi, scene, per, a.seed + 1000 * s) for s in range(a.splits)]
+        pd = [render(mi, scene, 3, per, a.seed + 1000 * s) - render(mi, scene, 2, per, a.seed + 1000 * s)
+              for s in range(a.splits)]
+        m_fg, m_pd = float(np.mean(fg)), float(np.mean(pd))
+        se = float(np.std([f.mean() - p.mean() for f, p in zip(fg, pd)]) / max(math.sqrt(a.splits), 1.0))
+        print(f"self-check: lightcut_first_glossy {m_fg:.6f}, path(3) - path(2) {m_pd:.6f}: "
+              f"{(m_fg / m_pd - 1) * 100:+.2f}% (difference's std. error {se / m_pd * 100:.2f}%)")
+        return 0
 
     report = {
         "mitsuba_version": mi.__version__,
@@ -678,6 +756,10 @@ def main(argv=None) -> int:
             i_splits = []
             for s in range(a.splits):
                 seed = a.seed + 7919 + 1000 * s
+                if a.brdf == "ggx":
+                    # GGX at the camera's hit, diffuse emitters beyond (as our VPLs).
+                    i_splits.append(render_first_glossy(mi, scene_i, per_i, seed))
+                    continue
                 # Same seed for both depths so the direct part cancels in the difference.
                 i_splits.append(render(mi, scene_i, a.bounces + 2, per_i, seed) - render(mi, scene_i, 2, per_i, seed))
             t_ind = time.time() - t0
@@ -685,7 +767,8 @@ def main(argv=None) -> int:
         mts_ind = np.mean(i_splits, axis=0)
         write_exr(mi, a.out / f"mitsuba_{part}.exr", mts_ind)
         r = compare(ours_ind, i_splits, a.grid, ours_albedo, mat_id, mat_names)
-        r.update({"spp": per_i * a.splits, "render_s": t_ind, "max_depth": f"{a.bounces + 2} minus 2", "bounces": a.bounces, "reused": reused_ind})
+        how = "lightcut_first_glossy" if a.brdf == "ggx" else f"{a.bounces + 2} minus 2"
+        r.update({"spp": per_i * a.splits, "render_s": t_ind, "max_depth": how, "bounces": a.bounces, "reused": reused_ind})
         report["parts"][part] = r
         scale = 1.0 / max(float(np.percentile(mts_ind, 99.5)), 1e-30)
         strip = np.concatenate([tonemap(ours_ind, scale), tonemap(mts_ind, scale),

@@ -198,7 +198,7 @@ fn irradiance_scales_linearly_and_back_faces_of_the_sun_are_dark() {
 fn a_method_without_ggx_keeps_the_whole_frame_lambert() {
     // The default room made glossy. With gi.brdf = Ggx the direct light changes under a method
     // that shades with GGX ("off" here), and stays Lambert's under one that refuses GGX
-    // (Lightcuts): the frame's BRDF is the method's (`MethodId::brdf`).
+    // (Lightcut Interpolation): the frame's BRDF is the method's (`MethodId::brdf`).
     let Some(ctx) = common::gpu() else { return };
     let mut scene = lightcut::scene::default_scene::build();
     for m in &mut scene.materials {
@@ -223,7 +223,7 @@ fn a_method_without_ggx_keeps_the_whole_frame_lambert() {
     use lightcut::renderer::settings::Brdf;
     let (off, lc) = (
         lightcut::methods::direct_only::ID,
-        lightcut::methods::lightcuts::ID,
+        lightcut::methods::lightcut_interpolation::ID,
     );
     let lambert = direct(off, Brdf::Lambert);
     assert_ne!(direct(off, Brdf::Ggx), lambert, "GGX changed nothing");
