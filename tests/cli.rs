@@ -213,6 +213,7 @@ fn ggx_is_refused_by_methods_that_shade_with_lambert_only() {
         e.contains("Lightcuts"),
         "the message names the glossy methods: {e}"
     );
+    // Light culling shades GGX, but not through its geometry-aware filter.
     let e = one_line_error(&[
         "render",
         "--method",
@@ -222,7 +223,10 @@ fn ggx_is_refused_by_methods_that_shade_with_lambert_only() {
         "--out",
         "/tmp/x",
     ]);
-    assert!(e.contains("Lambert only"), "{e}");
+    assert!(
+        e.contains("methods.light-culling.interleave.filter_radius=0"),
+        "{e}"
+    );
     let e = one_line_error(&[
         "sheet",
         "--methods",

@@ -1095,3 +1095,92 @@ fn tree_shading_with_maps_matches(st: &Setup, lc: &LightCullingSettings, s: &Ren
     eprintln!("tree with maps: {close} of {lit} lit pixels' shading within 1e-3 of the CPU");
     assert!(lit > 100 && close >= lit * 98 / 100, "{close} of {lit}");
 }
+
+/// With `gi.brdf = "Ggx"` (filter radius 0, which GGX requires): every pixel's `raw` is the
+/// CPU's `shade_shaded` (each VPL times f(v, l)) on a room of rough dielectrics and satin
+/// metals, the image is `raw` itself (no albedo / pi after), and the mean over frames of the
+/// stochastic and the tree variant converges to the unshadowed GGX ground truth.
+#[test]
+fn with_ggx_the_shading_equals_the_cpu_and_the_means_converge_to_the_ggx_truth() {
+    use lightcut::reference::brdf::{Shading, Surface};
+    use lightcut::reference::light_culling::shade_shaded;
+    let Some(ctx) = common::gpu() else { return };
+    let mut lc = small(0.002);
+    lc.interleave.filter_radius = 0;
+    let mut s = settings(lc.clone());
+    s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
+    s.sampling.fixed_seed = true;
+    let scene = || {
+        let mut scene = lightcut::scene::default_scene::build();
+        for (i, m) in scene.materials.iter_mut().enumerate() {
+            (m.metallic, m.roughness) = if i % 2 == 0 { (0.0, 0.35) } else { (1.0, 0.5) };
+        }
+        scene
+    };
+    let mut st = Setup::with_scene(&ctx, scene(), s.clone(), (W, H));
+    st.frame();
+    let errs = ctx.errors.take();
+    assert!(errs.is_empty(), "{errs:?}");
+    let vpls = st.r.read_vpls().unwrap();
+    let n = vpls.len();
+    let gl = gpu_lights(&st, n);
+    let grid = LightCulling::grid(&lc, (W, H));
+    let il = Interleave::new(lc.interleave.n, n as u32, LightCulling::seed(&s, 0));
+    let b = lc_of(&st).buffers();
+    let count = gpu_u32(&st, &b.tile_count);
+    let lists = gpu_u32(&st, &b.tile_lists);
+    let raw: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &b.raw).unwrap());
+    let cap = lc.max_lights_per_tile as usize;
+    let sv = shade_vpls(&vpls);
+    let bvh = Bvh::build(&st.scene.positions, &st.scene.indices);
+    let pos = st.r.read(Buffer::Position).unwrap();
+    let nrm = st.r.read(Buffer::Normal).unwrap();
+    let alb = st.r.read(Buffer::Albedo).unwrap();
+    let ind = st.indirect();
+    let eye = st.cam.position;
+    let (mut lit, mut close, mut same) = (0, 0, 0);
+    for y in 0..H {
+        for x in 0..W {
+            let k = (y * W + x) as usize;
+            let g = pos.pixels[k];
+            if g[3] == 0.0 {
+                continue;
+            }
+            let p = Vec3::new(g[0], g[1], g[2]);
+            let nx = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
+            let sh = Shading {
+                v: (eye - p).normalize(),
+                surface: Surface {
+                    base: Vec3::from_slice(&alb.pixels[k][..3]),
+                    metallic: alb.pixels[k][3],
+                    roughness: nrm.pixels[k][3],
+                },
+            };
+            let t = grid.tile_of(x, y) as usize;
+            let list = &lists[t * cap..t * cap + count[t] as usize];
+            let vis = visible(&bvh, &sv, p, nx, s.gi.ray_offset);
+            let cpu = shade_shaded(p, nx, list, &sv, &gl, il, s.gi.distance_epsilon, vis, Some(&sh));
+            let gpu = Vec3::from_slice(&raw[k][..3]);
+            tally(&mut lit, &mut close, gpu, cpu);
+            // Filter radius 0: the image is the pixel's own radiance.
+            let img = Vec3::from_slice(&ind.pixels[k][..3]);
+            same += ((img - gpu).abs().max_element() <= 1e-5 * gpu.max_element().max(1e-6)) as u32;
+        }
+    }
+    eprintln!("GGX shading: {close} of {lit} lit pixels within 1e-3 of the CPU, {same} images equal to raw");
+    assert!(lit > 200 && close >= lit * 98 / 100, "{close} of {lit}");
+    assert!(same as usize >= lit, "{same} of {lit}");
+
+    // Unbiased over frames, without shadow rays (the unshadowed GGX truth), both variants.
+    for method in [light_culling::ID, light_culling::TREE] {
+        let mut s = s.clone();
+        s.gi.method = method;
+        s.gi.shadow_rays = false;
+        s.sampling.fixed_seed = false;
+        let mut st = Setup::with_scene(&ctx, scene(), s, (W, H));
+        st.frame();
+        let gt = st.ground_truth_of_these_vpls();
+        converges(&mut st, &gt, &format!("{method} with GGX"), 0.02);
+    }
+    assert!(ctx.errors.take().is_empty());
+}

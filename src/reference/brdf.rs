@@ -19,6 +19,14 @@ pub struct Surface {
     pub roughness: f32,
 }
 
+/// A receiver's view direction (unit, towards the eye) and material for the glossy BRDF
+/// (`gi.brdf = "Ggx"`): what the methods' CPU twins shade with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shading {
+    pub v: Vec3,
+    pub surface: Surface,
+}
+
 pub fn alpha(roughness: f32) -> f32 {
     (roughness * roughness).max(MIN_ALPHA)
 }

@@ -10,6 +10,7 @@
 //! f(l) = 1 / max(l^2, eps^2) (`gi.distance_epsilon`), so the method is unbiased with respect
 //! to the ground truth of the same VPLs and the same eps.
 
+use crate::reference::brdf;
 use glam::{UVec2, Vec3};
 
 pub use super::interleave::{Interleave, filter_pixel};
@@ -335,7 +336,24 @@ pub fn shade(
     lights: &[LightRange],
     il: Interleave,
     eps: f32,
+    visible: impl FnMut(u32) -> bool,
+) -> Vec3 {
+    shade_shaded(x, nx, list, vpls, lights, il, eps, visible, None)
+}
+
+/// [`shade`], each term times the glossy BRDF f(v, l) where `sh` is given (radiance: no
+/// albedo / pi after). Twin: `term` in `lcull_term.wgsl` with `gi.brdf = GGX`.
+#[allow(clippy::too_many_arguments)]
+pub fn shade_shaded(
+    x: Vec3,
+    nx: Vec3,
+    list: &[u32],
+    vpls: &[ShadeVpl],
+    lights: &[LightRange],
+    il: Interleave,
+    eps: f32,
     mut visible: impl FnMut(u32) -> bool,
+    sh: Option<&brdf::Shading>,
 ) -> Vec3 {
     let pi = std::f32::consts::PI;
     let mut sum = Vec3::ZERO;
@@ -352,7 +370,11 @@ pub fn shade(
         if cx <= 0.0 || cv <= 0.0 || !visible(i) {
             continue;
         }
-        sum += v.flux / pi * (cx * cv * f);
+        let value = v.flux / pi * (cx * cv * f);
+        sum += match sh {
+            Some(sh) => value * brdf::eval(brdf::Brdf::Ggx, nx, sh.v, w, &sh.surface),
+            None => value,
+        };
     }
     sum * il.cells() as f32
 }

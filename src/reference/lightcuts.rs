@@ -276,12 +276,7 @@ pub fn emitter_cos_bound(x: Vec3, lo: Vec3, hi: Vec3, cone: Cone) -> f32 {
     }
 }
 
-/// The receiver's view direction and material for the glossy BRDF (`gi.brdf = "Ggx"`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Shading {
-    pub v: Vec3,
-    pub surface: brdf::Surface,
-}
+pub use crate::reference::brdf::Shading;
 
 /// Upper bound of luminance(f(v, l)) x n.l over the directions l from x into the box, with
 /// `cx` >= n.l (> 0) from [`cos_bound`]: Lightcuts' material bound (Walter et al. 4.1 bound

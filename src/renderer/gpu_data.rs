@@ -656,6 +656,11 @@ mod tests {
                         offset_of!(P, stride),
                         offset_of!(P, leaves),
                         offset_of!(P, ism_flags),
+                        offset_of!(P, brdf),
+                        offset_of!(P, _pad),
+                        offset_of!(P, _pad) + 4,
+                        offset_of!(P, _pad) + 8,
+                        offset_of!(P, eye),
                     ]
                 },
             ),

@@ -23,6 +23,11 @@ struct LcullParams {
     stride: u32,        // runs of `stride` consecutive VPLs share an interleaving subset
     leaves: u32,        // the tree variant: leaves of the light tree (a power of two)
     ism_flags: u32,     // bit 0: write the VPLs' ISM lights; bit 1: section 4.3's range culling
+    brdf: u32,          // BRDF_LAMBERT / BRDF_GGX (common/brdf.wgsl): the shading's
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+    eye: vec4<f32>,     // xyz the camera's position (the glossy BRDF's view direction)
 };
 
 const LCULL_RANGE_INF: f32 = 1e30;

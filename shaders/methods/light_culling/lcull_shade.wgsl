@@ -5,6 +5,7 @@
 // (`interleave_filter.wgsl`, section 4.2) then undoes the interleaving into the GI
 // accumulation. Twin: reference::light_culling::shade.
 #include "common/math.wgsl"
+#include "common/brdf.wgsl"
 #include "common/vpl.wgsl"
 #include "common/vpl_visibility.wgsl"
 #include "methods/light_culling/lcull_common.wgsl"
@@ -25,6 +26,8 @@
 // The VPLs' imperfect shadow maps (shadow_rays == 2; a dummy otherwise).
 @group(0) @binding(12) var<uniform> ism: IsmParams;
 @group(0) @binding(13) var<storage, read> ism_depth: array<f32>;
+// The G-buffer's albedo (base colour, metallic in a) for the glossy BRDF.
+@group(0) @binding(14) var gb_albedo: texture_2d<f32>;
 
 #include "common/stats64.wgsl"
 
@@ -47,6 +50,7 @@ fn shade_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let nx = normalize(textureLoad(gb_normal, vec2<i32>(gid.xy), 0).xyz);
+    lcull_shading(gid.xy, g.xyz);
     let t = lcull_tile_of(params, gid.x, gid.y);
     let c = tile_count[t];
     var sum = vec3<f32>(0.0);

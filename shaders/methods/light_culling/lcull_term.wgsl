@@ -1,4 +1,5 @@
-// One VPL's demodulated contribution (without albedo / pi) with its stochastic or clamped
+// One VPL's demodulated contribution (without albedo / pi; with gi.brdf = GGX times f(v, l):
+// radiance) with its stochastic or clamped
 // fall-off and, with visibility on, a BVH shadow ray (shadow_rays 1) or a lookup in the VPL's
 // imperfect shadow map (2: map i, common/ism.wgsl). Textual include: the including shader
 // declares `params` (LcullParams), `lights` (two vec4 per VPL, lcull_light.wgsl), `vpls`,
@@ -11,7 +12,26 @@ struct Term {
     ray: u32,
 };
 
-// VPL i's contribution to (x, nx) without albedo / pi.
+// The shading point's material (gi.brdf = GGX), set per pixel by lcull_shading. The includer
+// also includes common/brdf.wgsl and declares gb_albedo and gb_normal.
+var<private> glossy: bool;
+var<private> sh_v: vec3<f32>;
+var<private> sh_base: vec3<f32>;
+var<private> sh_metallic: f32;
+var<private> sh_roughness: f32;
+
+fn lcull_shading(px: vec2<u32>, x: vec3<f32>) {
+    glossy = params.brdf != BRDF_LAMBERT;
+    if glossy {
+        let a = textureLoad(gb_albedo, vec2<i32>(px), 0);
+        sh_v = normalize(params.eye.xyz - x);
+        sh_base = a.rgb;
+        sh_metallic = a.a;
+        sh_roughness = textureLoad(gb_normal, vec2<i32>(px), 0).w;
+    }
+}
+
+// VPL i's contribution to (x, nx) without albedo / pi (GGX: with f(v, l)).
 fn term(i: u32, x: vec3<f32>, nx: vec3<f32>) -> Term {
     var t = Term(vec3<f32>(0.0), 0u, 0u);
     let l = lights[2u * i];
@@ -42,6 +62,9 @@ fn term(i: u32, x: vec3<f32>, nx: vec3<f32>) -> Term {
         }
     }
     t.value = v.flux.rgb / PI * (cx * cv * f);
+    if glossy {
+        t.value *= brdf_eval(params.brdf, nx, sh_v, w, sh_base, sh_metallic, sh_roughness);
+    }
     return t;
 }
 

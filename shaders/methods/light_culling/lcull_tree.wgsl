@@ -23,6 +23,7 @@
 //                  demodulated into `raw` (the shared interleave_filter.wgsl then x albedo / pi).
 // Twins: reference::light_culling::{tree_max_ranges, tree_traverse, tree_shade}.
 #include "common/math.wgsl"
+#include "common/brdf.wgsl"
 #include "common/random.wgsl"
 #include "common/vpl.wgsl"
 #include "common/sst_node.wgsl"
@@ -53,6 +54,8 @@
 @group(0) @binding(14) var<uniform> ism: IsmParams;
 @group(0) @binding(15) var<storage, read> ism_depth: array<f32>;
 @group(0) @binding(16) var<storage, read_write> ism_lights: array<vec4<f32>>;
+// The G-buffer's albedo (base colour, metallic in a) for the glossy BRDF.
+@group(0) @binding(17) var gb_albedo: texture_2d<f32>;
 
 #include "common/stats64.wgsl"
 #include "methods/light_culling/lcull_term.wgsl"
@@ -203,6 +206,7 @@ fn shade_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let x = g.xyz;
     let nx = normalize(textureLoad(gb_normal, vec2<i32>(gid.xy), 0).xyz);
+    lcull_shading(gid.xy, x);
     let cap = params.cap;
     let mv = tree_m[k];
     let m = mv.x;

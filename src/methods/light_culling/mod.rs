@@ -178,11 +178,13 @@ const TESTS: &[&str] = &[
     "light_culling::gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing",
     "light_culling::the_mean_over_frames_converges_to_the_unshadowed_ground_truth_and_clamping_darkens",
     "light_culling::ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays",
+    "light_culling::with_ggx_the_shading_equals_the_cpu_and_the_means_converge_to_the_ggx_truth",
 ];
 
 const TREE_TESTS: &[&str] = &[
     "light_culling::the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_truth",
     "light_culling::ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays",
+    "light_culling::with_ggx_the_shading_equals_the_cpu_and_the_means_converge_to_the_ggx_truth",
 ];
 
 pub static INFO: MethodInfo = MethodInfo {
@@ -208,7 +210,7 @@ pub static INFO: MethodInfo = MethodInfo {
     shadow_ray_switch: true,
     truth_of_vpls: false,
     one_bounce: false,
-    glossy: false,
+    glossy: true,
     validate,
     invalid_example: Some(invalid_example),
     ui: ui::settings_ui,
@@ -239,7 +241,7 @@ pub static CLAMPED_INFO: MethodInfo = MethodInfo {
     shadow_ray_switch: true,
     truth_of_vpls: false,
     one_bounce: false,
-    glossy: false,
+    glossy: true,
     validate,
     invalid_example: Some(invalid_example),
     ui: ui::settings_ui,
@@ -272,7 +274,7 @@ pub static TREE_INFO: MethodInfo = MethodInfo {
     shadow_ray_switch: true,
     truth_of_vpls: false,
     one_bounce: false,
-    glossy: false,
+    glossy: true,
     validate,
     invalid_example: Some(invalid_example),
     ui: ui::settings_ui,
@@ -330,7 +332,25 @@ pub fn set_visibility(s: &mut RenderSettings, ism: bool) {
 }
 
 fn validate(s: &RenderSettings) -> Result<(), String> {
-    s.method::<LightCullingSettings>(ID)?.validate()
+    let lc = s.method::<LightCullingSettings>(ID)?;
+    lc.validate()?;
+    // The geometry-aware filter averages Lambert's irradiance-like `raw` over a window and
+    // multiplies the pixel's albedo / pi back; a glossy BRDF's radiance cannot be averaged so.
+    // Interleaving alone (each pixel its subset x n^2) stays unbiased.
+    let culling = [ID, CLAMPED, TREE].contains(&s.gi.method);
+    if culling && s.gi.brdf == crate::renderer::settings::Brdf::Ggx {
+        let (name, r) = if s.gi.method == TREE {
+            ("tree_filter_radius", lc.tree_filter_radius)
+        } else {
+            ("interleave.filter_radius", lc.interleave.filter_radius)
+        };
+        if r > 0 {
+            return Err(format!(
+                "gi.brdf = Ggx with methods.light-culling.{name} {r}: the geometry-aware filter averages Lambert's irradiance and multiplies the albedo / pi back; set methods.light-culling.{name}=0 (interleaving alone stays unbiased) or use gi.brdf = Lambert"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Decades of the list-length scales: 1 .. 10^decades >= cap.
@@ -683,11 +703,17 @@ impl Method for LightCulling {
             stride: il.stride,
             leaves: 0,
             ism_flags,
+            brdf: cx.brdf.gpu(),
+            _pad: [0; 3],
+            eye: cx.eye.extend(0.0).to_array(),
         };
-        // The filter: raw (before albedo / pi) x albedo / pi into the accumulation.
+        // The filter: raw (before albedo / pi) x albedo / pi into the accumulation; with GGX
+        // raw is radiance already (and validation keeps the filter's window to the pixel).
+        let glossy = cx.brdf != crate::renderer::settings::Brdf::Lambert;
         let fp = GpuFilterParams {
             accumulate: (frames > 1) as u32,
-            scale: std::f32::consts::FRAC_1_PI,
+            scale: if glossy { 1.0 } else { std::f32::consts::FRAC_1_PI },
+            modulate: (!glossy) as u32,
             ..GpuFilterParams::new(cx.size, &lc.interleave)
         };
         self.settings = lc;

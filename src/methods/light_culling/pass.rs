@@ -58,6 +58,11 @@ pub struct GpuLcullParams {
     /// visibility, or the atlas view); bit 1: a map leaves out the points beyond its VPL's
     /// range (section 4.3).
     pub ism_flags: u32,
+    /// The shading's BRDF (`Brdf::gpu`): with GGX `raw` is radiance (no albedo / pi after).
+    pub brdf: u32,
+    pub _pad: [u32; 3],
+    /// xyz the camera's position (the glossy BRDF's view direction).
+    pub eye: [f32; 4],
 }
 
 /// `GpuLcullParams::shadow_rays` of ISM visibility.
@@ -367,6 +372,7 @@ impl LcullPass {
         se.extend((3..=8).map(|b| storage_entry(b, c, true)));
         se.extend((9..=11).map(|b| storage_entry(b, c, false)));
         se.extend([uniform_entry(12, c), storage_entry(13, c, true)]);
+        se.push(float_texture_entry(14));
         let shade_layout = layout("lcull_shade::layout", &se);
         let mut te = vec![
             uniform_entry(0, c),
@@ -379,6 +385,7 @@ impl LcullPass {
             uniform_entry(14, c),
             storage_entry(15, c, true),
             storage_entry(16, c, false),
+            float_texture_entry(17),
         ]);
         let tree_layout = layout("lcull_tree::layout", &te);
         let views_layout = layout(
@@ -599,6 +606,7 @@ impl LcullPass {
                 b.stats.as_entire_binding(),
                 self.ism_params.as_entire_binding(),
                 ism_depth.as_entire_binding(),
+                tv(&g.albedo_view),
             ],
         )
     }
@@ -652,6 +660,7 @@ impl LcullPass {
                 self.ism_params.as_entire_binding(),
                 ism_depth.as_entire_binding(),
                 ism_lights.as_entire_binding(),
+                tv(&g.albedo_view),
             ],
         );
         let (gx, gy) = groups_1d_as_2d(p.leaves.div_ceil(WG_1D).max(1));
