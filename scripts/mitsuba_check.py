@@ -46,9 +46,12 @@ def parse_args(argv=None):
     p.add_argument("--indirect-spp", type=int, default=None,
                    help="samples per pixel for the two indirect renders (default: --spp)")
     p.add_argument("--indirect", action="store_true", help="also compare the indirect light (needs ours/indirect.exr)")
-    p.add_argument("--brdf", choices=["lambert", "ggx"], default="lambert",
+    p.add_argument("--brdf", choices=["lambert", "ggx", "principled"], default="lambert",
                    help="ggx: the workbench's GGX BRDF (as a Python BSDF) with the exported metallic / roughness; "
-                        "ours rendered with `render --brdf ggx`")
+                        "ours rendered with `render --brdf ggx`. principled: Mitsuba's own `principled` BSDF with "
+                        "the same base colour / metallic / roughness (specular 0.5 = F0 0.04, no tint, sheen, "
+                        "clearcoat or transmission) against ours with GGX: a comparison of the models (Disney "
+                        "diffuse, separable Smith masking), direct light only")
     p.add_argument("--bounces", type=int, default=1,
                    help="diffuse bounces of the indirect part: path max_depth = bounces + 2 (ours: render --bounces)")
     p.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (scalar_rgb, llvm_ad_rgb, ...)")
@@ -139,7 +142,9 @@ def register_lightcut_ggx(mi):
             h = dr.normalize(wi + wo)
             d, _ = self._d(h)
             a2 = self._alpha() ** 2
-            vis = 0.5 / (nl * dr.sqrt(nv * nv * (1.0 - a2) + a2) + nv * dr.sqrt(nl * nl * (1.0 - a2) + a2))
+            # (Clamped away from 0 only for the scalar variants' Python floats; inactive lanes.)
+            nlc, nvc = dr.maximum(nl, 1e-7), dr.maximum(nv, 1e-7)
+            vis = 0.5 / (nlc * dr.sqrt(nvc * nvc * (1.0 - a2) + a2) + nvc * dr.sqrt(nlc * nlc * (1.0 - a2) + a2))
             spec = schlick(dr.dot(wi, h)) * (d * vis)
             diff = (1.0 - self.metallic) * base * (1.0 - schlick(nv)) * (1.0 - schlick(nl)) / dr.pi
             return dr.select(active, diff + spec, 0.0), active
@@ -200,6 +205,32 @@ def register_lightcut_ggx(mi):
     mi.register_bsdf("lightcut_ggx", lambda props: LightcutGgx(props))
 
 
+def principled_probe(mi) -> list[dict]:
+    """f x cos of Mitsuba's `principled` (as `--brdf principled` configures it) and of
+    `lightcut_ggx` for one base colour, a few materials and directions (view 29 degrees, light
+    11 .. 80 degrees in the plane of incidence, opposite side): where the two models agree."""
+    import drjit as dr
+    register_lightcut_ggx(mi)
+    rows = []
+    base = {"type": "rgb", "value": [0.8, 0.8, 0.8]}
+    for metallic, rough in [(1.0, 0.17), (1.0, 0.5), (0.0, 0.39), (0.0, 0.97)]:
+        p = mi.load_dict({"type": "principled", "base_color": base, "metallic": metallic, "roughness": rough,
+                          "specular": 0.5, "spec_tint": 0.0, "anisotropic": 0.0, "sheen": 0.0, "clearcoat": 0.0,
+                          "spec_trans": 0.0})
+        g = mi.load_dict({"type": "lightcut_ggx", "base": base, "metallic": metallic, "roughness": rough})
+        si = dr.zeros(mi.SurfaceInteraction3f)
+        si.n = mi.Normal3f(0, 0, 1)
+        si.sh_frame = mi.Frame3f(si.n)
+        si.wi = mi.Vector3f(math.sin(0.5), 0, math.cos(0.5))
+        for th in (0.2, 0.5, 1.0, 1.4):
+            wo = mi.Vector3f(-math.sin(th), 0, math.cos(th))
+            fp = float(np.array(p.eval(mi.BSDFContext(), si, wo)).ravel()[0])
+            fg = float(np.array(g.eval(mi.BSDFContext(), si, wo)).ravel()[0])
+            rows.append({"metallic": metallic, "roughness": rough, "light_deg": math.degrees(th),
+                         "principled": fp, "ours": fg, "ratio": fp / fg if fg > 0 else None})
+    return rows
+
+
 def build_scene_dict(mi, scene_dir: Path, meta: dict, width: int, height: int, sampler: str, spp: int,
                      flip_v: bool, brdf: str = "lambert") -> dict:
     cam = meta["camera"]
@@ -251,6 +282,10 @@ def build_scene_dict(mi, scene_dir: Path, meta: dict, width: int, height: int, s
             "face_normals": False,  # use the exported vertex normals as shading normals
             "bsdf": {"type": "twosided", "bsdf": (
                 {"type": "diffuse", "reflectance": refl} if brdf == "lambert" else
+                {"type": "principled", "base_color": refl, "metallic": float(m.get("metallic", 1.0)),
+                 "roughness": float(m.get("roughness", 1.0)), "specular": 0.5, "spec_tint": 0.0,
+                 "anisotropic": 0.0, "sheen": 0.0, "clearcoat": 0.0, "spec_trans": 0.0}
+                if brdf == "principled" else
                 {"type": "lightcut_ggx", "base": refl, "metallic": float(m.get("metallic", 1.0)),
                  "roughness": float(m.get("roughness", 1.0))})},
         }
@@ -603,6 +638,8 @@ def main(argv=None) -> int:
         raise SystemExit("error: --bounces must be at least 1")
     if a.indirect and not ours_ind_path.exists():
         raise SystemExit(f"error: --indirect given but {ours_ind_path} does not exist (indirect not rendered yet)")
+    if a.brdf == "principled" and a.indirect:
+        raise SystemExit("error: --brdf principled compares the direct light only (drop --indirect)")
     if a.splits < 1 or a.spp < a.splits:
         raise SystemExit("error: need --splits >= 1 and --spp >= --splits")
 
@@ -673,6 +710,12 @@ def main(argv=None) -> int:
               f"{(m_fg / m_pd - 1) * 100:+.2f}% (difference's std. error {se / m_pd * 100:.2f}%)")
         return 0
 
+    if a.brdf == "principled":
+        probe = principled_probe(mi)
+        print("principled / ours (f x cos, view 29 deg):")
+        for r in probe:
+            print(f"  metallic {r['metallic']:.0f} roughness {r['roughness']:.2f} light {r['light_deg']:5.1f} deg: "
+                  f"{r['principled']:.5g} / {r['ours']:.5g} = {r['ratio']:.4f}")
     report = {
         "mitsuba_version": mi.__version__,
         "variant": a.variant,
