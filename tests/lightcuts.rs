@@ -390,10 +390,10 @@ fn mixed_glossy_room() -> lightcut::scene::Scene {
     scene
 }
 
-/// Lightcuts' material bound for GGX (`ggx_cos_bound`) is never below the true
-/// luminance(f(v, l)) x G of a VPL in the box and the cone, over random boxes, receivers,
-/// views and materials (roughness 0.05..1, metallic 0..1), with a quarter of the views set up
-/// so that the box lies on the mirror direction (the lobe's peak).
+/// Lightcuts' material bound for GGX (`geometry_brdf_bound`) is never below the true
+/// luminance(flux x f(v, l)) x G of a coloured VPL in the box and the cone, over random boxes,
+/// receivers, views, fluxes and materials (roughness 0.05..1, metallic 0..1), with a quarter of
+/// the views set up so that the box lies on the mirror direction (the lobe's peak).
 #[test]
 fn the_ggx_error_bound_is_never_below_the_true_glossy_term() {
     use lightcut::reference::brdf::{self, Brdf, Surface};
@@ -429,7 +429,9 @@ fn the_ggx_error_bound_is_never_below_the_true_glossy_term() {
             half_angle: rnd() * rnd() * std::f32::consts::PI,
         };
         let eps = 0.05;
-        let bound = geometry_brdf_bound(x, n, lo, hi, cone, eps, &sh);
+        // A coloured VPL (its flux is the cluster's): the bound must hold per channel too.
+        let flux = Vec3::new(rnd(), rnd(), rnd()) * Vec3::new(1.0, rnd(), rnd());
+        let bound = geometry_brdf_bound(x, n, lo, hi, cone, eps, &sh, flux);
         let mut largest = 0.0f32;
         for _ in 0..64 {
             let p = lo + (hi - lo) * Vec3::new(rnd(), rnd(), rnd());
@@ -439,11 +441,10 @@ fn the_ggx_error_bound_is_never_below_the_true_glossy_term() {
                 continue;
             }
             let l = (p - x).normalize();
-            let f = lightcut::base::display::luminance(brdf::eval(Brdf::Ggx, n, v, l, &surface));
-            let t = f * g;
+            let t = lightcut::base::display::luminance(flux * brdf::eval(Brdf::Ggx, n, v, l, &surface)) * g;
             assert!(
                 t <= bound * (1.0 + 1e-4) + 1e-6,
-                "case {case}: lum(f) G {t} above the bound {bound} (box {lo}..{hi}, x {x}, n {n}, v {v}, {surface:?}, cone {cone:?})"
+                "case {case}: lum(flux f) G {t} above the bound {bound} (box {lo}..{hi}, x {x}, n {n}, v {v}, {surface:?}, flux {flux}, cone {cone:?})"
             );
             largest = largest.max(t);
             checked += 1;

@@ -278,21 +278,21 @@ pub fn emitter_cos_bound(x: Vec3, lo: Vec3, hi: Vec3, cone: Cone) -> f32 {
 
 pub use crate::reference::brdf::Shading;
 
-/// Upper bound of luminance(f(v, l)) x n.l over the directions l from x into the box, with
+/// Upper bound, per RGB channel, of f(v, l) x n.l over the directions l from x into the box, with
 /// `cx` >= n.l (> 0) from [`cos_bound`]: Lightcuts' material bound (Walter et al. 4.1 bound
 /// Lambert, Phong and Ward alike) for the GGX BRDF. Derivation in
 /// `shaders/methods/lightcuts/lc_brdf_bound.wgsl` (its twin `lc_ggx_cos_bound`): the diffuse
 /// part by (1 - metallic) lum(base) / pi x cx; D by its value at n.h = cos(theta_lr / 2), theta_lr
 /// the least angle between the mirror direction and the box; Schlick's F at the least v.h;
 /// Vis x n.l by min(0.5 / (n.v alpha) x cx, 0.5 / (A + n.v)).
-pub fn ggx_cos_bound(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cx: f32, sh: &Shading) -> f32 {
+pub fn ggx_cos_bound(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cx: f32, sh: &Shading) -> Vec3 {
     let (v, s) = (sh.v, &sh.surface);
     let nv = n.dot(v);
     if nv.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        return 0.0;
+        return Vec3::ZERO;
     }
     let pi = std::f32::consts::PI;
-    let diffuse = (1.0 - s.metallic) * luminance(s.base) / pi * cx;
+    let diffuse = (1.0 - s.metallic) * s.base / pi * cx;
     let a = brdf::alpha(s.roughness);
     let a2 = a * a;
     let r = 2.0 * nv * n - v;
@@ -300,15 +300,28 @@ pub fn ggx_cos_bound(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cx: f32, sh: &Shading
     let d = brdf::ggx_d((0.5 * t_lr).cos(), a2);
     let t_back = cos_bound(-v, x, lo, hi).clamp(0.0, 1.0).acos();
     let vh = (0.5 * (pi - t_back)).cos();
-    let f = luminance(brdf::schlick(brdf::f0(s.base, s.metallic), vh));
+    let f = brdf::schlick(brdf::f0(s.base, s.metallic), vh);
     let big_a = (nv * nv * (1.0 - a2) + a2).sqrt();
     let vis_cos = (0.5 / (nv * a) * cx).min(0.5 / (big_a + nv));
     diffuse + f * d * vis_cos
 }
 
-/// [`geometry_bound`] with the glossy BRDF: an upper bound of luminance(f(v, l)) x cos_x x
-/// cos_v / max(d^2, eps^2) over the box and the cone. Twin: `lc_geometry_brdf_bound`.
-pub fn geometry_brdf_bound(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cone: Cone, eps: f32, sh: &Shading) -> f32 {
+/// With the glossy BRDF: an upper bound of luminance(sum of flux_i x f(v, l_i) x cos_x x
+/// cos_v / max(d^2, eps^2)) over VPLs in the box and the cone whose fluxes sum to
+/// `intensity`: luminance(intensity x [`ggx_cos_bound`]) x the emitter cosine and distance
+/// bounds (per channel first: the flux and the BRDF may share a colour). Twin:
+/// `lc_geometry_brdf_bound`.
+#[allow(clippy::too_many_arguments)]
+pub fn geometry_brdf_bound(
+    x: Vec3,
+    n: Vec3,
+    lo: Vec3,
+    hi: Vec3,
+    cone: Cone,
+    eps: f32,
+    sh: &Shading,
+    intensity: Vec3,
+) -> f32 {
     if cone.is_empty() {
         return 0.0;
     }
@@ -318,7 +331,7 @@ pub fn geometry_brdf_bound(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cone: Cone, eps
     }
     let cv = emitter_cos_bound(x, lo, hi, cone);
     let m = ggx_cos_bound(x, n, lo, hi, cx, sh);
-    m * cv / box_distance2(x, lo, hi).max(eps * eps)
+    luminance(intensity * m) * cv / box_distance2(x, lo, hi).max(eps * eps)
 }
 
 /// The error bound of node `node` at (x, n): 0 for leaves (exact) and empty nodes.
@@ -344,11 +357,16 @@ pub fn error_bound_shaded(
         return 0.0;
     }
     let cone = lc.cones[node as usize];
-    let g = match sh {
-        Some(sh) => geometry_brdf_bound(x, n, c.bbox_min, c.bbox_max, cone, eps, sh),
-        None => geometry_bound(x, n, c.bbox_min, c.bbox_max, cone, eps),
-    };
-    luminance(c.intensity) / std::f32::consts::PI * g
+    match sh {
+        Some(sh) => {
+            geometry_brdf_bound(x, n, c.bbox_min, c.bbox_max, cone, eps, sh, c.intensity)
+                / std::f32::consts::PI
+        }
+        None => {
+            luminance(c.intensity) / std::f32::consts::PI
+                * geometry_bound(x, n, c.bbox_min, c.bbox_max, cone, eps)
+        }
+    }
 }
 
 /// The exact (unbounded) geometric term of `vpl_geometry` in `common/vpl.wgsl`.

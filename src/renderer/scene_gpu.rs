@@ -269,7 +269,8 @@ impl SceneGpu {
                     layer(m.metallic_texture),
                     0,
                 ],
-                params: [m.metallic, m.roughness, 0.0, 0.0],
+                // In [0, 1] whatever built the scene (the GGX bounds assume alpha <= 1).
+                params: [m.metallic.clamp(0.0, 1.0), m.roughness.clamp(0.0, 1.0), 0.0, 0.0],
             })
             .collect();
         if mats.is_empty() {

@@ -699,6 +699,18 @@ fn metallic_roughness_textures_are_read_as_linear_data() {
         64,
         "colour bytes unchanged"
     );
+    // Every byte value comes back within half an sRGB step (at most 0.0040, near 0.85).
+    let mut all = crate::scene::TextureImage {
+        name: "ramp".into(),
+        width: 256,
+        height: 1,
+        rgba8: (0..=255u8).flat_map(|v| [v, v, v, 255]).collect(),
+    };
+    all.encode_linear_as_srgb();
+    for v in 0..256usize {
+        let back = crate::base::display::srgb8_to_linear(all.rgba8[4 * v]);
+        assert!((back - v as f32 / 255.0).abs() <= 0.0041, "byte {v}: {back}");
+    }
 }
 
 #[test]
@@ -709,6 +721,9 @@ fn split_roughness_metallic_textures_find_the_image_beside_their_dds() {
     image::RgbImage::from_pixel(2, 2, image::Rgb([255, 51, 102]))
         .save(dir.join("arch_rough.png"))
         .unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([9, 9, 9]))
+        .save(dir.join("plain.png"))
+        .unwrap();
     let mut gb = Gb::default();
     gb.vec3(&TRI);
     gb.indices(&[0, 1, 2]);
@@ -716,15 +731,19 @@ fn split_roughness_metallic_textures_find_the_image_beside_their_dds() {
     let rest = r#""extensionsUsed":["AMD_split_roughnessMetallic","MSFT_texture_dds"],
 "meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":2},"indices":1,"material":0},{"attributes":{"POSITION":0,"TEXCOORD_0":2},"indices":1,"material":1}]}],
 "materials":[{"name":"Arch","pbrMetallicRoughness":{"metallicFactor":0.1},"extensions":{"AMD_split_roughnessMetallic":{"roughnessTexture":{"index":0},"metallicTexture":{"index":1}}}},
-             {"name":"Lost","extensions":{"AMD_split_roughnessMetallic":{"roughnessTexture":{"index":2}}}}],
-"textures":[{"extensions":{"MSFT_texture_dds":{"source":0}}},{"extensions":{"MSFT_texture_dds":{"source":1}}},{"extensions":{"MSFT_texture_dds":{"source":2}}}],
-"images":[{"uri":"arch_rough.roughness.dds"},{"uri":"arch_rough.metallic.dds"},{"uri":"gone.roughness.dds"}],
+             {"name":"Lost","extensions":{"AMD_split_roughnessMetallic":{"roughnessTexture":{"index":2}}}},
+             {"name":"Plain","extensions":{"AMD_split_roughnessMetallic":{"roughnessTexture":{"index":3}}}}],
+"textures":[{"extensions":{"MSFT_texture_dds":{"source":0}}},{"extensions":{"MSFT_texture_dds":{"source":1}}},{"extensions":{"MSFT_texture_dds":{"source":2}}},{"extensions":{"MSFT_texture_dds":{"source":3}}}],
+"images":[{"uri":"arch_rough.roughness.dds"},{"uri":"arch_rough.metallic.dds"},{"uri":"gone.roughness.dds"},{"uri":"plain.dds"}],
 "nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]"#;
     let s = load_gltf(&gb.write(&dir, "s", rest)).unwrap();
     let arch = &s.materials[0];
     assert_eq!(arch.roughness_texture, Some(0), "{:?}", s.warnings);
     assert_eq!(arch.metallic_texture, Some(0), "one image, one data texture");
     assert_eq!(s.textures.len(), 1);
+    // A plain name.dds is not a split map: name.png beside it may be a colour image.
+    assert_eq!(s.materials[2].roughness_texture, None);
+    assert!(has_warning(&s, "material 'Plain'"), "{:?}", s.warnings);
     let lost = &s.materials[1];
     assert_eq!(lost.roughness_texture, None);
     assert!(has_warning(&s, "nor one beside its DDS"), "{:?}", s.warnings);

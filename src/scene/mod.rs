@@ -120,7 +120,7 @@ pub struct TextureImage {
 
 impl TextureImage {
     /// Re-encodes linear 8-bit data (a metallic-roughness texture) as the sRGB bytes whose
-    /// decode gives it back, to within half an sRGB step (at most 0.0023, at 1.0); alpha is
+    /// decode gives it back, to within half an sRGB step (at most 0.0040); alpha is
     /// kept. The renderer's texture array is sRGB: its sampler then returns the linear data.
     pub fn encode_linear_as_srgb(&mut self) {
         let lut: Vec<u8> = (0..=255u32)

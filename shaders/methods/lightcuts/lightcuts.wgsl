@@ -248,8 +248,8 @@ fn error_bound(node: u32, x: vec3<f32>, n: vec3<f32>) -> f32 {
         return 0.0;
     }
     if glossy {
-        return luminance(c.intensity) / PI * lc_geometry_brdf_bound(x, n, sh_v, c.bbox_min, c.bbox_max,
-            cones[node], lp.epsilon, sh_base, sh_metallic, sh_roughness);
+        return lc_geometry_brdf_bound(x, n, sh_v, c.bbox_min, c.bbox_max, cones[node], lp.epsilon,
+            sh_base, sh_metallic, sh_roughness, c.intensity) / PI;
     }
     return luminance(c.intensity) / PI * lc_geometry_bound(x, n, c.bbox_min, c.bbox_max, cones[node], lp.epsilon);
 }

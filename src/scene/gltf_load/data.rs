@@ -153,7 +153,7 @@ impl TexKind {
     }
 }
 
-/// The image file beside a DDS-only texture's `.dds`: `name[.roughness|.metallic].dds` ->
+/// The image file beside a DDS-only texture's `.dds`: `name.roughness.dds` / `name.metallic.dds` ->
 /// `name.png` / `.jpg` / `.jpeg`, if it exists. Sponza's `AMD_split_roughnessMetallic`
 /// textures are DDS-only (`sponza_arch_rough.roughness.dds`), split from the glTF
 /// metallic-roughness PNGs shipped beside them (`sponza_arch_rough.png`: roughness in G,
@@ -161,12 +161,14 @@ impl TexKind {
 pub(super) fn dds_sibling(base_dir: &Path, dds_uri: &str) -> Option<PathBuf> {
     let lower = dds_uri.to_ascii_lowercase();
     let stem_len = lower.strip_suffix(".dds")?.len();
-    let mut stem = &dds_uri[..stem_len];
-    for part in [".roughness", ".metallic"] {
-        if stem.to_ascii_lowercase().ends_with(part) {
-            stem = &stem[..stem.len() - part.len()];
-        }
-    }
+    let stem = &dds_uri[..stem_len];
+    // Only a split map's name (`.roughness` / `.metallic` before `.dds`): a plain `name.dds`
+    // beside `name.png` is as likely a base colour image.
+    let stem = [".roughness", ".metallic"].iter().find_map(|part| {
+        stem.to_ascii_lowercase()
+            .ends_with(part)
+            .then(|| &stem[..stem.len() - part.len()])
+    })?;
     ["png", "jpg", "jpeg"]
         .iter()
         .filter_map(|ext| resolve_uri(base_dir, &format!("{stem}.{ext}")).ok())

@@ -91,6 +91,8 @@ enum ExtPolicy {
     Supported,
     /// Does not change geometry or diffuse albedo: ignored with a warning.
     Ignored(&'static str),
+    /// Read, with a note on what of it is not (a warning).
+    Partial(&'static str),
     /// Changes how geometry is stored or placed: an error when required.
     Geometry(&'static str),
     /// Not known to this loader.
@@ -101,10 +103,12 @@ fn ext_policy(name: &str) -> ExtPolicy {
     match name {
         "KHR_lights_punctual" => ExtPolicy::Supported,
         "MSFT_texture_dds" => ExtPolicy::Ignored(
-            "DDS texture alternatives are not loaded; each texture's PNG/JPG source is used",
+            "DDS images are not decoded; each texture's PNG/JPG source is used (a DDS-only \
+             roughness / metallic texture: the PNG/JPG beside its .dds, if there is one)",
         ),
-        "AMD_split_roughnessMetallic" => ExtPolicy::Ignored(
-            "split roughness/metallic textures only affect specular shading, which is not rendered",
+        "AMD_split_roughnessMetallic" => ExtPolicy::Partial(
+            "its roughness / metallic textures are read (G / B channels; shading with --brdf ggx); \
+             DDS-only ones through the PNG/JPG beside their .dds",
         ),
         "KHR_texture_transform" => ExtPolicy::Ignored(
             "texture transforms are ignored: transformed base colour textures may look misplaced",
@@ -164,6 +168,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
             ExtPolicy::Ignored(why) => {
                 warnings.push(format!("glTF extension {name} (required) is ignored: {why}"))
             }
+            ExtPolicy::Partial(why) => warnings.push(format!("glTF extension {name} (required): {why}")),
             ExtPolicy::Geometry(why) => {
                 return Err(SceneError::UnsupportedExtension {
                     path: path.to_path_buf(),
@@ -184,6 +189,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
         match ext_policy(name) {
             ExtPolicy::Supported => {}
             ExtPolicy::Ignored(why) => warnings.push(format!("glTF extension {name} is ignored: {why}")),
+            ExtPolicy::Partial(why) => warnings.push(format!("glTF extension {name}: {why}")),
             ExtPolicy::Geometry(why) => warnings.push(format!(
                 "glTF extension {name} is used but not required and is ignored ({why}); \
                  the uncompressed fallback data is loaded"
@@ -334,6 +340,15 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                     .and_then(|t| t.get("texCoord"))
                     .and_then(|v| v.as_u64())
                     .unwrap_or(0) as u32;
+                let slot = if key == "roughnessTexture" {
+                    &mut req.roughness
+                } else {
+                    &mut req.metallic
+                };
+                // glTF's own metallicRoughnessTexture takes precedence.
+                if slot.is_some() {
+                    continue;
+                }
                 let found = if (tex as usize) < doc.textures().len() {
                     source(tex as usize, TexKind::Data, what, &mut warnings)
                 } else {
@@ -342,15 +357,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                     ));
                     None
                 };
-                let slot = if key == "roughnessTexture" {
-                    &mut req.roughness
-                } else {
-                    &mut req.metallic
-                };
-                // glTF's own metallicRoughnessTexture takes precedence.
-                if slot.is_none() {
-                    *slot = found.map(|s| (s, set));
-                }
+                *slot = found.map(|s| (s, set));
             }
         }
         for (src, kind) in [
