@@ -306,11 +306,12 @@ def build_scene_dict(mi, scene_dir: Path, meta: dict, width: int, height: int, s
 MAX_PASS_SPP = 64  # the JIT variants trace all of a pass's samples at once: bound the memory
 
 
-def render(mi, scene, max_depth: int, spp: int, seed: int) -> np.ndarray:
+def render(mi, scene, max_depth: int, spp: int, seed: int, integrator: dict | None = None) -> np.ndarray:
     """Average of ceil(spp / MAX_PASS_SPP) passes with seeds derived from `seed` (deterministic,
-    so two calls with the same seed and spp use the same samples)."""
-    integ = mi.load_dict({"type": "path", "max_depth": max_depth, "rr_depth": max_depth + 100,
-                          "hide_emitters": False})
+    so two calls with the same seed and spp use the same samples). `integrator`: instead of
+    `path` with `max_depth`."""
+    integ = mi.load_dict(integrator or {"type": "path", "max_depth": max_depth, "rr_depth": max_depth + 100,
+                                        "hide_emitters": False})
     passes = max(1, -(-spp // MAX_PASS_SPP))
     per = spp // passes
     acc = None
@@ -366,14 +367,7 @@ def register_first_glossy(mi, bounces: int):
 
 def render_first_glossy(mi, scene, spp: int, seed: int) -> np.ndarray:
     """`render` with `lightcut_first_glossy` (registered by `register_first_glossy`)."""
-    integ = mi.load_dict({"type": "lightcut_first_glossy"})
-    passes = max(1, -(-spp // MAX_PASS_SPP))
-    per = spp // passes
-    acc = None
-    for k in range(passes):
-        img = np.array(mi.render(scene, integrator=integ, spp=per, seed=seed * 1009 + k), dtype=np.float64)[:, :, :3]
-        acc = img if acc is None else acc + img
-    return acc / passes
+    return render(mi, scene, 0, spp, seed, {"type": "lightcut_first_glossy"})
 
 
 # ----------------------------------------------------------------------------------------------

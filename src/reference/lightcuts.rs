@@ -249,15 +249,23 @@ pub fn box_distance2(x: Vec3, lo: Vec3, hi: Vec3) -> f32 {
 /// box [lo, hi] with its normal inside `cone`, at a receiver x with normal n. Twin:
 /// `lc_geometry_bound`.
 pub fn geometry_bound(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cone: Cone, eps: f32) -> f32 {
-    if cone.is_empty() {
+    let Some((cx, cv)) = cosines(x, n, lo, hi, cone) else {
         return 0.0;
+    };
+    cx * cv / box_distance2(x, lo, hi).max(eps * eps)
+}
+
+/// The receiver's and the emitter's cosine bounds (cos_x, cos_v) of a cluster; None when the
+/// cone is empty or the box lies behind the receiver (the bound is then 0). Twin: `lc_cosines`.
+pub fn cosines(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cone: Cone) -> Option<(f32, f32)> {
+    if cone.is_empty() {
+        return None;
     }
     let cx = cos_bound(n, x, lo, hi);
     if cx <= 0.0 {
-        return 0.0;
+        return None;
     }
-    let cv = emitter_cos_bound(x, lo, hi, cone);
-    cx * cv / box_distance2(x, lo, hi).max(eps * eps)
+    Some((cx, emitter_cos_bound(x, lo, hi, cone)))
 }
 
 /// Upper bound of the emitter's cosine over VPLs in the box with normals in the cone: the
@@ -322,14 +330,9 @@ pub fn geometry_brdf_bound(
     sh: &Shading,
     intensity: Vec3,
 ) -> f32 {
-    if cone.is_empty() {
+    let Some((cx, cv)) = cosines(x, n, lo, hi, cone) else {
         return 0.0;
-    }
-    let cx = cos_bound(n, x, lo, hi);
-    if cx <= 0.0 {
-        return 0.0;
-    }
-    let cv = emitter_cos_bound(x, lo, hi, cone);
+    };
     let m = ggx_cos_bound(x, n, lo, hi, cx, sh);
     luminance(intensity * m) * cv / box_distance2(x, lo, hi).max(eps * eps)
 }

@@ -45,14 +45,10 @@ fn lc_ggx_cos_bound(x: vec3<f32>, n: vec3<f32>, v: vec3<f32>, lo: vec3<f32>, hi:
 // luminance(intensity x the BRDF's bound) x cos_v / d^2 bounds (pi x lc_geometry_bound's).
 fn lc_geometry_brdf_bound(x: vec3<f32>, n: vec3<f32>, v: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>,
     cone: vec4<f32>, eps: f32, base: vec3<f32>, metallic: f32, roughness: f32, intensity: vec3<f32>) -> f32 {
-    if cone.w < 0.0 {
+    let c = lc_cosines(x, n, lo, hi, cone);
+    if c.x <= 0.0 {
         return 0.0;
     }
-    let cx = lc_cos_bound(n, x, lo, hi);
-    if cx <= 0.0 {
-        return 0.0;
-    }
-    let cv = lc_emitter_cos_bound(x, lo, hi, cone);
-    let m = lc_ggx_cos_bound(x, n, v, lo, hi, cx, base, metallic, roughness);
-    return luminance(intensity * m) * cv / max(lc_box_distance2(x, lo, hi), eps * eps);
+    let m = lc_ggx_cos_bound(x, n, v, lo, hi, c.x, base, metallic, roughness);
+    return luminance(intensity * m) * c.y / max(lc_box_distance2(x, lo, hi), eps * eps);
 }

@@ -44,15 +44,24 @@ fn lc_box_distance2(x: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> f32 {
 // Upper bound of cos_x x cos_v / max(d^2, eps^2) over VPLs in [lo, hi] with normals in the
 // cone (xyz axis, w half-angle; w < 0 = empty).
 fn lc_geometry_bound(x: vec3<f32>, n: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>, cone: vec4<f32>, eps: f32) -> f32 {
-    if cone.w < 0.0 {
+    let c = lc_cosines(x, n, lo, hi, cone);
+    if c.x <= 0.0 {
         return 0.0;
+    }
+    return c.x * c.y / max(lc_box_distance2(x, lo, hi), eps * eps);
+}
+
+// The receiver's and the emitter's cosine bounds (cos_x, cos_v) of a cluster; cos_x = 0 when
+// the cone is empty or the box lies behind the receiver (the bound is then 0).
+fn lc_cosines(x: vec3<f32>, n: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>, cone: vec4<f32>) -> vec2<f32> {
+    if cone.w < 0.0 {
+        return vec2<f32>(0.0);
     }
     let cx = lc_cos_bound(n, x, lo, hi);
     if cx <= 0.0 {
-        return 0.0;
+        return vec2<f32>(0.0);
     }
-    let cv = lc_emitter_cos_bound(x, lo, hi, cone);
-    return cx * cv / max(lc_box_distance2(x, lo, hi), eps * eps);
+    return vec2<f32>(cx, lc_emitter_cos_bound(x, lo, hi, cone));
 }
 
 // Upper bound of the emitter's cosine (its normal m against x - p) over VPLs in [lo, hi] with
