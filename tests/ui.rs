@@ -807,3 +807,23 @@ fn the_brdf_combo_reaches_the_renderer_and_lambert_only_methods_say_so() {
     );
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }
+
+/// The built-in scenes (issue 37) are one click away: each button opens its scene, whose
+/// name and triangle count the scene section shows, and the view changes.
+#[test]
+fn the_builtin_scene_buttons_open_their_scenes() {
+    let Some(mut h) = harness() else { return };
+    h.run_steps(2);
+    let before = shown_pixels(&h);
+    for (button, name) in [("corridor", "Corridor: "), ("window-box", "Window box: ")] {
+        h.get_by_label(button).click();
+        h.run_steps(3);
+        assert!(
+            h.state().errors().is_empty(),
+            "{button}: {:?}",
+            h.state().errors()
+        );
+        h.get_by_label_contains(name);
+        assert_ne!(shown_pixels(&h), before, "{button}: the view did not change");
+    }
+}

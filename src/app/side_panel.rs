@@ -24,8 +24,10 @@ impl WorkbenchApp {
             });
             ui.horizontal_wrapped(|ui| {
                 let mut choice = None;
-                if ui.button("default").clicked() {
-                    choice = Some("default".to_string());
+                for b in crate::scene::test_scenes::BUILTIN {
+                    if ui.button(b.name).on_hover_text(b.about).clicked() {
+                        choice = Some(b.name.to_string());
+                    }
                 }
                 for p in preset_files() {
                     let label = p

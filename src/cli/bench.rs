@@ -57,7 +57,8 @@ pub enum BenchKind {
 pub struct BenchArgs {
     #[arg(value_enum, default_value = "rays")]
     pub kind: BenchKind,
-    /// `default`, a .gltf/.glb file, or a preset .toml (e.g. scenes/sponza.toml).
+    /// `default` or another built-in scene (`window-box`, `corridor`, `glossy-thin`), a
+    /// .gltf/.glb file, or a preset .toml (e.g. scenes/sponza.toml).
     #[arg(long, default_value = "default")]
     pub scene: String,
     /// Rays per dispatch (at most 4194240, the default: enough to fill a large GPU).

@@ -24,7 +24,8 @@ use crate::scene::{Camera, Scene};
 
 #[derive(Args, Debug)]
 pub struct ExportSceneArgs {
-    /// `default`, a .gltf/.glb file, or a preset .toml.
+    /// `default` or another built-in scene (`window-box`, `corridor`, `glossy-thin`), a
+    /// .gltf/.glb file, or a preset .toml.
     #[arg(long, default_value = "default")]
     pub scene: String,
     /// Camera name (default: the preset's, else the first).

@@ -19,7 +19,8 @@ use std::path::PathBuf;
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
-    /// Scene to open in the GUI: `default`, a .gltf/.glb file, or a preset .toml under scenes/.
+    /// Scene to open in the GUI: `default` or another built-in scene (`window-box`, `corridor`,
+    /// `glossy-thin`), a .gltf/.glb file, or a preset .toml under scenes/.
     #[arg(long, default_value = "default")]
     pub scene: String,
     /// Camera name from the scene file (default: the preset's, else the first).

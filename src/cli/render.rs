@@ -383,7 +383,8 @@ pub enum Output {
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// `default`, a .gltf/.glb file, or a preset .toml.
+    /// `default` or another built-in scene (`window-box`, `corridor`, `glossy-thin`), a
+    /// .gltf/.glb file, or a preset .toml.
     #[arg(long, default_value = "default")]
     pub scene: String,
     #[arg(long, default_value_t = 640)]

@@ -18,7 +18,8 @@ use crate::{
 
 #[derive(Args, Debug)]
 pub struct SheetArgs {
-    /// `default`, a .gltf/.glb file, or a preset .toml.
+    /// `default` or another built-in scene (`window-box`, `corridor`, `glossy-thin`), a
+    /// .gltf/.glb file, or a preset .toml.
     #[arg(long, default_value = "default")]
     pub scene: String,
     #[arg(long)]
@@ -114,13 +115,13 @@ pub fn run(args: &SheetArgs) -> anyhow::Result<()> {
     for c in &sheet.columns {
         let m = &c.metrics;
         println!(
-            "{:<16} RMSE {:.4e} (rel. {:.4}) · SSIM {:.4} · FLIP {:.4} · mean ratio {:.4} · GPU {} ms/frame",
+            "{:<16} RMSE {:.4e} (rel. {:.4}) · mean ratio {:.4} · SSIM {:.4} · FLIP {:.4} · GPU {} ms/frame",
             c.method.name(),
             m.rmse,
             m.relative_rmse,
+            m.mean_ratio,
             m.ssim,
             m.flip,
-            m.mean_ratio,
             c.gpu_ms.map_or("n/a".into(), |t| format!("{t:.2}"))
         );
     }

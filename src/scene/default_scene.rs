@@ -192,7 +192,7 @@ pub fn checker_texture(size: u32, checks: u32) -> TextureImage {
     }
 }
 
-fn push_vertex(s: &mut Scene, p: Vec3, n: Vec3, uv: Vec2) -> u32 {
+pub(crate) fn push_vertex(s: &mut Scene, p: Vec3, n: Vec3, uv: Vec2) -> u32 {
     s.positions.push(p);
     s.normals.push(n);
     s.uvs.push(uv);
@@ -200,7 +200,7 @@ fn push_vertex(s: &mut Scene, p: Vec3, n: Vec3, uv: Vec2) -> u32 {
 }
 
 /// Pushes a triangle, ordering it CCW around the average of its vertex normals.
-fn push_triangle(s: &mut Scene, a: u32, b: u32, c: u32, material: u32) {
+pub(crate) fn push_triangle(s: &mut Scene, a: u32, b: u32, c: u32, material: u32) {
     let (pa, pb, pc) = (
         s.positions[a as usize],
         s.positions[b as usize],
@@ -217,7 +217,7 @@ fn push_triangle(s: &mut Scene, a: u32, b: u32, c: u32, material: u32) {
 
 /// A box with centre `c`, half extents `h` in its local frame, rotated by `rot`; faces point
 /// out of the box. Each face has UVs spanning [0, 1].
-fn add_box(s: &mut Scene, c: Vec3, h: Vec3, rot: Quat, material: u32) {
+pub(crate) fn add_box(s: &mut Scene, c: Vec3, h: Vec3, rot: Quat, material: u32) {
     let axes = [Vec3::X, Vec3::Y, Vec3::Z];
     for a in 0..3 {
         for sign in [1.0f32, -1.0] {
@@ -241,7 +241,7 @@ fn add_box(s: &mut Scene, c: Vec3, h: Vec3, rot: Quat, material: u32) {
 }
 
 /// A UV sphere with smooth outward normals.
-fn add_sphere(s: &mut Scene, c: Vec3, r: f32, slices: u32, stacks: u32, material: u32) {
+pub(crate) fn add_sphere(s: &mut Scene, c: Vec3, r: f32, slices: u32, stacks: u32, material: u32) {
     let base = s.positions.len() as u32;
     for i in 0..=stacks {
         let theta = std::f32::consts::PI * i as f32 / stacks as f32;

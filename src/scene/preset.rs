@@ -28,7 +28,7 @@ use glam::Vec3;
 use serde::Deserialize;
 
 use super::gltf_load::{SceneError, load_gltf};
-use super::{Camera, DirectionalLight, Scene, default_scene};
+use super::{Camera, DirectionalLight, Scene, default_scene, test_scenes};
 
 /// A scene preset as stored in a `.toml` file. Unknown fields are rejected.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -268,6 +268,8 @@ pub fn load_preset(path: &Path) -> Result<ScenePreset, SceneError> {
 pub enum SceneSource {
     /// The embedded default scene ([`default_scene::build`]).
     Default,
+    /// One of the other scenes built in code ([`test_scenes::BUILTIN`], by name).
+    Builtin(&'static str),
     /// A `.gltf` / `.glb` file.
     Gltf(PathBuf),
     /// A `.toml` scene preset.
@@ -275,11 +277,15 @@ pub enum SceneSource {
 }
 
 impl SceneSource {
-    /// `"default"` -> `Default`; a path ending in `.toml` -> `Preset`; anything else -> `Gltf`.
+    /// `"default"` -> `Default`; another built-in scene's name (`window-box`, `corridor`,
+    /// `glossy-thin`) -> `Builtin`; a path ending in `.toml` -> `Preset`; anything else ->
+    /// `Gltf`.
     pub fn from_arg(s: &str) -> SceneSource {
         let p = PathBuf::from(s);
         if s == "default" {
             SceneSource::Default
+        } else if let Some(b) = test_scenes::find(s) {
+            SceneSource::Builtin(b.name)
         } else if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
             SceneSource::Preset(p)
         } else {
@@ -308,6 +314,12 @@ pub fn open_scene(src: &SceneSource) -> Result<OpenedScene, SceneError> {
     let mut opened = match src {
         SceneSource::Default => OpenedScene {
             scene: default_scene::build(),
+            camera_name: None,
+            exposure_ev: 0.0,
+            source: src.clone(),
+        },
+        SceneSource::Builtin(name) => OpenedScene {
+            scene: test_scenes::find(name).map_or_else(default_scene::build, |b| (b.build)()),
             camera_name: None,
             exposure_ev: 0.0,
             source: src.clone(),
