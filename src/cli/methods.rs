@@ -1,5 +1,6 @@
 //! `methods`: the GI-method registry as a table (CLI name, kind, label, the views each draws,
-//! its timed GPU passes, and the tests that check it).
+//! its timed GPU passes, its bias against the ground truth (and how to make it unbiased), and
+//! the tests that check it).
 
 use crate::methods::{Kind, REGISTRY};
 
@@ -30,6 +31,23 @@ pub fn run() -> anyhow::Result<()> {
             let brdf = if m.glossy { "Lambert, GGX" } else { "Lambert only" };
             let bounces = if m.one_bounce { "1 (RSM texels)" } else { "1..=8" };
             println!("{:<14} BRDF: {brdf}; VPL bounces: {bounces}", "");
+        }
+        if m.kind == Kind::PerFrame {
+            let defaults = crate::renderer::settings::RenderSettings {
+                gi: crate::renderer::settings::GiSettings {
+                    method: m.id,
+                    ..Default::default()
+                },
+                ..Default::default()
+            };
+            println!(
+                "{:<14} against the ground truth of the same VPLs: {}",
+                "",
+                (m.bias)(&defaults).describe()
+            );
+            if let Some(u) = &m.unbiased {
+                println!("{:<14} unbiased with: {}", "", u.how);
+            }
         }
         if !m.tests.is_empty() {
             println!("{:<14} checked by: {}", "", m.tests.join(", "));

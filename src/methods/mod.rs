@@ -495,6 +495,64 @@ pub struct MethodInfo {
     pub tests: &'static [&'static str],
     /// Its quality knob for `results`' equal-time sweep (per-frame methods).
     pub sweep: Option<&'static Sweep>,
+    /// What its image estimates under these settings, against the ground truth of the same
+    /// VPLs (the bias contract, issue 37: `tests/methods.rs` holds every per-frame method to
+    /// it on every built-in scene; `methods` lists it).
+    pub bias: fn(&RenderSettings) -> Bias,
+    /// For a method biased at its defaults: changes the settings to its unbiased
+    /// configuration, if it has one (RTSLC's cut per pixel, Lightcuts' threshold 0, light
+    /// culling without the filter); the contract checks that `bias` then says `Unbiased` and
+    /// that the N-frame means converge to the truth.
+    pub unbiased: Option<Unbiased>,
+}
+
+/// A biased method's unbiased configuration (`MethodInfo::unbiased`).
+pub struct Unbiased {
+    /// The settings it changes, as a user would write them (`methods`, docs).
+    pub how: &'static str,
+    /// Changes a copy of the settings to it.
+    pub apply: fn(&mut RenderSettings),
+}
+
+/// What a method's image estimates, measured against the ground truth of the frame's own
+/// VPLs by the means of the GI (indirect light) images: the contract `tests/methods.rs`
+/// checks on every built-in scene (`scene::test_scenes`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bias {
+    /// Its expected image is the ground truth of the same VPLs: the mean of N frames
+    /// converges to it, with an error that falls as 1/sqrt(N) (zero for a deterministic
+    /// method that computes it exactly, Lightcuts at threshold 0).
+    Unbiased,
+    /// Its expected image differs from that truth by design: the mean of N frames' GI stays
+    /// within `tolerance` (relative, of the truth's GI mean) of the truth's mean, on every
+    /// built-in scene; `reason` names what biases it (substitute sampling, clustering,
+    /// imperfect shadow maps, clamped ranges, ...).
+    Biased { tolerance: f64, reason: &'static str },
+    /// Not an estimate of the ground truth of the frame's VPLs: the truth itself, the
+    /// converged reference over every RSM texel, direct light only.
+    NotCompared,
+}
+
+impl Bias {
+    /// The relative tolerance of an N-frame mean's GI against the truth's (0 for unbiased
+    /// estimates, whose allowance is statistical; None where not compared).
+    pub fn tolerance(self) -> Option<f64> {
+        match self {
+            Bias::Unbiased => Some(0.0),
+            Bias::Biased { tolerance, .. } => Some(tolerance),
+            Bias::NotCompared => None,
+        }
+    }
+    /// One line for tables: "unbiased", "biased (within 10%: clustering)", "not compared".
+    pub fn describe(self) -> String {
+        match self {
+            Bias::Unbiased => "unbiased".into(),
+            Bias::Biased { tolerance, reason } => {
+                format!("biased, within {:.0}%: {reason}", 100.0 * tolerance)
+            }
+            Bias::NotCompared => "not compared".into(),
+        }
+    }
 }
 
 /// What a method's `record` may use: the frame's resources and where to write.

@@ -35,6 +35,8 @@ pub static INFO: MethodInfo = MethodInfo {
     ui: |_, _, _| {},
     tests: &["direct_light::lit_quad_matches_rho_over_pi_e_cos_and_shadow_is_zero"],
     sweep: None,
+    bias: |_| super::Bias::NotCompared,
+    unbiased: None,
 };
 
 struct DirectOnly;

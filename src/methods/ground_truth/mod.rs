@@ -53,6 +53,8 @@ pub static INFO: MethodInfo = MethodInfo {
         "vpl::ground_truth_with_ggx_equals_a_cpu_evaluation_with_the_brdf",
     ],
     sweep: None,
+    bias: |_| super::Bias::NotCompared,
+    unbiased: None,
 };
 
 fn validate(s: &RenderSettings) -> Result<(), String> {

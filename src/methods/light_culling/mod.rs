@@ -35,7 +35,7 @@ use pass::{
     FrameInputs, GpuLcullParams, GpuLcullViewParams, IsmFrame, LcullBuffers, LcullPass, LcullStats,
     TreeCullBuffers, TreeInputs, VISIBILITY_ISM,
 };
-use settings::{IsmAdaptive, IsmSettings, LightCullingSettings};
+use settings::{CullingVisibility, IsmAdaptive, IsmSettings, LightCullingSettings};
 
 /// The paper's stochastic light culling.
 pub const ID: MethodId = MethodId::new("light-culling");
@@ -216,6 +216,11 @@ pub static INFO: MethodInfo = MethodInfo {
     ui: ui::settings_ui,
     tests: TESTS,
     sweep: Some(&SWEEP),
+    bias: stochastic_bias,
+    unbiased: Some(super::Unbiased {
+        how: "methods.light-culling.interleave.filter_radius = 0 (interleaving alone)",
+        apply: no_filter,
+    }),
 };
 
 pub static CLAMPED_INFO: MethodInfo = MethodInfo {
@@ -247,6 +252,8 @@ pub static CLAMPED_INFO: MethodInfo = MethodInfo {
     ui: ui::settings_ui,
     tests: TESTS,
     sweep: Some(&SWEEP),
+    bias: clamped_bias,
+    unbiased: None,
 };
 
 pub static TREE_INFO: MethodInfo = MethodInfo {
@@ -280,7 +287,63 @@ pub static TREE_INFO: MethodInfo = MethodInfo {
     ui: ui::settings_ui,
     tests: TREE_TESTS,
     sweep: Some(&SWEEP),
+    bias: tree_bias,
+    unbiased: Some(super::Unbiased {
+        how: "methods.light-culling.tree_filter_radius = 0",
+        apply: no_filter,
+    }),
 };
+
+/// What biases every variant alike: imperfect shadow maps, the geometry-aware filter (the
+/// filter `radius` the variant uses); None when neither is on.
+fn shared_bias(s: &RenderSettings, radius: u32) -> Option<super::Bias> {
+    let lc: LightCullingSettings = s.method(ID).unwrap_or_default();
+    if s.gi.shadow_rays && lc.visibility == CullingVisibility::Ism {
+        Some(super::Bias::Biased {
+            tolerance: 0.35,
+            reason: "imperfect shadow maps for visibility (mean 1.074x the rays' image: docs/light-culling.md)",
+        })
+    } else if radius > 0 {
+        Some(super::Bias::Biased {
+            tolerance: 0.05,
+            reason: "the geometry-aware filter averages neighbours' light (section 4.2)",
+        })
+    } else {
+        None
+    }
+}
+
+/// The variants without the filter (interleaving alone stays unbiased).
+fn no_filter(s: &mut RenderSettings) {
+    let mut lc: LightCullingSettings = s.method(ID).unwrap_or_default();
+    (lc.interleave.filter_radius, lc.tree_filter_radius) = (0, 0);
+    let _ = s.set_method(ID, &lc);
+}
+
+/// Stochastic ranges are unbiased Russian roulette (eq. 2); interleaving alone keeps it so.
+fn stochastic_bias(s: &RenderSettings) -> super::Bias {
+    let lc: LightCullingSettings = s.method(ID).unwrap_or_default();
+    shared_bias(s, lc.interleave.filter_radius).unwrap_or(super::Bias::Unbiased)
+}
+
+/// Appendix A's deterministic ranges drop every VPL's light beyond its range: darker (the
+/// filter's smaller bias is inside this tolerance).
+fn clamped_bias(s: &RenderSettings) -> super::Bias {
+    match shared_bias(s, 0) {
+        Some(ism) => ism,
+        None => super::Bias::Biased {
+            tolerance: 0.10,
+            reason: "clamped ranges drop each VPL's light beyond its range (appendix A: darker)",
+        },
+    }
+}
+
+/// Section 5's tree: the same stochastic ranges, and a resampled VPL divided by its
+/// resampling probability: unbiased.
+fn tree_bias(s: &RenderSettings) -> super::Bias {
+    let lc: LightCullingSettings = s.method(ID).unwrap_or_default();
+    shared_bias(s, lc.tree_filter_radius).unwrap_or(super::Bias::Unbiased)
+}
 
 /// The error bound eps_max, loose to tight (the paper's 0.0005 among them).
 pub static SWEEP: super::Sweep = super::Sweep {

@@ -154,7 +154,25 @@ pub static INFO: MethodInfo = MethodInfo {
         "lightcut_interpolation::interpolated_visibility_shoots_no_rays_and_stays_close",
     ],
     sweep: Some(&SWEEP),
+    bias,
+    unbiased: None,
 };
+
+/// A pixel's cut is interpolated from its records' cuts, so the error bound holds at the
+/// records, not at the pixel; with interpolated visibility the records' visibility stands
+/// for the pixel's (the paper's section 3.4).
+fn bias(s: &RenderSettings) -> super::Bias {
+    match s.method::<LightcutInterpolationSettings>(ID) {
+        Ok(li) if li.visibility != LiVisibility::Full => super::Bias::Biased {
+            tolerance: 0.15,
+            reason: "interpolated cuts with the records' visibility standing for the pixel's",
+        },
+        _ => super::Bias::Biased {
+            tolerance: 0.05,
+            reason: "cuts interpolated from records' cuts: the error bound holds at the records, not at the pixel",
+        },
+    }
+}
 
 /// The record density: R- and R+ scaled together (1 = the paper's 4 and 15 pixel sizes).
 pub static SWEEP: super::Sweep = super::Sweep {

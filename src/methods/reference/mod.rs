@@ -62,6 +62,8 @@ pub static INFO: MethodInfo = MethodInfo {
         "vpl::converged_reference_with_ggx_converges_to_the_exact_brdf_sum",
     ],
     sweep: None,
+    bias: |_| super::Bias::NotCompared,
+    unbiased: None,
 };
 
 fn validate(s: &RenderSettings) -> Result<(), String> {

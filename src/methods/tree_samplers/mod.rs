@@ -17,7 +17,7 @@ pub mod settings;
 mod ui;
 
 use super::{
-    FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
+    Bias, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
 };
 use crate::base::sst_node::TreeKind;
 use crate::reference::interleave::Interleave;
@@ -31,7 +31,7 @@ use crate::renderer::{
 };
 use half::{HalfPass, HalfTargets};
 use pass::{GpuSlcViewParams, PixelTrace, SamplingStats, SlcBuffers, SlcPass};
-use settings::{ChildProbability, CutBlending, CutFallback};
+use settings::{ChildProbability, CutBlending, CutFallback, SamplerVisibility};
 
 pub const SLC: MethodId = MethodId::new("slc");
 pub const SST: MethodId = MethodId::new("sst");
@@ -165,6 +165,11 @@ pub static SLC_INFO: MethodInfo = MethodInfo {
     ui: ui::settings_ui,
     tests: TESTS,
     sweep: Some(&SPP_SWEEP),
+    bias: slc_bias,
+    unbiased: Some(super::Unbiased {
+        how: "tree.v_min = 1, tree.sigma_max = 0 (only leaves usable: RTSLC's traversal), sampling.block_size = 1",
+        apply: |s| (s.tree.v_min, s.tree.sigma_max, s.sampling.block_size) = (1.0, 0.0, 1),
+    }),
 };
 
 pub static SST_INFO: MethodInfo = MethodInfo {
@@ -197,6 +202,11 @@ pub static SST_INFO: MethodInfo = MethodInfo {
     ui: ui::settings_ui,
     tests: TESTS,
     sweep: Some(&SPP_SWEEP),
+    bias: sst_bias,
+    unbiased: Some(super::Unbiased {
+        how: "tree.v_min = 1, tree.sigma_max = 0 (only leaves usable)",
+        apply: |s| (s.tree.v_min, s.tree.sigma_max) = (1.0, 0.0),
+    }),
 };
 
 pub static RTSLC_INFO: MethodInfo = MethodInfo {
@@ -230,7 +240,72 @@ pub static RTSLC_INFO: MethodInfo = MethodInfo {
     ui: ui::settings_ui,
     tests: TESTS,
     sweep: Some(&SPP_SWEEP),
+    bias: rtslc_bias,
+    unbiased: Some(super::Unbiased {
+        how: "sampling.block_size = 1 (a cut per pixel: culling drops only nodes that cannot light it)",
+        apply: |s| s.sampling.block_size = 1,
+    }),
 };
+
+/// What biases every tree sampler alike: imperfect shadow maps, the interleaving's filter,
+/// half-resolution upsampling (docs/sampling.md); None when none of them is on.
+fn shared_bias(s: &RenderSettings) -> Option<Bias> {
+    let sm = &s.sampling;
+    if s.gi.shadow_rays && sm.visibility == SamplerVisibility::Ism {
+        Some(Bias::Biased {
+            tolerance: 0.35,
+            reason: "imperfect shadow maps for visibility (Sponza 1.29x, Breakfast Room 0.83x: docs/sampling.md)",
+        })
+    } else if sm.half_resolution {
+        Some(Bias::Biased {
+            tolerance: 0.05,
+            reason: "half-resolution GI, upsampled by a joint bilateral filter",
+        })
+    } else if sm.interleave.filter_radius > 0 {
+        Some(Bias::Biased {
+            tolerance: 0.05,
+            reason: "the interleaving's geometry-aware filter averages neighbours' light",
+        })
+    } else {
+        None
+    }
+}
+
+/// RTSLC samples leaves: unbiased with complete cuts (`cull_behind` off) or a cut per pixel;
+/// otherwise a node culled behind the block centre's surface may still light a pixel of the
+/// block (docs/sampling.md, *Unbiasedness*).
+fn rtslc_bias(s: &RenderSettings) -> Bias {
+    shared_bias(s).unwrap_or(if !s.sampling.cull_behind || s.sampling.block_size == 1 {
+        Bias::Unbiased
+    } else {
+        Bias::Biased {
+            tolerance: 0.02,
+            reason: "nodes culled behind the block centre's surface (cull_behind) can light other pixels of the block",
+        }
+    })
+}
+
+/// SLC and SST stop at usable inner nodes and shade a point of their substitute
+/// distribution (the SST paper's section 4.2): biased, unless only leaves are usable
+/// (`tree.v_min` 1, `tree.sigma_max` 0), where SLC traverses exactly as RTSLC does.
+fn substitute_bias(s: &RenderSettings, leaf_bias: Bias) -> Bias {
+    if s.tree.v_min >= 1.0 && s.tree.sigma_max <= 0.0 {
+        return shared_bias(s).unwrap_or(leaf_bias);
+    }
+    shared_bias(s).unwrap_or(Bias::Biased {
+        tolerance: 0.10,
+        reason: "substitute sampling: a Gaussian point of a usable node stands for its VPLs (SST paper 4.2)",
+    })
+}
+
+fn slc_bias(s: &RenderSettings) -> Bias {
+    substitute_bias(s, rtslc_bias(s))
+}
+
+/// SST starts every traversal at the root: with leaves only it is unbiased.
+fn sst_bias(s: &RenderSettings) -> Bias {
+    substitute_bias(s, Bias::Unbiased)
+}
 
 /// `[sampling]`: every field in range, or a message naming it.
 fn validate(s: &RenderSettings) -> Result<(), String> {
