@@ -96,10 +96,25 @@ impl Rsm {
     }
 }
 
+/// Normals of one surface's texels agree within this cosine (the downsample's dominant
+/// surface; twin `SAME_NORMAL` in val_downsample.wgsl).
+pub const SAME_NORMAL: f32 = 0.9;
+
+/// Whether texel `t` lies on `r`'s surface: normals within [`SAME_NORMAL`], within `tol` of
+/// `r`'s tangent plane.
+fn same_surface(r: &RsmTexel, t: &RsmTexel, tol: f32) -> bool {
+    t.normal.dot(r.normal) >= SAME_NORMAL && (t.position - r.position).dot(r.normal).abs() <= tol
+}
+
 /// The RSM the clustering runs on: `rsm` summed down to `res`^2 (a power-of-two fraction of
 /// its resolution; at least its resolution: a copy). A coarse texel holds its block's lit
-/// texels (geometry with flux): their summed flux, mean position, normalised summed normal and
-/// summed surface area; it is lit when any of them is. Flux and area are kept exactly.
+/// texels (geometry with flux): their summed flux and summed surface area, kept exactly, and
+/// the mean position and normalised summed normal of the block's *dominant surface*, the
+/// texels on the surface (normals within [`SAME_NORMAL`], within a block's edge of its plane)
+/// of the lit texel whose surface holds the most flux (the first such texel in row order).
+/// It is lit when any texel is. A block straddling a blind slat and the floor past it would
+/// otherwise put its light in mid-air with a blended normal, lighting the floor whose flux it
+/// carries: 1.3-1.9x too bright (issue 37, docs/val.md *Brightness*).
 /// (The paper clusters a low-resolution RSM without saying which; clustering at full
 /// resolution sends most texels through the fallback, which costs clusters x texels.)
 /// Twin: `val_downsample.wgsl`.
@@ -108,34 +123,48 @@ pub fn downsample(rsm: &Rsm, res: u32) -> Rsm {
     let f = rsm.res / res;
     let mut texels = vec![RsmTexel::default(); (res * res) as usize];
     let mut areas = vec![0.0f32; (res * res) as usize];
+    let tol = rsm.texel_area.sqrt() * f as f32;
     for y in 0..res {
         for x in 0..res {
-            let (mut n, mut pos, mut nrm, mut flux, mut area) =
-                (0u32, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, 0.0f32);
-            for dy in 0..f {
-                for dx in 0..f {
-                    let i = ((y * f + dy) * rsm.res + x * f + dx) as usize;
-                    if !rsm.lit(i) {
-                        continue;
-                    }
-                    let t = &rsm.texels[i];
-                    n += 1;
-                    pos += t.position;
-                    nrm += t.normal;
-                    flux += t.flux;
-                    area += rsm.surface_area(i);
+            let block: Vec<usize> = (0..f * f)
+                .map(|k| ((y * f + k / f) * rsm.res + x * f + k % f) as usize)
+                .filter(|&i| rsm.lit(i))
+                .collect();
+            let Some(&first) = block.first() else {
+                continue;
+            };
+            let t = |i: usize| &rsm.texels[i];
+            let on = |r: usize| -> f32 {
+                block
+                    .iter()
+                    .filter(|&&i| same_surface(t(r), t(i), tol))
+                    .map(|&i| t(i).flux.x + t(i).flux.y + t(i).flux.z)
+                    .sum()
+            };
+            let (mut best, mut best_on) = (first, on(first));
+            for &r in &block[1..] {
+                let o = on(r);
+                if o > best_on {
+                    (best, best_on) = (r, o);
                 }
             }
+            let surface: Vec<usize> = block
+                .iter()
+                .copied()
+                .filter(|&i| same_surface(t(best), t(i), tol))
+                .collect();
             let k = (y * res + x) as usize;
-            if n > 0 {
-                texels[k] = RsmTexel {
-                    position: pos / n as f32,
-                    normal: nrm.normalize_or(Vec3::Z),
-                    flux,
-                    valid: true,
-                };
-                areas[k] = area;
-            }
+            texels[k] = RsmTexel {
+                position: surface.iter().map(|&i| t(i).position).sum::<Vec3>() / surface.len().max(1) as f32,
+                normal: surface
+                    .iter()
+                    .map(|&i| t(i).normal)
+                    .sum::<Vec3>()
+                    .normalize_or(Vec3::Z),
+                flux: block.iter().map(|&i| t(i).flux).sum(),
+                valid: true,
+            };
+            areas[k] = block.iter().map(|&i| rsm.surface_area(i)).sum();
         }
     }
     Rsm {
@@ -685,6 +714,45 @@ mod tests {
         assert_eq!(seeds_from_vpls(&ids, 2, 0, 8, 1), vec![0, 2 | 2 << 16]);
         // No VPL of the layer: texel 0.
         assert_eq!(seeds_from_vpls(&[NONE, 1 << 24], 2, 0, 8, 1), vec![0, 0]);
+    }
+
+    /// Issue 37: a block over two surfaces (a slat 1 m above the floor, the floor past it)
+    /// takes the position and normal of the surface holding most of its flux and keeps the
+    /// whole block's flux: its light stays on a surface instead of hanging between them.
+    #[test]
+    fn a_block_over_two_surfaces_keeps_its_dominant_one() {
+        let mut rsm = floor(8);
+        let slat = Vec3::new(0.0, 0.6, 0.8).normalize();
+        // Block (0, 0) of 4 x 4: its top row is a slat (less flux per texel, 4 texels), the
+        // rest the floor (12 texels).
+        for x in 0..4u32 {
+            let t = &mut rsm.texels[x as usize];
+            t.position = Vec3::new(x as f32 * 0.1, 1.0, 0.0);
+            t.normal = slat;
+            t.flux = Vec3::splat(0.02);
+        }
+        let c = downsample(&rsm, 2);
+        let t = c.texel(UVec2::new(0, 0));
+        // The floor holds 12 x 0.014 of the block's flux, the slat 4 x 0.06.
+        let floor_flux = (4..16)
+            .map(|i| rsm.texels[(i / 4 * 8 + i % 4) as usize].flux)
+            .sum::<Vec3>();
+        let slat_flux = Vec3::splat(4.0 * 0.02);
+        let dominant_is_slat = slat_flux.element_sum() > floor_flux.element_sum();
+        assert!(dominant_is_slat);
+        assert!((t.normal - slat).length() < 1e-5, "{}", t.normal);
+        assert!((t.position.y - 1.0).abs() < 1e-5, "{}", t.position);
+        assert!((t.flux - (floor_flux + slat_flux)).abs().max_element() < 1e-6);
+        // The plain mean would have put it in mid-air between them.
+        let mean_y = (4.0 * 1.0 + 12.0 * 0.0) / 16.0;
+        assert!((t.position.y - mean_y).abs() > 0.5);
+        // With the slat dimmer than the floor the floor wins, and its light stays on it.
+        for x in 0..4u32 {
+            rsm.texels[x as usize].flux = Vec3::splat(0.001);
+        }
+        let c = downsample(&rsm, 2);
+        let t = c.texel(UVec2::new(0, 0));
+        assert!((t.normal - Vec3::Y).length() < 1e-5 && t.position.y.abs() < 1e-5);
     }
 
     #[test]
