@@ -11,6 +11,11 @@
 //   atrous     : one iteration of the 5x5 B3-spline a-trous wavelet with SVGF's depth,
 //                normal and variance-scaled luminance weights, variance filtered with the
 //                squared weights (section 4.3); iteration `feedback` feeds the history
+//   atrous_prep, atrous_weight, atrous_conserving : the light-conserving iteration
+//                (temporal.atrous = conserving): symmetric weights e(p, q) = e(q, p), each
+//                pixel's weight sum W, then out_p = X_p + sum s_pq r_pq (X_q - X_p) with
+//                s_pq = k e / max(W_p, W_q) and the albedo share r_pq = min(a_p, a_q) / a_p:
+//                the radiance p takes from q, q gives (docs/temporal.md)
 //   modulate   : x albedo -> radiance for the composite
 //   view_*     : the stage's views
 // CPU twin: reference::temporal (every entry point).
@@ -41,7 +46,7 @@ struct TemporalParams {
     view_mode: u32,
     view_lo: f32,
     view_hi: f32,
-    _pad0: u32,
+    conserving: u32,       // 1: the variance pass keeps the colour (conserving a-trous)
     _pad1: u32,
 };
 
@@ -71,6 +76,10 @@ struct TemporalParams {
 @group(0) @binding(22) var<storage, read_write> iter_copy: array<vec4<f32>>;
 @group(0) @binding(23) var view_radiance_out: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(24) var view_out: texture_storage_2d<rgba8unorm, write>;
+// The conserving a-trous: per pixel (view depth, depth derivative, luminance, prefiltered
+// variance; w = -1 uncovered), and its weight sum W.
+@group(0) @binding(25) var<storage, read_write> aux: array<vec4<f32>>;
+@group(0) @binding(26) var<storage, read_write> weight: array<f32>;
 
 const EMPTY: vec4<f32> = vec4<f32>(0.0);
 // fwidth(z)'s floor relative to the depth (a plane facing the camera has a zero depth
@@ -355,9 +364,42 @@ fn variance(@builtin(global_invocation_id) gid: vec3<u32>) {
     c /= wsum;
     mm /= wsum;
     let v = max(mm.y - mm.x * mm.x, 0.0) * 4.0 / max(len, 1.0);
-    dst[k] = vec4<f32>(c, v);
+    // The conserving choice keeps the pixel's colour (a normalised bilateral blur moves light).
+    dst[k] = vec4<f32>(select(c, it.rgb, p.conserving == 1u), v);
 }
 
+// The variance of src prefiltered by a 3x3 Gaussian over the covered pixels (SVGF's g(var)).
+fn prefiltered_variance(px: vec2<i32>) -> f32 {
+    var gv = 0.0;
+    var gw = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = px + vec2<i32>(dx, dy);
+            if inside(q) && textureLoad(gb_position, q, 0).w != 0.0 {
+                let w = select(0.5, 0.25, dx != 0) * select(0.5, 0.25, dy != 0);
+                gv += w * src[idx(q)].w;
+                gw += w;
+            }
+        }
+    }
+    return max(gv / gw, 0.0);
+}
+
+// Writes an iteration's output: the next buffer, the history (feedback), the view's copy.
+fn store_iteration(k: u32, o: vec4<f32>) {
+    dst[k] = o;
+    if p.iteration == p.feedback {
+        hist_color_next[k] = vec4<f32>(o.rgb, hist_color_next[k].w);
+    }
+    if p.iteration == p.view_iteration {
+        iter_copy[k] = o;
+    }
+}
+
+const B3 = array<f32, 3>(3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
+
+// SVGF's iteration: each output normalised by its own weight sum, the luminance scale from
+// the pixel's own variance.
 @compute @workgroup_size(8, 8, 1)
 fn atrous(@builtin(global_invocation_id) gid: vec3<u32>) {
     if gid.x >= p.width || gid.y >= p.height {
@@ -377,22 +419,9 @@ fn atrous(@builtin(global_invocation_id) gid: vec3<u32>) {
     let n = normalize(textureLoad(gb_normal, px, 0).xyz);
     let z = view_depth(g.xyz);
     let fw = max(depth_fwidth(px, z), DEPTH_FLOOR * z);
-    // The variance prefiltered by a 3x3 Gaussian (covered pixels).
-    var gv = 0.0;
-    var gw = 0.0;
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let q = px + vec2<i32>(dx, dy);
-            if inside(q) && textureLoad(gb_position, q, 0).w != 0.0 {
-                let w = select(0.5, 0.25, dx != 0) * select(0.5, 0.25, dy != 0);
-                gv += w * src[idx(q)].w;
-                gw += w;
-            }
-        }
-    }
-    let phi_l = p.sigma_l * sqrt(max(gv / gw, 0.0) + 1e-10);
+    let phi_l = p.sigma_l * sqrt(prefiltered_variance(px) + 1e-10);
     let lp = luminance(c.rgb);
-    var h = array<f32, 3>(3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
+    var h = B3;
     var wsum = h[0] * h[0];
     var sc = wsum * c.rgb;
     var sv = wsum * wsum * c.w;
@@ -419,14 +448,128 @@ fn atrous(@builtin(global_invocation_id) gid: vec3<u32>) {
             sv += w * w * sq.w;
         }
     }
-    let o = vec4<f32>(sc / wsum, sv / (wsum * wsum));
-    dst[k] = o;
-    if p.iteration == p.feedback {
-        hist_color_next[k] = vec4<f32>(o.rgb, hist_color_next[k].w);
+    store_iteration(k, vec4<f32>(sc / wsum, sv / (wsum * wsum)));
+}
+
+// The conserving iteration, pass 1: what the symmetric weights read of each pixel.
+@compute @workgroup_size(8, 8, 1)
+fn atrous_prep(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= p.width || gid.y >= p.height {
+        return;
     }
-    if p.iteration == p.view_iteration {
-        iter_copy[k] = o;
+    let px = vec2<i32>(gid.xy);
+    let k = idx(px);
+    let g = textureLoad(gb_position, px, 0);
+    if g.w == 0.0 {
+        aux[k] = vec4<f32>(0.0, 0.0, 0.0, -1.0);
+        return;
     }
+    let z = view_depth(g.xyz);
+    let fw = max(depth_fwidth(px, z), DEPTH_FLOOR * z);
+    aux[k] = vec4<f32>(z, fw, luminance(src[k].rgb), prefiltered_variance(px));
+}
+
+// The symmetric edge-stopping weight of pixels a and b (their aux records and normals) at
+// `dist` steps: SVGF's functions with the depth scale from the larger depth derivative and
+// the luminance scale from the larger variance, so that e(a, b) = e(b, a).
+fn symmetric_weight(a: vec4<f32>, b: vec4<f32>, na: vec3<f32>, nb: vec3<f32>, dist: f32) -> f32 {
+    let phi_z = p.sigma_z * max(a.y, b.y) * f32(p.step) * dist;
+    let phi_l = p.sigma_l * sqrt(max(a.w, b.w) + 1e-10);
+    return edge_weight(a.x, b.x, phi_z, na, nb, a.z, b.z, phi_l);
+}
+
+// The covered tap (dx, dy) of pixel px (its index, or -1).
+fn conserving_tap(px: vec2<i32>, dx: i32, dy: i32) -> i32 {
+    let q = px + vec2<i32>(dx, dy) * i32(p.step);
+    if !inside(q) || aux[idx(q)].w < 0.0 {
+        return -1;
+    }
+    return i32(idx(q));
+}
+
+// Pass 2: each pixel's weight sum W (the centre's kernel weight and every covered tap's).
+@compute @workgroup_size(8, 8, 1)
+fn atrous_weight(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= p.width || gid.y >= p.height {
+        return;
+    }
+    let px = vec2<i32>(gid.xy);
+    let k = idx(px);
+    let a = aux[k];
+    if a.w < 0.0 {
+        weight[k] = 0.0;
+        return;
+    }
+    let n = normalize(textureLoad(gb_normal, px, 0).xyz);
+    var h = B3;
+    var w = h[0] * h[0];
+    for (var dy = -2; dy <= 2; dy++) {
+        for (var dx = -2; dx <= 2; dx++) {
+            let q = conserving_tap(px, dx, dy);
+            if (dx == 0 && dy == 0) || q < 0 {
+                continue;
+            }
+            let nq = normalize(textureLoad(gb_normal, px + vec2<i32>(dx, dy) * i32(p.step), 0).xyz);
+            let e = symmetric_weight(a, aux[q], n, nq, length(vec2<f32>(f32(dx), f32(dy))));
+            w += h[abs(dx)] * h[abs(dy)] * e;
+        }
+    }
+    weight[k] = w;
+}
+
+// The share of a conserving transfer to a pixel of albedo a from one of albedo b, per channel:
+// min(a, b) / a (a x share = b x its share: radiance given is radiance taken); 0 where either
+// albedo is at most 1e-3 (no demodulated GI there).
+fn albedo_share(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
+    let ok = a > vec3<f32>(1e-3) & b > vec3<f32>(1e-3);
+    return select(vec3<f32>(0.0), min(a, b) / max(a, vec3<f32>(1e-3)), ok);
+}
+
+// Pass 3: out_p = X_p + sum_q s_pq r_pq (X_q - X_p) per channel, s_pq = k e_pq / max(W_p, W_q)
+// symmetric and r_pq the albedo share: the remodulated image's sum stays. Variance
+// (1 - sum s l(r))^2 var_p + sum (s l(r))^2 var_q (l: the luminance weights).
+@compute @workgroup_size(8, 8, 1)
+fn atrous_conserving(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= p.width || gid.y >= p.height {
+        return;
+    }
+    let px = vec2<i32>(gid.xy);
+    let k = idx(px);
+    let a = aux[k];
+    if a.w < 0.0 {
+        dst[k] = EMPTY;
+        if p.iteration == p.view_iteration {
+            iter_copy[k] = EMPTY;
+        }
+        return;
+    }
+    let c = src[k];
+    let wp = weight[k];
+    let n = normalize(textureLoad(gb_normal, px, 0).xyz);
+    let ap = textureLoad(gb_albedo, px, 0).rgb;
+    var h = B3;
+    var d = vec3<f32>(0.0);
+    var ssum = 0.0;
+    var sv = 0.0;
+    for (var dy = -2; dy <= 2; dy++) {
+        for (var dx = -2; dx <= 2; dx++) {
+            let q = conserving_tap(px, dx, dy);
+            if (dx == 0 && dy == 0) || q < 0 {
+                continue;
+            }
+            let tq = px + vec2<i32>(dx, dy) * i32(p.step);
+            let nq = normalize(textureLoad(gb_normal, tq, 0).xyz);
+            let e = symmetric_weight(a, aux[q], n, nq, length(vec2<f32>(f32(dx), f32(dy))));
+            let s = h[abs(dx)] * h[abs(dy)] * e / max(wp, weight[q]);
+            let r = s * albedo_share(ap, textureLoad(gb_albedo, tq, 0).rgb);
+            let sq = src[q];
+            d += r * (sq.rgb - c.rgb);
+            let rl = luminance(r);
+            ssum += rl;
+            sv += rl * rl * sq.w;
+        }
+    }
+    store_iteration(k, vec4<f32>(c.rgb + d, (1.0 - ssum) * (1.0 - ssum) * c.w + sv));
 }
 
 @compute @workgroup_size(8, 8, 1)

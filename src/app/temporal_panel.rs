@@ -3,6 +3,7 @@
 //! section's player).
 
 use crate::renderer::settings::{MAX_ATROUS_ITERATIONS, TemporalMode, TemporalSettings};
+use crate::renderer::temporal_settings::AtrousFilter;
 use crate::scene::camera_path::CameraPath;
 use crate::scene::{Camera, Scene};
 
@@ -52,6 +53,22 @@ pub fn temporal_ui(ui: &mut egui::Ui, t: &mut TemporalSettings, per_frame: bool)
             if t.mode == TemporalMode::Svgf {
                 ui.add(egui::Slider::new(&mut t.iterations, 0..=MAX_ATROUS_ITERATIONS).text("à-trous iterations"))
                     .on_hover_text("steps 1, 2, 4, ... pixels (SVGF 5)");
+                egui::ComboBox::from_label("à-trous weights")
+                    .selected_text(t.atrous.label())
+                    .show_ui(ui, |ui| {
+                        for a in AtrousFilter::ALL {
+                            ui.selectable_value(&mut t.atrous, a, a.label()).on_hover_text(match a {
+                                AtrousFilter::Conserving => {
+                                    "symmetric weights: what a pixel takes from a neighbour, the neighbour gives; the image's light stays (3 passes per iteration)"
+                                }
+                                AtrousFilter::Svgf => {
+                                    "the paper's: each pixel normalised by its own weights; darkens under skewed noise (issue 37)"
+                                }
+                            });
+                        }
+                    })
+                    .response
+                    .on_hover_text("temporal.atrous (docs/temporal.md, \"Where SVGF lost light\")");
                 t.feedback_iteration = t.feedback_iteration.min(t.iterations);
                 ui.add(egui::Slider::new(&mut t.feedback_iteration, 0..=t.iterations).text("history from iteration"))
                     .on_hover_text("SVGF 1; 0 = the unfiltered integrated colour");

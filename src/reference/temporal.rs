@@ -1,8 +1,9 @@
 //! CPU twin of the temporal stage (`shaders/temporal.wgsl`, `renderer::passes::temporal`):
-//! SVGF (Schied et al. 2017) on the albedo-demodulated GI. Each function mirrors one entry
-//! point pixel by pixel, so that a test can feed it the GPU's inputs of that pass and compare
-//! the outputs; [`Frame`] runs them in the pass order on whole images (the statistical tests
-//! of the filter use it).
+//! SVGF (Schied et al. 2017) on the albedo-demodulated GI, with SVGF's à-trous or the
+//! light-conserving one (`Params::conserving`, docs/temporal.md). Each function mirrors one
+//! entry point pixel by pixel, so that a test can feed it the GPU's inputs of that pass and
+//! compare the outputs; [`Frame`] runs them in the pass order on whole images (the statistical
+//! tests of the filter use it).
 
 use glam::{Vec2, Vec3};
 
@@ -46,10 +47,14 @@ pub struct Params {
     pub spatial_frames: f32,
     pub gradient: bool,
     pub gradient_scale: f32,
+    /// The light-conserving à-trous (symmetric weights, `atrous_prep` / `atrous_weight` /
+    /// `atrous_conserving`) and the variance pass keeping the colour unfiltered; false:
+    /// SVGF's (`atrous`).
+    pub conserving: bool,
 }
 
 impl Default for Params {
-    /// SVGF's values (`TemporalSettings::default`).
+    /// SVGF's values with the conserving à-trous (`TemporalSettings::default`).
     fn default() -> Self {
         Self {
             alpha: 0.2,
@@ -63,6 +68,7 @@ impl Default for Params {
             spatial_frames: 4.0,
             gradient: false,
             gradient_scale: 2.0,
+            conserving: true,
         }
     }
 }
@@ -316,7 +322,9 @@ pub fn edge_weight(
 }
 
 /// The `variance` entry point at pixel k: the filter's input (demodulated rgb, variance) from
-/// the integrated colours and moments of every pixel (`Accumulated`).
+/// the integrated colours and moments of every pixel (`Accumulated`). On a short history the
+/// moments are filtered spatially; SVGF filters the colour with them, the conserving choice
+/// keeps the pixel's own (a normalised bilateral blur moves light).
 pub fn variance_pixel(k: usize, gb: &Gbuffer, cam: &Cam, acc: &[Accumulated], p: &Params) -> [f32; 4] {
     if !gb.covered(k) {
         return [0.0; 4];
@@ -359,6 +367,9 @@ pub fn variance_pixel(k: usize, gb: &Gbuffer, cam: &Cam, acc: &[Accumulated], p:
     let wsum = wsum.max(1e-10);
     let (c, mm) = (c / wsum, mm / wsum);
     let v = (mm.y - mm.x * mm.x).max(0.0) * 4.0 / len.max(1.0);
+    if p.conserving {
+        return [it[0], it[1], it[2], v];
+    }
     [c.x, c.y, c.z, v]
 }
 
@@ -369,17 +380,9 @@ pub const DEPTH_FLOOR: f32 = 1e-4;
 /// The B3-spline kernel's taps for offsets 0, 1, 2.
 pub const B3: [f32; 3] = [3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0];
 
-/// One à-trous iteration (the `atrous` entry point) at pixel k with step `step`, from the
-/// input `src` (demodulated rgb, variance) of every pixel.
-pub fn atrous_pixel(k: usize, gb: &Gbuffer, cam: &Cam, src: &[[f32; 4]], step: i32, p: &Params) -> [f32; 4] {
-    if !gb.covered(k) {
-        return [0.0; 4];
-    }
-    let (x, y) = ((k as u32 % gb.width) as i32, (k as u32 / gb.width) as i32);
-    let c = src[k];
-    let n = gb.normal[k].normalize_or_zero();
-    let z = cam.view_depth(gb.point(k));
-    let fw = depth_fwidth(gb, cam, x, y, z).max(DEPTH_FLOOR * z);
+/// The variance of `src` at (x, y) prefiltered by a 3x3 Gaussian over the covered pixels
+/// (SVGF's g(var)).
+fn prefiltered_variance(gb: &Gbuffer, src: &[[f32; 4]], x: i32, y: i32) -> f32 {
     let (mut gv, mut gw) = (0.0f32, 0.0f32);
     for dy in -1..=1i32 {
         for dx in -1..=1i32 {
@@ -390,7 +393,22 @@ pub fn atrous_pixel(k: usize, gb: &Gbuffer, cam: &Cam, src: &[[f32; 4]], step: i
             }
         }
     }
-    let phi_l = p.sigma_l * ((gv / gw).max(0.0) + 1e-10).sqrt();
+    (gv / gw).max(0.0)
+}
+
+/// One iteration of SVGF's à-trous (the `atrous` entry point) at pixel k with step `step`,
+/// from the input `src` (demodulated rgb, variance) of every pixel: each output normalised by
+/// its own weight sum, the luminance scale from the pixel's own variance.
+pub fn atrous_pixel(k: usize, gb: &Gbuffer, cam: &Cam, src: &[[f32; 4]], step: i32, p: &Params) -> [f32; 4] {
+    if !gb.covered(k) {
+        return [0.0; 4];
+    }
+    let (x, y) = ((k as u32 % gb.width) as i32, (k as u32 / gb.width) as i32);
+    let c = src[k];
+    let n = gb.normal[k].normalize_or_zero();
+    let z = cam.view_depth(gb.point(k));
+    let fw = depth_fwidth(gb, cam, x, y, z).max(DEPTH_FLOOR * z);
+    let phi_l = p.sigma_l * (prefiltered_variance(gb, src, x, y) + 1e-10).sqrt();
     let lp = luminance(Vec3::from_slice(&c[..3]));
     let mut wsum = B3[0] * B3[0];
     let mut sc = wsum * Vec3::from_slice(&c[..3]);
@@ -427,10 +445,141 @@ pub fn atrous_pixel(k: usize, gb: &Gbuffer, cam: &Cam, src: &[[f32; 4]], step: i
     [o.x, o.y, o.z, sv / (wsum * wsum)]
 }
 
-/// A whole image through one stage.
+/// The `atrous_prep` entry point at pixel k (the conserving à-trous): what the symmetric
+/// weights read of each pixel, (view depth, depth derivative, luminance, prefiltered
+/// variance); an uncovered pixel is (0, 0, 0, -1).
+pub fn atrous_prep_pixel(k: usize, gb: &Gbuffer, cam: &Cam, src: &[[f32; 4]]) -> [f32; 4] {
+    if !gb.covered(k) {
+        return [0.0, 0.0, 0.0, -1.0];
+    }
+    let (x, y) = ((k as u32 % gb.width) as i32, (k as u32 / gb.width) as i32);
+    let z = cam.view_depth(gb.point(k));
+    let fw = depth_fwidth(gb, cam, x, y, z).max(DEPTH_FLOOR * z);
+    let l = luminance(Vec3::from_slice(&src[k][..3]));
+    [z, fw, l, prefiltered_variance(gb, src, x, y)]
+}
+
+/// The symmetric edge-stopping weight of pixels a and b (their `atrous_prep` records and
+/// normals) at distance `dist` steps of `step` pixels: SVGF's functions with the depth scale
+/// from the larger depth derivative and the luminance scale from the larger variance, so
+/// that e(a, b) = e(b, a) exactly.
+pub fn symmetric_weight(
+    a: [f32; 4],
+    b: [f32; 4],
+    na: Vec3,
+    nb: Vec3,
+    dist: f32,
+    step: i32,
+    p: &Params,
+) -> f32 {
+    let phi_z = p.sigma_z * a[1].max(b[1]) * step as f32 * dist;
+    let phi_l = p.sigma_l * (a[3].max(b[3]) + 1e-10).sqrt();
+    edge_weight(a[0], b[0], phi_z, na, nb, a[2], b[2], phi_l, p.sigma_n)
+}
+
+/// Calls `f(q, kernel x symmetric weight)` for each covered tap q != k of pixel k's 5x5
+/// window with holes `step` (the weight and filter passes share it).
+fn conserving_taps(
+    k: usize,
+    gb: &Gbuffer,
+    aux: &[[f32; 4]],
+    step: i32,
+    p: &Params,
+    mut f: impl FnMut(usize, f32),
+) {
+    let (x, y) = ((k as u32 % gb.width) as i32, (k as u32 / gb.width) as i32);
+    let n = gb.normal[k].normalize_or_zero();
+    for dy in -2..=2i32 {
+        for dx in -2..=2i32 {
+            if dx == 0 && dy == 0 {
+                continue;
+            }
+            let Some(q) = gb.idx(x + dx * step, y + dy * step).filter(|&q| aux[q][3] >= 0.0) else {
+                continue;
+            };
+            let dist = Vec2::new(dx as f32, dy as f32).length();
+            let e = symmetric_weight(aux[k], aux[q], n, gb.normal[q].normalize_or_zero(), dist, step, p);
+            f(
+                q,
+                B3[dx.unsigned_abs() as usize] * B3[dy.unsigned_abs() as usize] * e,
+            );
+        }
+    }
+}
+
+/// The `atrous_weight` entry point at pixel k: its weight sum W_k (the centre's kernel weight
+/// plus the kernel x symmetric weight of each covered tap); 0 uncovered.
+pub fn atrous_weight_pixel(k: usize, gb: &Gbuffer, aux: &[[f32; 4]], step: i32, p: &Params) -> f32 {
+    if aux[k][3] < 0.0 {
+        return 0.0;
+    }
+    let mut w = B3[0] * B3[0];
+    conserving_taps(k, gb, aux, step, p, |_, kw| w += kw);
+    w
+}
+
+/// The share of a conserving transfer between pixels of albedos `a` (the receiver) and `b`,
+/// per channel: min(a, b) / a, so that the radiance a takes from b (a x share x the
+/// demodulated difference) is what b gives (b x its share); 0 where either albedo is at most
+/// 1e-3 (no demodulated GI there).
+pub fn albedo_share(a: Vec3, b: Vec3) -> Vec3 {
+    let f = |a: f32, b: f32| {
+        if a > 1e-3 && b > 1e-3 {
+            a.min(b) / a.max(1e-3)
+        } else {
+            0.0
+        }
+    };
+    Vec3::new(f(a.x, b.x), f(a.y, b.y), f(a.z, b.z))
+}
+
+/// The `atrous_conserving` entry point at pixel k: out_k = X_k + sum_q s_kq r_kq (X_q - X_k)
+/// per channel, with the symmetric s_kq = kernel x e_kq / max(W_k, W_q) and the albedo share
+/// r_kq = min(a_k, a_q) / a_k: the radiance k takes from q, q gives to k, so the remodulated
+/// image's sum stays (uncovered pixels give and take nothing). The variance follows as
+/// (1 - sum s l(r))^2 var_k + sum (s l(r))^2 var_q (l: the luminance weights).
+pub fn atrous_conserving_pixel(
+    k: usize,
+    gb: &Gbuffer,
+    aux: &[[f32; 4]],
+    weight: &[f32],
+    src: &[[f32; 4]],
+    step: i32,
+    p: &Params,
+) -> [f32; 4] {
+    if aux[k][3] < 0.0 {
+        return [0.0; 4];
+    }
+    let c = Vec3::from_slice(&src[k][..3]);
+    let (mut d, mut ssum, mut sv) = (Vec3::ZERO, 0.0f32, 0.0f32);
+    conserving_taps(k, gb, aux, step, p, |q, kw| {
+        let s = kw / weight[k].max(weight[q]);
+        let r = s * albedo_share(gb.albedo[k], gb.albedo[q]);
+        d += r * (Vec3::from_slice(&src[q][..3]) - c);
+        let rl = luminance(r);
+        ssum += rl;
+        sv += rl * rl * src[q][3];
+    });
+    let o = c + d;
+    [o.x, o.y, o.z, (1.0 - ssum) * (1.0 - ssum) * src[k][3] + sv]
+}
+
+/// A whole image through one iteration: SVGF's, or with `p.conserving` the three passes of
+/// the conserving one.
 pub fn atrous(gb: &Gbuffer, cam: &Cam, src: &[[f32; 4]], step: i32, p: &Params) -> Vec<[f32; 4]> {
+    if !p.conserving {
+        return (0..src.len())
+            .map(|k| atrous_pixel(k, gb, cam, src, step, p))
+            .collect();
+    }
+    let aux: Vec<[f32; 4]> = (0..src.len())
+        .map(|k| atrous_prep_pixel(k, gb, cam, src))
+        .collect();
+    let weight: Vec<f32> = (0..src.len())
+        .map(|k| atrous_weight_pixel(k, gb, &aux, step, p))
+        .collect();
     (0..src.len())
-        .map(|k| atrous_pixel(k, gb, cam, src, step, p))
+        .map(|k| atrous_conserving_pixel(k, gb, &aux, &weight, src, step, p))
         .collect()
 }
 
@@ -573,6 +722,16 @@ mod tests {
         (gb, c)
     }
 
+    /// Uniform numbers in [0, 1] (a PCG hash chain from `seed`).
+    fn uniform(seed: u32) -> impl FnMut() -> f32 {
+        let mut rng = seed;
+        move || {
+            rng = rng.wrapping_mul(747796405).wrapping_add(2891336453);
+            let x = ((rng >> ((rng >> 28) + 4)) ^ rng).wrapping_mul(277803737);
+            ((x >> 22) ^ x) as f32 / u32::MAX as f32
+        }
+    }
+
     #[test]
     fn a_pixel_reprojects_to_itself_under_a_still_camera() {
         let (gb, cam) = plane(16, 12, None);
@@ -582,16 +741,146 @@ mod tests {
         assert!(z > 0.0);
     }
 
+    /// Both choices of the à-trous.
+    fn both() -> [Params; 2] {
+        [
+            Params::default(),
+            Params {
+                conserving: false,
+                ..Params::default()
+            },
+        ]
+    }
+
     #[test]
     fn the_filter_leaves_a_constant_image_unchanged() {
         let (gb, cam) = plane(24, 20, Some(12));
         let src = vec![[0.3, 0.6, 0.9, 0.01]; 24 * 20];
-        for step in [1, 2, 4] {
-            let out = atrous(&gb, &cam, &src, step, &Params::default());
-            for o in &out {
-                for i in 0..3 {
-                    assert!((o[i] - src[0][i]).abs() < 1e-5, "{o:?}");
+        for p in both() {
+            for step in [1, 2, 4] {
+                let out = atrous(&gb, &cam, &src, step, &p);
+                for o in &out {
+                    for i in 0..3 {
+                        assert!((o[i] - src[0][i]).abs() < 1e-5, "{o:?}");
+                    }
                 }
+            }
+        }
+    }
+
+    /// The symmetric weights are symmetric to the bit, so the conserving filter moves light
+    /// and never makes or loses it: SLC-like right-skewed noise (0.5 with probability 0.95,
+    /// 10.5 otherwise: mean 1) of the demodulated GI on a plane with a depth step and a second
+    /// albedo, 4 still frames, 5 iterations, history from iteration 1. Its output's mean is
+    /// the frames' mean (the history of a still view averages them exactly over 4 frames);
+    /// SVGF's normalisation by each pixel's own weight sum, with the luminance scale from the
+    /// pixel's own variance, lets an outlier give light to its neighbours but not take
+    /// theirs: darker.
+    #[test]
+    fn the_conserving_filter_keeps_the_mean_of_skewed_noise_and_svgfs_loses_light() {
+        let (w, h) = (48, 32);
+        let (mut gb, cam) = plane(w, h, Some(30));
+        let n = (w * h) as usize;
+        // A stripe of another albedo on the far plane.
+        for k in 0..n {
+            if (10..20).contains(&(k as u32 % w)) {
+                gb.albedo[k] = Vec3::new(0.8, 0.6, 0.3);
+            }
+        }
+        let mut next = uniform(777);
+        let frames: Vec<Vec<Vec3>> = (0..4)
+            .map(|_| {
+                (0..n)
+                    .map(|k| {
+                        let x = if next() < 0.95 { 0.5 } else { 10.5 };
+                        x * gb.albedo[k]
+                    })
+                    .collect()
+            })
+            .collect();
+        let mean = |img: &[Vec3]| img.iter().map(|&c| luminance(c) as f64).sum::<f64>() / img.len() as f64;
+        let raw = frames.iter().map(|f| mean(f.as_slice())).sum::<f64>() / frames.len() as f64;
+        let mut ratios = Vec::new();
+        for p in both() {
+            let mut f = Frame::default();
+            let mut out = None;
+            for img in &frames {
+                out = Some(f.run(&gb, &cam, img, &p, 5, 1));
+            }
+            let out = out.expect("four frames ran");
+            let m = mean(&out.radiance);
+            eprintln!(
+                "{}: output mean {m:.6}, raw mean {raw:.6}, ratio - 1 = {:.2e}",
+                if p.conserving { "conserving" } else { "svgf" },
+                m / raw - 1.0
+            );
+            // Not vacuous: the filter smoothed the outliers away.
+            let max = out.radiance.iter().map(|c| c.x).fold(0.0f32, f32::max);
+            assert!(max < 0.5 * 10.5 * 0.8, "max {max}");
+            ratios.push(m / raw);
+        }
+        assert!((ratios[0] - 1.0).abs() < 1e-4, "conserving: {}", ratios[0]);
+        assert!(ratios[1] < 0.97, "svgf: {}", ratios[1]);
+    }
+
+    /// The conserving weights' pieces: e(a, b) = e(b, a) bit for bit, each pixel's taps sum
+    /// below 1 (a convex combination), and an uncovered pixel neither gives nor takes.
+    #[test]
+    fn the_conserving_weights_are_symmetric_and_convex() {
+        let (w, h) = (20, 16);
+        let (mut gb, cam) = plane(w, h, Some(10));
+        // A hole (sky) in the middle.
+        gb.position[(8 * w + 5) as usize][3] = 0.0;
+        let mut next = uniform(99);
+        // Albedos of every kind, a black channel (no demodulated GI) among them.
+        for a in gb.albedo.iter_mut() {
+            *a = Vec3::new(next(), next(), if next() < 0.2 { 0.0 } else { next() });
+        }
+        let src: Vec<[f32; 4]> = (0..w * h)
+            .map(|_| {
+                let v = 3.0 * next();
+                [v, 0.5 * v, v, next()]
+            })
+            .collect();
+        let p = Params::default();
+        let aux: Vec<[f32; 4]> = (0..src.len())
+            .map(|k| atrous_prep_pixel(k, &gb, &cam, &src))
+            .collect();
+        assert_eq!(aux[(8 * w + 5) as usize], [0.0, 0.0, 0.0, -1.0]);
+        for step in [1, 2] {
+            let weight: Vec<f32> = (0..src.len())
+                .map(|k| atrous_weight_pixel(k, &gb, &aux, step, &p))
+                .collect();
+            let mut taken = vec![vec![0.0f32; src.len()]; src.len()];
+            for k in 0..src.len() {
+                let mut sum = 0.0;
+                conserving_taps(k, &gb, &aux, step, &p, |q, kw| {
+                    let s = kw / weight[k].max(weight[q]);
+                    taken[k][q] = s;
+                    sum += s;
+                });
+                assert!(sum < 1.0, "{k}: {sum}");
+            }
+            for (k, row) in taken.iter().enumerate() {
+                for (q, s) in row.iter().enumerate() {
+                    assert_eq!(s.to_bits(), taken[q][k].to_bits(), "{k} {q}");
+                }
+            }
+            let hole = (8 * w + 5) as usize;
+            assert!(taken[hole].iter().all(|&s| s == 0.0));
+            let out = atrous(&gb, &cam, &src, step, &p);
+            assert_eq!(out[hole], [0.0; 4]);
+            // The remodulated sum over the covered pixels (the hole's input is not the
+            // image's; a channel of albedo 0 has no GI), per channel.
+            let sum = |img: &[[f32; 4]], i: usize| {
+                (0..img.len())
+                    .filter(|&k| gb.covered(k) && gb.albedo[k][i] > 1e-3)
+                    .map(|k| (img[k][i] * gb.albedo[k][i]) as f64)
+                    .sum::<f64>()
+            };
+            for i in 0..3 {
+                let r = sum(&out, i) / sum(&src, i);
+                assert!((r - 1.0).abs() < 1e-5, "step {step}, channel {i}: {r}");
             }
         }
     }
@@ -603,12 +892,7 @@ mod tests {
     fn one_iteration_reduces_white_noise_variance_by_the_kernels_factor() {
         let (w, h) = (96, 96);
         let (gb, cam) = plane(w, h, None);
-        let mut rng = 12345u32;
-        let mut next = || {
-            rng = rng.wrapping_mul(747796405).wrapping_add(2891336453);
-            let x = ((rng >> ((rng >> 28) + 4)) ^ rng).wrapping_mul(277803737);
-            ((x >> 22) ^ x) as f32 / u32::MAX as f32
-        };
+        let mut next = uniform(12345);
         let s2 = 1.0 / 12.0; // uniform [0, 1)
         let src: Vec<[f32; 4]> = (0..w * h)
             .map(|_| {
@@ -616,34 +900,34 @@ mod tests {
                 [v, v, v, s2]
             })
             .collect();
-        let p = Params {
-            sigma_l: 1e4,
-            ..Params::default()
-        };
-        let out = atrous(&gb, &cam, &src, 1, &p);
-        let inner: Vec<f32> = (0..(w * h) as usize)
-            .filter(|k| {
-                let (x, y) = (*k as u32 % w, *k as u32 / w);
-                (4..w - 4).contains(&x) && (4..h - 4).contains(&y)
-            })
-            .map(|k| out[k][0])
-            .collect();
-        let mean = inner.iter().sum::<f32>() / inner.len() as f32;
-        let var = inner.iter().map(|v| (v - mean).powi(2)).sum::<f32>() / (inner.len() - 1) as f32;
-        let factor: f32 = B3.iter().map(|h| h * h).sum::<f32>() * 2.0 - B3[0] * B3[0];
-        let expected = s2 * factor * factor;
-        // 7744 correlated samples: the estimate's relative error is a few percent.
-        assert!(
-            (var / expected - 1.0).abs() < 0.1,
-            "variance {var}, expected {expected}"
-        );
-        // The propagated variance estimate says the same.
-        let est = out[(48 * w + 48) as usize][3];
-        assert!(
-            (est / expected - 1.0).abs() < 0.05,
-            "estimate {est}, expected {expected}"
-        );
-        assert!((mean - 0.5).abs() < 0.01);
+        // Both choices: with every edge weight 1 the conserving weights are SVGF's.
+        for p in both() {
+            let p = Params { sigma_l: 1e4, ..p };
+            let out = atrous(&gb, &cam, &src, 1, &p);
+            let inner: Vec<f32> = (0..(w * h) as usize)
+                .filter(|k| {
+                    let (x, y) = (*k as u32 % w, *k as u32 / w);
+                    (4..w - 4).contains(&x) && (4..h - 4).contains(&y)
+                })
+                .map(|k| out[k][0])
+                .collect();
+            let mean = inner.iter().sum::<f32>() / inner.len() as f32;
+            let var = inner.iter().map(|v| (v - mean).powi(2)).sum::<f32>() / (inner.len() - 1) as f32;
+            let factor: f32 = B3.iter().map(|h| h * h).sum::<f32>() * 2.0 - B3[0] * B3[0];
+            let expected = s2 * factor * factor;
+            // 7744 correlated samples: the estimate's relative error is a few percent.
+            assert!(
+                (var / expected - 1.0).abs() < 0.1,
+                "variance {var}, expected {expected}"
+            );
+            // The propagated variance estimate says the same.
+            let est = out[(48 * w + 48) as usize][3];
+            assert!(
+                (est / expected - 1.0).abs() < 0.05,
+                "estimate {est}, expected {expected}"
+            );
+            assert!((mean - 0.5).abs() < 0.01);
+        }
     }
 
     #[test]
@@ -660,14 +944,16 @@ mod tests {
                 }
             })
             .collect();
-        let mut cur = src.clone();
-        for i in 0..5 {
-            cur = atrous(&gb, &cam, &cur, 1 << i, &Params::default());
-        }
-        for y in 0..h {
-            let l = cur[(y * w + 15) as usize][0];
-            let r = cur[(y * w + 16) as usize][0];
-            assert!((l - 0.1).abs() < 0.01 && (r - 1.0).abs() < 0.01, "{l} {r}");
+        for p in both() {
+            let mut cur = src.clone();
+            for i in 0..5 {
+                cur = atrous(&gb, &cam, &cur, 1 << i, &p);
+            }
+            for y in 0..h {
+                let l = cur[(y * w + 15) as usize][0];
+                let r = cur[(y * w + 16) as usize][0];
+                assert!((l - 0.1).abs() < 0.01 && (r - 1.0).abs() < 0.01, "{l} {r}");
+            }
         }
         // A normal step (same depth, a crease) likewise.
         let mut gb2 = gb.clone();
@@ -678,13 +964,15 @@ mod tests {
                 gb2.normal[k] = Vec3::new(0.6, 0.0, 0.8);
             }
         }
-        let mut cur = src.clone();
-        for i in 0..5 {
-            cur = atrous(&gb2, &cam, &cur, 1 << i, &Params::default());
+        for p in both() {
+            let mut cur = src.clone();
+            for i in 0..5 {
+                cur = atrous(&gb2, &cam, &cur, 1 << i, &p);
+            }
+            let l = cur[(8 * w + 15) as usize][0];
+            let r = cur[(8 * w + 16) as usize][0];
+            assert!((l - 0.1).abs() < 0.01 && (r - 1.0).abs() < 0.01, "{l} {r}");
         }
-        let l = cur[(8 * w + 15) as usize][0];
-        let r = cur[(8 * w + 16) as usize][0];
-        assert!((l - 0.1).abs() < 0.01 && (r - 1.0).abs() < 0.01, "{l} {r}");
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! Settings and views of the temporal stage (`renderer::passes::temporal`): reprojection of
 //! the GI through the camera motion with history rejection, an exponential history with a
 //! per-pixel length, and the variance-guided à-trous filter of SVGF (Schied et al. 2017,
-//! "Spatiotemporal Variance-Guided Filtering"). The `[temporal]` table of a settings file.
+//! "Spatiotemporal Variance-Guided Filtering"), as the paper has it or conserving the
+//! image's light (`atrous`). The `[temporal]` table of a settings file.
 
 use serde::{Deserialize, Serialize};
 
@@ -41,8 +42,46 @@ impl TemporalMode {
     }
 }
 
+/// The à-trous iterations' weights (`temporal.atrous`, docs/temporal.md "Where SVGF lost
+/// light").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AtrousFilter {
+    /// Symmetric weights e(p, q) = e(q, p) (depth scale from the larger depth derivative,
+    /// luminance scale from the larger variance), normalised by the larger of the two pixels'
+    /// weight sums, applied as out_p = X_p + Σ s_pq (X_q - X_p): what p takes from q, q gives,
+    /// so the image's light stays. Three passes per iteration (prep, weight sums, filter). The
+    /// variance pass keeps each pixel's colour on short histories.
+    #[default]
+    Conserving,
+    /// SVGF as published (Schied et al. 2017, section 4.3): each output normalised by its own
+    /// weight sum, the luminance scale from its own variance; on short histories the variance
+    /// pass blurs the colour too. Loses light under right-skewed noise (an outlier gives to
+    /// its neighbours and takes little back): SLC on a still view lost 5% (issue 37).
+    Svgf,
+}
+
+impl AtrousFilter {
+    /// Both choices, the default first.
+    pub const ALL: [AtrousFilter; 2] = [AtrousFilter::Conserving, AtrousFilter::Svgf];
+    /// The settings spelling (`--set temporal.atrous=svgf`).
+    pub fn cli(self) -> &'static str {
+        match self {
+            AtrousFilter::Conserving => "conserving",
+            AtrousFilter::Svgf => "svgf",
+        }
+    }
+    /// The GUI's label.
+    pub fn label(self) -> &'static str {
+        match self {
+            AtrousFilter::Conserving => "light-conserving",
+            AtrousFilter::Svgf => "SVGF (as published)",
+        }
+    }
+}
+
 /// The temporal stage's parameters. SVGF's values (section 4 of the paper and its reference
-/// implementation) are the defaults.
+/// implementation) are the defaults, with the light-conserving à-trous (`atrous`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TemporalSettings {
@@ -69,6 +108,9 @@ pub struct TemporalSettings {
     /// The iteration (1-based) whose output becomes the colour history (SVGF: 1); 0 keeps
     /// the unfiltered integrated colour.
     pub feedback_iteration: u32,
+    /// The iterations' weights: `conserving` (default; keeps the image's light) or `svgf`
+    /// (the paper's, which darkens under skewed noise).
+    pub atrous: AtrousFilter,
     /// Luminance edge-stopping: weight exp(-|l_p - l_q| / (sigma_l sqrt(g(var_p)))). SVGF: 4.
     pub sigma_l: f32,
     /// Normal edge-stopping: max(0, n_p . n_q)^sigma_n. SVGF: 128.
@@ -99,6 +141,7 @@ impl Default for TemporalSettings {
             depth_tolerance: 0.02,
             iterations: 5,
             feedback_iteration: 1,
+            atrous: AtrousFilter::Conserving,
             sigma_l: 4.0,
             sigma_n: 128.0,
             sigma_z: 1.0,
@@ -251,6 +294,7 @@ mod tests {
             (s.alpha, s.iterations, s.sigma_l, s.sigma_n),
             (0.2, 5, 4.0, 128.0)
         );
+        assert_eq!(s.atrous, AtrousFilter::Conserving);
         for (edit, name) in [
             (
                 (|s: &mut TemporalSettings| s.alpha = 0.0) as fn(&mut TemporalSettings),
@@ -268,5 +312,10 @@ mod tests {
         let text = "mode = \"svgf\"\niterations = 3";
         let t: TemporalSettings = toml::from_str(text).unwrap();
         assert_eq!((t.mode, t.iterations, t.alpha), (TemporalMode::Svgf, 3, 0.2));
+        for a in AtrousFilter::ALL {
+            let t: TemporalSettings = toml::from_str(&format!("atrous = \"{}\"", a.cli())).unwrap();
+            assert_eq!(t.atrous, a);
+        }
+        assert!(toml::from_str::<TemporalSettings>("atrous = \"gaussian\"").is_err());
     }
 }

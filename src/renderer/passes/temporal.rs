@@ -4,7 +4,9 @@
 //! its per-pixel length, luminance moments) and the previous G-buffer, ping-ponged by frame.
 //! Writes: the filtered GI radiance the composite reads. Passes (timer names):
 //! `temporal_reproject`, `temporal_accumulate`, and with SVGF `temporal_variance` and
-//! `temporal_atrous` (every iteration in one compute pass), then `temporal_modulate`.
+//! `temporal_atrous` (every iteration in one compute pass: SVGF's `atrous`, or with
+//! `temporal.atrous = conserving` the light-conserving `atrous_prep`, `atrous_weight`,
+//! `atrous_conserving` per iteration), then `temporal_modulate`.
 //! Settings: `settings::TemporalSettings` (`[temporal]`). Twin: `reference::temporal`.
 
 use bytemuck::{Pod, Zeroable};
@@ -18,6 +20,7 @@ use crate::renderer::{
     gpu_data::GpuCamera,
     settings::{TemporalMode, TemporalSettings, TemporalView},
     shaders,
+    temporal_settings::AtrousFilter,
     timing::GpuTimer,
 };
 
@@ -47,10 +50,14 @@ pub struct GpuTemporalParams {
     pub view_mode: u32,
     pub view_lo: f32,
     pub view_hi: f32,
-    pub _pad: [u32; 2],
+    /// 1: the conserving à-trous (the variance pass keeps the colour).
+    pub conserving: u32,
+    pub _pad: u32,
 }
 
 impl GpuTemporalParams {
+    /// The parameters of a frame at `size` with the method's accumulation `scale` (`first`:
+    /// no history); the à-trous step, iteration and view fields at their first values.
     pub fn new(s: &TemporalSettings, size: (u32, u32), scale: f32, first: bool) -> Self {
         Self {
             width: size.0,
@@ -79,7 +86,8 @@ impl GpuTemporalParams {
             view_mode: 0,
             view_lo: 0.0,
             view_hi: 1.0,
-            _pad: [0; 2],
+            conserving: (s.atrous == AtrousFilter::Conserving) as u32,
+            _pad: 0,
         }
     }
     /// The twin's parameters.
@@ -96,6 +104,7 @@ impl GpuTemporalParams {
             spatial_frames: s.spatial_variance_frames as f32,
             gradient: s.gradient_reset,
             gradient_scale: s.gradient_scale,
+            conserving: s.atrous == AtrousFilter::Conserving,
         }
     }
 }
@@ -137,6 +146,11 @@ pub struct TemporalBuffers {
     pub pong: wgpu::Buffer,
     /// The iteration the view shows.
     pub iter_copy: wgpu::Buffer,
+    /// The conserving à-trous, per pixel: (view depth, depth derivative, luminance,
+    /// prefiltered variance; w = -1 uncovered) of the last iteration's input ...
+    pub aux: wgpu::Buffer,
+    /// ... and its weight sum W (one f32 per pixel).
+    pub weight: wgpu::Buffer,
     /// The result (radiance) the composite reads.
     pub out: wgpu::Buffer,
     _view_tex: wgpu::Texture,
@@ -180,6 +194,8 @@ impl TemporalBuffers {
             ping: b("temporal::ping"),
             pong: b("temporal::pong"),
             iter_copy: b("temporal::iter_copy"),
+            aux: b("temporal::aux"),
+            weight: storage_buffer(device, "temporal::weight", 4 * px),
             out: b("temporal::out"),
             _view_tex: view_tex,
             view_tex_view,
@@ -221,6 +237,9 @@ pub struct TemporalPass {
     accumulate: Pipe,
     variance: Pipe,
     atrous: Pipe,
+    atrous_prep: Pipe,
+    atrous_weight: Pipe,
+    atrous_conserving: Pipe,
     modulate: Pipe,
     view_radiance: Pipe,
     view_heat: Pipe,
@@ -274,6 +293,9 @@ impl TemporalPass {
             accumulate: pipe("accumulate", &[0, 1, 3, 4, 11, 12, 13, 14, 15, 16, 17]),
             variance: pipe("variance", &[0, 1, 3, 4, 16, 17, 19]),
             atrous: pipe("atrous", &[0, 1, 3, 4, 15, 18, 19, 22]),
+            atrous_prep: pipe("atrous_prep", &[0, 1, 3, 18, 25]),
+            atrous_weight: pipe("atrous_weight", &[0, 4, 25, 26]),
+            atrous_conserving: pipe("atrous_conserving", &[0, 4, 5, 15, 18, 19, 22, 25, 26]),
             modulate: pipe("modulate", &[0, 3, 5, 18, 20]),
             view_radiance: pipe("view_radiance", &[0, 5, 18, 23]),
             view_heat: pipe("view_heat", &[0, 3, 18, 24]),
@@ -372,6 +394,8 @@ impl TemporalPass {
                 22 => buf(&b.iter_copy),
                 23 => wgpu::BindingResource::TextureView(&b.view_tex_view),
                 24 => wgpu::BindingResource::TextureView(view_out?),
+                25 => buf(&b.aux),
+                26 => buf(&b.weight),
                 _ => return None,
             };
             entries.push(wgpu::BindGroupEntry { binding: n, resource });
@@ -468,6 +492,14 @@ impl TemporalPass {
                 "temporal_variance",
                 &[(&self.variance, &variance, SLOT_VARIANCE)],
             );
+            // Per iteration: SVGF's one pass, or the conserving prep, weight sums and filter
+            // (all three at the iteration's parameters).
+            let pipes: &[&Pipe] = match s.atrous {
+                AtrousFilter::Svgf => &[&self.atrous],
+                AtrousFilter::Conserving => {
+                    &[&self.atrous_prep, &self.atrous_weight, &self.atrous_conserving]
+                }
+            };
             let mut binds = Vec::new();
             let mut src = &b.filter_input;
             for it in 1..=s.iterations {
@@ -476,14 +508,13 @@ impl TemporalPass {
                 p.step = 1 << (it - 1);
                 p.iteration = it;
                 write(SLOT_ATROUS + it - 1, p);
-                binds.push(self.bind(device, &self.atrous, i, parity, Some(src), Some(dst), None)?);
+                for &pipe in pipes {
+                    let bind = self.bind(device, pipe, i, parity, Some(src), Some(dst), None)?;
+                    binds.push((pipe, bind, SLOT_ATROUS + it - 1));
+                }
                 src = dst;
             }
-            let steps: Vec<_> = binds
-                .iter()
-                .enumerate()
-                .map(|(k, bg)| (&self.atrous, bg, SLOT_ATROUS + k as u32))
-                .collect();
+            let steps: Vec<_> = binds.iter().map(|(pipe, bg, slot)| (*pipe, bg, *slot)).collect();
             dispatch(enc, timer, "temporal_atrous", &steps);
             src
         } else {
