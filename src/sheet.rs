@@ -1,7 +1,8 @@
 //! Comparison sheets: the chosen methods side by side on the same VPLs and tree, each with its
 //! final image, the relative error of its GI against the ground truth of those VPLs (log false
-//! colour, as the relative-error view), and a caption (method, settings, RMSE, SSIM, FLIP,
-//! GPU time per frame). One image, for papers and reports.
+//! colour, as the relative-error view), and a caption (method, settings, RMSE with the
+//! image-mean ratio against the ground truth beside it, relative RMSE, SSIM, FLIP, GPU time
+//! per frame). One image, for papers and reports.
 //!
 //! [`SheetJob`] does the work one frame per [`SheetJob::step`], so the GUI stays responsive,
 //! shows progress and can cancel; the `sheet` command loops it. [`compose`] draws the sheet
@@ -262,7 +263,9 @@ impl SheetJob {
     }
 }
 
-/// The sheet's numbers as JSON (per column: method, frames, GPU ms per frame, metrics).
+/// The sheet's numbers as JSON (per column: method, frames, GPU ms per frame, and the metrics
+/// against the ground truth under `vs_ground_truth`: `rmse`, `relative_rmse`, `ssim`,
+/// `mean_ratio`, `reference_mean`, `flip`; NaN is written as null).
 pub fn metrics_json(sheet: &Sheet) -> String {
     let columns: Vec<serde_json::Value> = sheet
         .columns
@@ -361,6 +364,26 @@ pub fn relative_error_rgb8(a: [f32; 4], b: [f32; 4]) -> [u8; 3] {
     false_color(t).map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
 }
 
+/// The caption lines under a method's images (at most [`CAPTION_LINES`]): the frames, then
+/// the RMSE with the image-mean ratio against the ground truth beside it (a bias cannot hide
+/// behind a small RMSE), the relative RMSE and SSIM, FLIP, and the GPU time.
+pub fn caption(cl: &SheetColumn) -> Vec<String> {
+    let m = &cl.metrics;
+    vec![
+        format!("{} frames accumulated", cl.frames),
+        format!("RMSE {:.3e} · mean {:.3}x", m.rmse, m.mean_ratio),
+        format!("rel. RMSE {:.3} · SSIM {:.4}", m.relative_rmse, m.ssim),
+        format!("FLIP {:.4}", m.flip),
+        match cl.gpu_ms {
+            Some(t) => format!("GPU {t:.2} ms / frame (all passes)"),
+            None => "GPU time: no timestamps".into(),
+        },
+    ]
+}
+
+/// Lines of a column's caption (room the sheet keeps under every column).
+pub const CAPTION_LINES: usize = 5;
+
 /// Draws the sheet: a title, then one column for the ground truth and one per method (final
 /// image; relative error of the GI, or the reference GI; caption), and the error legend.
 pub fn compose(sheet: &Sheet) -> Result<Canvas, String> {
@@ -374,7 +397,7 @@ pub fn compose(sheet: &Sheet) -> Result<Canvas, String> {
     let (margin, gap, text) = (16u32, 12u32, 13.0f32);
     let line = (text * 1.35) as u32;
     let n = 1 + sheet.columns.len() as u32;
-    let caption_lines = 5;
+    let caption_lines = CAPTION_LINES as u32;
     let width = 2 * margin + n * cw + (n - 1) * gap;
     let header = 2 * line + 8;
     let height = margin + header + 2 * (ch + line + 6) + caption_lines * line + 3 * line + margin;
@@ -454,18 +477,7 @@ pub fn compose(sheet: &Sheet) -> Result<Canvas, String> {
                 )
             }]
         } else {
-            let cl = &sheet.columns[col as usize - 1];
-            let m = &cl.metrics;
-            vec![
-                format!("{} frames accumulated", cl.frames),
-                format!("RMSE {:.3e} (rel. {:.3})", m.rmse, m.relative_rmse),
-                format!("SSIM {:.4} · FLIP {:.4}", m.ssim, m.flip),
-                format!("mean ratio {:.4}", m.mean_ratio),
-                match cl.gpu_ms {
-                    Some(t) => format!("GPU {t:.2} ms / frame (all passes)"),
-                    None => "GPU time: no timestamps".into(),
-                },
-            ]
+            caption(&sheet.columns[col as usize - 1])
         };
         for l in lines {
             c.text(&font, x as f32, y as f32, text, grey, &l);
@@ -502,4 +514,87 @@ pub fn compose(sheet: &Sheet) -> Result<Canvas, String> {
         );
     }
     Ok(c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn column(m: Metrics, gpu_ms: Option<f64>, frames: u32) -> SheetColumn {
+        let img = ImageF32 {
+            width: 2,
+            height: 2,
+            pixels: vec![[0.5, 0.5, 0.5, 1.0]; 4],
+        };
+        SheetColumn {
+            method: crate::methods::tree_samplers::SLC,
+            final_: img.clone(),
+            indirect: img,
+            metrics: m,
+            gpu_ms,
+            frames,
+        }
+    }
+
+    fn metrics(rmse: f64, mean_ratio: f64) -> Metrics {
+        Metrics {
+            rmse,
+            relative_rmse: 0.123,
+            ssim: 0.9876,
+            mean_ratio,
+            reference_mean: 0.1,
+            flip: 0.0543,
+        }
+    }
+
+    #[test]
+    fn the_caption_shows_the_mean_ratio_beside_the_rmse_and_fits_its_column() {
+        let lines = caption(&column(metrics(0.012, 0.98), Some(1.5), 16));
+        assert!(lines.len() <= CAPTION_LINES, "{lines:?}");
+        assert_eq!(lines[1], "RMSE 1.200e-2 · mean 0.980x");
+        assert!(lines.iter().any(|l| l.contains("SSIM 0.9876")), "{lines:?}");
+        assert!(lines.iter().any(|l| l.contains("FLIP 0.0543")), "{lines:?}");
+        // The widest numbers stay within the narrowest column (320 px at the captions'
+        // 13 px).
+        let font = FontRef::try_from_slice(epaint_default_fonts::HACK_REGULAR).expect("Hack");
+        let mut c = Canvas::new(1, 1, [0, 0, 0]);
+        let wide = Metrics {
+            relative_rmse: 123.456,
+            ssim: -0.1234,
+            ..metrics(1.234e-12, 123.456)
+        };
+        for l in caption(&column(wide, Some(12345.67), 4096)) {
+            let w = c.text(&font, 0.0, 0.0, 13.0, [255; 3], &l);
+            assert!(w <= 320.0, "'{l}' is {w} px wide");
+        }
+    }
+
+    #[test]
+    fn the_json_has_each_methods_mean_ratio() {
+        let img = ImageF32 {
+            width: 2,
+            height: 2,
+            pixels: vec![[0.5, 0.5, 0.5, 1.0]; 4],
+        };
+        let sheet = Sheet {
+            reference_final: img.clone(),
+            reference_indirect: img,
+            columns: vec![
+                column(metrics(0.012, 0.98), None, 4),
+                column(metrics(0.02, 1.25), Some(2.0), 4),
+            ],
+            settings: RenderSettings::default(),
+            vpls: 256,
+            title: "test".into(),
+        };
+        let json: serde_json::Value =
+            serde_json::from_str(&metrics_json(&sheet)).expect("the sheet's JSON parses");
+        let ratios: Vec<f64> = json["columns"]
+            .as_array()
+            .expect("columns")
+            .iter()
+            .filter_map(|c| c["vs_ground_truth"]["mean_ratio"].as_f64())
+            .collect();
+        assert_eq!(ratios, [0.98, 1.25]);
+    }
 }

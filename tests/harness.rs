@@ -225,6 +225,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "gi_gpu_ms",
             "frame_wall_ms",
             "rmse",
+            "mean_ratio",
             "ssim",
         ],
         2,
@@ -233,21 +234,35 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         &d,
         "blending.csv",
         &["config", "blending", "fallback"],
-        &["frame_wall_ms", "gi_gpu_ms", "rmse", "ssim", "fallback_fraction"],
+        &[
+            "frame_wall_ms",
+            "gi_gpu_ms",
+            "rmse",
+            "mean_ratio",
+            "ssim",
+            "fallback_fraction",
+        ],
         5,
     );
     check_csv(
         &d,
         "upsampling.csv",
         &["width", "height", "gi_resolution"],
-        &["rmse", "ssim", "gi_gpu_ms", "frame_wall_ms"],
+        &["rmse", "mean_ratio", "ssim", "gi_gpu_ms", "frame_wall_ms"],
         2,
     );
     check_csv(
         &d,
         "scaling.csv",
         &["vpls"],
-        &["tree_gpu_ms", "gi_gpu_ms", "frame_wall_ms", "rmse", "ssim"],
+        &[
+            "tree_gpu_ms",
+            "gi_gpu_ms",
+            "frame_wall_ms",
+            "rmse",
+            "mean_ratio",
+            "ssim",
+        ],
         2,
     );
     check_csv(
@@ -260,7 +275,9 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "rmse_vs_ground_truth",
             "relative_rmse_vs_ground_truth",
             "ssim_vs_ground_truth",
+            "mean_ratio",
             "rmse_vs_lightcuts",
+            "mean_ratio_vs_lightcuts",
         ],
         3,
     );
@@ -278,6 +295,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             "rmse_vs_same_visibility_truth",
             "mean_ratio",
             "rmse_vs_true_ground_truth",
+            "mean_ratio_vs_true_ground_truth",
             "shade_ms",
             "ism_ms",
         ],
@@ -317,13 +335,14 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     check_csv(
         &d,
         "val.csv",
-        &["method", "vals", "visibility"],
+        &["method", "vals", "visibility", "mean_ratio_vs_exact_visibility"],
         &[
             "clustering_ms",
             "indirect_ms",
             "ism_ms",
             "gi_gpu_ms",
             "rmse_vs_ground_truth",
+            "mean_ratio_vs_ground_truth",
         ],
         10,
     );
@@ -422,8 +441,26 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             r["rmse_filtered"].parse().unwrap(),
         );
         assert!(raw.is_finite() && filt.is_finite() && raw > 0.0, "{r:?}");
+        for c in ["mean_ratio_raw", "mean_ratio_filtered"] {
+            assert!(
+                r[c].parse::<f64>().is_ok_and(|v| v.is_finite() && v > 0.0),
+                "{c}: {r:?}"
+            );
+        }
         assert_eq!(r["temporal"], "svgf");
     }
+    check_csv(
+        &d,
+        "temporal.csv",
+        &["motion", "method", "frame"],
+        &[
+            "rmse_raw",
+            "rmse_filtered",
+            "mean_ratio_raw",
+            "mean_ratio_filtered",
+        ],
+        3 * 5 * 3,
+    );
     let (_, rows) = common::read_csv(&d.join("temporal.csv"));
     assert_eq!(rows.len(), 3 * 5 * 3);
     let (_, rows) = common::read_csv(&d.join("temporal_timing.csv"));
@@ -484,6 +521,18 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     }
     decodes(&d.join("bounces_rmse.png"));
     decodes(&d.join("bounces_light.png"));
+    check_csv(
+        &d,
+        "trees_equal_time.csv",
+        &["method", "extrapolated"],
+        &[
+            "rmse_perfect",
+            "rmse_lbvh",
+            "mean_ratio_perfect",
+            "mean_ratio_lbvh",
+        ],
+        4,
+    );
     let (_, rows) = common::read_csv(&d.join("trees_equal_time.csv"));
     assert_eq!(rows.len(), 4, "{rows:?}");
     decodes(&d.join("trees_rmse.png"));

@@ -130,6 +130,9 @@ pub struct Measured {
     /// Per diagnostic frame: GI against the ground truth (tree samplers with a ground truth).
     pub rmse: Vec<f64>,
     pub ssim: Vec<f64>,
+    /// Per diagnostic frame: the image-mean ratio mean(GI) / mean(ground truth)
+    /// (`metrics::Metrics::mean_ratio`, the bias indicator beside the RMSE; see
+    /// [`Measured::mean_ratio`]).
     pub mean_ratio: Vec<f64>,
     /// The frames' error split into bias and noise (`metrics::bias_noise`: RMSEs of the
     /// frames' mean and of a frame around it); NaN without a ground truth or with one frame.
@@ -191,6 +194,14 @@ impl Measured {
     }
     pub fn ssim(&self) -> (f64, f64) {
         mean_std(&self.ssim)
+    }
+    /// The image-mean ratio against the ground truth: the mean and sample standard deviation
+    /// over the diagnostic frames, averaged as [`Measured::rmse`] is. Every frame is compared
+    /// with the same ground truth and the ratio is linear in the image, so this mean equals
+    /// the ratio of the frames' mean image (the image `bias_rmse` is measured on) up to
+    /// rounding: the bias split's mean image and this column tell the same bias.
+    pub fn mean_ratio(&self) -> (f64, f64) {
+        mean_std(&self.mean_ratio)
     }
     pub fn steps_per_traversal(&self) -> f64 {
         self.stats.map_or(f64::NAN, |s| s.steps_per_traversal())
@@ -607,5 +618,47 @@ pub fn num(v: f64) -> String {
         format!("{v}")
     } else {
         "nan".into()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`Measured::mean_ratio`]'s claim: against one ground truth, the mean of the frames'
+    /// ratios is the ratio of the frames' mean image.
+    #[test]
+    fn the_frames_mean_ratio_is_their_mean_images_ratio() {
+        let img = |f: &dyn Fn(usize) -> f32| ImageF32 {
+            width: 4,
+            height: 2,
+            pixels: (0..8)
+                .map(|i| {
+                    let v = f(i);
+                    [v, 0.5 * v, 2.0 * v, 1.0]
+                })
+                .collect(),
+        };
+        let truth = img(&|i| 0.1 + 0.05 * i as f32);
+        let frames: Vec<ImageF32> = (0..3)
+            .map(|k| img(&|i| 0.08 + 0.03 * ((i * 7 + k * 5) % 4) as f32))
+            .collect();
+        let ratio =
+            |a: &ImageF32| metrics::compare_without_flip(a, &truth, 0.0, display::Tonemap::Clamp).mean_ratio;
+        let m = Measured {
+            mean_ratio: frames.iter().map(ratio).collect(),
+            ..Default::default()
+        };
+        let mut mean = img(&|_| 0.0);
+        for f in &frames {
+            for (a, p) in mean.pixels.iter_mut().zip(&f.pixels) {
+                for c in 0..3 {
+                    a[c] += p[c] / frames.len() as f32;
+                }
+            }
+        }
+        let (r, _) = m.mean_ratio();
+        assert!((r - ratio(&mean)).abs() < 1e-6, "{r} vs {}", ratio(&mean));
+        assert!((r - 1.0).abs() > 0.1, "a biased example: {r}");
     }
 }

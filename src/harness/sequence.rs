@@ -1,8 +1,8 @@
 //! Frame sequences for temporal measurements: a motion (a camera path through bookmarks, a sun
 //! sweep, or a still view) walked frame by frame, the ground truth of each frame's VPLs, and
-//! per frame the method's raw estimate and the temporal stage's output against it (RMSE,
-//! SSIM) and their flicker (frame-to-frame change in static regions beyond the truth's own).
-//! Used by `render --camera-path / --sun-sweep` and `results temporal`.
+//! per frame the method's raw estimate and the temporal stage's output against it (RMSE, the
+//! image-mean ratio, SSIM) and their flicker (frame-to-frame change in static regions beyond
+//! the truth's own). Used by `render --camera-path / --sun-sweep` and `results temporal`.
 
 use anyhow::{anyhow, bail};
 
@@ -227,6 +227,11 @@ pub fn ground_truths(
 pub struct SeqFrame {
     pub rmse_raw: f64,
     pub rmse_filtered: f64,
+    /// Image-mean ratio mean(image) / mean(truth) of the raw estimate and of the stage's
+    /// output against the frame's truth (`metrics::Metrics::mean_ratio`: the bias beside the
+    /// RMSE).
+    pub mean_ratio_raw: f64,
+    pub mean_ratio_filtered: f64,
     pub ssim_raw: f64,
     pub ssim_filtered: f64,
     /// Relative frame-to-frame change in static pixels beyond the truth's change (NaN on the
@@ -276,9 +281,10 @@ pub fn flicker(
 
 /// Walks `m` with settings `s` (a per-frame method; its temporal stage as `s.temporal` says)
 /// from a fresh history, diagnostic frames, and compares each frame's raw estimate and its
-/// output with `truths` (SSIM at `exposure_ev`). Checks that every frame saw its truth's VPLs.
-/// `on_frame(r, i)` runs after each frame (writing its images, say). Also returns the wall
-/// time spent rendering and waiting for the GPU (the rest is readbacks and metrics).
+/// output with `truths` (RMSE, mean ratio, SSIM at `exposure_ev`). Checks that every frame
+/// saw its truth's VPLs. `on_frame(r, i)` runs after each frame (writing its images, say).
+/// Also returns the wall time spent rendering and waiting for the GPU (the rest is readbacks
+/// and metrics).
 pub fn measure(
     r: &mut Renderer,
     s: &RenderSettings,
@@ -314,6 +320,8 @@ pub fn measure(
         let mut f = SeqFrame {
             rmse_raw: a.rmse,
             rmse_filtered: b.rmse,
+            mean_ratio_raw: a.mean_ratio,
+            mean_ratio_filtered: b.mean_ratio,
             ssim_raw: a.ssim,
             ssim_filtered: b.ssim,
             flicker_raw: f64::NAN,

@@ -1,13 +1,14 @@
 //! Stochastic Light Culling's study (Tokuyoshi & Harada 2016, section 4.4, figures 4-6 and
-//! Table 1) on our scenes: stochastic against clamped ranges (appendix A) over the VPL count
-//! and over the error bound eps_max, without visibility (the paper's setting, against the
-//! unshadowed ground truth) and with shadow rays (against the true one): GI GPU time, VPLs
-//! per pixel, error, bias and noise; the clamped ranges at the stochastic ones' GPU time
-//! (figure 4's comparison) interpolated from the eps_max sweep; the paper's Table 1 beside our
-//! pass times. Section 5's bounding-sphere-tree variant runs beside them on the same VPLs and
-//! bounds (per-pixel culling, k-entry reservoir lists, one shadow ray). The stochastic ranges
-//! also run with imperfect shadow maps (sections 4.3-4.4, against the true ground truth), and
-//! with the maps' range culling off (figure 7: the maps' build time with and without it).
+//! Table 1) on our scenes: stochastic against clamped ranges (appendix A) over the VPL
+//! count and over the error bound eps_max, without visibility (the paper's setting, against
+//! the unshadowed ground truth) and with shadow rays (against the true one): GI GPU time,
+//! VPLs per pixel, error (RMSE and the image-mean ratio against each truth), bias and
+//! noise; the clamped ranges at the stochastic ones' GPU time (figure 4's comparison)
+//! interpolated from the eps_max sweep; the paper's Table 1 beside our pass times. Section
+//! 5's bounding-sphere-tree variant runs beside them on the same VPLs and bounds (per-pixel
+//! culling, k-entry reservoir lists, one shadow ray). The stochastic ranges also run with
+//! imperfect shadow maps (sections 4.3-4.4, against the true ground truth), and with the
+//! maps' range culling off (figure 7: the maps' build time with and without it).
 
 use super::*;
 use crate::methods::light_culling::{
@@ -68,8 +69,12 @@ struct Row {
     rmse: f64,
     bias: f64,
     noise: f64,
+    /// Image-mean ratio against the same visibility's truth (mean over the diagnostic frames).
     mean_ratio: f64,
+    /// RMSE and image-mean ratio of the last diagnostic frame against the true ground truth
+    /// (shadow rays).
     rmse_true: f64,
+    mean_ratio_true: f64,
     passes: Vec<(&'static str, f64)>,
     /// The maps' build (`lcull_ism`; 0 without maps).
     ism_ms: f64,
@@ -146,17 +151,19 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             }),
             o.size,
         )?;
-        let rmse_true = m.indirect.as_ref().map_or(f64::NAN, |x| {
-            metrics::compare_without_flip(x, &truth, b.gi_exposure, b.base.display.tonemap).rmse
+        let (rmse_true, mean_ratio_true) = m.indirect.as_ref().map_or((f64::NAN, f64::NAN), |x| {
+            let c = metrics::compare_without_flip(x, &truth, b.gi_exposure, b.base.display.tonemap);
+            (c.rmse, c.mean_ratio)
         });
         let (gi_ms, gi_std) = m.gi_ms();
         eprintln!(
-            "[{}] {} {} VPLs eps {eps}, visibility {}: GI {gi_ms:.3} ms GPU, RMSE {:.4e}",
+            "[{}] {} {} VPLs eps {eps}, visibility {}: GI {gi_ms:.3} ms GPU, RMSE {:.4e}, mean {:.3}x",
             b.scene,
             modes[mode].1,
             vpls,
             vis.label(),
-            m.rmse().0
+            m.rmse().0,
+            m.mean_ratio().0
         );
         if vpls == b.base.vpl.count
             && same_eps(eps, base_eps)
@@ -180,8 +187,9 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             rmse: m.rmse().0,
             bias: m.bias_rmse,
             noise: m.noise_rmse,
-            mean_ratio: mean_std(&m.mean_ratio).0,
+            mean_ratio: m.mean_ratio().0,
             rmse_true,
+            mean_ratio_true,
             passes: passes_of(mode)
                 .into_iter()
                 .map(|p| (p, m.pass_ms(&[p]).0))
@@ -238,6 +246,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "noise_rmse",
         "mean_ratio",
         "rmse_vs_true_ground_truth",
+        "mean_ratio_vs_true_ground_truth",
         // Tiled: lcull_ranges, lcull_tiles, lcull_shade; tree: lcull_tree_leaves,
         // lcull_tree_traverse, lcull_tree_shade; both lcull_filter.
         "ranges_ms",
@@ -265,6 +274,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             num(r.noise),
             num(r.mean_ratio),
             num(r.rmse_true),
+            num(r.mean_ratio_true),
         ];
         cells.extend(r.passes.iter().map(|p| num(p.1)));
         cells.push(num(r.tree_build_ms));
@@ -373,7 +383,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     );
     for r in rows.iter().filter(|r| at_base_eps(r)) {
         table.push_str(&format!(
-            "  {:<10} {:<12} {:>6} VPLs: GI {:>9.3} ms GPU{}, {:>6.1} VPLs in range/pixel, RMSE {:.4e} (bias {:.2e}), mean ratio {:.3}, RMSE vs true GT {:.4e}\n",
+            "  {:<10} {:<12} {:>6} VPLs: GI {:>9.3} ms GPU{}, {:>6.1} VPLs in range/pixel, RMSE {:.4e} (bias {:.2e}), mean ratio {:.3}, RMSE vs true GT {:.4e} (mean ratio {:.3})\n",
             r.mode,
             r.vis.label(),
             r.vpls,
@@ -390,6 +400,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             r.bias,
             r.mean_ratio,
             r.rmse_true,
+            r.mean_ratio_true,
         ));
     }
     // The paper's Table 1 beside our passes, at the largest VPL count without visibility.
@@ -453,14 +464,16 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         )
     {
         table.push_str(&format!(
-            "  Figure 7 ({n} VPLs, {}^2 maps of {} points, front-face culling {}): the maps' build {:.3} ms with range culling, {:.3} ms without (paper: 16,384 AISMs in about 22 ms with it, R9 290X); with the maps RMSE vs the true GT {:.4e}, with shadow rays {:.4e}\n",
+            "  Figure 7 ({n} VPLs, {}^2 maps of {} points, front-face culling {}): the maps' build {:.3} ms with range culling, {:.3} ms without (paper: 16,384 AISMs in about 22 ms with it, R9 290X); with the maps RMSE vs the true GT {:.4e} (mean ratio {:.3}), with shadow rays {:.4e} (mean ratio {:.3})\n",
             base.ism.tile,
             base.ism.points_per_light,
             if base.ism.front_face_culling { "on" } else { "off" },
             c.ism_ms,
             u.ism_ms,
             c.rmse_true,
+            c.mean_ratio_true,
             find("stochastic", Vis::Rays, n).map_or(f64::NAN, |r| r.rmse_true),
+            find("stochastic", Vis::Rays, n).map_or(f64::NAN, |r| r.mean_ratio_true),
         ));
         checks.push(check(
             b,

@@ -403,7 +403,7 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
                 num(rs),
                 num(q),
                 num(qs),
-                num(mean_std(&m.mean_ratio).0),
+                num(m.mean_ratio().0),
                 num(m.bias_rmse),
                 num(m.noise_rmse),
                 num(m.steps_per_traversal()),
@@ -416,7 +416,7 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
                 sweep.name,
                 m.bias_rmse,
                 m.noise_rmse,
-                mean_std(&m.mean_ratio).0
+                m.mean_ratio().0
             );
             pts.push((t, r, q, v));
         }
@@ -548,7 +548,7 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
             num(m.rmse().0),
             num(m.ssim().0),
             num(flip),
-            num(mean_std(&m.mean_ratio).0),
+            num(m.mean_ratio().0),
             num(m.bias_rmse),
         ]);
         table.push_str(&format!(
@@ -558,7 +558,7 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
             m.gi_ms().0,
             m.rmse().0,
             m.bias_rmse,
-            mean_std(&m.mean_ratio).0
+            m.mean_ratio().0
         ));
         at.push((*method, r));
     }

@@ -2,9 +2,10 @@
 
 use super::*;
 
-/// Thesis table 7.2: full vs half GI resolution at one or more frame sizes: RMSE, SSIM, GI
-/// time (GPU timestamps of the GI passes: cuts, sampling, down- and upsampling) and the
-/// frame's wall clock (a separate column).
+/// Thesis table 7.2: full vs half GI resolution at one or more frame sizes: RMSE, the
+/// image-mean ratio against the ground truth, SSIM, GI time (GPU timestamps of the GI
+/// passes: cuts, sampling, down- and upsampling) and the frame's wall clock (a separate
+/// column).
 pub fn upsampling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let mut csv = Csv::new(&[
         "scene",
@@ -13,6 +14,7 @@ pub fn upsampling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
         "gi_resolution",
         "rmse",
         "rmse_std",
+        "mean_ratio",
         "ssim",
         "gi_gpu_ms",
         "gi_gpu_ms_std",
@@ -45,15 +47,17 @@ pub fn upsampling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
                 label.into(),
                 num(r),
                 num(rs),
+                num(m.mean_ratio().0),
                 num(m.ssim().0),
                 num(gi),
                 num(gi_s),
                 num(t),
             ]);
             table.push_str(&format!(
-                "  {}x{} {label:<4} GI: RMSE {r:.4e}, SSIM {:.3}, GI {gi:.2} ms (GPU), frame {t:.1} ms (wall)\n",
+                "  {}x{} {label:<4} GI: RMSE {r:.4e}, mean {:.3}x GT, SSIM {:.3}, GI {gi:.2} ms (GPU), frame {t:.1} ms (wall)\n",
                 size.0,
                 size.1,
+                m.mean_ratio().0,
                 m.ssim().0
             ));
             if si == 0
@@ -103,8 +107,8 @@ pub fn upsampling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
     Ok(Report { table, checks })
 }
 
-/// VPL count 2^10 .. 2^16: tree build GPU time (keys, sort, build, classify), GI GPU time and
-/// RMSE against the ground truth of each count.
+/// VPL count 2^10 .. 2^16: tree build GPU time (keys, sort, build, classify), GI GPU time,
+/// RMSE and the image-mean ratio against the ground truth of each count.
 pub fn scaling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let mut csv = Csv::new(&[
         "scene",
@@ -116,6 +120,7 @@ pub fn scaling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "frame_wall_ms",
         "rmse",
         "rmse_std",
+        "mean_ratio",
         "ssim",
         "steps_per_traversal",
     ]);
@@ -142,12 +147,14 @@ pub fn scaling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             num(m.frame_ms().0),
             num(r),
             num(rs),
+            num(m.mean_ratio().0),
             num(m.ssim().0),
             num(m.steps_per_traversal()),
         ]);
         table.push_str(&format!(
-            "  {n:>6} VPLs: tree {:>8.3} ms (sort {sort:.3} + build {build:.3}), GI {gi:>8.3} ms (GPU), RMSE {r:.4e}\n",
-            sort + build
+            "  {n:>6} VPLs: tree {:>8.3} ms (sort {sort:.3} + build {build:.3}), GI {gi:>8.3} ms (GPU), RMSE {r:.4e}, mean {:.3}x GT\n",
+            sort + build,
+            m.mean_ratio().0
         ));
         rows.push((n as f64, sort + build, gi, r));
     }

@@ -164,7 +164,8 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
 }
 
 /// Thesis fig. 7.5: SLC over block sizes k: cut-building and sampling GPU time (timed
-/// frames), frame wall clock (a separate column), RMSE.
+/// frames), frame wall clock (a separate column), RMSE and the image-mean ratio against the
+/// ground truth.
 pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let mut csv = Csv::new(&[
         "scene",
@@ -179,6 +180,7 @@ pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "frame_wall_ms_std",
         "rmse",
         "rmse_std",
+        "mean_ratio",
         "ssim",
         "fallback_fraction",
     ]);
@@ -209,12 +211,14 @@ pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             num(ts),
             num(r),
             num(rs),
+            num(m.mean_ratio().0),
             num(m.ssim().0),
             num(m.fallback_fraction()),
         ]);
         table.push_str(&format!(
-            "  k = {k:<3} {cuts:>6} cuts: {c:>9.3} ms to build, GI {:>8.3} ms (GPU), frame {t:>8.1} ms (wall), RMSE {r:.4e}, SSIM {:.3}\n",
+            "  k = {k:<3} {cuts:>6} cuts: {c:>9.3} ms to build, GI {:>8.3} ms (GPU), frame {t:>8.1} ms (wall), RMSE {r:.4e}, mean {:.3}x GT, SSIM {:.3}\n",
             m.gi_ms().0,
+            m.mean_ratio().0,
             m.ssim().0
         ));
         if let Some(ind) = &m.indirect {
@@ -283,7 +287,7 @@ pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
 
 /// Thesis fig. 7.4 and 7.6: no blending vs blending, and the fallbacks for pixels without a
 /// similar cut (mock cut, averaging, root traversal, recomputed cut): images, error maps,
-/// RMSE over the image and over the fallback pixels, time.
+/// RMSE over the image and over the fallback pixels, the image-mean ratio, time.
 pub fn blending(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let configs = [
         (
@@ -326,6 +330,7 @@ pub fn blending(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "gi_gpu_ms",
         "rmse",
         "rmse_std",
+        "mean_ratio",
         "rmse_fallback_pixels",
         "ssim",
         "fallback_fraction",
@@ -360,12 +365,14 @@ pub fn blending(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             num(gi),
             num(r),
             num(rs),
+            num(m.mean_ratio().0),
             num(rf),
             num(m.ssim().0),
             num(m.fallback_fraction()),
         ]);
         table.push_str(&format!(
-            "  {label:<20} RMSE {r:.4e} (fallback pixels {rf:.4e}), SSIM {:.3}, GI {gi:.1} ms (GPU), {:.1}% fallback\n",
+            "  {label:<20} RMSE {r:.4e} (fallback pixels {rf:.4e}), mean {:.3}x GT, SSIM {:.3}, GI {gi:.1} ms (GPU), {:.1}% fallback\n",
+            m.mean_ratio().0,
             m.ssim().0,
             100.0 * m.fallback_fraction()
         ));

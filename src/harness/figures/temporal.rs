@@ -2,11 +2,12 @@
 //! after every per-frame method, on three repeatable motions: a camera path through the
 //! scene's bookmarks (`--temporal-path-frames` from first to last, its first `--temporal-frames`
 //! measured: a few pixels of motion per frame), a sun sweep (`--sun-sweep-deg` over the
-//! frames) and a still view. Per frame and method: RMSE and SSIM of the raw estimate and of
-//! the stage's output against the ground truth of that frame's VPLs, and flicker (the
-//! frame-to-frame change in static pixels beyond the truth's own change, over the second half
-//! of the frames, after the history's warm-up). Then the stage's GPU
-//! time per pass at `--temporal-timing-width x height` (1280 x 720 by default) along the path.
+//! frames) and a still view. Per frame and method: RMSE, the image-mean ratio and SSIM of the
+//! raw estimate and of the stage's output against the ground truth of that frame's VPLs
+//! (`temporal_summary.csv`: their means over the frames), and flicker (the frame-to-frame
+//! change in static pixels beyond the truth's own change, over the second half of the frames,
+//! after the history's warm-up). Then the stage's GPU time per pass at
+//! `--temporal-timing-width x height` (1280 x 720 by default) along the path.
 
 use super::*;
 use crate::harness::{
@@ -66,6 +67,8 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "frame",
         "rmse_raw",
         "rmse_filtered",
+        "mean_ratio_raw",
+        "mean_ratio_filtered",
         "ssim_raw",
         "ssim_filtered",
         "flicker_raw",
@@ -81,6 +84,8 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "rmse_raw",
         "rmse_filtered",
         "rmse_ratio",
+        "mean_ratio_raw",
+        "mean_ratio_filtered",
         "ssim_raw",
         "ssim_filtered",
         "flicker_raw",
@@ -91,7 +96,7 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         checks: Vec::new(),
     };
     report.table += &format!(
-        "temporal stage ({}) at {}x{}, {} frames per motion, vs each frame's ground truth ({}):\n{:<22} {:<10} {:>10} {:>10} {:>6} {:>8} {:>8} {:>8} {:>8}\n",
+        "temporal stage ({}) at {}x{}, {} frames per motion, vs each frame's ground truth ({}):\n{:<22} {:<10} {:>10} {:>10} {:>6} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8}\n",
         stage(b, SLC).temporal.mode.cli(),
         o.size.0,
         o.size.1,
@@ -102,6 +107,8 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "RMSE raw",
         "filtered",
         "ratio",
+        "mean raw",
+        "filt.",
         "SSIM raw",
         "filt.",
         "flick.raw",
@@ -144,6 +151,8 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                     i.to_string(),
                     num(f.rmse_raw),
                     num(f.rmse_filtered),
+                    num(f.mean_ratio_raw),
+                    num(f.mean_ratio_filtered),
                     num(f.ssim_raw),
                     num(f.ssim_filtered),
                     num(f.flicker_raw),
@@ -153,6 +162,9 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             }
             let avg = |g: fn(&SeqFrame) -> f64| mean_finite(frames.iter().map(g));
             let (rr, rf) = (avg(|f| f.rmse_raw), avg(|f| f.rmse_filtered));
+            // The image-mean ratios averaged over the frames as the RMSEs are (each frame's
+            // against its own truth: a mean of ratios, not the ratio of mean images).
+            let (mr, mf) = (avg(|f| f.mean_ratio_raw), avg(|f| f.mean_ratio_filtered));
             // Flicker over the second half: the first frames are the history's warm-up (the
             // filter's variance estimate settling), not frame-to-frame instability.
             let late = |g: fn(&SeqFrame) -> f64| mean_finite(frames.iter().skip(frames.len() / 2).map(g));
@@ -166,18 +178,22 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 num(rr),
                 num(rf),
                 num(rf / rr),
+                num(mr),
+                num(mf),
                 num(avg(|f| f.ssim_raw)),
                 num(avg(|f| f.ssim_filtered)),
                 num(fr),
                 num(ff),
             ]);
             report.table += &format!(
-                "{:<22} {:<10} {:>10.3e} {:>10.3e} {:>6.3} {:>8.4} {:>8.4} {:>8.4} {:>8.4}\n",
+                "{:<22} {:<10} {:>10.3e} {:>10.3e} {:>6.3} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4}\n",
                 m.name,
                 short,
                 rr,
                 rf,
                 rf / rr,
+                mr,
+                mf,
                 avg(|f| f.ssim_raw),
                 avg(|f| f.ssim_filtered),
                 fr,

@@ -2,17 +2,19 @@
 //! Lightcuts) on the thesis's perfect binary tree and on the SST paper's radix tree (LBVH) over
 //! the same VPLs and keys. Per method and tree: its quality sweep (the samplers' spp,
 //! Lightcuts' relative error) with GPU time (the method's passes + the tree's build), RMSE,
-//! SSIM and traversal steps; the RMSE of each tree interpolated at equal GPU time (the perfect
-//! tree's time at the base value: the base spp, the middle relative error). `bench tree` times the builds alone over 2^12 .. 2^20 VPLs and
-//! `bench lightcuts` measures the trees' far-paired clusters.
+//! SSIM, the image-mean ratio and traversal steps; the RMSE and the mean ratio of each tree
+//! interpolated at equal GPU time (the perfect tree's time at the base value: the base spp,
+//! the middle relative error). `bench tree` times the builds alone over 2^12 .. 2^20 VPLs
+//! and `bench lightcuts` measures the trees' far-paired clusters.
 
 use super::*;
 use crate::renderer::settings::TreeKind;
 
-/// One tree's sweep: (total ms, RMSE) points, and at the base spp the steps per traversal,
-/// the build's ms and the total ms.
+/// One tree's sweep: (total ms, RMSE) and (total ms, image-mean ratio) points, and at the
+/// base spp the steps per traversal, the build's ms and the total ms.
 struct TreeCurve {
     points: Vec<(f64, f64)>,
+    ratios: Vec<(f64, f64)>,
     steps: f64,
     build: f64,
     t_base: f64,
@@ -48,6 +50,8 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "rmse_perfect",
         "rmse_lbvh",
         "rmse_ratio_lbvh_over_perfect",
+        "mean_ratio_perfect",
+        "mean_ratio_lbvh",
         "extrapolated",
         "steps_perfect",
         "steps_lbvh",
@@ -83,7 +87,7 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         // Per tree: (total ms, RMSE) over the sweep, the base value's steps and build time.
         let mut curves: Vec<TreeCurve> = Vec::new();
         for (ki, kind) in TreeKind::ALL.into_iter().enumerate() {
-            let mut pts = Vec::new();
+            let (mut pts, mut ratios) = (Vec::new(), Vec::new());
             let (mut steps, mut build, mut t_base) = (f64::NAN, f64::NAN, f64::NAN);
             for &v in &values {
                 let s = with(b, |s| {
@@ -108,15 +112,16 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                     num(r),
                     num(rs),
                     num(m.ssim().0),
-                    num(mean_std(&m.mean_ratio).0),
+                    num(m.mean_ratio().0),
                     num(m.steps_per_traversal()),
                     num(m.steps_per_pixel()),
                 ]);
                 eprintln!(
-                    "[{}] {label} on the {} tree, {} {value}: GI {gi:.3} + build {tb:.3} ms GPU, RMSE {r:.4e}, {:.2} steps per traversal",
+                    "[{}] {label} on the {} tree, {} {value}: GI {gi:.3} + build {tb:.3} ms GPU, RMSE {r:.4e}, mean {:.3}x GT, {:.2} steps per traversal",
                     b.scene,
                     kind.name(),
                     sweep.name,
+                    m.mean_ratio().0,
                     m.steps_per_traversal()
                 );
                 if v == base {
@@ -125,8 +130,10 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                     t_base = gi + tb;
                 }
                 pts.push((gi + tb, r));
+                ratios.push((gi + tb, m.mean_ratio().0));
             }
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            ratios.sort_by(|a, b| a.0.total_cmp(&b.0));
             series.push(plot::Series {
                 name: format!("{label} {}", kind.name()),
                 color: 2 * mi + ki,
@@ -134,6 +141,7 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             });
             curves.push(TreeCurve {
                 points: pts,
+                ratios,
                 steps,
                 build,
                 t_base,
@@ -142,6 +150,9 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         let t = curves[0].t_base;
         let (r_p, ex_p) = interp_loglog(&curves[0].points, t);
         let (r_l, ex_l) = interp_loglog(&curves[1].points, t);
+        // The image-mean ratios at the same time, interpolated as the RMSEs are.
+        let (q_p, _) = interp_loglog(&curves[0].ratios, t);
+        let (q_l, _) = interp_loglog(&curves[1].ratios, t);
         matched.row(vec![
             b.scene.clone(),
             label.to_string(),
@@ -149,6 +160,8 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             num(r_p),
             num(r_l),
             num(r_l / r_p),
+            num(q_p),
+            num(q_l),
             (ex_p || ex_l).to_string(),
             num(curves[0].steps),
             num(curves[1].steps),
@@ -156,7 +169,7 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             num(curves[1].build),
         ]);
         table.push_str(&format!(
-            "  {label:<6} at {t:.2} ms: RMSE perfect {r_p:.4e}, radix {r_l:.4e} ({:.2}x{}); steps per traversal {:.2} vs {:.2}; build {:.3} vs {:.3} ms\n",
+            "  {label:<6} at {t:.2} ms: RMSE perfect {r_p:.4e}, radix {r_l:.4e} ({:.2}x{}); mean vs GT perfect {q_p:.3}x, radix {q_l:.3}x; steps per traversal {:.2} vs {:.2}; build {:.3} vs {:.3} ms\n",
             r_l / r_p,
             if ex_l { ", extrapolated" } else { "" },
             curves[0].steps,
