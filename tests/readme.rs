@@ -655,7 +655,13 @@ fn cli_examples_write_what_they_promise() {
     let (_, rows) = common::read_csv(&tp.join("sequence.csv"));
     assert_eq!(rows.len(), 3);
     for r in &rows {
-        for k in ["rmse_raw", "rmse_filtered", "ssim_filtered"] {
+        for k in [
+            "rmse_raw",
+            "rmse_filtered",
+            "mean_ratio_raw",
+            "mean_ratio_filtered",
+            "ssim_filtered",
+        ] {
             assert!(r[k].parse::<f64>().is_ok_and(f64::is_finite), "{k}: {r:?}");
         }
     }

@@ -129,6 +129,8 @@ pub fn run(
         "frame_gpu_ms",
         "rmse_raw",
         "rmse_filtered",
+        "mean_ratio_raw",
+        "mean_ratio_filtered",
         "ssim_raw",
         "ssim_filtered",
         "flicker_raw",
@@ -151,6 +153,8 @@ pub fn run(
             g(t.map(|t| t.total_ms())),
             g(f.map(|f| f.rmse_raw)),
             g(f.map(|f| f.rmse_filtered)),
+            g(f.map(|f| f.mean_ratio_raw)),
+            g(f.map(|f| f.mean_ratio_filtered)),
             g(f.map(|f| f.ssim_raw)),
             g(f.map(|f| f.ssim_filtered)),
             g(f.map(|f| f.flicker_raw)),
@@ -182,11 +186,13 @@ pub fn run(
             mean_std(&x).0
         };
         println!(
-            "vs each frame's ground truth (mean over {} frames): RMSE raw {:.6} / filtered {:.6} (ratio {:.3}), SSIM raw {:.4} / filtered {:.4}, flicker raw {:.4} / filtered {:.4}",
+            "vs each frame's ground truth (mean over {} frames): RMSE raw {:.6} / filtered {:.6} (ratio {:.3}), image mean / truth's raw {:.4} / filtered {:.4}, SSIM raw {:.4} / filtered {:.4}, flicker raw {:.4} / filtered {:.4}",
             v.len(),
             mean(|f| f.rmse_raw),
             mean(|f| f.rmse_filtered),
             mean(|f| f.rmse_filtered) / mean(|f| f.rmse_raw),
+            mean(|f| f.mean_ratio_raw),
+            mean(|f| f.mean_ratio_filtered),
             mean(|f| f.ssim_raw),
             mean(|f| f.ssim_filtered),
             mean(|f| f.flicker_raw),
