@@ -368,6 +368,21 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         &["ours_64_pcss_ms", "ours_512_simple_ms", "paper_64_pcss_ms"],
         4,
     );
+    // The whole configurations' error against the truth, the mean ratio beside the RMSE.
+    let (_, rows) = read_csv(&d.join("val_table1.csv"));
+    let complete = rows
+        .iter()
+        .find(|r| r["row"].starts_with("complete"))
+        .expect("complete row");
+    for k in [
+        "ours_64_pcss_rmse_vs_ground_truth",
+        "ours_64_pcss_mean_ratio_vs_ground_truth",
+        "ours_512_simple_rmse_vs_ground_truth",
+        "ours_512_simple_mean_ratio_vs_ground_truth",
+    ] {
+        let v: f64 = complete[k].parse().unwrap_or(f64::NAN);
+        assert!(v.is_finite() && v > 0.0, "{k}: {complete:?}");
+    }
     let (_, rows) = read_csv(&d.join("interpolation.csv"));
     let names: Vec<&str> = rows.iter().map(|r| r["method"].as_str()).collect();
     assert_eq!(names, ["Lightcuts", "LI full vis.", "LI interp. vis."]);

@@ -332,10 +332,12 @@ fn cut_size_64_counts_like_cut_size_32() {
 /// at 1e-4 of the truth: float rounding of a deterministic method):
 /// - a biased method's 16-frame mean is within its declared tolerance of the truth's, plus
 ///   3 se_16 for its noise;
-/// - an unbiased method's error falls as 1/sqrt(N): the 16- and the 64-frame means are both
-///   within 4.5 standard errors of the truth (z-tests), and the 64-frame mean is within 2%
-///   (or 4.5 se_64 where the estimator is that noisy at this size: light culling's stochastic
-///   ranges at the paper's eps_max, se 1-2% here).
+/// - an unbiased method's error falls as 1/sqrt(N): the means of four disjoint 16-frame
+///   batches and of all 64 frames are each within 4.5 of their standard errors of the truth
+///   (z-tests; sd / 4 and sd / 8, sd the per-frame means' spread over all 64 frames), and the 64-frame mean is within 2% (light culling's stochastic ranges: or
+///   4.5 se_64, their noise at the paper's eps_max being 1-2% per 64 frames at this size).
+///   The RMSE of the N-frame average image (printed, 16 -> 64 frames; 2x expected) is not
+///   asserted: the leaf samplers' per-pixel errors are heavy-tailed (1.2x - 4.4x measured).
 ///
 /// Every failure is collected and the whole table printed, so one run shows every method on
 /// every scene.
@@ -427,16 +429,10 @@ fn every_per_frame_method_keeps_its_declared_bias_on_every_builtin_scene() {
                         rmse16 = rmse_of_average(&sum, f, gt);
                     }
                 }
-                // z of the N-frame mean over the first n frames.
-                let z_at = |n: usize| {
-                    let x = &means[..n];
-                    let nf = n as f64;
-                    let avg = x.iter().sum::<f64>() / nf;
-                    let var = x.iter().map(|v| (v - avg).powi(2)).sum::<f64>() / (nf - 1.0);
-                    let se = (var / nf + (1e-4 * truth_mean).powi(2)).sqrt();
-                    (avg / truth_mean, (avg - truth_mean) / se, se / truth_mean)
-                };
+                // z of the mean of the first n frames.
+                let z_at = |n: usize| z_of(&means[..n], truth_mean);
                 let (ratio, z, se) = z_at(frames);
+                let n_frames = frames as f64;
                 let fall = rmse16 / rmse_of_average(&sum, frames, gt);
                 table.push_str(&format!(
                     "{} | {} | {config} | {} | {} | {frames} | {ratio:.4} | {se:.4} | {z:.2} | {}\n",
@@ -454,15 +450,38 @@ fn every_per_frame_method_keeps_its_declared_bias_on_every_builtin_scene() {
                 if !ratio.is_finite() {
                     failures.push(format!("{what}: mean ratio {ratio}"));
                 } else if bias == Bias::Unbiased {
-                    let (r16, z16, _) = z_at(16);
-                    if z16.abs() > 4.5 || z.abs() > 4.5 {
-                        failures.push(format!(
-                            "{what}: the mean is off by z = {z16:.2} after 16 frames ({r16:.4}x), {z:.2} after 64 ({ratio:.4}x)"
-                        ));
+                    // The error falls as 1/sqrt(N): each of four disjoint 16-frame batches
+                    // and the whole 64 are within 4.5 of their own standard errors.
+                    // The batches' standard error from the spread of all 64 frames (iid under
+                    // the hypothesis; a 16-frame batch's own spread misses the rare bright
+                    // frames of a heavy-tailed estimator).
+                    let se16 = se * (n_frames / 16.0).sqrt() * truth_mean;
+                    for batch in 0..4 {
+                        let x = &means[16 * batch..16 * (batch + 1)];
+                        let mb = x.iter().sum::<f64>() / 16.0;
+                        let (rb, zb) = (mb / truth_mean, (mb - truth_mean) / se16);
+                        if zb.abs() > 4.5 {
+                            failures.push(format!(
+                                "{what}: frames {}..{} mean {rb:.4}x the truth, z = {zb:.2}",
+                                16 * batch,
+                                16 * (batch + 1)
+                            ));
+                        }
                     }
-                    if (ratio - 1.0).abs() > 0.02_f64.max(4.5 * se) {
+                    if z.abs() > 4.5 {
+                        failures.push(format!("{what}: 64-frame mean {ratio:.4}x the truth, z = {z:.2}"));
+                    }
+                    // Within 2%, but for light culling's stochastic ranges, whose noise at the
+                    // paper's eps_max is 1-2% per 64 frames at this size: 4.5 se there.
+                    let allowed = if m.id == methods::light_culling::ID {
+                        0.02_f64.max(4.5 * se)
+                    } else {
+                        0.02
+                    };
+                    if (ratio - 1.0).abs() > allowed {
                         failures.push(format!(
-                            "{what}: 64-frame mean {ratio:.4}x the truth (over 2%, se {se:.4})"
+                            "{what}: 64-frame mean {ratio:.4}x the truth (over {:.1}%, se {se:.4})",
+                            100.0 * allowed
                         ));
                     }
                 } else if (ratio - 1.0).abs() > tolerance + 3.0 * se {
@@ -482,6 +501,16 @@ fn every_per_frame_method_keeps_its_declared_bias_on_every_builtin_scene() {
         "the bias contract fails:\n{}",
         failures.join("\n")
     );
+}
+
+/// (mean / truth, z, se / truth) of per-frame means `x` against `truth`: se = the spread of
+/// `x` over sqrt(n), floored at 1e-4 of the truth (float rounding of a deterministic method).
+fn z_of(x: &[f64], truth: f64) -> (f64, f64, f64) {
+    let n = x.len() as f64;
+    let avg = x.iter().sum::<f64>() / n;
+    let var = x.iter().map(|v| (v - avg).powi(2)).sum::<f64>() / (n - 1.0);
+    let se = (var / n + (1e-4 * truth).powi(2)).sqrt();
+    (avg / truth, (avg - truth) / se, se / truth)
 }
 
 /// The mean of an image's RGB (what `metrics::compare`'s mean ratio divides).

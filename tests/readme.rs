@@ -292,6 +292,19 @@ fn cli_examples_write_what_they_promise() {
             m.id
         );
     }
+    // The README's promise: each per-frame method's bias, and how to make it unbiased.
+    let per_frame = REGISTRY.iter().filter(|m| m.kind == Kind::PerFrame).count();
+    let biases = out
+        .lines()
+        .filter(|l| l.contains("against the ground truth of the same VPLs: "))
+        .count();
+    assert_eq!(biases, per_frame, "{out}");
+    let unbiasable = REGISTRY.iter().filter(|m| m.unbiased.is_some()).count();
+    assert_eq!(out.matches("unbiased with: ").count(), unbiasable, "{out}");
+    assert!(
+        out.contains("biased, within 2%") && out.contains("unbiased"),
+        "{out}"
+    );
 
     // Ground truth and reference: GI written, the promised summary printed.
     let gt = tmp("gt");

@@ -100,6 +100,11 @@ impl Rsm {
 /// surface; twin `SAME_NORMAL` in val_downsample.wgsl).
 pub const SAME_NORMAL: f32 = 0.9;
 
+/// Reference texels tried per block for the dominant surface (every (factor^2 /
+/// this)-th texel; all of a 4 x 4 block), so the search costs this x factor^2 per coarse
+/// texel whatever the factor (twin `CANDIDATES` in val_downsample.wgsl).
+pub const DOMINANT_CANDIDATES: u32 = 16;
+
 /// Whether texel `t` lies on `r`'s surface: normals within [`SAME_NORMAL`], within `tol` of
 /// `r`'s tangent plane.
 fn same_surface(r: &RsmTexel, t: &RsmTexel, tol: f32) -> bool {
@@ -141,12 +146,24 @@ pub fn downsample(rsm: &Rsm, res: u32) -> Rsm {
                     .map(|&i| t(i).flux.x + t(i).flux.y + t(i).flux.z)
                     .sum()
             };
-            let (mut best, mut best_on) = (first, on(first));
-            for &r in &block[1..] {
+            // Candidates: every `stride`-th texel of the block in row order (all of a 4 x 4
+            // block), the lit ones; the first lit texel is tried only where it is one.
+            let stride = (f * f / DOMINANT_CANDIDATES).max(1);
+            let mut best = first;
+            let mut best_on = -1.0f32;
+            for k in (0..f * f).step_by(stride as usize) {
+                let r = ((y * f + k / f) * rsm.res + x * f + k % f) as usize;
+                if !rsm.lit(r) {
+                    continue;
+                }
                 let o = on(r);
                 if o > best_on {
                     (best, best_on) = (r, o);
                 }
+            }
+            if best_on < 0.0 {
+                // No candidate lit: the block's first lit texel.
+                best = first;
             }
             let surface: Vec<usize> = block
                 .iter()

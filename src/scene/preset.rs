@@ -324,6 +324,12 @@ pub fn open_scene(src: &SceneSource) -> Result<OpenedScene, SceneError> {
             exposure_ev: 0.0,
             source: src.clone(),
         },
+        SceneSource::Gltf(p) if p.extension().is_none() && !p.exists() => {
+            return Err(SceneError::UnknownScene {
+                name: p.display().to_string(),
+                builtin: test_scenes::names(),
+            });
+        }
         SceneSource::Gltf(p) => OpenedScene {
             scene: load_gltf(p)?,
             camera_name: None,

@@ -25,6 +25,7 @@ pub struct BuiltinScene {
     pub name: &'static str,
     /// One line: what it is for.
     pub about: &'static str,
+    /// Builds it (deterministic; a few hundred to a thousand triangles).
     pub build: fn() -> Scene,
 }
 
@@ -422,16 +423,50 @@ mod tests {
             assert_eq!(s.lights.len(), 1, "{}: one sun", b.name);
             assert!(s.lights[0].direction.y < 0.0, "{}: the sun shines down", b.name);
             assert!(!s.cameras.is_empty() && !s.bounds.is_empty(), "{}", b.name);
-            // The camera is inside the scene's bounds (every scene is a closed room).
-            let c = s.cameras[0].position;
-            assert!(
-                c.cmpge(s.bounds.min).all() && c.cmple(s.bounds.max).all(),
-                "{}: camera outside",
-                b.name
-            );
+            // Every camera is inside the room (the bounds less the walls' thickness), and
+            // looks at geometry (a closed room: its view ray hits a wall, never the sky).
+            let bvh = crate::scene::bvh::Bvh::build(&s.positions, &s.indices);
+            let (lo, hi) = (s.bounds.min + Vec3::splat(T), s.bounds.max - Vec3::splat(T));
+            for c in &s.cameras {
+                let p = c.position;
+                assert!(
+                    p.cmpgt(lo).all() && p.cmplt(hi).all(),
+                    "{}: camera {} at {p} is outside the room",
+                    b.name,
+                    c.name
+                );
+                let ray = crate::scene::bvh::Ray::new(p, c.forward, 1e-3, 1e3);
+                assert!(
+                    bvh.closest_hit(&ray).is_some(),
+                    "{}: camera {} sees the sky",
+                    b.name,
+                    c.name
+                );
+            }
         }
         assert_eq!(BUILTIN[0].name, "default");
         assert!(find("corridor").is_some() && find("nope").is_none());
+    }
+
+    /// `--scene <name>` opens a built-in scene; a misspelt name is refused with the names.
+    #[test]
+    fn scene_arguments_name_the_builtin_scenes() {
+        use crate::scene::preset::{SceneSource, open_scene};
+        for b in BUILTIN {
+            let o = open_scene(&SceneSource::from_arg(b.name)).unwrap();
+            assert_eq!(o.scene.name, (b.build)().name);
+        }
+        assert_eq!(
+            SceneSource::from_arg("corridor"),
+            SceneSource::Builtin("corridor")
+        );
+        let e = open_scene(&SceneSource::from_arg("corridoor"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("corridoor") && e.contains("window-box") && e.contains("glossy-thin"),
+            "{e}"
+        );
     }
 
     /// The sun reaches into each room through its opening: a ray against the sun from a

@@ -29,6 +29,8 @@ struct DownParams {
 
 // Texels on one surface: normals within SAME_NORMAL, within `tol` of the reference's plane.
 const SAME_NORMAL: f32 = 0.9;
+// Reference texels tried per block (twin: DOMINANT_CANDIDATES).
+const CANDIDATES: u32 = 16u;
 
 fn fine_texel(b: vec2<u32>, k: u32) -> vec2<i32> {
     return vec2<i32>(b * dp.factor + vec2<u32>(k % dp.factor, k / dp.factor));
@@ -54,8 +56,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let tol = sqrt(dp.texel_area) * f32(dp.factor);
     var flux = vec3<f32>(0.0);
     var area = 0.0;
+    var first = f2;
     var best = f2;
     var best_on = -1.0;
+    // At most CANDIDATES texels of the block are tried as the dominant surface's reference
+    // (every `stride`-th; all of a 4 x 4 block): the search costs CANDIDATES x factor^2.
+    let stride = max(f2 / CANDIDATES, 1u);
     for (var r = 0u; r < f2; r++) {
         let cr = fine_texel(gid.xy, r);
         if !lit(cr) {
@@ -67,6 +73,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         flux += fr;
         // Twin: Rsm::surface_area.
         area += dp.texel_area / max(dot(nr, -dp.light_dir), 0.05);
+        if first == f2 {
+            first = r;
+        }
+        if r % stride != 0u {
+            continue;
+        }
         // The flux on r's surface.
         var on = 0.0;
         for (var k = 0u; k < f2; k++) {
@@ -88,11 +100,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
     let t = vec2<i32>(gid.xy);
-    if best == f2 {
+    if first == f2 {
         textureStore(out_position, t, vec4<f32>(0.0));
         textureStore(out_normal, t, vec4<f32>(0.0));
         textureStore(out_flux, t, vec4<f32>(0.0));
         return;
+    }
+    if best == f2 {
+        // No candidate lit: the block's first lit texel.
+        best = first;
     }
     let cb = fine_texel(gid.xy, best);
     let pb = textureLoad(rsm_position, cb, l, 0).xyz;

@@ -298,6 +298,7 @@ fn substitute_bias(s: &RenderSettings, leaf_bias: Bias) -> Bias {
     })
 }
 
+/// SLC: substitute sampling; with only leaves usable, RTSLC's bias (its cuts and blending).
 fn slc_bias(s: &RenderSettings) -> Bias {
     substitute_bias(s, rtslc_bias(s))
 }

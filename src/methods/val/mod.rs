@@ -198,19 +198,26 @@ const fn info(
 
 /// Clustering replaces a cluster's texels by one light at their mean position (and, for
 /// `val`, a disk): biased whatever the visibility, less with more clusters. Measured after
-/// the downsample's dominant-surface fix at 64 clusters (docs/val.md, *Brightness*): within
-/// 5% of the truth in the default room and the window box, 1.2x in the corridor, 0.88x in
-/// glossy-thin, within 4% everywhere at 1024. Imperfect shadow maps add their own error.
+/// the downsample's dominant-surface fix (docs/val.md, *Brightness*; 160 x 120): at 64
+/// clusters 0.91-0.98x in the default room, 0.99-1.03x in the window box, 1.18-1.22x in the
+/// corridor, 0.88-0.98x in glossy-thin; at 1024 within 4% of the truth; at 16 from 0.65x to
+/// 1.9x. Imperfect shadow maps add their own error.
 fn bias(s: &RenderSettings) -> super::Bias {
     let v: ValSettings = s.method(ID).unwrap_or_default();
-    if s.gi.shadow_rays && matches!(v.visibility, ValVisibility::Ism | ValVisibility::Pcss) {
+    let maps = s.gi.shadow_rays && matches!(v.visibility, ValVisibility::Ism | ValVisibility::Pcss);
+    if v.clusters < 64 {
+        super::Bias::Biased {
+            tolerance: 1.0,
+            reason: "clustering with fewer than 64 clusters: each cluster's flux at its mean position (0.65x - 1.9x at 16)",
+        }
+    } else if maps {
         super::Bias::Biased {
             tolerance: 0.25,
             reason: "clustering (each cluster's flux at its mean position), and imperfect shadow maps",
         }
     } else {
         super::Bias::Biased {
-            tolerance: 0.20,
+            tolerance: 0.25,
             reason: "clustering: each cluster's flux at its mean position (less with more clusters)",
         }
     }

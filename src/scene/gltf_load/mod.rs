@@ -30,6 +30,15 @@ use data::*;
 /// Everything that can stop a scene from loading. Each variant displays as one line.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
+    /// A scene named without a file extension that is neither a built-in scene nor a file.
+    #[error(
+        "no scene '{name}': not a built-in scene ({}) and no such file (a glTF file ends in .gltf or .glb, a preset in .toml)",
+        builtin.join(", ")
+    )]
+    UnknownScene {
+        name: String,
+        builtin: Vec<&'static str>,
+    },
     /// The file (glTF, preset, ...) could not be opened or read.
     #[error("cannot read {}: {source}", path.display())]
     Io {
