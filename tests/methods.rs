@@ -334,8 +334,9 @@ fn cut_size_64_counts_like_cut_size_32() {
 ///   3 se_16 for its noise;
 /// - an unbiased method's error falls as 1/sqrt(N): the means of four disjoint 16-frame
 ///   batches and of all 64 frames are each within 4.5 of their standard errors of the truth
-///   (z-tests; sd / 4 and sd / 8, sd the per-frame means' spread over all 64 frames), and the 64-frame mean is within 2% (light culling's stochastic ranges: or
-///   4.5 se_64, their noise at the paper's eps_max being 1-2% per 64 frames at this size).
+///   (z-tests; sd / 4 and sd / 8, sd the per-frame means' spread over all 64 frames), and
+///   the 64-frame mean is within 2% (or 4.5 se_64 for the two estimators that noisy at this
+///   size: light culling's stochastic ranges, SST's root traversals; se 1-2.6%).
 ///   The RMSE of the N-frame average image (printed, 16 -> 64 frames; 2x expected) is not
 ///   asserted: the leaf samplers' per-pixel errors are heavy-tailed (1.2x - 4.4x measured).
 ///
@@ -384,14 +385,11 @@ fn every_per_frame_method_keeps_its_declared_bias_on_every_builtin_scene() {
                 }
                 configs.push(("unbiased", s));
             }
-            // The VALs with exact visibility too: their remaining bias is the clustering's.
-            if methods::val::METHODS.contains(&m.id) {
-                let mut s = at_defaults.clone();
-                let mut v: methods::val::settings::ValSettings = s.method(methods::val::ID).unwrap();
-                v.visibility = methods::val::settings::ValVisibility::Rays;
-                s.set_method(methods::val::ID, &v).unwrap();
-                configs.push(("ray visibility", s));
-            }
+            // Every other branch of the declarations once (on the methods whose rows declare
+            // it): the VALs with exact visibility (their remaining bias is the clustering's)
+            // and 16 rays to the disk, imperfect shadow maps, half resolution, the tree
+            // samplers' filter, Lightcut Interpolation's interpolated visibility.
+            configs.extend(branch_configs(m.id, &at_defaults));
             for (config, mut s) in configs {
                 // GGX on the glossy scene where the method takes it with these settings.
                 if glossy && m.glossy {
@@ -471,9 +469,12 @@ fn every_per_frame_method_keeps_its_declared_bias_on_every_builtin_scene() {
                     if z.abs() > 4.5 {
                         failures.push(format!("{what}: 64-frame mean {ratio:.4}x the truth, z = {z:.2}"));
                     }
-                    // Within 2%, but for light culling's stochastic ranges, whose noise at the
-                    // paper's eps_max is 1-2% per 64 frames at this size: 4.5 se there.
-                    let allowed = if m.id == methods::light_culling::ID {
+                    // Within 2%, but for the two estimators whose noise at this size is 1-2.6%
+                    // per 64 frames (se, measured): light culling's stochastic ranges at the
+                    // paper's eps_max, and SST's root-to-leaf traversals in the corridor
+                    // (every sample from the root): 4.5 se there.
+                    let noisy = [methods::light_culling::ID, methods::tree_samplers::SST];
+                    let allowed = if noisy.contains(&m.id) {
                         0.02_f64.max(4.5 * se)
                     } else {
                         0.02
@@ -501,6 +502,67 @@ fn every_per_frame_method_keeps_its_declared_bias_on_every_builtin_scene() {
         "the bias contract fails:\n{}",
         failures.join("\n")
     );
+}
+
+/// The configurations beside the defaults that exercise the other branches of `m`'s bias
+/// declaration (one method per shared declaration).
+fn branch_configs(m: MethodId, defaults: &RenderSettings) -> Vec<(&'static str, RenderSettings)> {
+    use methods::{light_culling, lightcut_interpolation as li, tree_samplers, val};
+    let with = |f: &dyn Fn(&mut RenderSettings)| {
+        let mut s = defaults.clone();
+        f(&mut s);
+        s
+    };
+    let val_vis = |v: val::settings::ValVisibility| {
+        with(&|s: &mut RenderSettings| {
+            let mut vs: val::settings::ValSettings = s.method(val::ID).unwrap();
+            vs.visibility = v;
+            s.set_method(val::ID, &vs).unwrap();
+        })
+    };
+    if m == val::ID {
+        vec![
+            ("ray visibility", val_vis(val::settings::ValVisibility::Rays)),
+            ("disk visibility", val_vis(val::settings::ValVisibility::Disk)),
+        ]
+    } else if m == val::VPL {
+        vec![("ray visibility", val_vis(val::settings::ValVisibility::Rays))]
+    } else if m == tree_samplers::SLC {
+        vec![
+            (
+                "ism visibility",
+                with(&|s| s.sampling.visibility = tree_samplers::settings::SamplerVisibility::Ism),
+            ),
+            ("half resolution", with(&|s| s.sampling.half_resolution = true)),
+            (
+                "2 x 2 interleave + filter",
+                with(&|s| {
+                    s.sampling.interleave = lightcut::renderer::settings::InterleaveSettings::pattern(2)
+                }),
+            ),
+        ]
+    } else if m == light_culling::ID {
+        vec![(
+            "ism visibility",
+            with(&|s| {
+                let mut lc: light_culling::settings::LightCullingSettings =
+                    s.method(light_culling::ID).unwrap();
+                lc.visibility = light_culling::settings::CullingVisibility::Ism;
+                s.set_method(light_culling::ID, &lc).unwrap();
+            }),
+        )]
+    } else if m == li::ID {
+        vec![(
+            "interpolated visibility",
+            with(&|s| {
+                let mut l: li::settings::LightcutInterpolationSettings = s.method(li::ID).unwrap();
+                l.visibility = li::settings::LiVisibility::Interpolated;
+                s.set_method(li::ID, &l).unwrap();
+            }),
+        )]
+    } else {
+        Vec::new()
+    }
 }
 
 /// (mean / truth, z, se / truth) of per-frame means `x` against `truth`: se = the spread of
