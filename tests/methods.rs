@@ -428,8 +428,7 @@ fn every_per_frame_method_keeps_its_declared_bias_on_every_builtin_scene() {
                     }
                 }
                 // z of the mean of the first n frames.
-                let z_at = |n: usize| z_of(&means[..n], truth_mean);
-                let (ratio, z, se) = z_at(frames);
+                let (ratio, z, se) = z_of(&means, truth_mean);
                 let n_frames = frames as f64;
                 let fall = rmse16 / rmse_of_average(&sum, frames, gt);
                 table.push_str(&format!(

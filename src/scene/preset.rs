@@ -319,7 +319,12 @@ pub fn open_scene(src: &SceneSource) -> Result<OpenedScene, SceneError> {
             source: src.clone(),
         },
         SceneSource::Builtin(name) => OpenedScene {
-            scene: test_scenes::find(name).map_or_else(default_scene::build, |b| (b.build)()),
+            scene: test_scenes::find(name)
+                .map(|b| (b.build)())
+                .ok_or_else(|| SceneError::UnknownScene {
+                    name: name.to_string(),
+                    builtin: test_scenes::names(),
+                })?,
             camera_name: None,
             exposure_ev: 0.0,
             source: src.clone(),
