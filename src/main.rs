@@ -27,4 +27,12 @@ fn main() {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }
+    // A GPU error (validation, out of memory, device lost) met anywhere in a command fails
+    // it, with the pass named, even where the command's own loop did not look.
+    if cli.command.is_some()
+        && let Some(e) = lightcut::renderer::context::first_gpu_error()
+    {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
 }

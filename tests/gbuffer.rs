@@ -24,7 +24,7 @@ fn camera_buffer(ctx: &GpuContext, cam: &Camera, size: (u32, u32)) -> wgpu::Buff
     ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("test::camera"),
         contents: bytemuck::bytes_of(&GpuCamera::new(cam, size.0, size.1)),
-        usage: wgpu::BufferUsages::UNIFORM,
+        usage: lightcut::renderer::passes::PARAMS_USAGE,
     })
 }
 

@@ -41,7 +41,10 @@ fn material_albedo_lod(material: u32, uv: vec2<f32>, lod: u32) -> vec4<f32> {
     var albedo = m.base_color;
     if m.texture.x >= 0 {
         let level = min(lod, textureNumLevels(textures) - 1u);
-        let size = textureDimensions(textures, level);
+        // Level `level`'s size from level 0's (each level halves, at least 1): the same as
+        // textureDimensions(textures, level), which lavapipe answers with level 0's size
+        // when the level is not a compile-time constant.
+        let size = max(textureDimensions(textures) >> vec2<u32>(level), vec2<u32>(1u));
         let f = uv - floor(uv);
         let t = min(vec2<u32>(f * vec2<f32>(size)), size - 1u);
         // Rgba8UnormSrgb: the load returns linear values.

@@ -14,6 +14,23 @@ impl WorkbenchApp {
         let Some(renderer) = self.renderer.as_mut() else {
             return;
         };
+        // A lost device: everything made on it is gone, eframe's painter included (egui-wgpu
+        // 0.37 does not recreate its device), so rendering stops and says why.
+        if renderer.ctx.errors.device_lost() {
+            for e in renderer.ctx.errors.take() {
+                if !self.errors.contains(&e) {
+                    self.errors.push(e);
+                }
+            }
+            ui.centered_and_justified(|ui| {
+                ui.colored_label(
+                    ui.visuals().error_fg_color,
+                    "The GPU device was lost (see the status line). Rendering has stopped; \
+                     restart the workbench (its settings are saved on exit).",
+                )
+            });
+            return;
+        }
         // Render resolution: the largest view's image area (last layout) at the render scale.
         let px = self.layout.largest_view_px().unwrap_or(avail * ppp);
         let w = ((px.x * self.render_scale) as u32).clamp(16, 8192);
@@ -359,6 +376,24 @@ impl WorkbenchApp {
                     });
             } else {
                 ui.label("GPU timings: no timed frame yet");
+            }
+            // GPU errors (validation, out of memory, device lost) and refused settings: the
+            // latest, with the pass it names; all of them on hover.
+            if let Some(last) = self.errors.last() {
+                ui.separator();
+                let text = if self.errors.len() > 1 {
+                    format!("{} errors; last: {last}", self.errors.len())
+                } else {
+                    last.clone()
+                };
+                ui.add(
+                    egui::Label::new(egui::RichText::new(text).color(ui.visuals().error_fg_color)).truncate(),
+                )
+                .on_hover_ui(|ui| {
+                    for e in &self.errors {
+                        ui.label(e);
+                    }
+                });
             }
         });
     }

@@ -398,6 +398,18 @@ impl WorkbenchApp {
             .main_pane()
             .map_or(ViewBuffer::Final, |p| p.spec.buffer)
     }
+    /// The render resolution as a fraction of the view's pixels (the side panel's slider).
+    pub fn render_scale(&self) -> f32 {
+        self.render_scale
+    }
+    /// Sets the render scale, clamped to the slider's 0.25..=1.
+    pub fn set_render_scale(&mut self, scale: f32) {
+        self.render_scale = if scale.is_finite() {
+            scale.clamp(0.25, 1.0)
+        } else {
+            1.0
+        };
+    }
     pub fn set_view(&mut self, v: ViewBuffer) {
         if let Some(p) = self.layout.main_pane_mut() {
             p.spec.buffer = v;

@@ -3,6 +3,7 @@
 //! for 2^12 .. 2^20 VPLs, with the log-log slope of time against N.
 //! `bench gbuffer`: fragments and bytes per pixel with and without the depth pre-pass.
 //! `bench lightcuts`: `bench_lightcuts.rs`.
+//! `bench soak`: `bench_soak.rs`.
 
 use anyhow::anyhow;
 use clap::{Args, ValueEnum};
@@ -51,6 +52,10 @@ pub enum BenchKind {
     /// relative error (--errors) the GPU time, cut size, shadow rays, max-cut pixels and the
     /// share of refinements on far-paired nodes (docs/lightcuts.md).
     Lightcuts,
+    /// A long run (`--minutes`) that moves the camera and switches methods, printing frames
+    /// per second, resident and GPU memory and live GPU objects, with a verdict on growth
+    /// (`bench_soak.rs`).
+    Soak,
 }
 
 #[derive(Args, Debug)]
@@ -93,6 +98,24 @@ pub struct BenchArgs {
     /// `bench lightcuts`: pixels the CPU reference refines (a regular subset).
     #[arg(long, default_value_t = 400)]
     pub cpu_pixels: u32,
+    /// `bench soak`: how long to run, minutes.
+    #[arg(long, default_value_t = 1.0)]
+    pub minutes: f64,
+    /// `bench soak`: the methods it cycles through (`all`: every per-frame method).
+    #[arg(long, default_value = "slc,lightcuts,light-culling,val")]
+    pub methods: String,
+    /// `bench soak`: seconds each method renders before the next.
+    #[arg(long, default_value_t = 10.0)]
+    pub switch_seconds: f64,
+    /// `bench soak`: seconds between printed samples.
+    #[arg(long, default_value_t = 1.0)]
+    pub sample_seconds: f64,
+    /// `bench soak`: folder for soak.csv and the plots.
+    #[arg(long, default_value = "soak")]
+    pub out: std::path::PathBuf,
+    /// `bench soak`: exit non-zero when live objects or resident memory grew.
+    #[arg(long)]
+    pub check: bool,
 }
 
 /// Area-weighted random points on the scene's triangles, with their geometric normals.
@@ -218,6 +241,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchKind::Tree => run_tree(args),
         BenchKind::Gbuffer => run_gbuffer(args),
         BenchKind::Lightcuts => super::bench_lightcuts::run(args),
+        BenchKind::Soak => super::bench_soak::run(args),
     }
 }
 
@@ -236,7 +260,7 @@ fn run_gbuffer(args: &BenchArgs) -> anyhow::Result<()> {
     let camera_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("bench::camera"),
         contents: bytemuck::bytes_of(&GpuCamera::new(&camera, size.0, size.1)),
-        usage: wgpu::BufferUsages::UNIFORM,
+        usage: crate::renderer::passes::PARAMS_USAGE,
     });
     println!(
         "scene: {} ({} triangles, one draw in file order), camera '{}', {}x{}",

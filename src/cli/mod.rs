@@ -2,6 +2,7 @@
 
 pub mod bench;
 pub mod bench_lightcuts;
+pub mod bench_soak;
 pub mod compare;
 pub mod export_scene;
 pub mod methods;

@@ -15,6 +15,7 @@ use crate::{
         context::GpuContext,
         readback::ImageF32,
         settings::{MethodId, MethodView, TreeColor, TreeOverlay, ViewBuffer},
+        soak::{self, Watch},
         timing::PassTimings,
     },
     scene::preset::{SceneSource, open_scene},
@@ -463,6 +464,15 @@ fn mean_timings(frames: &[PassTimings]) -> Option<PassTimings> {
     Some(PassTimings { passes })
 }
 
+/// Prints the run's resources line and writes them to resources.json (`render` and its
+/// sequences): live GPU objects and resident memory after the warm-up and at the end.
+pub(super) fn write_resources(out: &std::path::Path, report: &soak::Report) -> anyhow::Result<()> {
+    println!("{}", report.line());
+    let path = out.join("resources.json");
+    std::fs::write(&path, serde_json::to_string_pretty(report)?)
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
 /// metrics.json of a per-frame method: frames averaged, per-pass GPU times of the timed
 /// frames, the tree samplers' traversal statistics, and (with --compare-gt) RMSE / SSIM
 /// against the ground truth of the same VPLs.
@@ -653,6 +663,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         r.set_settings(s)?;
     }
     let n_timing = args.timing_frames.max(1);
+    // Live GPU objects and resident memory after 30 frames and at the end (issue 42).
+    let mut watch = Watch::new(Watch::WARM_FRAMES);
     let mut timed: Vec<PassTimings> = Vec::new();
     let mut wall_ms: Vec<f64> = Vec::new();
     // Progressive methods: the GPU time of every frame's passes adds up.
@@ -661,6 +673,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         let t0 = std::time::Instant::now();
         frame(&mut r, ViewBuffer::Final);
         r.ctx.wait_idle()?;
+        watch.frame(&r.ctx);
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         let t = r.wait_new_timings();
         gi_ms += t.as_ref().map_or(0.0, |t| method_ms(t, method));
@@ -695,6 +708,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             }
             frame(&mut r, ViewBuffer::Final);
             r.ctx.wait_idle()?;
+            watch.frame(&r.ctx);
         }
         frames_averaged = Some(r.sampling_frames());
         if let Some(st) = r.sampling_stats_blocking().filter(|_| method.samples_tree()) {
@@ -717,6 +731,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
         frame(&mut r, ViewBuffer::Final);
         r.ctx.wait_idle()?;
+        watch.frame(&r.ctx);
         if let Some(t) = r.wait_new_timings() {
             gi_ms += method_ms(&t, method);
         }
@@ -744,8 +759,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if let Some(e) = r.ctx.errors.take().into_iter().next() {
         return Err(anyhow!("GPU error: {e}"));
     }
-
     let out = &args.out;
+    write_resources(out, &watch.finish(&r.ctx))?;
+
     let direct = r.read(Buffer::Direct)?;
     let indirect = r.read(Buffer::Indirect)?;
     if wants(Output::Direct) {

@@ -13,7 +13,9 @@ use crate::{
         Csv, mean_std, num,
         sequence::{self, Motion, SeqFrame},
     },
-    renderer::{Buffer, Renderer, context::GpuContext, settings::RenderSettings, timing::PassTimings},
+    renderer::{
+        Buffer, Renderer, context::GpuContext, settings::RenderSettings, soak::Watch, timing::PassTimings,
+    },
     scene::{Camera, preset::OpenedScene},
 };
 
@@ -85,7 +87,10 @@ pub fn run(
     let timed: Vec<PassTimings> = sequence::time(&mut r, &settings, &m, m.len(), 2)?;
     // 2. Diagnostic frames: PNGs and, with --compare-gt, the errors.
     let wants_png = args.output.contains(&Output::All) || args.output.contains(&Output::Png);
+    // Live GPU objects and resident memory after 30 frames of the walk and at its end.
+    let watch = std::cell::RefCell::new(Watch::new(Watch::WARM_FRAMES));
     let write_frame = |r: &mut Renderer, i: usize| -> anyhow::Result<()> {
+        watch.borrow_mut().frame(&r.ctx);
         if wants_png {
             let (w, h, bytes) = r.read_view_rgba8()?;
             write_png(&out.join("frames").join(format!("{i:04}.png")), w, h, &bytes)?;
@@ -118,6 +123,7 @@ pub fn run(
     if let Some(e) = r.ctx.errors.take().into_iter().next() {
         return Err(anyhow!("GPU error: {e}"));
     }
+    super::render::write_resources(out, &watch.borrow().finish(&r.ctx))?;
     let mut csv = Csv::new(&[
         "frame",
         "camera_x",

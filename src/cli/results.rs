@@ -304,7 +304,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
             adapter.clone(),
         );
         b.bookmarks = sc.scene.cameras.clone();
-        b.scene_radius = sc.scene.bounds.radius().max(1e-3);
+        b.scene_radius = sc.scene.bounds.radius().max(1e-30);
         let mut figure_times = Vec::new();
         for f in &figures {
             let t = std::time::Instant::now();

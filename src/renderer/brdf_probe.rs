@@ -36,10 +36,13 @@ impl BrdfProbe {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "brdf_eval.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("brdf_eval::layout"),
-            entries: &[storage_entry(0, c, true), storage_entry(1, c, false)],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("brdf_eval::layout"),
+                entries: &[storage_entry(0, c, true), storage_entry(1, c, false)],
+            },
+        );
         Ok(Self {
             pipeline: compute_pipeline(device, "brdf_eval", &[Some(&layout)], &module, "main"),
             layout,

@@ -41,15 +41,18 @@ impl BvhTracer {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "bvh_rays.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("bvh_rays::layout"),
-            entries: &[
-                storage_entry(0, c, true),
-                storage_entry(1, c, true),
-                storage_entry(2, c, true),
-                storage_entry(3, c, false),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("bvh_rays::layout"),
+                entries: &[
+                    storage_entry(0, c, true),
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, true),
+                    storage_entry(3, c, false),
+                ],
+            },
+        );
         Ok(Self {
             any: compute_pipeline(
                 device,
@@ -188,20 +191,23 @@ impl SurfaceProbe {
         use super::passes::{float_array_texture_entry, uniform_entry};
         let module = shaders::create_module(device, "surface_rays.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("surface_rays::layout"),
-            entries: &[
-                storage_entry(0, c, true),
-                storage_entry(1, c, true),
-                storage_entry(2, c, true),
-                storage_entry(3, c, false),
-                storage_entry(4, c, true),
-                storage_entry(5, c, true),
-                storage_entry(6, c, true),
-                float_array_texture_entry(7),
-                uniform_entry(8, c),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("surface_rays::layout"),
+                entries: &[
+                    storage_entry(0, c, true),
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, true),
+                    storage_entry(3, c, false),
+                    storage_entry(4, c, true),
+                    storage_entry(5, c, true),
+                    storage_entry(6, c, true),
+                    float_array_texture_entry(7),
+                    uniform_entry(8, c),
+                ],
+            },
+        );
         Ok(Self {
             pipeline: compute_pipeline(device, "surface_rays", &[Some(&layout)], &module, "main"),
             layout,
@@ -239,7 +245,7 @@ impl SurfaceProbe {
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("surface_rays::params"),
             contents: bytemuck::cast_slice(&[lod, 0, 0, 0]),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: crate::renderer::passes::PARAMS_USAGE,
         });
         let bind = super::passes::bind_group_seq(
             device,

@@ -47,7 +47,7 @@ pub fn wanted_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
         max_texture_dimension_2d: a.max_texture_dimension_2d.min(16384),
         max_storage_buffer_binding_size: a.max_storage_buffer_binding_size.min(1 << 30),
         max_buffer_size: a.max_buffer_size.min(1 << 31),
-        max_storage_buffers_per_shader_stage: a.max_storage_buffers_per_shader_stage.min(16),
+        max_storage_buffers_per_shader_stage: a.max_storage_buffers_per_shader_stage.min(32),
         max_storage_textures_per_shader_stage: a.max_storage_textures_per_shader_stage.min(8),
         max_texture_array_layers: a.max_texture_array_layers.min(2048),
         ..wgpu::Limits::default()
@@ -80,28 +80,99 @@ pub fn describe_adapter(info: &wgpu::AdapterInfo) -> String {
 #[derive(Clone, Default)]
 pub struct ErrorSink {
     inner: Arc<Mutex<Vec<String>>>,
+    lost: Arc<std::sync::atomic::AtomicBool>,
+}
+
+/// The first GPU error of this process (validation, out of memory, device lost), for the CLI's
+/// exit status: a command that met one exits non-zero even where its own loop did not look.
+static FIRST_ERROR: Mutex<Option<String>> = Mutex::new(None);
+
+/// The first GPU error any [`ErrorSink`] of this process received.
+pub fn first_gpu_error() -> Option<String> {
+    FIRST_ERROR.lock().ok().and_then(|e| e.clone())
+}
+
+/// A wgpu error as one line naming the failing pass: our labels are `pass::object`, and wgpu
+/// says which labelled object the failing call was on ("In Device::create_bind_group, label =
+/// 'sst_build::bind_group'"); the pass is the label's first part.
+pub fn describe_gpu_error(kind: &str, text: &str) -> String {
+    let lines: Vec<&str> = text.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+    let label = text
+        .split("label = '")
+        .nth(1)
+        .and_then(|r| r.split('\'').next())
+        .filter(|l| !l.is_empty());
+    let call = lines.iter().find(|l| l.starts_with("In ")).map(|l| {
+        l.trim_start_matches("In ")
+            .split(',')
+            .next()
+            .unwrap_or("")
+            .to_string()
+    });
+    // The cause: what follows the "In ..." line, else every line but the headings.
+    let cause: Vec<&str> = match lines.iter().position(|l| l.starts_with("In ")) {
+        Some(i) => lines[i + 1..].to_vec(),
+        None => lines
+            .iter()
+            .copied()
+            .filter(|l| *l != "Caused by:" && !l.ends_with("Error"))
+            .collect(),
+    };
+    let cause = if cause.is_empty() {
+        lines.join(" ")
+    } else {
+        cause.join(" ")
+    };
+    match (label, call) {
+        (Some(l), call) => format!(
+            "GPU {kind} in pass '{}' ({}label '{l}'): {cause}",
+            l.split("::").next().unwrap_or(l),
+            call.map_or(String::new(), |c| format!("{c}, "))
+        ),
+        (None, Some(c)) => format!("GPU {kind} ({c}): {cause}"),
+        (None, None) => format!("GPU {kind}: {cause}"),
+    }
 }
 
 impl ErrorSink {
     pub fn install(&self, device: &wgpu::Device) {
-        let sink = self.inner.clone();
+        let sink = self.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-            let msg = e.to_string();
-            log::error!("GPU error: {msg}");
-            if let Ok(mut v) = sink.lock()
-                && !v.iter().any(|m| m == &msg)
-            {
-                v.push(msg);
-            }
+            let kind = match &e {
+                wgpu::Error::OutOfMemory { .. } => "out of memory",
+                wgpu::Error::Validation { .. } => "validation error",
+                wgpu::Error::Internal { .. } => "internal error",
+            };
+            let msg = describe_gpu_error(kind, &e.to_string());
+            log::error!("{msg}");
+            sink.report(msg);
         }));
+        let sink = self.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            // (Dropping a device does not call this; `destroy` does, with `Destroyed`.)
+            sink.lost.store(true, std::sync::atomic::Ordering::SeqCst);
+            let msg = format!("GPU device lost ({reason:?}): {message}");
+            log::error!("{msg}");
+            sink.report(msg);
+        });
     }
     /// Records a message (shown like a GPU error, once).
     pub fn report(&self, msg: String) {
+        if let Ok(mut first) = FIRST_ERROR.lock()
+            && first.is_none()
+        {
+            *first = Some(msg.clone());
+        }
         if let Ok(mut v) = self.inner.lock()
             && !v.contains(&msg)
         {
             v.push(msg);
         }
+    }
+
+    /// Whether the device was lost (everything made on it is gone).
+    pub fn device_lost(&self) -> bool {
+        self.lost.load(std::sync::atomic::Ordering::SeqCst)
     }
 
     /// Takes the errors gathered since the last call.
@@ -182,11 +253,84 @@ impl GpuContext {
         self.device.features().contains(wgpu::Features::TIMESTAMP_QUERY)
     }
 
+    /// The live GPU objects of each kind and the GPU memory held, from wgpu's internal
+    /// counters (the `counters` feature). A frame that allocates and frees the same objects
+    /// leaves these flat; a leak shows as a kind that grows from frame to frame.
+    pub fn live_objects(&self) -> LiveObjects {
+        let hal = self.device.get_internal_counters().hal;
+        LiveObjects {
+            buffers: hal.buffers.read(),
+            textures: hal.textures.read(),
+            texture_views: hal.texture_views.read(),
+            bind_groups: hal.bind_groups.read(),
+            bind_group_layouts: hal.bind_group_layouts.read(),
+            pipelines: hal.render_pipelines.read() + hal.compute_pipelines.read(),
+            pipeline_layouts: hal.pipeline_layouts.read(),
+            samplers: hal.samplers.read(),
+            command_encoders: hal.command_encoders.read(),
+            shader_modules: hal.shader_modules.read(),
+            query_sets: hal.query_sets.read(),
+            buffer_bytes: hal.buffer_memory.read(),
+            texture_bytes: hal.texture_memory.read(),
+            memory_allocations: hal.memory_allocations.read(),
+        }
+    }
+
     /// Blocks until all submitted work is done.
     pub fn wait_idle(&self) -> Result<(), GpuError> {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
             .map_err(|e| GpuError::Readback(e.to_string()))
+    }
+}
+
+/// Live GPU objects per kind (see [`GpuContext::live_objects`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct LiveObjects {
+    pub buffers: isize,
+    pub textures: isize,
+    pub texture_views: isize,
+    pub bind_groups: isize,
+    pub bind_group_layouts: isize,
+    pub pipelines: isize,
+    pub pipeline_layouts: isize,
+    pub samplers: isize,
+    pub command_encoders: isize,
+    pub shader_modules: isize,
+    pub query_sets: isize,
+    pub buffer_bytes: isize,
+    pub texture_bytes: isize,
+    pub memory_allocations: isize,
+}
+
+impl LiveObjects {
+    /// The counts that must not grow once a run is warm (memory sizes excluded: a pool
+    /// may keep its blocks).
+    pub fn objects(&self) -> [(&'static str, isize); 11] {
+        [
+            ("buffers", self.buffers),
+            ("textures", self.textures),
+            ("texture views", self.texture_views),
+            ("bind groups", self.bind_groups),
+            ("bind group layouts", self.bind_group_layouts),
+            ("pipelines", self.pipelines),
+            ("pipeline layouts", self.pipeline_layouts),
+            ("samplers", self.samplers),
+            ("command encoders", self.command_encoders),
+            ("shader modules", self.shader_modules),
+            ("query sets", self.query_sets),
+        ]
+    }
+
+    /// One line: every kind's count and the GPU memory in MiB.
+    pub fn summary(&self) -> String {
+        let mut s: Vec<String> = self.objects().iter().map(|(k, v)| format!("{v} {k}")).collect();
+        s.push(format!(
+            "{:.1} MiB buffers, {:.1} MiB textures",
+            self.buffer_bytes as f64 / 1048576.0,
+            self.texture_bytes as f64 / 1048576.0
+        ));
+        s.join(", ")
     }
 }

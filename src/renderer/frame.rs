@@ -113,6 +113,8 @@ pub struct ShadowTargets {
 
 pub const RSM_POSITION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const RSM_NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Flux in watts (albedo x E x texel area), in half floats: 6e-8..65504 W a texel, which a scene
+/// of metres holds (`Scene::scale_warnings` names the scales that it does not).
 pub const RSM_FLUX_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 fn array_and_layers(

@@ -81,7 +81,7 @@ pub fn light_frustum(direction: Vec3, bounds: &Aabb, resolution: u32) -> (Mat4, 
     let (c, r) = if bounds.is_empty() {
         (Vec3::ZERO, 1.0)
     } else {
-        (bounds.center(), bounds.radius().max(1e-3))
+        (bounds.center(), bounds.radius().max(1e-30))
     };
     let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
     let eye = c - dir * (2.0 * r);
@@ -101,7 +101,7 @@ pub fn light_frustum(direction: Vec3, bounds: &Aabb, resolution: u32) -> (Mat4, 
         hi = hi.max(q);
     }
     // Square texels: use the larger extent for both axes; pad half a texel each side.
-    let ext = (hi.x - lo.x).max(hi.y - lo.y).max(1e-3);
+    let ext = (hi.x - lo.x).max(hi.y - lo.y).max(1e-6 * r);
     let pad = ext / resolution as f32;
     let cx = 0.5 * (lo.x + hi.x);
     let cy = 0.5 * (lo.y + hi.y);

@@ -13,6 +13,7 @@ pub mod readback;
 pub mod scene_gpu;
 pub mod settings;
 pub mod shaders;
+pub mod soak;
 pub mod temporal_settings;
 pub mod timing;
 pub mod views;
@@ -260,7 +261,9 @@ impl Renderer {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
                 size: size as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::UNIFORM
+                    | wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             })
         };

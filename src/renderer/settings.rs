@@ -820,15 +820,16 @@ impl RenderSettings {
             ));
         }
         let g = &self.gi;
-        if !(g.distance_epsilon > 0.0 && g.distance_epsilon <= 100.0) {
+        if !(g.distance_epsilon > 0.0 && g.distance_epsilon.is_finite()) {
             return Err(format!(
-                "gi.distance_epsilon {} is out of range (0..=100 m, > 0)",
+                "gi.distance_epsilon {} must be a finite distance > 0 m",
                 g.distance_epsilon
             ));
         }
-        if !(0.0..=1.0).contains(&g.ray_offset) {
+        // Metres, so any size: a scene modelled in millimetres-as-metres needs a large one.
+        if !(g.ray_offset.is_finite() && g.ray_offset >= 0.0) {
             return Err(format!(
-                "gi.ray_offset {} is out of range (0..=1 m)",
+                "gi.ray_offset {} must be a finite distance >= 0 m",
                 g.ray_offset
             ));
         }

@@ -285,12 +285,24 @@ pub fn validate(name: &str, text: &str) -> Result<naga::Module, ShaderError> {
     Ok(module)
 }
 
+/// `var<uniform>` declarations read as `var<storage, read>` (the same struct layout).
+pub fn uniforms_to_storage(text: &str) -> String {
+    text.replace("var<uniform>", "var<storage, read>")
+}
+
 /// Creates a wgpu shader module from a (preprocessed) shader.
 pub fn create_module(device: &wgpu::Device, name: &str) -> Result<wgpu::ShaderModule, ShaderError> {
     let text = if ShaderSourceDisk::reload_from_disk() {
         load_validated(&ShaderSourceDisk, name)?
     } else {
         load_validated(&Embedded, name)?
+    };
+    // Parameter blocks as read-only storage where the layouts make them so (lavapipe; see
+    // `passes::uniforms_as_storage`).
+    let text = if super::passes::uniforms_as_storage(device) {
+        uniforms_to_storage(&text)
+    } else {
+        text
     };
     Ok(device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(name),
@@ -348,6 +360,63 @@ mod tests {
             if let Err(e) = load_validated(&Embedded, name) {
                 panic!("{e}");
             }
+        }
+    }
+
+    /// The storage rewrite (lavapipe, `passes::uniforms_as_storage`) leaves no uniform
+    /// binding behind, validates, and keeps every global at the same group and binding.
+    #[test]
+    fn every_shader_reads_its_uniforms_as_storage_with_the_same_bindings() {
+        for name in entry_shaders() {
+            let text = load_validated(&Embedded, name).unwrap();
+            let rewritten = uniforms_to_storage(&text);
+            assert!(
+                !rewritten.contains("uniform>"),
+                "{name}: a uniform declaration the rewrite missed"
+            );
+            let a = validate(name, &text).unwrap();
+            let b = validate(name, &rewritten).unwrap_or_else(|e| panic!("{e}"));
+            let bindings = |m: &naga::Module| -> Vec<_> {
+                m.global_variables
+                    .iter()
+                    .map(|(_, g)| (g.name.clone(), g.binding, g.ty))
+                    .collect()
+            };
+            assert_eq!(bindings(&a), bindings(&b), "{name}");
+            for (_, g) in b.global_variables.iter() {
+                assert_ne!(g.space, naga::AddressSpace::Uniform, "{name}: {:?}", g.name);
+            }
+        }
+    }
+
+    /// Every bind group layout is made by `passes::bind_group_layout`, so that none keeps a
+    /// uniform binding the rewritten shaders no longer declare.
+    #[test]
+    fn bind_group_layouts_are_made_in_one_place() {
+        fn walk(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+            for e in std::fs::read_dir(dir).unwrap().flatten() {
+                let p = e.path();
+                if p.is_dir() {
+                    walk(&p, out);
+                } else if p.extension().is_some_and(|x| x == "rs") {
+                    out.push(p);
+                }
+            }
+        }
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut files = Vec::new();
+        walk(&root.join("src"), &mut files);
+        walk(&root.join("tests"), &mut files);
+        let call = ["create_bind_group", "_layout("].concat();
+        for f in files {
+            let text = std::fs::read_to_string(&f).unwrap();
+            let n = text.matches(&call).count();
+            let allowed = usize::from(f.ends_with("src/renderer/passes/mod.rs")) * 2;
+            assert!(
+                n <= allowed,
+                "{}: {n} direct layout creation(s); use passes::bind_group_layout",
+                f.display()
+            );
         }
     }
 }

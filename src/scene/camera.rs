@@ -45,12 +45,69 @@ impl Camera {
         let (c, r) = if bounds.is_empty() {
             (Vec3::ZERO, 1.0)
         } else {
-            (bounds.center(), bounds.radius().max(1e-3))
+            // Any scale: a scene of micrometres is framed as one of metres is.
+            (bounds.center(), bounds.radius().max(f32::MIN_POSITIVE * 1e6))
         };
         let yfov = 50f32.to_radians();
         let dist = r / (0.5 * yfov).sin();
         let eye = c + Vec3::new(0.35, 0.35, 1.0).normalize() * dist;
         Self::look_at("framing", eye, c, yfov, dist * 1e-3, dist + 2.0 * r)
+    }
+
+    /// The view depths (along `forward`) that `bounds` spans from this camera: (nearest, farthest),
+    /// the nearest 0 when the camera is inside or beside them; None when all of them lie
+    /// behind the camera.
+    pub fn depth_range(&self, bounds: &Aabb) -> Option<(f32, f32)> {
+        let mut lo = f32::INFINITY;
+        let mut hi = f32::NEG_INFINITY;
+        for i in 0..8 {
+            let c = Vec3::new(
+                if i & 1 == 0 { bounds.min.x } else { bounds.max.x },
+                if i & 2 == 0 { bounds.min.y } else { bounds.max.y },
+                if i & 4 == 0 { bounds.min.z } else { bounds.max.z },
+            );
+            let z = (c - self.position).dot(self.forward);
+            lo = lo.min(z);
+            hi = hi.max(z);
+        }
+        (hi > 0.0 && hi.is_finite()).then_some((lo.max(0.0), hi))
+    }
+
+    /// When the clip range [znear, zfar] misses `bounds` (holds under 10^-3 of their depths: a
+    /// scene scaled by 10^6 beyond a fixed far plane, or by 10^-6 inside the near plane), a
+    /// range from the bounds'
+    /// depths: far twice the farthest, near 10^-3 of it or the old near if smaller, but at
+    /// least 10^-6 of far (depth precision). Returns the warning to show; None when the range
+    /// already holds some of the scene (or the scene is behind the camera).
+    pub fn fit_clip_range(&mut self, bounds: &Aabb) -> Option<String> {
+        if bounds.is_empty() {
+            return None;
+        }
+        let (lo, hi) = self.depth_range(bounds)?;
+        // Misses: the clip range holds less than 10^-3 of the depths the bounds span (none of
+        // them, or a sliver: a camera inside a room scaled by 10^6 with its far plane at 30 m).
+        let overlap = self.zfar.min(hi) - self.znear.max(lo);
+        let holds = self.znear.is_finite()
+            && self.znear > 0.0
+            && self.zfar > self.znear
+            && overlap.partial_cmp(&(1e-3 * (hi - lo))) != Some(std::cmp::Ordering::Less)
+            && !overlap.is_nan();
+        let misses = !holds;
+        if !misses {
+            return None;
+        }
+        let (old_near, old_far) = (self.znear, self.zfar);
+        self.zfar = 2.0 * hi;
+        let near = if old_near.is_finite() && old_near > 0.0 {
+            old_near.min(1e-3 * hi)
+        } else {
+            1e-3 * hi
+        };
+        self.znear = near.max(1e-6 * self.zfar);
+        Some(format!(
+            "camera '{}': its clip range {old_near:.3e}..{old_far:.3e} misses the scene ({lo:.3e}..{hi:.3e} in front of it); using {:.3e}..{:.3e}",
+            self.name, self.znear, self.zfar
+        ))
     }
 
     pub fn right(&self) -> Vec3 {

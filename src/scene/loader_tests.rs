@@ -1146,3 +1146,77 @@ fn camera_bookmarks_append_to_a_preset_and_load_as_cameras() {
     assert!((back.forward - cam.forward).length() < 1e-3);
     assert!((back.yfov - cam.yfov).abs() < 1e-4);
 }
+
+/// A sun with `intensity` and `color` (JSON text) over one triangle.
+fn sun_file(dir: &Path, name: &str, intensity: &str, color: &str) -> PathBuf {
+    let rest = format!(
+        r#"{ONE_NODE_NO_SCENE},
+"extensionsUsed":["KHR_lights_punctual"],
+"extensions":{{"KHR_lights_punctual":{{"lights":[
+  {{"name":"Noon","type":"directional","intensity":{intensity},"color":{color}}}]}}}},
+"nodes":[{{"mesh":0}},{{"name":"sunnode","extensions":{{"KHR_lights_punctual":{{"light":0}}}}}}],
+"scenes":[{{"nodes":[0,1]}}],"scene":0"#
+    );
+    one_triangle().write(dir, name, &rest)
+}
+
+#[test]
+fn negative_or_non_finite_light_is_refused_naming_the_light() {
+    let dir = temp_dir("badlight");
+    for (i, (intensity, color)) in [("-3.0", "[1,1,1]"), ("2.0", "[1,-0.5,1]"), ("1e39", "[1,1,1]")]
+        .into_iter()
+        .enumerate()
+    {
+        let err = load_gltf(&sun_file(&dir, &format!("l{i}"), intensity, color)).unwrap_err();
+        let msg = err.to_string();
+        assert!(matches!(err, SceneError::InvalidGltf { .. }), "{msg}");
+        assert!(
+            msg.contains("'Noon'") && msg.contains("must be finite and >= 0"),
+            "{msg}"
+        );
+        assert!(!msg.contains('\n'), "one line: {msg}");
+    }
+    let ok = load_gltf(&sun_file(&dir, "ok", "0.0", "[1,1,1]")).unwrap();
+    assert_eq!(ok.lights[0].irradiance, Vec3::ZERO, "a dark sun is allowed");
+}
+
+/// One triangle under a node scaled by `scale`, seen by a camera 2 units away (before the
+/// scale) with the clip range 0.05..100.
+fn scaled_scene(dir: &Path, name: &str, scale: f32) -> Scene {
+    let rest = format!(
+        r#"{ONE_NODE_NO_SCENE},
+"cameras":[{{"name":"Cam","type":"perspective","perspective":{{"yfov":0.8,"znear":0.05,"zfar":100.0}}}}],
+"nodes":[{{"scale":[{scale},{scale},{scale}],"children":[1,2]}},{{"mesh":0}},
+  {{"name":"camnode","translation":[0.3,0.3,2],"camera":0}}],
+"scenes":[{{"nodes":[0]}}],"scene":0"#
+    );
+    load_gltf(&one_triangle().write(dir, name, &rest)).unwrap()
+}
+
+#[test]
+fn a_camera_whose_clip_range_misses_a_scaled_scene_gets_one_from_the_bounds() {
+    let dir = temp_dir("scaled");
+    let s = scaled_scene(&dir, "one", 1.0);
+    assert_eq!(
+        (s.cameras[0].znear, s.cameras[0].zfar),
+        (0.05, 100.0),
+        "kept when it fits"
+    );
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    for scale in [1e6f32, 1e-6] {
+        let s = scaled_scene(&dir, &format!("s{}", scale.log10()), scale);
+        let c = &s.cameras[0];
+        let (lo, hi) = c.depth_range(&s.bounds).unwrap();
+        assert!(
+            lo <= hi && (hi - 2.0 * scale).abs() < 0.01 * scale,
+            "{scale}: {lo}..{hi}"
+        );
+        assert!(
+            c.znear < lo.max(1e-3 * hi) + 1e-30 && c.zfar > hi && c.zfar / c.znear <= 1.0001e6,
+            "{scale}: {}..{} for the scene's {lo}..{hi}",
+            c.znear,
+            c.zfar
+        );
+        assert!(has_warning(&s, "misses the scene"), "{scale}: {:?}", s.warnings);
+    }
+}

@@ -214,6 +214,52 @@ impl Scene {
             self.positions[i[2] as usize],
         ]
     }
+    /// Warnings for a scene whose size defeats the settings kept in metres (a file exported
+    /// in the wrong unit, scaled by 10^6 or 10^-6): shadow rays offset by `gi.ray_offset`
+    /// (default 1 mm) start inside their own surface where a float's step at the scene's
+    /// coordinates is larger (black GI), and `gi.distance_epsilon` (default 5 cm) clamps
+    /// every VPL of a scene not much larger than it (dark GI). Each names the setting to change.
+    pub fn scale_warnings(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.bounds.is_empty() {
+            return out;
+        }
+        let defaults = crate::renderer::settings::GiSettings::default();
+        let extent = self.bounds.min.abs().max(self.bounds.max.abs()).max_element();
+        let step = extent * f32::EPSILON;
+        if 16.0 * step > defaults.ray_offset {
+            out.push(format!(
+                "coordinates reach {extent:.3e} m, where a float's step is {step:.1e} m: the default gi.ray_offset of {} m cannot lift shadow rays off their surfaces (black GI); set gi.ray_offset to at least {:.2e} (--set gi.ray_offset=..., or a settings file)",
+                defaults.ray_offset,
+                64.0 * step
+            ));
+        }
+        let radius = self.bounds.radius();
+        if radius < 20.0 * defaults.distance_epsilon {
+            out.push(format!(
+                "the scene's radius is {radius:.3e} m, not much larger than the default gi.distance_epsilon of {} m, which bounds every VPL's distance from below (dark GI); set gi.distance_epsilon to about {:.2e} (--set gi.distance_epsilon=...)",
+                defaults.distance_epsilon,
+                radius * 0.01
+            ));
+        }
+        // The RSM keeps each texel's flux (albedo x E x texel area, W) in half floats: at the
+        // default 512 texels over the scene's diameter, a sun of E W/m^2 on albedo 0.5 gives
+        // 0.5 E (2 r / 512)^2 W, which must lie in 6e-8..65504.
+        let e = self
+            .lights
+            .iter()
+            .map(|l| l.irradiance.max_element())
+            .fold(0.0f32, f32::max);
+        let texel_flux = 0.5 * e * (2.0 * radius / 512.0).powi(2);
+        if e > 0.0 && !(6e-8..=65504.0).contains(&texel_flux) {
+            out.push(format!(
+                "a reflective-shadow-map texel of this scene carries ~{texel_flux:.1e} W, outside the half floats' 6e-8..65504 the RSM stores flux in: its VPLs will be {}; is the file in metres? (rescale it)",
+                if texel_flux < 6e-8 { "black" } else { "infinite" }
+            ));
+        }
+        out
+    }
+
     pub fn recompute_bounds(&mut self) {
         let mut b = Aabb::EMPTY;
         for &p in &self.positions {

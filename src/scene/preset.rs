@@ -354,6 +354,10 @@ pub fn open_scene(src: &SceneSource) -> Result<OpenedScene, SceneError> {
         }
     };
     let scene = &mut opened.scene;
+    for w in scene.scale_warnings() {
+        log::warn!("{w}");
+        scene.warnings.push(w);
+    }
     if scene.lights.is_empty() {
         let msg = format!(
             "the scene has no directional light; a default sun (azimuth 30, elevation 60 degrees, {DEFAULT_SUN_IRRADIANCE} W/m^2) was added"

@@ -24,19 +24,22 @@ impl GroundTruthPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "methods/ground_truth/ground_truth.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ground_truth::layout"),
-            entries: &[
-                dynamic_uniform_entry(0, c, std::mem::size_of::<GpuGtParams>() as u64),
-                storage_entry(1, c, true),
-                storage_entry(2, c, true),
-                storage_entry(3, c, true),
-                float_texture_entry(4),
-                float_texture_entry(5),
-                float_texture_entry(6),
-                storage_entry(7, c, false),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("ground_truth::layout"),
+                entries: &[
+                    dynamic_uniform_entry(0, c, std::mem::size_of::<GpuGtParams>() as u64),
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, true),
+                    storage_entry(3, c, true),
+                    float_texture_entry(4),
+                    float_texture_entry(5),
+                    float_texture_entry(6),
+                    storage_entry(7, c, false),
+                ],
+            },
+        );
         let pipeline = compute_pipeline(
             device,
             "ground_truth::pipeline",
@@ -47,7 +50,7 @@ impl GroundTruthPass {
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("ground_truth::params"),
             size: STRIDE * MAX_BATCHES as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         Ok(Self {

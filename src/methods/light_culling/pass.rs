@@ -341,10 +341,13 @@ impl LcullPass {
         let vmod = shaders::create_module(device, "methods/light_culling/lcull_views.wgsl")?;
         let trmod = shaders::create_module(device, "methods/light_culling/lcull_tree.wgsl")?;
         let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(label),
-                entries,
-            })
+            crate::renderer::passes::bind_group_layout(
+                device,
+                &wgpu::BindGroupLayoutDescriptor {
+                    label: Some(label),
+                    entries,
+                },
+            )
         };
         let ranges_layout = layout(
             "lcull_ranges::layout",

@@ -353,10 +353,13 @@ impl LiPass {
         let vmod = shaders::create_module(device, "methods/lightcut_interpolation/li_views.wgsl")?;
         let psize = std::mem::size_of::<GpuLiParams>() as u64;
         let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(label),
-                entries,
-            })
+            crate::renderer::passes::bind_group_layout(
+                device,
+                &wgpu::BindGroupLayoutDescriptor {
+                    label: Some(label),
+                    entries,
+                },
+            )
         };
         let mut re = vec![
             dynamic_uniform_entry(0, c, psize),

@@ -295,10 +295,13 @@ impl CutKernel {
         entries.push(storage_entry(17, c, false));
         entries.push(storage_entry(18, c, false));
         entries.push(storage_entry(19, c, true));
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lightcuts::layout"),
-            entries: &entries,
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("lightcuts::layout"),
+                entries: &entries,
+            },
+        );
         let (mode_f, base_f) = (mode as f64, stats_base as f64);
         let consts = [("MODE", mode_f), ("STATS_BASE", base_f)];
         let timed = [("DIAGNOSTICS", 0.0), ("MODE", mode_f), ("STATS_BASE", base_f)];
@@ -414,30 +417,36 @@ impl BuildKernel {
         let c = wgpu::ShaderStages::COMPUTE;
         let module = shaders::create_module(device, "methods/lightcuts/lc_build.wgsl")?;
         let uniform = dynamic_uniform_entry(0, c, std::mem::size_of::<GpuLcBuildParams>() as u64);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lightcuts_build::layout"),
-            entries: &[
-                uniform,
-                storage_entry(1, c, true),
-                storage_entry(2, c, true),
-                storage_entry(3, c, false),
-                storage_entry(4, c, false),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("lightcuts_build::layout"),
+                entries: &[
+                    uniform,
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, true),
+                    storage_entry(3, c, false),
+                    storage_entry(4, c, false),
+                ],
+            },
+        );
         let rmodule = shaders::create_module(device, "methods/lightcuts/lc_build_radix.wgsl")?;
-        let radix_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lightcuts_build_radix::layout"),
-            entries: &[
-                uniform,
-                storage_entry(1, c, true),
-                storage_entry(2, c, true),
-                storage_entry(3, c, false),
-                storage_entry(4, c, false),
-                storage_entry(5, c, true),
-                storage_entry(6, c, true),
-                storage_entry(7, c, false),
-            ],
-        });
+        let radix_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("lightcuts_build_radix::layout"),
+                entries: &[
+                    uniform,
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, true),
+                    storage_entry(3, c, false),
+                    storage_entry(4, c, false),
+                    storage_entry(5, c, true),
+                    storage_entry(6, c, true),
+                    storage_entry(7, c, false),
+                ],
+            },
+        );
         Ok(Self {
             build: compute_pipeline_with(device, "lightcuts_build", &[Some(&layout)], &module, "main", &[]),
             radix: compute_pipeline_with(
@@ -551,16 +560,19 @@ impl LightcutsPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let c = wgpu::ShaderStages::COMPUTE;
         let vmod = shaders::create_module(device, "methods/lightcuts/lc_views.wgsl")?;
-        let views_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lightcuts_views::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                float_texture_entry(1),
-                float_texture_entry(2),
-                storage_entry(3, c, true),
-                storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm),
-            ],
-        });
+        let views_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("lightcuts_views::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    float_texture_entry(1),
+                    float_texture_entry(2),
+                    storage_entry(3, c, true),
+                    storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm),
+                ],
+            },
+        );
         Ok(Self {
             build: BuildKernel::new(device)?,
             cut: CutKernel::new(device, 0, 0)?,

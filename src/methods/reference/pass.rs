@@ -45,25 +45,28 @@ impl ReferencePass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "methods/reference/reference.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("reference::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                uniform_entry(1, c),
-                float_array_texture_entry(2),
-                float_array_texture_entry(3),
-                float_array_texture_entry(4),
-                float_texture_entry(5),
-                float_texture_entry(6),
-                float_texture_entry(7),
-                storage_entry(8, c, true),
-                storage_entry(9, c, true),
-                storage_entry(10, c, true),
-                storage_entry(11, c, true),
-                storage_entry(12, c, true),
-                storage_entry(13, c, false),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("reference::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    uniform_entry(1, c),
+                    float_array_texture_entry(2),
+                    float_array_texture_entry(3),
+                    float_array_texture_entry(4),
+                    float_texture_entry(5),
+                    float_texture_entry(6),
+                    float_texture_entry(7),
+                    storage_entry(8, c, true),
+                    storage_entry(9, c, true),
+                    storage_entry(10, c, true),
+                    storage_entry(11, c, true),
+                    storage_entry(12, c, true),
+                    storage_entry(13, c, false),
+                ],
+            },
+        );
         let pipeline = compute_pipeline(device, "reference::pipeline", &[Some(&layout)], &module, "main");
         let params = uniform_buffer::<GpuRefParams>(device, "reference::params");
         Ok(Self {

@@ -70,32 +70,38 @@ impl HalfPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let c = wgpu::ShaderStages::COMPUTE;
         let dmod = shaders::create_module(device, "methods/tree_samplers/slc_half.wgsl")?;
-        let down_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("slc_half::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                float_texture_entry(1),
-                float_texture_entry(2),
-                float_texture_entry(3),
-                storage_texture_entry(4, crate::renderer::passes::gbuffer::POSITION_FORMAT),
-                storage_texture_entry(5, crate::renderer::passes::gbuffer::NORMAL_FORMAT),
-                storage_texture_entry(6, crate::renderer::passes::gbuffer::ALBEDO_FORMAT),
-            ],
-        });
+        let down_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("slc_half::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    float_texture_entry(1),
+                    float_texture_entry(2),
+                    float_texture_entry(3),
+                    storage_texture_entry(4, crate::renderer::passes::gbuffer::POSITION_FORMAT),
+                    storage_texture_entry(5, crate::renderer::passes::gbuffer::NORMAL_FORMAT),
+                    storage_texture_entry(6, crate::renderer::passes::gbuffer::ALBEDO_FORMAT),
+                ],
+            },
+        );
         let umod = shaders::create_module(device, "methods/tree_samplers/slc_upsample.wgsl")?;
-        let up_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("slc_upsample::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                float_texture_entry(1),
-                float_texture_entry(2),
-                float_texture_entry(3),
-                float_texture_entry(4),
-                float_texture_entry(5),
-                storage_entry(6, c, true),
-                storage_entry(7, c, false),
-            ],
-        });
+        let up_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("slc_upsample::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    float_texture_entry(1),
+                    float_texture_entry(2),
+                    float_texture_entry(3),
+                    float_texture_entry(4),
+                    float_texture_entry(5),
+                    storage_entry(6, c, true),
+                    storage_entry(7, c, false),
+                ],
+            },
+        );
         Ok(Self {
             down: compute_pipeline(device, "slc_half", &[Some(&down_layout)], &dmod, "downsample"),
             up: compute_pipeline(device, "slc_upsample", &[Some(&up_layout)], &umod, "upsample"),

@@ -384,54 +384,63 @@ impl SlcPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let c = wgpu::ShaderStages::COMPUTE;
         let cmod = shaders::create_module(device, "methods/tree_samplers/slc_cuts.wgsl")?;
-        let cuts_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("slc_cuts::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                storage_entry(1, c, true),
-                float_texture_entry(2),
-                float_texture_entry(3),
-                storage_entry(4, c, false),
-                storage_entry(5, c, true),
-            ],
-        });
+        let cuts_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("slc_cuts::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    storage_entry(1, c, true),
+                    float_texture_entry(2),
+                    float_texture_entry(3),
+                    storage_entry(4, c, false),
+                    storage_entry(5, c, true),
+                ],
+            },
+        );
         let smod = shaders::create_module(device, "methods/tree_samplers/slc_sample.wgsl")?;
-        let sample_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("slc_sample::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                storage_entry(1, c, true),
-                storage_entry(2, c, true),
-                storage_entry(3, c, true),
-                storage_entry(4, c, true),
-                storage_entry(5, c, true),
-                storage_entry(6, c, true),
-                float_texture_entry(7),
-                float_texture_entry(8),
-                float_texture_entry(9),
-                storage_entry(10, c, false),
-                storage_entry(11, c, false),
-                storage_entry(12, c, false),
-                storage_entry(13, c, false),
-                uniform_entry(14, c),
-                storage_entry(15, c, true),
-                storage_entry(16, c, false),
-                storage_entry(17, c, true),
-            ],
-        });
+        let sample_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("slc_sample::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, true),
+                    storage_entry(3, c, true),
+                    storage_entry(4, c, true),
+                    storage_entry(5, c, true),
+                    storage_entry(6, c, true),
+                    float_texture_entry(7),
+                    float_texture_entry(8),
+                    float_texture_entry(9),
+                    storage_entry(10, c, false),
+                    storage_entry(11, c, false),
+                    storage_entry(12, c, false),
+                    storage_entry(13, c, false),
+                    uniform_entry(14, c),
+                    storage_entry(15, c, true),
+                    storage_entry(16, c, false),
+                    storage_entry(17, c, true),
+                ],
+            },
+        );
         let vmod = shaders::create_module(device, "methods/tree_samplers/slc_views.wgsl")?;
-        let views_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("slc_views::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                float_texture_entry(1),
-                float_texture_entry(2),
-                storage_entry(3, c, true),
-                storage_entry(4, c, true),
-                storage_texture_entry(5, crate::renderer::passes::display::VIEW_FORMAT),
-                storage_entry(6, c, true),
-            ],
-        });
+        let views_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("slc_views::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    float_texture_entry(1),
+                    float_texture_entry(2),
+                    storage_entry(3, c, true),
+                    storage_entry(4, c, true),
+                    storage_texture_entry(5, crate::renderer::passes::display::VIEW_FORMAT),
+                    storage_entry(6, c, true),
+                ],
+            },
+        );
         Ok(Self {
             views: compute_pipeline(device, "slc_views", &[Some(&views_layout)], &vmod, "main"),
             views_layout,

@@ -234,10 +234,13 @@ impl ValPass {
         let vmod = shaders::create_module(device, "methods/val/val_views.wgsl")?;
         let dmod = shaders::create_module(device, "methods/val/val_downsample.wgsl")?;
         let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(label),
-                entries,
-            })
+            crate::renderer::passes::bind_group_layout(
+                device,
+                &wgpu::BindGroupLayoutDescriptor {
+                    label: Some(label),
+                    entries,
+                },
+            )
         };
         let mut se = vec![
             uniform_entry(0, c),

@@ -35,16 +35,19 @@ pub struct CompareViewsPass {
 impl CompareViewsPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "compare_views.wgsl")?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("compare_views::layout"),
-            entries: &[
-                uniform_entry(0, wgpu::ShaderStages::COMPUTE),
-                float_texture_entry(1),
-                float_texture_entry(2),
-                float_texture_entry(3),
-                storage_texture_entry(4, VIEW_FORMAT),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("compare_views::layout"),
+                entries: &[
+                    uniform_entry(0, wgpu::ShaderStages::COMPUTE),
+                    float_texture_entry(1),
+                    float_texture_entry(2),
+                    float_texture_entry(3),
+                    storage_texture_entry(4, VIEW_FORMAT),
+                ],
+            },
+        );
         Ok(Self {
             pipeline: compute_pipeline(device, "compare_views", &[Some(&layout)], &module, "main"),
             params: uniform_buffer::<GpuCmpParams>(device, "compare_views::params"),

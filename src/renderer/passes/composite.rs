@@ -30,16 +30,19 @@ impl CompositePass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "composite.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("composite::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                float_texture_entry(1),
-                storage_entry(2, c, true),
-                storage_texture_entry(3, RADIANCE_FORMAT),
-                storage_texture_entry(4, RADIANCE_FORMAT),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("composite::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    float_texture_entry(1),
+                    storage_entry(2, c, true),
+                    storage_texture_entry(3, RADIANCE_FORMAT),
+                    storage_texture_entry(4, RADIANCE_FORMAT),
+                ],
+            },
+        );
         let pipeline = compute_pipeline(device, "composite::pipeline", &[Some(&layout)], &module, "main");
         let params = uniform_buffer::<GpuCompositeParams>(device, "composite::params");
         Ok(Self {

@@ -25,29 +25,32 @@ impl DirectPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "direct.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("direct::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                uniform_entry(1, c),
-                texture_entry(
-                    2,
-                    c,
-                    wgpu::TextureSampleType::Depth,
-                    wgpu::TextureViewDimension::D2Array,
-                ),
-                float_texture_entry(3),
-                float_texture_entry(4),
-                float_texture_entry(5),
-                storage_texture_entry(6, RADIANCE_FORMAT),
-                uniform_entry(7, c),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("direct::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    uniform_entry(1, c),
+                    texture_entry(
+                        2,
+                        c,
+                        wgpu::TextureSampleType::Depth,
+                        wgpu::TextureViewDimension::D2Array,
+                    ),
+                    float_texture_entry(3),
+                    float_texture_entry(4),
+                    float_texture_entry(5),
+                    storage_texture_entry(6, RADIANCE_FORMAT),
+                    uniform_entry(7, c),
+                ],
+            },
+        );
         let pipeline = compute_pipeline(device, "direct::pipeline", &[Some(&layout)], &module, "main");
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("direct::params"),
             size: 16,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         Ok(Self {

@@ -19,14 +19,17 @@ pub struct DisplayPass {
 impl DisplayPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "display.wgsl")?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("display::layout"),
-            entries: &[
-                uniform_entry(0, wgpu::ShaderStages::COMPUTE),
-                float_texture_entry(1),
-                storage_texture_entry(2, VIEW_FORMAT),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("display::layout"),
+                entries: &[
+                    uniform_entry(0, wgpu::ShaderStages::COMPUTE),
+                    float_texture_entry(1),
+                    storage_texture_entry(2, VIEW_FORMAT),
+                ],
+            },
+        );
         let pipeline = compute_pipeline(device, "display::pipeline", &[Some(&layout)], &module, "main");
         let params = uniform_buffer::<DisplayParams>(device, "display::params");
         Ok(Self {

@@ -75,25 +75,28 @@ impl GbufferPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "gbuffer.wgsl")?;
         let vis = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gbuffer::layout"),
-            entries: &[
-                uniform_entry(0, vis),
-                storage_entry(1, wgpu::ShaderStages::FRAGMENT, true),
-                texture_entry(
-                    2,
-                    wgpu::ShaderStages::FRAGMENT,
-                    wgpu::TextureSampleType::Float { filterable: true },
-                    wgpu::TextureViewDimension::D2Array,
-                ),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("gbuffer::layout"),
+                entries: &[
+                    uniform_entry(0, vis),
+                    storage_entry(1, wgpu::ShaderStages::FRAGMENT, true),
+                    texture_entry(
+                        2,
+                        wgpu::ShaderStages::FRAGMENT,
+                        wgpu::TextureSampleType::Float { filterable: true },
+                        wgpu::TextureViewDimension::D2Array,
+                    ),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 3,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                        count: None,
+                    },
+                ],
+            },
+        );
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer::pipeline_layout"),
             bind_group_layouts: &[Some(&layout)],
@@ -329,10 +332,13 @@ const COUNT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 impl OverdrawCounter {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "gbuffer_overdraw.wgsl")?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("overdraw::layout"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("overdraw::layout"),
+                entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
+            },
+        );
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("overdraw::pipeline_layout"),
             bind_group_layouts: &[Some(&layout)],

@@ -99,18 +99,21 @@ impl InterleaveFilter {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let c = wgpu::ShaderStages::COMPUTE;
         let module = shaders::create_module(device, "interleave_filter.wgsl")?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("interleave_filter::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                uniform_entry(1, c),
-                float_texture_entry(2),
-                float_texture_entry(3),
-                float_texture_entry(4),
-                storage_entry(5, c, true),
-                storage_entry(6, c, false),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("interleave_filter::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    uniform_entry(1, c),
+                    float_texture_entry(2),
+                    float_texture_entry(3),
+                    float_texture_entry(4),
+                    storage_entry(5, c, true),
+                    storage_entry(6, c, false),
+                ],
+            },
+        );
         Ok(Self {
             pipeline: compute_pipeline(device, "interleave_filter", &[Some(&layout)], &module, "main"),
             layout,

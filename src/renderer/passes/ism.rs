@@ -251,29 +251,35 @@ impl IsmPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let c = wgpu::ShaderStages::COMPUTE;
         let module = shaders::create_module(device, "ism.wgsl")?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ism::layout"),
-            entries: &[
-                dynamic_uniform_entry(0, c, std::mem::size_of::<GpuIsmParams>() as u64),
-                storage_entry(1, c, true),
-                storage_entry(2, c, true),
-                storage_entry(3, c, false),
-                storage_entry(4, c, false),
-                storage_entry(5, c, false),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("ism::layout"),
+                entries: &[
+                    dynamic_uniform_entry(0, c, std::mem::size_of::<GpuIsmParams>() as u64),
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, true),
+                    storage_entry(3, c, false),
+                    storage_entry(4, c, false),
+                    storage_entry(5, c, false),
+                ],
+            },
+        );
         let pipe = |entry: &str| compute_pipeline(device, entry, &[Some(&layout)], &module, entry);
         let view_module = shaders::create_module(device, "ism_view.wgsl")?;
-        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ism_view::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                storage_entry(1, c, true),
-                storage_entry(2, c, true),
-                storage_texture_entry(3, wgpu::TextureFormat::Rgba8Unorm),
-                storage_entry(4, c, false),
-            ],
-        });
+        let view_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("ism_view::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, true),
+                    storage_texture_entry(3, wgpu::TextureFormat::Rgba8Unorm),
+                    storage_entry(4, c, false),
+                ],
+            },
+        );
         Ok(Self {
             view: compute_pipeline(device, "ism_view", &[Some(&view_layout)], &view_module, "main"),
             view_layout,

@@ -88,28 +88,34 @@ impl LbvhPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "lbvh.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lbvh::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                storage_entry(1, c, true),
-                storage_entry(2, c, false),
-                storage_entry(3, c, false),
-            ],
-        });
-        let node_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lbvh::node_layout"),
-            entries: &[
-                uniform_entry(0, c),
-                storage_entry(1, c, true),
-                storage_entry(2, c, false),
-                storage_entry(3, c, false),
-                storage_entry(4, c, true),
-                storage_entry(5, c, false),
-                storage_entry(6, c, false),
-                storage_entry(7, c, false),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("lbvh::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, false),
+                    storage_entry(3, c, false),
+                ],
+            },
+        );
+        let node_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("lbvh::node_layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, false),
+                    storage_entry(3, c, false),
+                    storage_entry(4, c, true),
+                    storage_entry(5, c, false),
+                    storage_entry(6, c, false),
+                    storage_entry(7, c, false),
+                ],
+            },
+        );
         Ok(Self {
             pipeline: compute_pipeline(device, "lbvh::build", &[Some(&layout)], &module, "build"),
             node_pipeline: compute_pipeline(

@@ -120,31 +120,37 @@ impl LightPathPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "light_paths.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let rsm_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("light_paths::rsm_layout"),
-            entries: &[
-                uniform_entry(0, c),
-                float_array_texture_entry(1),
-                float_array_texture_entry(2),
-                float_array_texture_entry(3),
-                storage_entry(4, c, true),
-                storage_entry(5, c, true),
-            ],
-        });
-        let path_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("light_paths::path_layout"),
-            entries: &[
-                uniform_entry(0, c),
-                storage_entry(1, c, false),
-                storage_entry(2, c, false),
-                storage_entry(3, c, true),
-                storage_entry(4, c, true),
-                storage_entry(5, c, true),
-                storage_entry(6, c, true),
-                storage_entry(7, c, true),
-                float_array_texture_entry(8),
-            ],
-        });
+        let rsm_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("light_paths::rsm_layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    float_array_texture_entry(1),
+                    float_array_texture_entry(2),
+                    float_array_texture_entry(3),
+                    storage_entry(4, c, true),
+                    storage_entry(5, c, true),
+                ],
+            },
+        );
+        let path_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("light_paths::path_layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    storage_entry(1, c, false),
+                    storage_entry(2, c, false),
+                    storage_entry(3, c, true),
+                    storage_entry(4, c, true),
+                    storage_entry(5, c, true),
+                    storage_entry(6, c, true),
+                    storage_entry(7, c, true),
+                    float_array_texture_entry(8),
+                ],
+            },
+        );
         Ok(Self {
             starts_pipeline: compute_pipeline(
                 device,
@@ -165,7 +171,9 @@ impl LightPathPass {
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("light_paths::params"),
                 size: std::mem::size_of::<GpuPathParams>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::UNIFORM
+                    | wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             starts: storage_buffer(device, "light_paths::starts", 16),

@@ -37,7 +37,58 @@ pub fn groups_2d(w: u32, h: u32) -> (u32, u32) {
     (w.div_ceil(WG_2D), h.div_ceil(WG_2D))
 }
 
-pub(crate) fn uniform_entry(binding: u32, vis: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+/// Whether this device reads the `var<uniform>` parameter blocks as read-only storage
+/// buffers instead. True on CPU adapters (Mesa's lavapipe): lavapipe 22.3 inlines the values
+/// of uniforms that steer control flow into a freshly compiled shader at every pipeline bind
+/// (`update_inline_shader_state`), never frees it, and so grew ~2 MB and ~11 LLVM modules per
+/// frame (issue 42); it never inlines storage buffers. The layout of a struct is the same in
+/// both address spaces (WGSL's one layout algorithm), so the shaders read the same bytes.
+/// `LIGHTCUT_UNIFORMS=uniform` or `=storage` overrides the choice (to reproduce the growth, or
+/// to try storage on a GPU).
+pub fn uniforms_as_storage(device: &wgpu::Device) -> bool {
+    match std::env::var("LIGHTCUT_UNIFORMS").ok().as_deref() {
+        Some("uniform") => false,
+        Some("storage") => true,
+        _ => device.adapter_info().device_type == wgpu::DeviceType::Cpu,
+    }
+}
+
+/// Creates a bind group layout: every layout of the renderer and the methods goes through
+/// here, so that uniform bindings become read-only storage where [`uniforms_as_storage`]
+/// says so (the shaders are rewritten to match in `shaders::create_module`).
+pub fn bind_group_layout(
+    device: &wgpu::Device,
+    desc: &wgpu::BindGroupLayoutDescriptor<'_>,
+) -> wgpu::BindGroupLayout {
+    if !uniforms_as_storage(device) {
+        return device.create_bind_group_layout(desc);
+    }
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = desc
+        .entries
+        .iter()
+        .map(|e| {
+            let mut e = *e;
+            if let wgpu::BindingType::Buffer {
+                ty: ty @ wgpu::BufferBindingType::Uniform,
+                ..
+            } = &mut e.ty
+            {
+                *ty = wgpu::BufferBindingType::Storage { read_only: true };
+            }
+            e
+        })
+        .collect();
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: desc.label,
+        entries: &entries,
+    })
+}
+
+/// The usage of a parameter (`var<uniform>`) buffer: uniform, and storage for the devices
+/// that read parameters as storage ([`uniforms_as_storage`]).
+pub const PARAMS_USAGE: wgpu::BufferUsages = wgpu::BufferUsages::UNIFORM.union(wgpu::BufferUsages::STORAGE);
+
+pub fn uniform_entry(binding: u32, vis: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: vis,
@@ -50,11 +101,7 @@ pub(crate) fn uniform_entry(binding: u32, vis: wgpu::ShaderStages) -> wgpu::Bind
     }
 }
 
-pub(crate) fn storage_entry(
-    binding: u32,
-    vis: wgpu::ShaderStages,
-    read_only: bool,
-) -> wgpu::BindGroupLayoutEntry {
+pub fn storage_entry(binding: u32, vis: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: vis,
@@ -169,7 +216,7 @@ impl<T: bytemuck::Pod> StridedUniforms<T> {
         device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: count.max(1) as u64 * UNIFORM_STRIDE,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         })
     }
@@ -206,7 +253,7 @@ pub(crate) fn uniform_buffer<T>(device: &wgpu::Device, label: &str) -> wgpu::Buf
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size: std::mem::size_of::<T>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     })
 }

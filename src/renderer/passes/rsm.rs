@@ -39,29 +39,32 @@ pub struct RsmPass {
 impl RsmPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "rsm.wgsl")?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("rsm::layout"),
-            entries: &[
-                dynamic_uniform_entry(
-                    0,
-                    wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    std::mem::size_of::<GpuRsmLight>() as u64,
-                ),
-                storage_entry(1, wgpu::ShaderStages::FRAGMENT, true),
-                texture_entry(
-                    2,
-                    wgpu::ShaderStages::FRAGMENT,
-                    wgpu::TextureSampleType::Float { filterable: true },
-                    wgpu::TextureViewDimension::D2Array,
-                ),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("rsm::layout"),
+                entries: &[
+                    dynamic_uniform_entry(
+                        0,
+                        wgpu::ShaderStages::VERTEX_FRAGMENT,
+                        std::mem::size_of::<GpuRsmLight>() as u64,
+                    ),
+                    storage_entry(1, wgpu::ShaderStages::FRAGMENT, true),
+                    texture_entry(
+                        2,
+                        wgpu::ShaderStages::FRAGMENT,
+                        wgpu::TextureSampleType::Float { filterable: true },
+                        wgpu::TextureViewDimension::D2Array,
+                    ),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 3,
+                        visibility: wgpu::ShaderStages::FRAGMENT,
+                        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                        count: None,
+                    },
+                ],
+            },
+        );
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("rsm::pipeline_layout"),
             bind_group_layouts: &[Some(&layout)],
@@ -109,7 +112,7 @@ impl RsmPass {
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("rsm::lights"),
             size: STRIDE * MAX_LIGHTS as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         Ok(Self {

@@ -146,26 +146,32 @@ impl BuildPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let c = wgpu::ShaderStages::COMPUTE;
         let module = shaders::create_module(device, "sst_build.wgsl")?;
-        let build_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sst_build::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                storage_entry(1, c, true),
-                storage_entry(2, c, true),
-                storage_entry(3, c, false),
-                storage_entry(4, c, false),
-                storage_entry(5, c, false),
-            ],
-        });
+        let build_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("sst_build::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, true),
+                    storage_entry(3, c, false),
+                    storage_entry(4, c, false),
+                    storage_entry(5, c, false),
+                ],
+            },
+        );
         let cmodule = shaders::create_module(device, "sst_classify.wgsl")?;
-        let classify_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sst_classify::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                storage_entry(1, c, true),
-                storage_entry(2, c, false),
-            ],
-        });
+        let classify_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("sst_classify::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, false),
+                ],
+            },
+        );
         Ok(Self {
             lbvh: LbvhPass::new(device)?,
             build: compute_pipeline(device, "sst_build", &[Some(&build_layout)], &module, "build"),

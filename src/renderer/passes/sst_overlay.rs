@@ -41,23 +41,26 @@ impl SstOverlayPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "sst_overlay.wgsl")?;
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sst_overlay::layout"),
-            entries: &[
-                uniform_entry(0, vf),
-                uniform_entry(1, vf),
-                storage_entry(2, wgpu::ShaderStages::VERTEX, true),
-                storage_entry(3, wgpu::ShaderStages::VERTEX, true),
-                texture_entry(
-                    4,
-                    wgpu::ShaderStages::FRAGMENT,
-                    wgpu::TextureSampleType::Float { filterable: false },
-                    wgpu::TextureViewDimension::D2,
-                ),
-                storage_entry(5, wgpu::ShaderStages::VERTEX, true),
-                storage_entry(6, wgpu::ShaderStages::VERTEX, true),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("sst_overlay::layout"),
+                entries: &[
+                    uniform_entry(0, vf),
+                    uniform_entry(1, vf),
+                    storage_entry(2, wgpu::ShaderStages::VERTEX, true),
+                    storage_entry(3, wgpu::ShaderStages::VERTEX, true),
+                    texture_entry(
+                        4,
+                        wgpu::ShaderStages::FRAGMENT,
+                        wgpu::TextureSampleType::Float { filterable: false },
+                        wgpu::TextureViewDimension::D2,
+                    ),
+                    storage_entry(5, wgpu::ShaderStages::VERTEX, true),
+                    storage_entry(6, wgpu::ShaderStages::VERTEX, true),
+                ],
+            },
+        );
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("sst_overlay::pipeline_layout"),
             bind_group_layouts: &[Some(&layout)],

@@ -189,15 +189,18 @@ impl SortPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "sst_sort.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sst_sort::layout"),
-            entries: &[
-                dynamic_uniform_entry(0, c, 16),
-                storage_entry(1, c, true),
-                storage_entry(2, c, false),
-                storage_entry(3, c, false),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("sst_sort::layout"),
+                entries: &[
+                    dynamic_uniform_entry(0, c, 16),
+                    storage_entry(1, c, true),
+                    storage_entry(2, c, false),
+                    storage_entry(3, c, false),
+                ],
+            },
+        );
         let l = [Some(&layout)];
         Ok(Self {
             bounds: compute_pipeline(device, "sst_sort::bounds", &l, &module, "vpl_bounds"),
@@ -216,7 +219,9 @@ impl SortPass {
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("sst_sort::params"),
                 size: STRIDE * MAX_STEPS,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::UNIFORM
+                    | wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             layout,

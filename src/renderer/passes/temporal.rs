@@ -274,10 +274,13 @@ impl TemporalPass {
         let module = shaders::create_module(device, "temporal.wgsl")?;
         let pipe = |entry_point: &str, bindings: &'static [u32]| {
             let entries: Vec<_> = bindings.iter().map(|&b| entry(b)).collect();
-            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("temporal::layout"),
-                entries: &entries,
-            });
+            let layout = crate::renderer::passes::bind_group_layout(
+                device,
+                &wgpu::BindGroupLayoutDescriptor {
+                    label: Some("temporal::layout"),
+                    entries: &entries,
+                },
+            );
             let pipeline = compute_pipeline(device, entry_point, &[Some(&layout)], &module, entry_point);
             Pipe {
                 layout,
@@ -302,7 +305,9 @@ impl TemporalPass {
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("temporal::params"),
                 size: SLOTS as u64 * SLOT_STRIDE,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::UNIFORM
+                    | wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             prev_camera: super::uniform_buffer::<GpuCamera>(device, "temporal::prev_camera"),

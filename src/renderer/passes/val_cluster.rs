@@ -184,20 +184,23 @@ impl ValClusterPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let c = wgpu::ShaderStages::COMPUTE;
         let module = shaders::create_module(device, "val_cluster.wgsl")?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("val_cluster::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                float_array_texture_entry(1),
-                float_array_texture_entry(2),
-                float_array_texture_entry(3),
-                storage_entry(4, c, true),
-                storage_entry(5, c, false),
-                storage_entry(6, c, false),
-                storage_entry(7, c, false),
-                storage_entry(8, c, true),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("val_cluster::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    float_array_texture_entry(1),
+                    float_array_texture_entry(2),
+                    float_array_texture_entry(3),
+                    storage_entry(4, c, true),
+                    storage_entry(5, c, false),
+                    storage_entry(6, c, false),
+                    storage_entry(7, c, false),
+                    storage_entry(8, c, true),
+                ],
+            },
+        );
         let pipe = |entry: &str| compute_pipeline(device, entry, &[Some(&layout)], &module, entry);
         Ok(Self {
             clear: pipe("clear_main"),

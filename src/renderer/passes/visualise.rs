@@ -60,10 +60,13 @@ impl VisualisePass {
         let module = shaders::create_module(device, "visualise.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
         let bgl = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(label),
-                entries,
-            })
+            crate::renderer::passes::bind_group_layout(
+                device,
+                &wgpu::BindGroupLayoutDescriptor {
+                    label: Some(label),
+                    entries,
+                },
+            )
         };
         let common_layout = bgl(
             "visualise::common_layout",
@@ -139,7 +142,7 @@ impl VisualisePass {
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("visualise::params"),
             size: std::mem::size_of::<VisParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         Ok(Self {

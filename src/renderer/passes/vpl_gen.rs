@@ -164,34 +164,40 @@ impl VplGenPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "vpl_gen.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("vpl_gen::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                uniform_entry(1, c),
-                float_array_texture_entry(2),
-                float_array_texture_entry(3),
-                float_array_texture_entry(4),
-                float_texture_entry(5),
-                float_texture_entry(6),
-                float_texture_entry(7),
-                storage_entry(8, c, false),
-                storage_entry(9, c, false),
-                storage_entry(10, c, false),
-                storage_entry(11, c, false),
-                storage_entry(12, c, false),
-            ],
-        });
-        let level_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("vpl_gen::level_layout"),
-            entries: &[dynamic_uniform_entry(0, c, 4)],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("vpl_gen::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    uniform_entry(1, c),
+                    float_array_texture_entry(2),
+                    float_array_texture_entry(3),
+                    float_array_texture_entry(4),
+                    float_texture_entry(5),
+                    float_texture_entry(6),
+                    float_texture_entry(7),
+                    storage_entry(8, c, false),
+                    storage_entry(9, c, false),
+                    storage_entry(10, c, false),
+                    storage_entry(11, c, false),
+                    storage_entry(12, c, false),
+                ],
+            },
+        );
+        let level_layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("vpl_gen::level_layout"),
+                entries: &[dynamic_uniform_entry(0, c, 4)],
+            },
+        );
         let one = [Some(&layout)];
         let two = [Some(&layout), Some(&level_layout)];
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("vpl_gen::params"),
             size: std::mem::size_of::<GpuVplParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         // Level l's uniform is the constant l: written once, at creation.
@@ -202,7 +208,7 @@ impl VplGenPass {
         let level_params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("vpl_gen::level_params"),
             contents: &levels,
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: crate::renderer::passes::PARAMS_USAGE,
         });
         Ok(Self {
             importance: compute_pipeline(device, "vpl_gen::importance", &one, &module, "importance"),

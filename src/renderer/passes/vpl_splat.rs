@@ -38,17 +38,20 @@ impl VplSplatPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         let module = shaders::create_module(device, "vpl_splat.wgsl")?;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("vpl_splat::layout"),
-            entries: &[
-                uniform_entry(0, c),
-                uniform_entry(1, c),
-                storage_entry(2, c, true),
-                float_texture_entry(3),
-                storage_texture_entry(4, VIEW_FORMAT),
-                storage_entry(5, c, true),
-            ],
-        });
+        let layout = crate::renderer::passes::bind_group_layout(
+            device,
+            &wgpu::BindGroupLayoutDescriptor {
+                label: Some("vpl_splat::layout"),
+                entries: &[
+                    uniform_entry(0, c),
+                    uniform_entry(1, c),
+                    storage_entry(2, c, true),
+                    float_texture_entry(3),
+                    storage_texture_entry(4, VIEW_FORMAT),
+                    storage_entry(5, c, true),
+                ],
+            },
+        );
         let pipeline = compute_pipeline(device, "vpl_splat::pipeline", &[Some(&layout)], &module, "main");
         let params = uniform_buffer::<GpuSplatParams>(device, "vpl_splat::params");
         Ok(Self {

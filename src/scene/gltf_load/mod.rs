@@ -558,21 +558,34 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                 Some(l) => match l.type_ {
                     Checked::Valid(LightType::Directional) => {
                         let dir = Mat3::from_mat4(world) * Vec3::NEG_Z;
-                        let irr = l.intensity * Vec3::from_array(l.color);
-                        if dir.is_finite() && dir.length_squared() > 0.0 && irr.is_finite() {
-                            let name = l
-                                .name
-                                .clone()
-                                .or_else(|| node.name().map(str::to_string))
-                                .unwrap_or_else(|| format!("light{li}"));
+                        let name = l
+                            .name
+                            .clone()
+                            .or_else(|| node.name().map(str::to_string))
+                            .unwrap_or_else(|| format!("light{li}"));
+                        // KHR_lights_punctual: intensity (here irradiance, W/m^2) and colour
+                        // are non-negative; a negative or non-finite one is refused, not
+                        // clamped into a black or NaN image.
+                        let color = Vec3::from_array(l.color);
+                        if !(l.intensity.is_finite()
+                            && l.intensity >= 0.0
+                            && color.is_finite()
+                            && color.min_element() >= 0.0)
+                        {
+                            return Err(invalid(format!(
+                                "directional light '{name}' has intensity {} W/m^2 and colour {:?}: both must be finite and >= 0",
+                                l.intensity, l.color
+                            )));
+                        }
+                        if dir.is_finite() && dir.length_squared() > 0.0 {
                             scene.lights.push(DirectionalLight {
                                 name,
                                 direction: dir.normalize(),
-                                irradiance: irr.max(Vec3::ZERO),
+                                irradiance: l.intensity * color,
                             });
                         } else {
                             warnings.push(format!(
-                                "directional light {li} has a degenerate direction or non-finite intensity; skipped"
+                                "directional light '{name}' has a degenerate direction (a zero-scale node?); skipped"
                             ));
                         }
                     }
@@ -659,6 +672,9 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
             k += 1;
         }
         cam.name = name;
+        if let Some(w) = cam.fit_clip_range(&bounds) {
+            warnings.push(w);
+        }
         scene.cameras.push(cam);
     }
 
