@@ -24,6 +24,14 @@ use lightcut::{
     },
 };
 
+/// The in-process tests of this binary one at a time: the GUI soak measures this process's
+/// resident memory, which another test's renderer beside it would move.
+static IN_PROCESS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn in_process() -> std::sync::MutexGuard<'static, ()> {
+    IN_PROCESS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_lightcut-workbench"))
 }
@@ -146,6 +154,7 @@ enum Step {
 
 #[test]
 fn the_gui_switching_everything_holds_the_same_objects_and_memory_round_after_round() {
+    let _serial = in_process();
     if common::gpu().is_none() {
         return;
     }
@@ -256,6 +265,7 @@ fn the_gui_switching_everything_holds_the_same_objects_and_memory_round_after_ro
 
 #[test]
 fn gpu_errors_name_their_pass_in_one_line_and_a_lost_device_is_reported() {
+    let _serial = in_process();
     let Some(ctx) = common::gpu() else { return };
     // A bind group whose buffer lacks the usage its layout needs: a validation error on an
     // object labelled as our passes label theirs.
@@ -327,6 +337,7 @@ fn scaled_room(k: f32) -> (lightcut::scene::Scene, Vec<String>) {
 
 #[test]
 fn the_room_scaled_by_a_million_or_a_millionth_keeps_its_direct_light_and_says_what_darkens_its_gi() {
+    let _serial = in_process();
     let Some(ctx) = common::gpu() else { return };
     let size = (48, 32);
     // The room scaled by k, rendered with gi.ray_offset and gi.distance_epsilon scaled as its

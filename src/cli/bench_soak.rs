@@ -8,7 +8,7 @@
 //!
 //! The verdict compares like with like: the snapshot at the end of each method's slot in the
 //! second cycle through the methods (the first where every lazily made resource exists) with
-//! the same method's slot in the last cycle. Live objects must not grow and resident memory
+//! the same method's slot in the last cycle (so a run needs three cycles for a verdict). Live objects must not grow and resident memory
 //! must stay within 10% (+ 8 MiB); `--check` turns a failed verdict into a non-zero exit.
 
 use anyhow::anyhow;
@@ -219,12 +219,14 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Each method's slot in the reference cycle (the second, or the first when the run had
-/// fewer than three cycles) against its slot in the last complete-or-final cycle.
+/// Each method's slot in the second cycle against its slot in the last (possibly partial)
+/// cycle; fewer than three cycles: too short to judge.
 fn verdict(slots: &[SlotEnd], n_methods: usize) -> Result<String, String> {
+    // The second cycle is the reference: in the first, each method's slot ends before the
+    // later methods have made what they keep.
     let last_cycle = slots.last().map_or(0, |s| s.cycle);
-    let reference = if last_cycle >= 2 { 1 } else { 0 };
-    if last_cycle == reference {
+    let reference = 1;
+    if last_cycle < 2 {
         return Ok(format!(
             "verdict: too short to judge ({} slot(s) of {} method(s)); run at least {} switch periods",
             slots.len(),
@@ -369,4 +371,45 @@ fn write_outputs(args: &BenchArgs, samples: &[Sample]) -> anyhow::Result<()> {
         false,
     )?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::renderer::soak::HostMemory;
+
+    fn slot(cycle: usize, method: MethodId, bind_groups: isize, rss_mib: u64) -> SlotEnd {
+        let mut snap = Snapshot::default();
+        snap.live.bind_groups = bind_groups;
+        snap.host = Some(HostMemory {
+            rss: rss_mib << 20,
+            peak_rss: rss_mib << 20,
+        });
+        SlotEnd {
+            cycle,
+            method,
+            snap,
+            max_rss: rss_mib << 20,
+        }
+    }
+
+    #[test]
+    fn the_verdict_compares_each_methods_slot_in_the_last_cycle_with_the_second() {
+        let (a, b) = (crate::methods::tree_samplers::SLC, crate::methods::lightcuts::ID);
+        // The first cycle makes what the methods keep: its smaller counts are not compared.
+        let mut s = vec![slot(0, a, 1, 100), slot(0, b, 3, 150)];
+        assert!(verdict(&s, 2).unwrap().contains("too short"));
+        s.extend([slot(1, a, 4, 160), slot(1, b, 4, 160), slot(2, a, 4, 165)]);
+        assert!(
+            verdict(&s, 2)
+                .unwrap()
+                .starts_with("verdict: flat: 1 method slot")
+        );
+        s.push(slot(2, b, 5, 160));
+        let e = verdict(&s, 2).unwrap_err();
+        assert!(e.contains("bind groups 4 -> 5") && e.contains(b.cli()), "{e}");
+        s.pop();
+        s.push(slot(2, b, 4, 200));
+        assert!(verdict(&s, 2).unwrap_err().contains("resident memory 200 MiB"));
+    }
 }

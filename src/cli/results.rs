@@ -121,6 +121,10 @@ pub struct ResultsArgs {
     /// Results folder (one sub-folder per scene).
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
+    /// Exit non-zero when a check is not met (the thesis's ratios, and the figures' agreement
+    /// on SLC's sampling time: a measurement for a real GPU, not a test).
+    #[arg(long)]
+    pub check: bool,
     /// The per-frame methods the sweeps compare, by CLI name (default: every per-frame method
     /// of the registry; the thesis's checks need slc, rtslc and sst).
     #[arg(long, value_delimiter = ',', value_parser = crate::cli::render::parse_method)]
@@ -309,6 +313,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         for f in &figures {
             let t = std::time::Instant::now();
             let gpu0 = b.gpu_wall;
+            b.figure = format!("{f:?}");
             let rep = match f {
                 Figure::Timings => figures::timings(&mut b, &o, &dir)?,
                 Figure::EqualTime => figures::equal_time(&mut b, &o, &dir)?,
@@ -350,6 +355,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
             }));
             checks.extend(rep.checks);
         }
+        checks.extend(timing_agreement(&b, o.size, &dir)?);
         run_info.push(serde_json::json!({
             "scene": label,
             "scene_arg": arg,
@@ -380,6 +386,10 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
             println!("  {}", c.line());
         }
     }
+    let unmet: Vec<String> = checks.iter().filter(|c| !c.pass()).map(|c| c.line()).collect();
+    if args.check && !unmet.is_empty() {
+        return Err(anyhow!("{} check(s) not met: {}", unmet.len(), unmet.join("; ")));
+    }
     let info = serde_json::json!({
         // The program's own path is left out (it names a folder of this machine).
         "command": std::iter::once("lightcut-workbench".to_string())
@@ -409,4 +419,85 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// The figures' measurements of the same configuration (SLC at the base settings and size)
+/// side by side in `timing_agreement.csv`: the sampling pass's fastest and median GPU time and
+/// what was timed (the passes summed, every pass of the frame, the frame mode, the frame
+/// count). Two checks when two or more figures measured it: that they timed the same thing
+/// (machine-independent), and how far their fastest frames agree (max / min, at most 1.15;
+/// on a shared CPU adapter the speed itself wanders, so this one is for a real GPU).
+fn timing_agreement(b: &Bench, size: (u32, u32), dir: &std::path::Path) -> anyhow::Result<Vec<Check>> {
+    let mut rows: Vec<&crate::harness::BaseTiming> = Vec::new();
+    for t in b.base_timings.iter().filter(|t| t.size == size) {
+        if !rows.iter().any(|r| r.figure == t.figure) {
+            rows.push(t);
+        }
+    }
+    if rows.len() < 2 {
+        return Ok(Vec::new());
+    }
+    let mut csv = Csv::new(&[
+        "scene",
+        "figure",
+        "sample_ms_min",
+        "sample_ms_median",
+        "timed_passes",
+        "frame_passes",
+        "frame_kind",
+        "timed_frames",
+    ]);
+    for r in &rows {
+        csv.row(vec![
+            b.scene.clone(),
+            r.figure.clone(),
+            num(r.sample_ms_min),
+            num(r.sample_ms_median),
+            r.timed_passes.clone(),
+            r.frame_passes.clone(),
+            r.frame_kind.clone(),
+            r.timed_frames.to_string(),
+        ]);
+    }
+    csv.write(&dir.join("timing_agreement.csv"))?;
+    let same = |f: fn(&crate::harness::BaseTiming) -> String| rows.iter().all(|r| f(r) == f(rows[0]));
+    let same_all = same(|r| r.timed_passes.clone())
+        && same(|r| r.frame_passes.clone())
+        && same(|r| r.frame_kind.clone())
+        && same(|r| r.timed_frames.to_string());
+    let figures: Vec<&str> = rows.iter().map(|r| r.figure.as_str()).collect();
+    let lo = rows.iter().map(|r| r.sample_ms_min).fold(f64::INFINITY, f64::min);
+    let hi = rows.iter().map(|r| r.sample_ms_min).fold(0.0, f64::max);
+    Ok(vec![
+        Check {
+            scene: b.scene.clone(),
+            name: "the figures time the same passes of the same frames (SLC, base settings)".into(),
+            value: if same_all { 1.0 } else { 0.0 },
+            limit: 1.0,
+            at_least: true,
+            detail: format!(
+                "{}: {} of {} timed frames, summing {}",
+                figures.join(", "),
+                rows[0].frame_kind,
+                rows[0].timed_frames,
+                rows[0].timed_passes
+            ),
+        },
+        Check {
+            scene: b.scene.clone(),
+            name: "the figures' fastest SLC sampling frames agree (max / min)".into(),
+            value: hi / lo,
+            limit: 1.15,
+            at_least: false,
+            detail: format!(
+                "GPU timestamps of {} on {}; {}",
+                rows[0].timed_passes,
+                b.adapter,
+                rows.iter()
+                    .map(|r| format!("{} {:.3} ms", r.figure, r.sample_ms_min))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        },
+    ])
 }

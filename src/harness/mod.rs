@@ -127,6 +127,8 @@ pub struct Measured {
     pub frame_ms: Vec<f64>,
     /// GPU timestamps per pass, one entry per timed frame.
     pub passes: Vec<Vec<(String, f64)>>,
+    /// The frame mode the timed frames ran in (`FrameMode`'s name).
+    pub frame_kind: String,
     /// Per diagnostic frame: GI against the ground truth (tree samplers with a ground truth).
     pub rmse: Vec<f64>,
     pub ssim: Vec<f64>,
@@ -163,6 +165,28 @@ impl Measured {
     /// equal time is decided on.
     pub fn gi_ms(&self) -> (f64, f64) {
         self.pass_ms(&gi_passes())
+    }
+    /// Every timestamped pass of the timed frames, in order, joined by '+' ("varies" when
+    /// the frames timed different passes).
+    pub fn timed_frame_passes(&self) -> String {
+        let names = |f: &Vec<(String, f64)>| f.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>().join("+");
+        match self.passes.first() {
+            Some(first) if self.passes.iter().all(|f| names(f) == names(first)) => names(first),
+            Some(_) => "varies".into(),
+            None => String::new(),
+        }
+    }
+    /// The passes of `names` that the timed frames timed (what a sum over `names` adds).
+    pub fn timed_of(&self, names: &[&str]) -> String {
+        let mut seen: Vec<&str> = Vec::new();
+        for f in &self.passes {
+            for (n, _) in f {
+                if names.contains(&n.as_str()) && !seen.contains(&n.as_str()) {
+                    seen.push(n);
+                }
+            }
+        }
+        seen.join("+")
     }
     /// GPU time of a group of passes in each timed frame (`None`: every pass).
     pub fn pass_ms_per_frame(&self, names: Option<&[&str]>) -> Vec<f64> {
@@ -240,6 +264,29 @@ pub struct Bench {
     /// Wall clock spent rendering and waiting for the GPU (the rest of a figure's wall time
     /// is CPU work: readbacks, metrics, plots, PNGs).
     pub gpu_wall: Duration,
+    /// The figure being measured (set by `results` before each; names [`BaseTiming`]s).
+    pub figure: String,
+    /// Every measurement of SLC at the base settings, by figure: what each figure timed of
+    /// the same configuration (`results` compares them: `timing_agreement.csv`).
+    pub base_timings: Vec<BaseTiming>,
+}
+
+/// One timed measurement of SLC at the base settings ([`Bench::base_timings`]): the sampling
+/// pass's time and what was timed, to compare across figures without asserting a time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BaseTiming {
+    pub figure: String,
+    pub size: (u32, u32),
+    /// The sampling pass's GPU time: fastest timed frame and median, ms.
+    pub sample_ms_min: f64,
+    pub sample_ms_median: f64,
+    /// The passes summed into it (those of [`SAMPLE_PASSES`] the frames timed).
+    pub timed_passes: String,
+    /// Every timestamped pass of the timed frames, in order ("varies" if they differ).
+    pub frame_passes: String,
+    /// The frame mode of the timed frames (`FrameMode`'s name).
+    pub frame_kind: String,
+    pub timed_frames: usize,
 }
 
 /// Frames of one configuration's measurement ([`Bench::measure`]).
@@ -284,6 +331,8 @@ impl Bench {
             gt: HashMap::new(),
             verbose: true,
             gpu_wall: Duration::ZERO,
+            figure: String::new(),
+            base_timings: Vec::new(),
         }
     }
 
@@ -441,6 +490,21 @@ impl Bench {
             if let Some(t) = self.r.wait_new_timings() {
                 m.passes.push(t.passes);
             }
+        }
+        m.frame_kind = format!("{:?}", self.r.frame_mode());
+        let mut base_slc = self.base.clone();
+        base_slc.gi.method = crate::methods::tree_samplers::SLC;
+        if *s == base_slc && !m.passes.is_empty() {
+            self.base_timings.push(BaseTiming {
+                figure: self.figure.clone(),
+                size,
+                sample_ms_min: m.pass_ms_min(&SAMPLE_PASSES),
+                sample_ms_median: m.pass_ms(&SAMPLE_PASSES).0,
+                timed_passes: m.timed_of(&SAMPLE_PASSES),
+                frame_passes: m.timed_frame_passes(),
+                frame_kind: m.frame_kind.clone(),
+                timed_frames: m.passes.len(),
+            });
         }
         // 2. Diagnostic frames (untimed).
         self.r.set_frame_mode(FrameMode::Diagnostic);
