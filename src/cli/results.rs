@@ -386,10 +386,6 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
             println!("  {}", c.line());
         }
     }
-    let unmet: Vec<String> = checks.iter().filter(|c| !c.pass()).map(|c| c.line()).collect();
-    if args.check && !unmet.is_empty() {
-        return Err(anyhow!("{} check(s) not met: {}", unmet.len(), unmet.join("; ")));
-    }
     let info = serde_json::json!({
         // The program's own path is left out (it names a folder of this machine).
         "command": std::iter::once("lightcut-workbench".to_string())
@@ -418,6 +414,11 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         args.out.display(),
         started.elapsed().as_secs_f64()
     );
+    // After everything is written: an unmet check fails the command (--check).
+    let unmet: Vec<String> = checks.iter().filter(|c| !c.pass()).map(|c| c.line()).collect();
+    if args.check && !unmet.is_empty() {
+        return Err(anyhow!("{} check(s) not met: {}", unmet.len(), unmet.join("; ")));
+    }
     Ok(())
 }
 
