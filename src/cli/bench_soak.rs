@@ -138,8 +138,9 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             break;
         }
         // The method of this moment's slot; a new slot ends the last one.
+        // (One slot a switch period, each method in turn even when a frame outlasts one.)
         let now_slot = (t / args.switch_seconds) as usize;
-        if now_slot != slot {
+        if now_slot > slot {
             let snap = Snapshot::take(&r.ctx, frame);
             slots.push(SlotEnd {
                 cycle: slot / methods.len(),
@@ -147,7 +148,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
                 snap,
                 max_rss: slot_max_rss.max(snap.host.map_or(0, |h| h.rss)),
             });
-            slot = now_slot;
+            slot += 1;
             slot_max_rss = 0;
             let m = methods[slot % methods.len()];
             if r.settings().gi.method != m {
@@ -212,6 +213,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         args.out.display()
     );
     match verdict {
+        Ok(line) if args.check && line.contains("too short") => return Err(anyhow!("--check: {line}")),
         Ok(line) => println!("{line}"),
         Err(line) if args.check => return Err(anyhow!("{line}")),
         Err(line) => println!("{line}"),
@@ -265,6 +267,12 @@ fn verdict(slots: &[SlotEnd], n_methods: usize) -> Result<String, String> {
                 reference + 1
             ));
         }
+    }
+    if compared < n_methods.min(slots.iter().filter(|s| s.cycle == last_cycle).count()) {
+        problems.push(format!(
+            "only {compared} slot(s) of cycle {} had a slot to compare with",
+            last_cycle + 1
+        ));
     }
     if problems.is_empty() {
         Ok(format!(

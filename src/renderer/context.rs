@@ -87,21 +87,39 @@ pub struct ErrorSink {
 /// exit status: a command that met one exits non-zero even where its own loop did not look.
 static FIRST_ERROR: Mutex<Option<String>> = Mutex::new(None);
 
-/// The first GPU error any [`ErrorSink`] of this process received.
+fn set_first_error(msg: &str) {
+    if let Ok(mut first) = FIRST_ERROR.lock()
+        && first.is_none()
+    {
+        *first = Some(msg.to_string());
+    }
+}
+
+/// The first GPU error (validation, out of memory, device lost) wgpu reported to any
+/// [`ErrorSink`] of this process.
 pub fn first_gpu_error() -> Option<String> {
     FIRST_ERROR.lock().ok().and_then(|e| e.clone())
 }
 
 /// A wgpu error as one line naming the failing pass: our labels are `pass::object`, and wgpu
 /// says which labelled object the failing call was on ("In Device::create_bind_group, label =
-/// 'sst_build::bind_group'"); the pass is the label's first part.
+/// 'sst_build::bind_group'"); the pass is the label's first part. Errors inside a pass are
+/// raised when the frame's encoder finishes, on the encoder ('frame::encoder'), or at the
+/// submit: then the first other `pass::thing` the cause names ("RenderPipeline with
+/// 'rsm::pipeline' label is invalid") says which pass failed.
 pub fn describe_gpu_error(kind: &str, text: &str) -> String {
     let lines: Vec<&str> = text.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
-    let label = text
+    let on = text
         .split("label = '")
         .nth(1)
         .and_then(|r| r.split('\'').next())
         .filter(|l| !l.is_empty());
+    let named: Vec<&str> = text
+        .split('\'')
+        .skip(1)
+        .step_by(2)
+        .filter(|l| l.contains("::") && !l.contains(' ') && Some(*l) != on)
+        .collect();
     let call = lines.iter().find(|l| l.starts_with("In ")).map(|l| {
         l.trim_start_matches("In ")
             .split(',')
@@ -109,6 +127,14 @@ pub fn describe_gpu_error(kind: &str, text: &str) -> String {
             .unwrap_or("")
             .to_string()
     });
+    let frame_level = call
+        .as_deref()
+        .is_none_or(|c| c.contains("CommandEncoder") || c.contains("Queue::submit"));
+    let pass_label = match (on, named.first()) {
+        (_, Some(n)) if frame_level => Some(*n),
+        (Some(l), _) => Some(l),
+        (None, n) => n.copied(),
+    };
     // The cause: what follows the "In ..." line, else every line but the headings.
     let cause: Vec<&str> = match lines.iter().position(|l| l.starts_with("In ")) {
         Some(i) => lines[i + 1..].to_vec(),
@@ -123,14 +149,18 @@ pub fn describe_gpu_error(kind: &str, text: &str) -> String {
     } else {
         cause.join(" ")
     };
-    match (label, call) {
-        (Some(l), call) => format!(
-            "GPU {kind} in pass '{}' ({}label '{l}'): {cause}",
-            l.split("::").next().unwrap_or(l),
-            call.map_or(String::new(), |c| format!("{c}, "))
+    let object = match (call, on) {
+        (Some(c), Some(l)) => format!(" ({c}, label '{l}')"),
+        (Some(c), None) => format!(" ({c})"),
+        (None, Some(l)) => format!(" (label '{l}')"),
+        (None, None) => String::new(),
+    };
+    match pass_label {
+        Some(l) => format!(
+            "GPU {kind} in pass '{}'{object}: {cause}",
+            l.split("::").next().unwrap_or(l)
         ),
-        (None, Some(c)) => format!("GPU {kind} ({c}): {cause}"),
-        (None, None) => format!("GPU {kind}: {cause}"),
+        None => format!("GPU {kind}{object}: {cause}"),
     }
 }
 
@@ -143,26 +173,37 @@ impl ErrorSink {
                 wgpu::Error::Validation { .. } => "validation error",
                 wgpu::Error::Internal { .. } => "internal error",
             };
-            let msg = describe_gpu_error(kind, &e.to_string());
+            // wgpu's Display of out-of-memory is the bare kind; its sources say where.
+            let mut text = e.to_string();
+            let mut src = std::error::Error::source(&e);
+            while let Some(s) = src {
+                let t = s.to_string();
+                if !text.contains(&t) {
+                    text.push('\n');
+                    text.push_str(&t);
+                }
+                src = s.source();
+            }
+            let msg = describe_gpu_error(kind, &text);
             log::error!("{msg}");
+            set_first_error(&msg);
             sink.report(msg);
         }));
         let sink = self.clone();
         device.set_device_lost_callback(move |reason, message| {
             // (Dropping a device does not call this; `destroy` does, with `Destroyed`.)
             sink.lost.store(true, std::sync::atomic::Ordering::SeqCst);
-            let msg = format!("GPU device lost ({reason:?}): {message}");
+            let message: Vec<&str> = message.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+            let msg = format!("GPU device lost ({reason:?}): {}", message.join(" "));
             log::error!("{msg}");
+            set_first_error(&msg);
             sink.report(msg);
         });
     }
-    /// Records a message (shown like a GPU error, once).
+    /// Records a message (shown like a GPU error, once): GPU errors, and the renderer's
+    /// refusals and fallbacks (which do not fail a command: [`first_gpu_error`] holds only
+    /// what wgpu reported).
     pub fn report(&self, msg: String) {
-        if let Ok(mut first) = FIRST_ERROR.lock()
-            && first.is_none()
-        {
-            *first = Some(msg.clone());
-        }
         if let Ok(mut v) = self.inner.lock()
             && !v.contains(&msg)
         {
@@ -306,8 +347,9 @@ pub struct LiveObjects {
 
 impl LiveObjects {
     /// The counts that must not grow once a run is warm (memory sizes excluded: a pool
-    /// may keep its blocks).
-    pub fn objects(&self) -> [(&'static str, isize); 11] {
+    /// may keep its blocks; command encoders too: wgpu keeps finished ones in a pool that
+    /// holds the most ever in flight at once).
+    pub fn objects(&self) -> [(&'static str, isize); 10] {
         [
             ("buffers", self.buffers),
             ("textures", self.textures),
@@ -317,7 +359,6 @@ impl LiveObjects {
             ("pipelines", self.pipelines),
             ("pipeline layouts", self.pipeline_layouts),
             ("samplers", self.samplers),
-            ("command encoders", self.command_encoders),
             ("shader modules", self.shader_modules),
             ("query sets", self.query_sets),
         ]
@@ -332,5 +373,28 @@ impl LiveObjects {
             self.texture_bytes as f64 / 1048576.0
         ));
         s.join(", ")
+    }
+}
+
+#[cfg(test)]
+mod error_text_tests {
+    use super::describe_gpu_error;
+
+    #[test]
+    fn an_error_raised_at_the_encoder_names_the_pass_of_the_object_it_blames() {
+        let text = "Validation Error\n\nCaused by:\n  In a CommandEncoder, label = 'frame::encoder'\n    In a set_pipeline command\n      RenderPipeline with 'rsm::pipeline' label is invalid\n";
+        let m = describe_gpu_error("validation error", text);
+        assert!(
+            m.starts_with("GPU validation error in pass 'rsm' (a CommandEncoder, label 'frame::encoder'): "),
+            "{m}"
+        );
+        assert!(!m.contains('\n'), "{m}");
+        let direct = "Validation Error\n\nCaused by:\n  In Device::create_bind_group, label = 'sst_build::bind_group'\n    Usage flags of Buffer with 'sst_build::params' label do not contain STORAGE\n";
+        let m = describe_gpu_error("validation error", direct);
+        assert!(m.starts_with("GPU validation error in pass 'sst_build' (Device::create_bind_group, label 'sst_build::bind_group'): Usage"), "{m}");
+        assert_eq!(
+            describe_gpu_error("out of memory", "Out of Memory"),
+            "GPU out of memory: Out of Memory"
+        );
     }
 }

@@ -78,12 +78,17 @@ impl Camera {
     /// range from the bounds'
     /// depths: far twice the farthest, near 10^-3 of it or the old near if smaller, but at
     /// least 10^-6 of far (depth precision). Returns the warning to show; None when the range
-    /// already holds some of the scene (or the scene is behind the camera).
+    /// already holds some of the scene. A scene wholly behind the camera is only warned of.
     pub fn fit_clip_range(&mut self, bounds: &Aabb) -> Option<String> {
         if bounds.is_empty() {
             return None;
         }
-        let (lo, hi) = self.depth_range(bounds)?;
+        let Some((lo, hi)) = self.depth_range(bounds) else {
+            return Some(format!(
+                "camera '{}' looks away from the scene: all of it lies behind the camera (the view will be empty)",
+                self.name
+            ));
+        };
         // Misses: the clip range holds less than 10^-3 of the depths the bounds span (none of
         // them, or a sliver: a camera inside a room scaled by 10^6 with its far plane at 30 m).
         let overlap = self.zfar.min(hi) - self.znear.max(lo);

@@ -394,7 +394,10 @@ pub fn apply_preset(
     }
     for b in &preset.bookmarks {
         let far = 2.0 * (b.eye_distance_to(&scene.bounds) + scene.bounds.radius());
-        let cam = b.camera(far.max(1.0));
+        let mut cam = b.camera(far.max(1.0));
+        if let Some(w) = cam.fit_clip_range(&scene.bounds) {
+            scene.warnings.push(w);
+        }
         scene.cameras.retain(|c| c.name != cam.name);
         scene.cameras.push(cam);
     }
