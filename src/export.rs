@@ -10,17 +10,24 @@ pub enum ExportError {
     Write { path: String, message: String },
 }
 
-/// Writes linear RGBA floats as an EXR file, unscaled.
+/// Writes linear RGBA floats as an EXR file, unscaled. Blocks are compressed and written
+/// in order on one thread, so the same pixels give the same bytes (a capture reproduced
+/// from its record compares file by file; the parallel writer orders blocks as they finish).
 pub fn write_exr(path: &Path, img: &ImageF32) -> Result<(), ExportError> {
+    use exr::prelude::*;
     let w = img.width as usize;
-    exr::prelude::write_rgba_file(path, w, img.height as usize, |x, y| {
+    let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
         let p = img.pixels[y * w + x];
         (p[0], p[1], p[2], p[3])
-    })
-    .map_err(|e| ExportError::Write {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })
+    });
+    Image::from_channels((w, img.height as usize), channels)
+        .write()
+        .non_parallel()
+        .to_file(path)
+        .map_err(|e| ExportError::Write {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })
 }
 
 /// Writes RGBA8 bytes (already display-encoded) as a PNG.

@@ -3,6 +3,7 @@
 
 pub mod app;
 pub mod base;
+pub mod capture;
 pub mod cli;
 pub mod export;
 pub mod harness;

@@ -1,9 +1,8 @@
 //! `lightcut-workbench`: the GUI by default, headless commands as subcommands.
 
-use clap::Parser;
 use lightcut::{
     app::run_gui,
-    cli::{Cli, Command, bench, compare, export_scene, methods, render, results, sheet},
+    cli::{Cli, Command, bench, compare, export_scene, fetch_scenes, methods, render, results, sheet},
 };
 
 fn main() {
@@ -12,7 +11,18 @@ fn main() {
             .default_filter_or("info,wgpu_core=warn,wgpu_hal=warn,naga=warn,eframe=warn,egui_wgpu=warn"),
     )
     .init();
-    let cli = Cli::parse();
+    let matches = <Cli as clap::CommandFactory>::command().get_matches();
+    let mut cli = <Cli as clap::FromArgMatches>::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    // `render --settings <capture record>`: the record fills what the command line leaves out.
+    if let Some(Command::Render(a)) = &mut cli.command
+        && let Some(m) = matches.subcommand_matches("render")
+    {
+        a.explicit = m
+            .ids()
+            .filter(|id| m.value_source(id.as_str()) == Some(clap::parser::ValueSource::CommandLine))
+            .map(|id| id.to_string())
+            .collect();
+    }
     let result = match &cli.command {
         Some(Command::Render(args)) => render::run(args),
         Some(Command::Bench(args)) => bench::run(args),
@@ -20,6 +30,7 @@ fn main() {
         Some(Command::Compare(args)) => compare::run(args),
         Some(Command::Sheet(args)) => sheet::run(args),
         Some(Command::Results(args)) => results::run(args),
+        Some(Command::FetchScenes(args)) => fetch_scenes::run(args),
         Some(Command::Methods) => methods::run(),
         None => lightcut::cli::gui_options(&cli).and_then(run_gui),
     };

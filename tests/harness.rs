@@ -50,73 +50,120 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         return;
     }
     let out = std::env::temp_dir().join(format!("lightcut-results-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    // The sweep as two shards run at once (`results --shard`, the figures dealt between
+    // them; CI time), merged into `out` as one run writes it (`results merge`).
+    let shard = |k: u32| {
+        bin()
+            .args(ARGS)
+            .args(["--shard", &format!("{k}/2"), "--out"])
+            .arg(out.with_extension(format!("shard{k}")))
+            .output()
+            .unwrap()
+    };
+    let (o1, o2) = std::thread::scope(|sc| {
+        let a = sc.spawn(|| shard(1));
+        let b = sc.spawn(|| shard(2));
+        (a.join().unwrap(), b.join().unwrap())
+    });
+    for o in [&o1, &o2] {
+        assert!(
+            o.status.success(),
+            "stdout: {}\nstderr: {}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
     let o = bin()
-        .args([
-            "results",
-            "all",
-            "--scenes",
-            "default",
-            "--width",
-            "64",
-            "--height",
-            "48",
-            "--frames",
-            "2",
-            "--timing-frames",
-            "3",
-            "--spp",
-            "2,8",
-            "--blocks",
-            "1,8",
-            "--vpl-exponents",
-            "10,11",
-            "--scaling-width",
-            "32",
-            "--scaling-height",
-            "24",
-            "--upsampling-scales",
-            "1",
-            "--vpls",
-            "1024",
-            // Lightcuts and Lightcut Interpolation beside the three samplers, over two
-            // thresholds and one record reach (tiny: CI time).
-            "--methods",
-            "slc,rtslc,sst,lightcuts,lightcut-interpolation",
-            "--sweep",
-            "lightcuts=0.2,0.05",
-            "--sweep",
-            "lightcut-interpolation=2",
-            // The culling study's eps_max sweep: one bound beside the base one.
-            "--sweep",
-            "light-culling=0.005",
-            // The interpolation figure's cuts small (and `--set` reaching `results`).
-            "--set",
-            "methods.lightcut-interpolation.max_cut=64",
-            // The culling study at a looser base bound (shorter ranges: the sphere tree's
-            // per-pixel walks stay short at this size).
-            "--set",
-            "methods.light-culling.epsilon_max=0.002",
-            // The temporal figure: three frames per motion, timings at the frame size.
-            "--temporal-frames",
-            "3",
-            "--temporal-path-frames",
-            "30",
-            "--temporal-timing-width",
-            "64",
-            "--temporal-timing-height",
-            "48",
-            "--out",
-        ])
+        .args(["results", "merge"])
+        .arg(out.with_extension("shard1"))
+        .arg(out.with_extension("shard2"))
+        .arg("--out")
         .arg(&out)
         .output()
         .unwrap();
-    let stdout = String::from_utf8_lossy(&o.stdout);
+    let stdout = format!(
+        "{}{}{}",
+        String::from_utf8_lossy(&o1.stdout),
+        String::from_utf8_lossy(&o2.stdout),
+        String::from_utf8_lossy(&o.stdout)
+    );
     assert!(
         o.status.success(),
         "stdout: {stdout}\nstderr: {}",
         String::from_utf8_lossy(&o.stderr)
     );
+    for k in [1, 2] {
+        let _ = std::fs::remove_dir_all(out.with_extension(format!("shard{k}")));
+    }
     let d = out.join("default");
+    every_figure_checks(&out, &d, &stdout);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// The options of the tiny sweep.
+const ARGS: &[&str] = &[
+    "results",
+    "all",
+    "--scenes",
+    "default",
+    "--width",
+    "48",
+    "--height",
+    "32",
+    "--frames",
+    "2",
+    "--timing-frames",
+    "3",
+    "--spp",
+    "2,8",
+    "--blocks",
+    "1,8",
+    "--vpl-exponents",
+    "10,11",
+    "--scaling-width",
+    "32",
+    "--scaling-height",
+    "24",
+    "--upsampling-scales",
+    "1",
+    "--vpls",
+    "512",
+    // Lightcuts and Lightcut Interpolation beside the three samplers, over two
+    // thresholds and one record reach (tiny: CI time).
+    "--methods",
+    "slc,rtslc,sst,lightcuts,lightcut-interpolation",
+    "--sweep",
+    "lightcuts=0.2,0.05",
+    "--sweep",
+    "lightcut-interpolation=2",
+    // The culling study's eps_max sweep: one bound beside the base one.
+    "--sweep",
+    "light-culling=0.005",
+    // The interpolation figure's cuts small (and `--set` reaching `results`).
+    "--set",
+    "methods.lightcut-interpolation.max_cut=64",
+    // The culling study at a looser base bound (shorter ranges: the sphere tree's
+    // per-pixel walks stay short at this size).
+    "--set",
+    "methods.light-culling.epsilon_max=0.002",
+    // The temporal figure: three frames per motion, timings at the frame size.
+    // The bounce-count figure at 1 and 2 bounces (tiny: CI time).
+    "--bounce-counts",
+    "2",
+    "--temporal-frames",
+    "3",
+    "--temporal-path-frames",
+    "30",
+    "--temporal-timing-width",
+    "48",
+    "--temporal-timing-height",
+    "32",
+];
+
+/// What every figure of the tiny sweep wrote into `d` (and `out`), `stdout` the runs' output.
+fn every_figure_checks(out: &Path, d: &Path, stdout: &str) {
+    let d = d.to_path_buf();
     check_csv(
         &d,
         "timings.csv",
@@ -282,7 +329,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         3,
     );
     // Stochastic vs clamped culling and the sphere tree: 2 VPL counts x 2 visibilities x 3
-    // variants, then the second bound at the base count (1024 = 2^10) x 2 x 3; the stochastic
+    // variants, then the second bound at the base count (--vpls) x 2 x 3; the stochastic
     // ranges with imperfect shadow maps, with and without their range culling, at both counts
     // (+ 4), and with them at the second bound (+ 1).
     check_csv(
@@ -402,7 +449,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         2 + 2 * 8,
     );
     check_csv(
-        &out,
+        out,
         "checks.csv",
         &["scene", "check", "kind", "met"],
         &["value", "limit"],
@@ -510,10 +557,10 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
         );
         assert!(r["total_gpu_ms"].parse::<f64>().is_ok_and(|v| v > 0.0), "{r:?}");
     }
-    // The bounce-count figure: the five methods at 1 bounce and at 2..=4 bounces with paths
-    // by flux and mixed (7 configurations); light-path time only above one bounce.
+    // The bounce-count figure: the five methods at 1 bounce and at 2 bounces with paths by
+    // flux and mixed (3 configurations); light-path time only above one bounce.
     let (_, rows) = common::read_csv(&d.join("bounces.csv"));
-    assert_eq!(rows.len(), 5 * 7, "{rows:?}");
+    assert_eq!(rows.len(), 5 * 3, "{rows:?}");
     for r in &rows {
         let n: u32 = r["bounces"].parse().unwrap();
         let paths: f64 = r["light_paths_gpu_ms"].parse().unwrap();
@@ -553,7 +600,7 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
     decodes(&d.join("trees_rmse.png"));
     let run: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
-    assert_eq!(run["width"], 64);
+    assert_eq!(run["width"], 48);
     // Each figure's wall time and the share of it outside rendering / GPU waits.
     let times = run["scenes"][0]["figure_times"].as_array().unwrap();
     assert_eq!(times.len(), 13, "{times:?}");
@@ -570,7 +617,8 @@ fn every_figure_writes_csv_plots_and_images_at_a_tiny_size() {
             .is_some_and(|a| !a.is_empty())
     );
     assert!(stdout.contains("checks"), "{stdout}");
-    let _ = std::fs::remove_dir_all(&out);
+    assert_eq!(run["merged_shards"], 2);
+    assert_eq!(run["units"].as_array().map(Vec::len), Some(13));
 }
 
 #[test]

@@ -20,9 +20,10 @@ use lightcut::renderer::{Buffer, settings::ViewBuffer};
 /// The README's command lines (after `cargo run --release`), exactly as written there.
 const EXAMPLES: &[&str] = &[
     "",
+    "-- fetch-scenes",
     "-- methods",
     "-- --scene scenes/sponza.toml",
-    "-- --scene ../shared/scenes/breakfast_room/BreakfastRoom.gltf --camera CameraMain",
+    "-- --scene breakfast_room/BreakfastRoom.gltf --camera CameraMain",
     "-- render --scene scenes/breakfast_room.toml --width 1280 --height 720 --out out/",
     "-- render --scene default --width 320 --height 240 --method ground-truth --out out/gt",
     "-- render --scene default --width 320 --height 240 --method reference --samples 1024 --out out/ref",
@@ -165,8 +166,11 @@ fn mean(path: &Path) -> [f64; 3] {
         .mean_rgb()
 }
 
+/// The reference scenes on the scene search path (`fetch-scenes`, `LIGHTCUT_SCENES`,
+/// `../shared/scenes`), as the presets find them.
 fn shared_present() -> bool {
-    repo().join("../shared/scenes/sponza/Sponza.gltf").is_file()
+    lightcut::scene::scene_path::find(Path::new("sponza/Sponza.gltf"), Some(&repo().join("scenes"))).is_ok()
+        && lightcut::scene::scene_path::find(Path::new("breakfast_room/BreakfastRoom.gltf"), None).is_ok()
 }
 
 fn setup() -> egui_wgpu::WgpuSetup {
@@ -263,14 +267,16 @@ fn gui_examples_open_what_they_promise() {
     drop(h);
 
     if !shared_present() {
-        eprintln!("SKIPPED the shared-scene GUI examples: ../shared/scenes not found");
+        eprintln!(
+            "SKIPPED the shared-scene GUI examples: the reference scenes are not fetched (fetch-scenes)"
+        );
         return;
     }
     let h = gui("-- --scene scenes/sponza.toml", egui::vec2(400.0, 300.0), 1);
     assert_eq!(h.state().open().expect("a scene").scene.name, "Sponza");
     drop(h);
     let h = gui(
-        "-- --scene ../shared/scenes/breakfast_room/BreakfastRoom.gltf --camera CameraMain",
+        "-- --scene breakfast_room/BreakfastRoom.gltf --camera CameraMain",
         egui::vec2(400.0, 300.0),
         1,
     );
@@ -796,6 +802,10 @@ fn cli_examples_write_what_they_promise() {
         serde_json::from_str(&std::fs::read_to_string(sh.join("sheet.json")).unwrap()).unwrap();
     assert_eq!(json["columns"].as_array().map(Vec::len), Some(3));
     assert!(image::open(&png).is_ok());
+    assert!(
+        sh.join("sheet.capture.toml").is_file(),
+        "the sheet's capture record"
+    );
 
     // `results`: one figure at a tiny size (tests/harness.rs runs every figure).
     let rs = tmp("results");
@@ -854,9 +864,32 @@ fn cli_examples_write_what_they_promise() {
     }
 
     if !shared_present() {
-        eprintln!("SKIPPED the shared-scene CLI examples: ../shared/scenes not found");
+        eprintln!(
+            "SKIPPED the shared-scene CLI examples: the reference scenes are not fetched (fetch-scenes)"
+        );
         return;
     }
+    // The reference scenes fetched (from the local copy as a mirror) into a folder of their
+    // own, every file's checksum verified.
+    let fetched = tmp("fetched");
+    let shared = lightcut::scene::scene_path::find(Path::new("breakfast_room/BreakfastRoom.gltf"), None)
+        .expect("found above");
+    let mirror = shared.parent().and_then(|p| p.parent()).expect("scenes folder");
+    let out = run_cli(&args(
+        "-- fetch-scenes",
+        &[],
+        &[
+            "--from",
+            mirror.to_str().unwrap(),
+            "--into",
+            fetched.to_str().unwrap(),
+            "--scenes",
+            "breakfast_room",
+        ],
+    ));
+    assert!(out.contains("6 file(s) ok"), "{out}");
+    assert!(fetched.join("breakfast_room/BreakfastRoom.gltf").is_file());
+    let _ = std::fs::remove_dir_all(fetched);
     // Breakfast Room headless, SLC by default: GI, SLC's views and its metrics.
     let br = tmp("breakfast");
     run_cli(&args(

@@ -281,6 +281,7 @@ fn block_error(img: &ImageF32, reference: &ImageF32) -> f64 {
 }
 
 #[test]
+#[ignore = "long statistical test (15-30 s on a CPU adapter): `cargo test --release -- --include-ignored`; CI runs it"]
 fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
     let Some(ctx) = common::gpu() else { return };
     // A cut per pixel (k = 1): culling happens at the pixel itself and only drops nodes
@@ -1161,6 +1162,7 @@ fn converge(st: &mut Setup, gt: &lightcut::renderer::readback::ImageF32) -> Vec<
 }
 
 #[test]
+#[ignore = "long statistical test (15-30 s on a CPU adapter): `cargo test --release -- --include-ignored`; CI runs it"]
 fn with_ggx_glossy_samples_walk_to_leaves_so_the_samplers_converge_on_metal() {
     // SST paper section 4.3: a sample of the glossy part ignores substitutes and walks to a
     // leaf VPL. On an all-metal room (no diffuse part) every sample is glossy, so SLC and SST
@@ -1311,6 +1313,7 @@ fn glossy_walks_weigh_children_by_the_material_term_as_the_cpu_does() {
 /// mix against the GGX ground truth. All stay unbiased (mean within 3%); the defensive mix
 /// has the lowest RMSE and block error of the three for SLC and SST (docs/brdf.md).
 #[test]
+#[ignore = "long statistical test (15-30 s on a CPU adapter): `cargo test --release -- --include-ignored`; CI runs it"]
 fn the_defensive_glossy_weights_lower_the_error_on_polished_metal() {
     use lightcut::base::sampling::GlossyWeights;
     let Some(ctx) = common::gpu() else { return };

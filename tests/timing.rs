@@ -124,3 +124,63 @@ fn the_figures_time_the_same_passes_and_their_work_grows_with_spp() {
     }
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Issue 41's first screen: while the comparison's ground truth converges, the frames stay
+/// timed (their timings are the method's passes; the truth's passes take no timestamps), and
+/// the truth's composite shows the VPLs so far scaled to all of them, at about the final
+/// image's brightness.
+#[test]
+fn frames_are_timed_while_the_comparison_truth_converges() {
+    use lightcut::renderer::{Buffer, FrameMode};
+    let Some(ctx) = common::gpu() else { return };
+    let mut s = lightcut::renderer::settings::RenderSettings::default();
+    s.vpl.count = 1024;
+    // A few VPLs per frame: the truth takes many frames.
+    s.gi.rays_per_frame = 48 * 32 * 64;
+    let mut st = common::Setup::new(&ctx, s, (48, 32));
+    if !st.r.timestamps_supported() {
+        eprintln!("SKIPPED: no timestamps on this adapter");
+        return;
+    }
+    st.r.set_frame_mode(FrameMode::Timed);
+    st.r.set_compare_ground_truth(true);
+    let mut timed = 0;
+    let mut partial_means = Vec::new();
+    for _ in 0..6 {
+        st.frame();
+        ctx.wait_idle().unwrap();
+        if let Some(t) = st.r.wait_new_timings() {
+            timed += 1;
+            assert!(t.get("slc_sample").is_some(), "{:?}", t.passes);
+            assert!(
+                t.get("ground_truth").is_none(),
+                "the truth was timed: {:?}",
+                t.passes
+            );
+        }
+        let p = st.r.compare_progress().expect("the comparison runs");
+        assert!(!p.finished(), "the truth finished too early to test this");
+        let gt = st.r.read(Buffer::GroundTruthIndirect).unwrap().mean_rgb();
+        partial_means.push(gt[0] + gt[1] + gt[2]);
+    }
+    assert!(
+        timed >= 4,
+        "only {timed} of 6 frames timed while the truth converges"
+    );
+    // Run the truth to the end: its scaled partial images were near its final brightness.
+    let mut n = 0;
+    while !st.r.compare_progress().is_some_and(|p| p.finished()) && n < 400 {
+        st.frame();
+        n += 1;
+    }
+    let fin = st.r.read(Buffer::GroundTruthIndirect).unwrap().mean_rgb();
+    let fin = fin[0] + fin[1] + fin[2];
+    assert!(fin > 0.0);
+    for (i, m) in partial_means.iter().enumerate().skip(1) {
+        assert!(
+            (m / fin - 1.0).abs() < 0.35,
+            "frame {i}: the converging truth's mean is {:.3} of the final",
+            m / fin
+        );
+    }
+}

@@ -371,6 +371,33 @@ fn several_views_render_their_buffers_and_export_files_that_decode() {
         let e = lightcut::export::read_exr(f).expect("the EXR decodes");
         assert_eq!((e.width, e.height), (w, hh));
     }
+    // Every export has its capture record beside it: the settings shown, the camera and
+    // lights exactly, the render size and the frame index.
+    for f in png.iter().chain(&exr).chain(&ab_files) {
+        let rec = lightcut::capture::sidecar_path(f);
+        let text = std::fs::read_to_string(&rec).unwrap_or_else(|e| panic!("{}: {e}", rec.display()));
+        let (c, rest) = lightcut::capture::split(&text).expect("a record");
+        let c = c.expect("a [capture] table");
+        assert_eq!(c.what, "view export");
+        assert_eq!((c.width, c.height), (w, hh));
+        assert!(
+            c.frame_index >= 4 && !c.lights.is_empty() && c.camera.yfov > 0.0,
+            "{c:?}"
+        );
+        let s: lightcut::renderer::settings::RenderSettings = rest.try_into().expect("the settings");
+        assert_eq!(&s, h.state().renderer().unwrap().settings());
+    }
+    // A preset whose scene file is not fetched: one line naming the command that fetches
+    // it, and the open scene stays.
+    let preset = dir.join("unfetched.toml");
+    std::fs::write(&preset, "gltf = \"not-here/BreakfastRoom.gltf\"\n").unwrap();
+    let before = h.state().open().unwrap().scene.name.clone();
+    let e = h
+        .state_mut()
+        .open_scene(preset.to_str().unwrap(), None)
+        .unwrap_err();
+    assert!(e.contains("fetch-scenes") && !e.contains('\n'), "{e}");
+    assert_eq!(h.state().open().unwrap().scene.name, before);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -408,6 +435,9 @@ fn the_comparison_sheet_runs_in_the_gui_and_can_be_cancelled() {
     let png = written.split(", ").next().unwrap();
     let img = image::open(png).expect("the sheet decodes");
     assert!(img.width() > 3 * 320);
+    let rec = lightcut::capture::sidecar_path(std::path::Path::new(png));
+    let text = std::fs::read_to_string(&rec).unwrap_or_else(|e| panic!("{}: {e}", rec.display()));
+    assert!(text.contains("what = \"sheet\""), "{text}");
     assert_eq!(h.state().renderer().unwrap().settings().gi.method, SLC);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -26,7 +26,7 @@ pub(super) fn fresh_path(dir: &std::path::Path, stem: &str, ext: &str) -> PathBu
 }
 
 /// Writes a comparison sheet (PNG + JSON of its metrics) into `dir`; returns the paths.
-pub fn write_sheet(sheet: &crate::sheet::Sheet, dir: &std::path::Path) -> Result<String, String> {
+pub fn write_sheet(sheet: &crate::sheet::Sheet, dir: &std::path::Path) -> Result<(PathBuf, PathBuf), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     let canvas = crate::sheet::compose(sheet)?;
     let png = fresh_path(dir, "comparison sheet", "png");
@@ -34,7 +34,7 @@ pub fn write_sheet(sheet: &crate::sheet::Sheet, dir: &std::path::Path) -> Result
     let json = png.with_extension("json");
     std::fs::write(&json, crate::sheet::metrics_json(sheet))
         .map_err(|e| format!("cannot write {}: {e}", json.display()))?;
-    Ok(format!("{}, {}", png.display(), json.display()))
+    Ok((png, json))
 }
 
 /// The files of one view export (see [`WorkbenchApp::export_view`]).
@@ -72,6 +72,67 @@ pub fn export_view_files(
                 files.push(path);
             }
             Ok(files)
+        }
+    }
+}
+
+/// The capture record of what the workbench shows: settings, scene and its file's hash,
+/// camera, lights (with the sun as edited), render size, frame index and frames averaged,
+/// the adapter and the commit.
+pub(super) fn capture_of(
+    r: &Renderer,
+    open: &OpenScene,
+    lights: &[DirectionalLight],
+    what: &str,
+) -> (crate::capture::Capture, crate::renderer::settings::RenderSettings) {
+    let mut c = crate::capture::Capture::new(what, &r.ctx.adapter_info, &open.source, open.file.as_deref());
+    c.camera = (&open.camera).into();
+    c.lights = lights.iter().map(Into::into).collect();
+    (c.width, c.height) = r.size();
+    c.seed = r.settings().vpl.seed;
+    c.frames = r.sampling_frames().max(1);
+    c.frame_index = r.frame_index();
+    (c, r.settings().clone())
+}
+
+/// Writes the capture record beside each of `files` (`name.capture.toml`; one per stem).
+pub(super) fn write_capture_records(
+    mut c: crate::capture::Capture,
+    settings: &crate::renderer::settings::RenderSettings,
+    files: &[PathBuf],
+) -> Result<(), String> {
+    c.files = files
+        .iter()
+        .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().to_string()))
+        .collect();
+    let mut done = std::collections::BTreeSet::new();
+    for f in files {
+        let rec = crate::capture::sidecar_path(f);
+        if done.insert(rec.clone()) {
+            crate::capture::write_record(&rec, &c, settings)?;
+        }
+    }
+    Ok(())
+}
+
+impl WorkbenchApp {
+    /// [`capture_of`] the open scene, with the sun as edited.
+    pub fn capture_record(
+        &self,
+        what: &str,
+    ) -> Option<(crate::capture::Capture, crate::renderer::settings::RenderSettings)> {
+        let r = self.renderer.as_ref()?;
+        let open = self.open.as_ref()?;
+        let lights = super::frame::lights_with_sun(&open.scene, self.sun.as_ref());
+        Some(capture_of(r, open, &lights, what))
+    }
+
+    /// Writes the record of what is shown beside each of `files`; errors go to the status.
+    pub(super) fn record_captures(&mut self, what: &str, files: &[PathBuf]) {
+        if let Some((c, s)) = self.capture_record(what)
+            && let Err(e) = write_capture_records(c, &s, files)
+        {
+            self.errors.push(format!("capture record: {e}"));
         }
     }
 }

@@ -122,7 +122,13 @@ impl WorkbenchApp {
                     self.sheet_job = None;
                     self.sheet_status = None;
                     match write_sheet(&sheet, std::path::Path::new(&self.export_dir)) {
-                        Ok(files) => self.last_export = files,
+                        Ok((png, json)) => {
+                            self.last_export = format!("{}, {}", png.display(), json.display());
+                            let (c, s) = super::exports::capture_of(renderer, open, &lights, "sheet");
+                            if let Err(e) = super::exports::write_capture_records(c, &s, &[png, json]) {
+                                self.errors.push(format!("capture record: {e}"));
+                            }
+                        }
                         Err(e) => self.errors.push(format!("comparison sheet: {e}")),
                     }
                     let _ = renderer.set_settings(self.settings.clone());
@@ -416,6 +422,7 @@ impl WorkbenchApp {
                     .map(|f| f.display().to_string())
                     .collect::<Vec<_>>()
                     .join(", ");
+                self.record_captures("view export", &files);
                 files
             }
             Err(e) => {
@@ -437,6 +444,7 @@ impl WorkbenchApp {
                 if !self.screenshot_requested {
                     self.screenshot_requested = true;
                     let path = path.clone();
+                    self.record_captures("screenshot", std::slice::from_ref(&path));
                     let done = self.screenshot_done.clone();
                     let ctx2 = ctx.clone();
                     ctx.request_screenshot(move |img| {

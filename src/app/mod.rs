@@ -135,6 +135,8 @@ impl SunControls {
 pub struct OpenScene {
     pub scene: Scene,
     pub source: String,
+    /// The glTF file it was loaded from (capture records hash it).
+    pub file: Option<PathBuf>,
     pub camera: Camera,
     pub controller: CameraController,
     pub camera_index: Option<usize>,
@@ -148,6 +150,7 @@ impl OpenScene {
         Ok(Self {
             scene,
             source,
+            file: None,
             camera,
             controller,
             camera_index,
@@ -367,8 +370,9 @@ impl WorkbenchApp {
         let opened = open_scene(&SceneSource::from_arg(source))
             .map_err(|e| format!("Could not open '{source}': {e}"))?;
         let camera = camera.map(str::to_string).or(opened.camera_name.clone());
-        let open = OpenScene::new(opened.scene, source.to_string(), camera.as_deref())
+        let mut open = OpenScene::new(opened.scene, source.to_string(), camera.as_deref())
             .map_err(|e| format!("Could not open '{source}': {e}"))?;
+        open.file = opened.file;
         if self.options.settings.is_none() {
             self.settings.display.exposure_ev = opened.exposure_ev;
         }

@@ -72,14 +72,14 @@ impl TimingsPanel {
     pub fn contents(&self, ui: &mut egui::Ui) -> Option<ViewBuffer> {
         let Some(last) = self.history.back() else {
             ui.label(
-                "no timed frame yet: while the comparison's ground truth fills in, every frame \
-                 advances it and is untimed, and every 4th frame records diagnostics (or \
-                 timestamps are not supported on this adapter)",
+                "no timed frame yet: every 4th frame records diagnostics untimed, and the \
+                 first timestamps arrive a frame or two late (or timestamps are not supported \
+                 on this adapter)",
             );
             return None;
         };
         ui.label(format!(
-            "last timed frame: {:.3} ms GPU over {} passes (GPU timestamps of frames without diagnostics: every {}th frame records them untimed, as does a frame that advances the comparison's ground truth); hover a blue pass to see its output",
+            "last timed frame: {:.3} ms GPU over {} passes (GPU timestamps of frames without diagnostics: every {}th frame records them untimed; the comparison's ground truth is never timed); hover a blue pass to see its output",
             last.total_ms(),
             last.passes.len(),
             super::GUI_DIAGNOSTICS_EVERY

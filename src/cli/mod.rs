@@ -5,6 +5,7 @@ pub mod bench_lightcuts;
 pub mod bench_soak;
 pub mod compare;
 pub mod export_scene;
+pub mod fetch_scenes;
 pub mod methods;
 pub mod render;
 mod render_sequence;
@@ -140,6 +141,10 @@ pub enum Command {
     /// blocks, blending, upsampling, scaling): CSV, PNG plots and images per scene, the
     /// ratio checks in checks.csv.
     Results(results::ResultsArgs),
+    /// Download the reference scenes (Sponza, Breakfast Room) from AMD's CapsaicinTestMedia
+    /// (CC BY 3.0), check every file's SHA-256 against the files the measurements used, and
+    /// put them where presets find them (the user data folder by default).
+    FetchScenes(fetch_scenes::FetchScenesArgs),
     /// The GI methods this build knows (`render --method`, `sheet --methods`): name, kind,
     /// views, timed GPU passes and the tests that check each.
     Methods,
@@ -178,8 +183,13 @@ impl SettingsArgs {
             Some(p) => {
                 let text = std::fs::read_to_string(p)
                     .map_err(|e| anyhow::anyhow!("cannot read settings file {}: {e}", p.display()))?;
-                toml::from_str(&text)
-                    .map_err(|e| anyhow::anyhow!("bad settings file {}: {}", p.display(), e.message()))?
+                // A capture record is a settings file with a `[capture]` table (read by
+                // `render`, ignored here).
+                let (_, rest) = crate::capture::split(&text)
+                    .map_err(|e| anyhow::anyhow!("bad settings file {}: {e}", p.display()))?;
+                rest.try_into().map_err(|e: toml::de::Error| {
+                    anyhow::anyhow!("bad settings file {}: {}", p.display(), e.message())
+                })?
             }
             None => {
                 let mut s = crate::renderer::settings::RenderSettings::default();

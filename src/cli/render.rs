@@ -382,7 +382,7 @@ pub enum Output {
     Png,
 }
 
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
     /// `default` or another built-in scene (`window-box`, `corridor`, `glossy-thin`), a
     /// .gltf/.glb file, or a preset .toml.
@@ -439,6 +439,84 @@ pub struct RenderArgs {
     pub settings: SettingsArgs,
     #[command(flatten)]
     pub sampling: SamplingArgs,
+    /// The options given on the command line (by clap id; `main` fills it): a capture record
+    /// read with `--settings` supplies the others.
+    #[arg(skip)]
+    pub explicit: Vec<String>,
+}
+
+impl RenderArgs {
+    /// With `--settings <capture record>`: the record's scene, size, frame counts and camera
+    /// where the command line does not name them (the settings themselves come from the file
+    /// as from any settings file). Returns the arguments and the record's camera.
+    pub fn with_record(&self) -> anyhow::Result<(RenderArgs, Option<crate::capture::Capture>)> {
+        let mut a = self.clone();
+        let Some(path) = &self.settings.settings else {
+            return Ok((a, None));
+        };
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow!("cannot read settings file {}: {e}", path.display()))?;
+        let (Some(mut c), _) =
+            crate::capture::split(&text).map_err(|e| anyhow!("bad settings file {}: {e}", path.display()))?
+        else {
+            return Ok((a, None));
+        };
+        let given = |id: &str| self.explicit.iter().any(|e| e == id);
+        let mut camera = None;
+        if !given("scene") && !c.scene.is_empty() {
+            a.scene = c.scene.clone();
+        }
+        if !given("width") && c.width > 0 {
+            a.width = c.width;
+        }
+        if !given("height") && c.height > 0 {
+            a.height = c.height;
+        }
+        if !given("frames") && c.frames > 0 {
+            a.sampling.frames = c.frames;
+        }
+        if !given("timing_frames") && c.timing_frames > 0 {
+            a.timing_frames = c.timing_frames;
+        }
+        if !given("camera") && !c.camera.name.is_empty() {
+            camera = Some(c.camera.clone());
+        }
+        // A sequence's record: the same sequence again.
+        if !given("camera_path") && c.camera_path.is_some() {
+            a.camera_path = c.camera_path.clone();
+        }
+        if !given("sun_sweep") && c.sun_sweep.is_some() {
+            a.sun_sweep = c.sun_sweep;
+        }
+        if !given("path_frames") && c.path_frames.is_some() {
+            a.path_frames = c.path_frames;
+        }
+        if given("camera") || c.camera.name.is_empty() {
+            c.camera = Default::default();
+        }
+        println!(
+            "capture record {} ({} at {}): scene {}, camera '{}', {}x{}, {} frame(s) after {} timed",
+            path.display(),
+            c.what,
+            c.commit,
+            a.scene,
+            camera
+                .as_ref()
+                .map_or(a.camera.as_deref().unwrap_or("default"), |c| c.name.as_str()),
+            a.width,
+            a.height,
+            a.sampling.frames,
+            a.timing_frames
+        );
+        if c.commit != crate::capture::COMMIT {
+            println!(
+                "  note: recorded by commit {}, this binary is {} (bit-for-bit only with the same build and adapter)",
+                c.commit,
+                crate::capture::COMMIT
+            );
+        }
+        Ok((a, Some(c)))
+    }
 }
 
 /// What the timed frames of `render` measured, and the frames the image averaged.
@@ -462,6 +540,20 @@ fn mean_timings(frames: &[PassTimings]) -> Option<PassTimings> {
         })
         .collect();
     Some(PassTimings { passes })
+}
+
+/// The images and metrics in `out` (sorted): the files a capture record describes.
+fn written_files(out: &std::path::Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(out)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().to_string())
+                .filter(|n| n.ends_with(".exr") || n.ends_with(".png") || n == "metrics.json")
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
 }
 
 /// Prints the run's resources line and writes them to resources.json (`render` and its
@@ -581,7 +673,25 @@ fn linear_depth(position: &ImageF32, eye: glam::Vec3, fwd: glam::Vec3) -> ImageF
 }
 
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
-    let opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
+    let (args, record) = args.with_record()?;
+    let args = &args;
+    let mut opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
+    let record_camera = record.as_ref().map(|c| &c.camera).filter(|c| !c.name.is_empty());
+    if let Some(c) = &record {
+        if !c.scene_sha256.is_empty()
+            && let Some(f) = &opened.file
+            && let Ok(bytes) = std::fs::read(f)
+            && crate::scene::scene_path::sha256_hex(&bytes) != c.scene_sha256
+        {
+            println!(
+                "  note: {} differs from the recorded scene file (SHA-256)",
+                f.display()
+            );
+        }
+        if !c.lights.is_empty() {
+            opened.scene.lights = c.lights.iter().map(|l| l.light()).collect();
+        }
+    }
     let mut settings = args.settings.resolve(opened.exposure_ev)?;
     if let Some(m) = args.method {
         settings.gi.method = m;
@@ -620,10 +730,13 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     settings.validate().map_err(|e| anyhow!("{e}"))?;
     let wants = |o: Output| args.output.contains(&Output::All) || args.output.contains(&o);
     let cam_name = args.camera.clone().or(opened.camera_name.clone());
-    let camera = opened
-        .scene
-        .camera_or_default(cam_name.as_deref())
-        .map_err(|e| anyhow!("{e}"))?;
+    let camera = match record_camera {
+        Some(c) => c.camera(),
+        None => opened
+            .scene
+            .camera_or_default(cam_name.as_deref())
+            .map_err(|e| anyhow!("{e}"))?,
+    };
     if args.camera_path.is_some() || args.sun_sweep.is_some() {
         return super::render_sequence::run(args, &opened, settings, &camera);
     }
@@ -657,6 +770,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     // or more is a warm-up (pipelines, buffers) and is not counted.
     r.set_frame_mode(FrameMode::Timed);
     let image_settings = r.settings().clone();
+    let image_settings_for_record = image_settings.clone();
     if method.per_frame() {
         let mut s = image_settings.clone();
         s.sampling.accumulate = false;
@@ -914,6 +1028,20 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
         None => println!("GPU time per pass: timestamps not supported on this adapter"),
     }
+    // The capture record: what reproduces these files (`render --settings capture.toml`).
+    let mut capture =
+        crate::capture::Capture::new("render", &r.ctx.adapter_info, &args.scene, opened.file.as_deref());
+    capture.camera = (&camera).into();
+    capture.lights = lights.iter().map(Into::into).collect();
+    capture.width = args.width;
+    capture.height = args.height;
+    capture.seed = r.settings().vpl.seed;
+    capture.frames = args.sampling.frames;
+    capture.timing_frames = n_timing;
+    capture.frame_index = r.frame_index();
+    capture.files = written_files(out);
+    crate::capture::write_record(&out.join("capture.toml"), &capture, &image_settings_for_record)
+        .map_err(|e| anyhow!("{e}"))?;
     println!("wrote {}", out.display());
     Ok(())
 }

@@ -205,6 +205,25 @@ pub fn run(
             mean(|f| f.flicker_filtered),
         );
     }
+    // The capture record: `render --settings capture.toml` renders the same sequence again.
+    let mut capture = crate::capture::Capture::new(
+        "render sequence",
+        &r.ctx.adapter_info,
+        &args.scene,
+        opened.file.as_deref(),
+    );
+    capture.camera = camera.into();
+    capture.lights = opened.scene.lights.iter().map(Into::into).collect();
+    (capture.width, capture.height) = (args.width, args.height);
+    capture.seed = settings.vpl.seed;
+    capture.frames = 1;
+    capture.frame_index = r.frame_index();
+    capture.camera_path = args.camera_path.clone();
+    capture.sun_sweep = args.sun_sweep;
+    capture.path_frames = args.path_frames;
+    capture.files = vec!["sequence.csv".into(), "frames/".into()];
+    crate::capture::write_record(&out.join("capture.toml"), &capture, &settings)
+        .map_err(|e| anyhow!("{e}"))?;
     println!("wrote {}", out.display());
     Ok(())
 }

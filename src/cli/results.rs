@@ -77,8 +77,61 @@ const ORDER: [Figure; 13] = [
     Figure::Scaling,
 ];
 
+/// The K-th of N shards of a sweep (`--shard K/N`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Shard {
+    pub k: u32,
+    pub n: u32,
+}
+
+/// `K/N` with 1 <= K <= N.
+pub fn parse_shard(s: &str) -> Result<Shard, String> {
+    let (k, n) = s
+        .split_once('/')
+        .ok_or_else(|| format!("'{s}': write K/N, e.g. 2/4 (the second of four shards)"))?;
+    let p = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{s}': K and N must be whole numbers"))
+    };
+    let (k, n) = (p(k)?, p(n)?);
+    if n == 0 || k == 0 || k > n {
+        return Err(format!("'{s}': K must be 1..=N and N at least 1"));
+    }
+    Ok(Shard { k, n })
+}
+
+impl Shard {
+    /// Whether work unit `unit` (0-based, in the order an unsharded run does them) is this
+    /// shard's: units are dealt round-robin.
+    pub fn owns(&self, unit: usize) -> bool {
+        unit % self.n as usize == (self.k - 1) as usize
+    }
+}
+
+#[derive(clap::Subcommand, Debug)]
+pub enum ResultsCommand {
+    /// Join the folders of `results --shard K/N` runs into one, as an unsharded run writes it:
+    /// every figure's files, checks.csv (the timing-agreement checks recomputed over all
+    /// shards), run.json.
+    Merge(MergeArgs),
+}
+
 #[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// The shard folders (each a `results --shard K/N --out DIR`).
+    #[arg(required = true, num_args = 1..)]
+    pub shards: Vec<PathBuf>,
+    /// The merged results folder (created; must not hold another run).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct ResultsArgs {
+    #[command(subcommand)]
+    pub command: Option<ResultsCommand>,
     /// Figures to make (comma-separated).
     #[arg(value_enum, value_delimiter = ',', default_value = "all")]
     pub figures: Vec<Figure>,
@@ -143,11 +196,20 @@ pub struct ResultsArgs {
     /// Degrees the sun's azimuth turns over the temporal figure's sun sweep.
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     pub sun_sweep_deg: f32,
+    /// The bounce counts of the bounce-count figure (1 is always added: the others are
+    /// measured against it).
+    #[arg(long, value_delimiter = ',', default_value = "1,2,3,4")]
+    pub bounce_counts: Vec<u32>,
     /// Frame size of the temporal stage's GPU timings.
     #[arg(long, default_value_t = 1280)]
     pub temporal_timing_width: u32,
     #[arg(long, default_value_t = 720)]
     pub temporal_timing_height: u32,
+    /// Run only the K-th of N disjoint shards of the work: the (scene, figure) pairs, dealt
+    /// round-robin in the order an unsharded run does them. Each shard writes its own --out;
+    /// `results merge` joins them (docs/results.md: a Slurm job array).
+    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    pub shard: Option<Shard>,
     /// Number of VPLs (default 4096, as the thesis).
     #[arg(long)]
     pub vpls: Option<u32>,
@@ -227,7 +289,16 @@ impl ResultsArgs {
         {
             bail!("--temporal-timing-width/--temporal-timing-height must be 16..=8192");
         }
+        let max_b = crate::renderer::passes::light_paths::MAX_BOUNCES;
+        if self.bounce_counts.iter().any(|n| !(1..=max_b).contains(n)) {
+            bail!("--bounce-counts must be 1..={max_b}");
+        }
+        let mut bounces = self.bounce_counts.clone();
+        bounces.push(1);
+        bounces.sort_unstable();
+        bounces.dedup();
         Ok(Opts {
+            bounces,
             temporal_frames: self.temporal_frames,
             temporal_path_frames: self.temporal_path_frames,
             sun_sweep_deg: self.sun_sweep_deg,
@@ -256,6 +327,9 @@ fn scene_label(arg: &str) -> String {
 }
 
 pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
+    if let Some(ResultsCommand::Merge(m)) = &args.command {
+        return merge(m);
+    }
     let o = args.opts()?;
     let figures: Vec<Figure> = if args.figures.contains(&Figure::All) {
         ORDER.to_vec()
@@ -276,8 +350,25 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
     let mut checks: Vec<Check> = Vec::new();
     let mut run_info = Vec::new();
     let started = std::time::Instant::now();
+    // The work units, (scene, figure) in the order of an unsharded run; a shard takes every
+    // N-th.
+    let mut unit = 0usize;
+    let mut units_done: Vec<String> = Vec::new();
     for (arg, sc) in opened {
         let label = scene_label(&arg);
+        let figures: Vec<Figure> = figures
+            .iter()
+            .copied()
+            .filter(|_| {
+                let mine = args.shard.is_none_or(|s| s.owns(unit));
+                unit += 1;
+                mine
+            })
+            .collect();
+        if figures.is_empty() {
+            continue;
+        }
+        units_done.extend(figures.iter().map(|f| format!("{label}/{f:?}")));
         let dir = args.out.join(&label);
         std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let mut settings = args.settings.resolve(sc.exposure_ev)?;
@@ -405,6 +496,8 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         "upsampling_scales": o.upsampling_scales,
         "seconds": started.elapsed().as_secs_f64(),
         "scenes": run_info,
+        "units": units_done,
+        "shard": args.shard,
     });
     let p = args.out.join("run.json");
     std::fs::write(&p, serde_json::to_string_pretty(&info)?)
@@ -422,6 +515,9 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+const AGREEMENT_SAME: &str = "the figures time the same passes of the same frames (SLC, base settings)";
+const AGREEMENT_FASTEST: &str = "the figures' fastest SLC sampling frames agree (max / min)";
+
 /// The figures' measurements of the same configuration (SLC at the base settings and size)
 /// side by side in `timing_agreement.csv`: the sampling pass's fastest and median GPU time and
 /// what was timed (the passes summed, every pass of the frame, the frame mode, the frame
@@ -435,7 +531,7 @@ fn timing_agreement(b: &Bench, size: (u32, u32), dir: &std::path::Path) -> anyho
             rows.push(t);
         }
     }
-    if rows.len() < 2 {
+    if rows.is_empty() {
         return Ok(Vec::new());
     }
     let mut csv = Csv::new(&[
@@ -461,6 +557,14 @@ fn timing_agreement(b: &Bench, size: (u32, u32), dir: &std::path::Path) -> anyho
         ]);
     }
     csv.write(&dir.join("timing_agreement.csv"))?;
+    Ok(agreement_checks(&b.scene, &b.adapter, &rows))
+}
+
+/// The two timing-agreement checks over the figures' rows (none with fewer than two).
+fn agreement_checks(scene: &str, adapter: &str, rows: &[&crate::harness::BaseTiming]) -> Vec<Check> {
+    if rows.len() < 2 {
+        return Vec::new();
+    }
     let same = |f: fn(&crate::harness::BaseTiming) -> String| rows.iter().all(|r| f(r) == f(rows[0]));
     let same_all = same(|r| r.timed_passes.clone())
         && same(|r| r.frame_passes.clone())
@@ -469,10 +573,10 @@ fn timing_agreement(b: &Bench, size: (u32, u32), dir: &std::path::Path) -> anyho
     let figures: Vec<&str> = rows.iter().map(|r| r.figure.as_str()).collect();
     let lo = rows.iter().map(|r| r.sample_ms_min).fold(f64::INFINITY, f64::min);
     let hi = rows.iter().map(|r| r.sample_ms_min).fold(0.0, f64::max);
-    Ok(vec![
+    vec![
         Check {
-            scene: b.scene.clone(),
-            name: "the figures time the same passes of the same frames (SLC, base settings)".into(),
+            scene: scene.to_string(),
+            name: AGREEMENT_SAME.into(),
             value: if same_all { 1.0 } else { 0.0 },
             limit: 1.0,
             at_least: true,
@@ -485,20 +589,359 @@ fn timing_agreement(b: &Bench, size: (u32, u32), dir: &std::path::Path) -> anyho
             ),
         },
         Check {
-            scene: b.scene.clone(),
-            name: "the figures' fastest SLC sampling frames agree (max / min)".into(),
+            scene: scene.to_string(),
+            name: AGREEMENT_FASTEST.into(),
             value: hi / lo,
             limit: 1.15,
             at_least: false,
             detail: format!(
                 "GPU timestamps of {} on {}; {}",
                 rows[0].timed_passes,
-                b.adapter,
+                adapter,
                 rows.iter()
                     .map(|r| format!("{} {:.3} ms", r.figure, r.sample_ms_min))
                     .collect::<Vec<_>>()
                     .join(", ")
             ),
         },
-    ])
+    ]
+}
+
+/// One CSV line's cells (the quoting [`Csv::write`] writes: `"` around cells with `,` or
+/// `"`, doubled quotes inside).
+fn csv_cells(line: &str) -> Vec<String> {
+    let mut cells = Vec::new();
+    let mut cur = String::new();
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' if quoted && chars.peek() == Some(&'"') => {
+                cur.push('"');
+                chars.next();
+            }
+            '"' => quoted = !quoted,
+            ',' if !quoted => cells.push(std::mem::take(&mut cur)),
+            c => cur.push(c),
+        }
+    }
+    cells.push(cur);
+    cells
+}
+
+/// A CSV file's header and rows of cells.
+type CsvRows = (Vec<String>, Vec<Vec<String>>);
+
+/// A CSV file as header + rows of cells (`None` when absent).
+fn read_csv_rows(path: &std::path::Path) -> anyhow::Result<Option<CsvRows>> {
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut lines = text.lines().filter(|l| !l.is_empty());
+    let header = lines.next().map(csv_cells).unwrap_or_default();
+    Ok(Some((header, lines.map(csv_cells).collect())))
+}
+
+/// Every file under `dir`, relative to it, sorted.
+fn files_under(dir: &std::path::Path) -> anyhow::Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    let mut stack = vec![PathBuf::new()];
+    while let Some(rel) = stack.pop() {
+        let abs = dir.join(&rel);
+        for e in std::fs::read_dir(&abs).with_context(|| format!("cannot read {}", abs.display()))? {
+            let e = e?;
+            let r = rel.join(e.file_name());
+            if e.file_type()?.is_dir() {
+                stack.push(r);
+            } else {
+                out.push(r);
+            }
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// `results merge`: joins shard folders into one, as an unsharded run writes it.
+pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
+    // The shards: same options (all but the shard, the output and the times), one of each K.
+    let mut runs: Vec<(PathBuf, serde_json::Value)> = Vec::new();
+    for d in &m.shards {
+        let p = d.join("run.json");
+        let text = std::fs::read_to_string(&p)
+            .with_context(|| format!("{} is not a results folder (no run.json)", d.display()))?;
+        let v: serde_json::Value =
+            serde_json::from_str(&text).with_context(|| format!("bad {}", p.display()))?;
+        runs.push((d.clone(), v));
+    }
+    let shard_of =
+        |v: &serde_json::Value| -> Option<Shard> { serde_json::from_value(v["shard"].clone()).ok() };
+    let options = |v: &serde_json::Value| {
+        let mut o = v.clone();
+        if let Some(map) = o.as_object_mut() {
+            for k in ["seconds", "scenes", "units", "shard", "command"] {
+                map.remove(k);
+            }
+        }
+        o
+    };
+    let (first_dir, first) = &runs[0];
+    let n = shard_of(first)
+        .ok_or_else(|| {
+            anyhow!(
+                "{} is not a shard (its run.json has no shard)",
+                first_dir.display()
+            )
+        })?
+        .n;
+    let mut seen = vec![false; n as usize];
+    for (d, v) in &runs {
+        let s = shard_of(v)
+            .ok_or_else(|| anyhow!("{} is not a shard (its run.json has no shard)", d.display()))?;
+        if s.n != n {
+            bail!("{} is shard {}/{}, the others are of {n}", d.display(), s.k, s.n);
+        }
+        if std::mem::replace(&mut seen[(s.k - 1) as usize], true) {
+            bail!("shard {}/{n} is given twice ({})", s.k, d.display());
+        }
+        if options(v) != options(first) {
+            bail!(
+                "{} and {} were run with different options (compare their run.json)",
+                first_dir.display(),
+                d.display()
+            );
+        }
+    }
+    let missing: Vec<String> = (1..=n)
+        .filter(|k| !seen[(k - 1) as usize])
+        .map(|k| format!("{k}/{n}"))
+        .collect();
+    if !missing.is_empty() {
+        bail!("shard(s) {} missing: a merge needs all {n}", missing.join(", "));
+    }
+    if m.out.join("run.json").exists() {
+        bail!(
+            "{} already holds a results run: merge into a new folder",
+            m.out.display()
+        );
+    }
+    std::fs::create_dir_all(&m.out).with_context(|| format!("cannot create {}", m.out.display()))?;
+
+    // Every figure's files. A file two shards both wrote (a shared image) must be the same.
+    let merged_names = |rel: &std::path::Path| {
+        rel == std::path::Path::new("run.json")
+            || rel == std::path::Path::new("checks.csv")
+            || rel.file_name().is_some_and(|n| n == "timing_agreement.csv")
+    };
+    let mut copied = 0usize;
+    for (d, _) in &runs {
+        for rel in files_under(d)? {
+            if merged_names(&rel) {
+                continue;
+            }
+            let src = d.join(&rel);
+            let dst = m.out.join(&rel);
+            let bytes = std::fs::read(&src).with_context(|| format!("cannot read {}", src.display()))?;
+            if dst.exists() {
+                if std::fs::read(&dst)? != bytes {
+                    bail!(
+                        "{} differs between shards (one of them wrote it differently)",
+                        rel.display()
+                    );
+                }
+                continue;
+            }
+            if let Some(p) = dst.parent() {
+                std::fs::create_dir_all(p)?;
+            }
+            std::fs::write(&dst, bytes).with_context(|| format!("cannot write {}", dst.display()))?;
+            copied += 1;
+        }
+    }
+
+    // Per scene, the timing agreement over every shard's figures, and its checks.
+    let mut scenes: Vec<serde_json::Value> = Vec::new();
+    for (_, v) in &runs {
+        for sc in v["scenes"].as_array().into_iter().flatten() {
+            match scenes.iter_mut().find(|s| s["scene"] == sc["scene"]) {
+                Some(s) => {
+                    let mut times = s["figure_times"].as_array().cloned().unwrap_or_default();
+                    times.extend(sc["figure_times"].as_array().cloned().unwrap_or_default());
+                    let pos = |t: &serde_json::Value| {
+                        ORDER
+                            .iter()
+                            .position(|f| t["figure"].as_str() == Some(&format!("{f:?}")))
+                            .unwrap_or(usize::MAX)
+                    };
+                    times.sort_by_key(pos);
+                    s["figure_times"] = serde_json::Value::Array(times);
+                }
+                None => scenes.push(sc.clone()),
+            }
+        }
+    }
+    let mut agreement: Vec<Check> = Vec::new();
+    for sc in &scenes {
+        let label = sc["scene"].as_str().unwrap_or_default();
+        let mut rows: Vec<crate::harness::BaseTiming> = Vec::new();
+        let mut header = None;
+        for (d, _) in &runs {
+            let Some((h, rs)) = read_csv_rows(&d.join(label).join("timing_agreement.csv"))? else {
+                continue;
+            };
+            let col = |name: &str| h.iter().position(|c| c == name);
+            for r in rs {
+                let cell = |name: &str| col(name).and_then(|i| r.get(i)).cloned().unwrap_or_default();
+                let t = crate::harness::BaseTiming {
+                    figure: cell("figure"),
+                    size: (0, 0),
+                    sample_ms_min: cell("sample_ms_min").parse().unwrap_or(f64::NAN),
+                    sample_ms_median: cell("sample_ms_median").parse().unwrap_or(f64::NAN),
+                    timed_passes: cell("timed_passes"),
+                    frame_passes: cell("frame_passes"),
+                    frame_kind: cell("frame_kind"),
+                    timed_frames: cell("timed_frames").parse().unwrap_or(0),
+                };
+                if !rows.iter().any(|x| x.figure == t.figure) {
+                    rows.push(t);
+                }
+            }
+            header.get_or_insert(h);
+        }
+        if let Some(h) = header {
+            let pos = |t: &crate::harness::BaseTiming| {
+                ORDER
+                    .iter()
+                    .position(|f| format!("{f:?}") == t.figure)
+                    .unwrap_or(usize::MAX)
+            };
+            rows.sort_by_key(pos);
+            let mut text = h.join(",");
+            text.push('\n');
+            for r in &rows {
+                text.push_str(&crate::harness::csv_line(&[
+                    label.to_string(),
+                    r.figure.clone(),
+                    num(r.sample_ms_min),
+                    num(r.sample_ms_median),
+                    r.timed_passes.clone(),
+                    r.frame_passes.clone(),
+                    r.frame_kind.clone(),
+                    r.timed_frames.to_string(),
+                ]));
+                text.push('\n');
+            }
+            let p = m.out.join(label).join("timing_agreement.csv");
+            std::fs::write(&p, text).with_context(|| format!("cannot write {}", p.display()))?;
+            let refs: Vec<&crate::harness::BaseTiming> = rows.iter().collect();
+            agreement.extend(agreement_checks(
+                label,
+                sc["adapter"].as_str().unwrap_or_default(),
+                &refs,
+            ));
+        }
+    }
+
+    // checks.csv: every shard's checks (in unit order), the agreement recomputed at the end
+    // of each scene's.
+    let mut header: Option<Vec<String>> = None;
+    let mut rows: Vec<Vec<String>> = Vec::new();
+    for (d, _) in &runs {
+        if let Some((h, rs)) = read_csv_rows(&d.join("checks.csv"))? {
+            rows.extend(rs.into_iter().filter(|r| {
+                r.get(1)
+                    .is_none_or(|n| n != AGREEMENT_SAME && n != AGREEMENT_FASTEST)
+            }));
+            header.get_or_insert(h);
+        }
+    }
+    let scene_pos = |s: &str| {
+        scenes
+            .iter()
+            .position(|x| x["scene"].as_str() == Some(s))
+            .unwrap_or(usize::MAX)
+    };
+    rows.sort_by_key(|r| scene_pos(r.first().map_or("", |s| s.as_str())));
+    let mut csv = Csv::new(&["scene", "check", "value", "limit", "kind", "met", "detail"]);
+    let mut all: Vec<Vec<String>> = Vec::new();
+    for sc in &scenes {
+        let label = sc["scene"].as_str().unwrap_or_default();
+        all.extend(
+            rows.iter()
+                .filter(|r| r.first().map(|s| s.as_str()) == Some(label))
+                .cloned(),
+        );
+        all.extend(agreement.iter().filter(|c| c.scene == label).map(|c| {
+            vec![
+                c.scene.clone(),
+                c.name.clone(),
+                num(c.value),
+                num(c.limit),
+                if c.at_least { "at least" } else { "at most" }.into(),
+                c.pass().to_string(),
+                c.detail.clone(),
+            ]
+        }));
+    }
+    for r in all {
+        csv.row(r);
+    }
+    if header.is_some() || !csv.rows.is_empty() {
+        csv.write(&m.out.join("checks.csv"))?;
+    }
+
+    // run.json: the shared options, every shard's scenes and units, the summed time.
+    let mut info = first.clone();
+    let seconds: f64 = runs
+        .iter()
+        .map(|(_, v)| v["seconds"].as_f64().unwrap_or(0.0))
+        .sum();
+    let mut units: Vec<serde_json::Value> = Vec::new();
+    for (_, v) in &runs {
+        units.extend(v["units"].as_array().cloned().unwrap_or_default());
+    }
+    if let Some(map) = info.as_object_mut() {
+        map.remove("shard");
+        map.insert("seconds".into(), seconds.into());
+        map.insert("scenes".into(), serde_json::Value::Array(scenes.clone()));
+        map.insert("units".into(), serde_json::Value::Array(units));
+        map.insert("merged_shards".into(), n.into());
+    }
+    let p = m.out.join("run.json");
+    std::fs::write(&p, serde_json::to_string_pretty(&info)?)
+        .with_context(|| format!("cannot write {}", p.display()))?;
+    println!(
+        "merged {n} shard(s) into {}: {copied} file(s), {} scene(s), {} check(s)",
+        m.out.display(),
+        scenes.len(),
+        csv.rows.len()
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_deal_units_round_robin_and_parse() {
+        assert_eq!(parse_shard("2/3"), Ok(Shard { k: 2, n: 3 }));
+        for bad in ["0/3", "4/3", "1/0", "x/2", "3"] {
+            assert!(parse_shard(bad).is_err(), "{bad}");
+        }
+        let shards: Vec<Shard> = (1..=3).map(|k| Shard { k, n: 3 }).collect();
+        for unit in 0..20 {
+            assert_eq!(shards.iter().filter(|s| s.owns(unit)).count(), 1, "unit {unit}");
+        }
+    }
+
+    #[test]
+    fn csv_cells_undo_the_writers_quoting() {
+        assert_eq!(
+            csv_cells(r#"a,"b, c","say ""hi""",4"#),
+            ["a", "b, c", "say \"hi\"", "4"]
+        );
+        assert_eq!(csv_cells(""), [""]);
+    }
 }

@@ -100,6 +100,7 @@ pub fn run(args: &SheetArgs) -> anyhow::Result<()> {
     }
     let ctx = GpuContext::new_headless()?;
     println!("adapter: {}", ctx.describe());
+    let settings_for_record = settings.clone();
     let mut r = Renderer::new(ctx, &opened.scene, (args.width, args.height), settings)?;
     let mut last = -1.0f32;
     let sheet = job
@@ -128,6 +129,27 @@ pub fn run(args: &SheetArgs) -> anyhow::Result<()> {
     let jpath = args.out.with_extension("json");
     std::fs::write(&jpath, crate::sheet::metrics_json(&sheet))
         .with_context(|| format!("cannot write {}", jpath.display()))?;
-    println!("wrote {} and {}", args.out.display(), jpath.display());
+    // The capture record (the base settings, scene, camera; the sheet's JSON names each
+    // column's method and settings).
+    let mut rec =
+        crate::capture::Capture::new("sheet", &r.ctx.adapter_info, &args.scene, opened.file.as_deref());
+    rec.camera = (&camera).into();
+    rec.lights = opened.scene.lights.iter().map(Into::into).collect();
+    (rec.width, rec.height) = (args.width, args.height);
+    rec.seed = r.settings().vpl.seed;
+    rec.frames = args.sampling.frames;
+    rec.frame_index = r.frame_index();
+    rec.files = [&args.out, &jpath]
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().to_string()))
+        .collect();
+    let rpath = crate::capture::sidecar_path(&args.out);
+    crate::capture::write_record(&rpath, &rec, &settings_for_record).map_err(|e| anyhow!("{e}"))?;
+    println!(
+        "wrote {}, {} and {}",
+        args.out.display(),
+        jpath.display(),
+        rpath.display()
+    );
     Ok(())
 }

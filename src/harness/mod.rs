@@ -357,6 +357,9 @@ impl Bench {
             self.r.resize(size.0, size.1)?;
         }
         self.r.set_settings(s.clone())?;
+        // Every configuration starts at frame 0: its numbers do not depend on what ran
+        // before it (a sharded sweep gives an unsharded one's numbers, `results --shard`).
+        self.r.restart_frame_index();
         Ok(())
     }
 
@@ -506,8 +509,10 @@ impl Bench {
                 timed_frames: m.passes.len(),
             });
         }
-        // 2. Diagnostic frames (untimed).
+        // 2. Diagnostic frames (untimed). They start at frame 0 again: the warm-up runs for a
+        // time, not a frame count, and the errors must not depend on how fast it went.
         self.r.set_frame_mode(FrameMode::Diagnostic);
+        self.r.restart_frame_index();
         if !tree {
             return Ok(m);
         }
@@ -659,21 +664,26 @@ impl Csv {
         let mut s = self.header.join(",");
         s.push('\n');
         for r in &self.rows {
-            let cells: Vec<String> = r
-                .iter()
-                .map(|c| {
-                    if c.contains(',') || c.contains('"') {
-                        format!("\"{}\"", c.replace('"', "\"\""))
-                    } else {
-                        c.clone()
-                    }
-                })
-                .collect();
-            s.push_str(&cells.join(","));
+            s.push_str(&csv_line(r));
             s.push('\n');
         }
         std::fs::write(path, s).with_context(|| format!("cannot write {}", path.display()))
     }
+}
+
+/// One CSV line: cells with `,` or `"` quoted, quotes doubled.
+pub fn csv_line(cells: &[String]) -> String {
+    cells
+        .iter()
+        .map(|c| {
+            if c.contains(',') || c.contains('"') {
+                format!("\"{}\"", c.replace('"', "\"\""))
+            } else {
+                c.clone()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 /// A number for a CSV cell (full precision, "nan" for missing).

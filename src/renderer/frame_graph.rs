@@ -10,13 +10,17 @@ use super::*;
 /// borrowable), writing into `$accum`.
 macro_rules! frame_cx {
     ($r:ident, $method:expr, $accum:expr, $size:expr, $key:expr, $trace:expr, $diag:expr) => {
+        frame_cx!($r, $method, $accum, $size, $key, $trace, $diag, timer)
+    };
+    // The same with another timer field of `$r` (the comparison truth: `quiet_timer`).
+    ($r:ident, $method:expr, $accum:expr, $size:expr, $key:expr, $trace:expr, $diag:expr, $timer:ident) => {
         FrameCx {
             method: $method,
             device: &$r.ctx.device,
             adapter_type: $r.ctx.adapter_info.device_type,
             queue: &$r.ctx.queue,
             errors: &$r.ctx.errors,
-            timer: &mut $r.timer,
+            timer: &mut $r.$timer,
             settings: &$r.settings,
             scene: &$r.scene,
             scene_radius: $r.scene.bounds.radius().max(1e-30),
@@ -112,13 +116,14 @@ impl Renderer {
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("frame::encoder"),
         });
-        // A diagnostic frame or a timed one (FrameMode); a timed frame that must advance a
-        // converging comparison truth is untimed too.
+        // A diagnostic frame or a timed one (FrameMode). A frame that advances a converging
+        // comparison truth stays timed: the truth's passes record with the quiet timer, so
+        // its timings are the method's from the first frames on (issue 41).
         let diagnostic = self.next_frame_diagnostic();
         let compare_due = self.compare_on
             && s.gi.method.per_frame()
             && (diagnostic || !self.compare_settled(input, lights, size));
-        self.timer.begin_frame(!diagnostic && !compare_due);
+        self.timer.begin_frame(!diagnostic);
         let t = &self.targets;
         self.rsm.record(
             &device,
@@ -568,16 +573,27 @@ impl Renderer {
                 }
             },
         };
-        let mut cx = frame_cx!(self, truth, &cmp.targets.gi_accum, size, key, None, true);
-        cmp.truth.record(&mut cx, enc);
+        // Untimed: the frame's timings are the method's, not its ground truth's.
+        let mut cx = frame_cx!(
+            self,
+            truth,
+            &cmp.targets.gi_accum,
+            size,
+            key,
+            None,
+            true,
+            quiet_timer
+        );
+        // While it converges, the truth's views show the VPLs so far scaled to all of them.
+        let scale = cmp.truth.record(&mut cx, enc);
         cmp.key = key;
         self.compare_composite.record(
             &device,
             &queue,
             enc,
-            &mut self.timer,
+            &mut self.quiet_timer,
             size,
-            1.0,
+            scale,
             &self.targets.lighting.direct_view,
             &cmp.targets.gi_accum,
             &cmp.targets.indirect_view,

@@ -339,6 +339,10 @@ pub struct GpuGtParams {
     pub brdf: u32,
     /// xyz the camera's position (the view direction of glossy shading).
     pub eye: [f32; 4],
+    /// The order the VPLs are summed in: step i evaluates VPL (i x order[0]) mod order[1]
+    /// (a stride coprime with the count, [`crate::methods::ground_truth::visit_stride`]), so
+    /// that every partial sum is spread over the whole set.
+    pub order: [u32; 4],
 }
 
 #[cfg(test)]
@@ -887,6 +891,7 @@ mod tests {
                     offset_of!(GpuGtParams, shadow_rays),
                     offset_of!(GpuGtParams, brdf),
                     offset_of!(GpuGtParams, eye),
+                    offset_of!(GpuGtParams, order),
                 ],
             ),
             (

@@ -195,13 +195,20 @@ impl Renderer {
             .map(|(_, m)| m.as_ref())
     }
 
-    /// The GPU instance of the method module whose type is `T` (tests and tools that read a
-    /// method's own buffers, e.g. `methods::lightcuts::Lightcuts`).
     /// The index the next frame records with (`FrameCx::frame_index`: frames rendered so far).
     pub fn frame_index(&self) -> u64 {
         self.frames
     }
 
+    /// Numbers the next frame 0 again: its random numbers (keyed by the frame index) become
+    /// those of a fresh renderer, whatever ran before (the harness restarts every
+    /// configuration, so a figure's numbers do not depend on the figures before it).
+    pub fn restart_frame_index(&mut self) {
+        self.frames = 0;
+    }
+
+    /// The GPU instance of the method module whose type is `T` (tests and tools that read a
+    /// method's own buffers, e.g. `methods::lightcuts::Lightcuts`).
     pub fn method_module<T: Method>(&self) -> Option<&T> {
         self.methods
             .iter()

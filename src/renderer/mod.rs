@@ -111,7 +111,7 @@ pub enum FrameMode {
     /// method view read after a frame is that frame's).
     Diagnostic,
     /// Every frame timed, without diagnostics (the harness's and `render`'s timed frames).
-    /// The comparison's ground truth, while it still converges, makes a frame untimed.
+    /// The comparison's ground truth, while it converges, records beside it untimed.
     Timed,
     /// Every `n`-th frame diagnostic (untimed), the others timed (the GUI).
     Interleaved(u32),

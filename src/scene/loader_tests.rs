@@ -880,7 +880,11 @@ irradiance = 10.0
 "#;
     let pr = ScenePreset::from_toml_str(ok, &p).unwrap();
     assert_eq!(pr.sun.as_ref().unwrap().color, [1.0; 3]);
-    assert_eq!(pr.gltf_path(&p), dir.join("m.gltf"));
+    // Found beside the preset; missing, one line naming where it looked.
+    let e = pr.gltf_path(&p).unwrap_err().to_string();
+    assert!(e.contains("m.gltf not found") && e.contains("looked in"), "{e}");
+    std::fs::write(dir.join("m.gltf"), "{}").unwrap();
+    assert_eq!(pr.gltf_path(&p).unwrap(), dir.join("m.gltf"));
     for (bad, needle) in [
         ("gltf = 3", "line 1"),
         ("gltf = \"a.gltf\"\nbogus = 1", "bogus"),
@@ -980,18 +984,16 @@ yfov_deg = 40.0
 // Shared reference scenes (skipped when absent)
 // ---------------------------------------------------------------------------------------
 
+/// The folder of the reference scenes, found through the scene search path (`fetch-scenes`,
+/// `LIGHTCUT_SCENES`, `../shared/scenes`).
 fn shared_scenes() -> Option<PathBuf> {
-    let dir = std::env::var_os("LIGHTCUT_SHARED_SCENES")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/scenes"));
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!(
-            "skipping: shared scenes folder {} not found (set LIGHTCUT_SHARED_SCENES)",
-            dir.display()
-        );
-        None
+    let presets = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    match super::scene_path::find(Path::new("sponza/Sponza.gltf"), Some(&presets)) {
+        Ok(p) => p.parent().and_then(|d| d.parent()).map(Path::to_path_buf),
+        Err(e) => {
+            println!("skipping: {e}");
+            None
+        }
     }
 }
 
@@ -1083,10 +1085,6 @@ fn breakfast_room_loads() {
 fn presets_in_scenes_folder_open() {
     let Some(_) = shared_scenes() else { return };
     let presets = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    if std::env::var_os("LIGHTCUT_SHARED_SCENES").is_some() && !presets.join("../../shared/scenes").is_dir() {
-        println!("skipping: the presets' relative paths do not reach the shared scenes from here");
-        return;
-    }
     for (file, name) in [
         ("sponza.toml", "Sponza"),
         ("breakfast_room.toml", "Breakfast Room"),

@@ -10,6 +10,7 @@ pub mod camera_path;
 pub mod default_scene;
 pub mod gltf_load;
 pub mod preset;
+pub mod scene_path;
 pub mod test_scenes;
 
 #[cfg(test)]

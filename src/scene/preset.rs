@@ -3,7 +3,7 @@
 //!
 //! ```toml
 //! name = "Sponza"
-//! gltf = "../../shared/scenes/sponza/Sponza.gltf"   # relative to this preset file
+//! gltf = "sponza/Sponza.gltf"   # found beside this preset or on the scene search path
 //! camera = "CameraMain"          # a camera name from the file (optional)
 //! exposure_ev = 0.0              # display exposure in EV stops (optional, default 0)
 //! [sun]                          # optional: replaces the lights from the file
@@ -37,7 +37,8 @@ pub struct ScenePreset {
     /// Display name of the scene (defaults to the glTF file stem).
     #[serde(default)]
     pub name: Option<String>,
-    /// The `.gltf`/`.glb` file; a relative path is resolved against the preset file's folder.
+    /// The `.gltf`/`.glb` file; a relative path is looked up beside the preset file, then on
+    /// the scene search path ([`super::scene_path`]).
     pub gltf: PathBuf,
     /// Name of a camera in the glTF file to start with. Mutually exclusive with `camera_pose`.
     #[serde(default)]
@@ -244,13 +245,19 @@ impl ScenePreset {
         Ok(())
     }
 
-    /// The glTF path, resolved against the folder of the preset file `preset_path`.
-    pub fn gltf_path(&self, preset_path: &Path) -> PathBuf {
-        if self.gltf.is_absolute() {
-            self.gltf.clone()
+    /// The glTF path: absolute as given, relative ones through the scene search path
+    /// ([`super::scene_path`]: beside the preset file `preset_path` first).
+    pub fn gltf_path(&self, preset_path: &Path) -> Result<PathBuf, SceneError> {
+        let dir = preset_path.parent().unwrap_or(Path::new("."));
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
         } else {
-            preset_path.parent().unwrap_or(Path::new(".")).join(&self.gltf)
-        }
+            dir
+        };
+        super::scene_path::find(&self.gltf, Some(dir)).map_err(|message| SceneError::MissingScene {
+            path: self.gltf.clone(),
+            message,
+        })
     }
 }
 
@@ -303,6 +310,8 @@ pub struct OpenedScene {
     /// Display exposure in EV stops.
     pub exposure_ev: f32,
     pub source: SceneSource,
+    /// The glTF file the scene was loaded from, as found (none for built-in scenes).
+    pub file: Option<PathBuf>,
 }
 
 /// Irradiance of the sun added to scenes that have no light at all (W/m^2).
@@ -317,6 +326,7 @@ pub fn open_scene(src: &SceneSource) -> Result<OpenedScene, SceneError> {
             camera_name: None,
             exposure_ev: 0.0,
             source: src.clone(),
+            file: None,
         },
         SceneSource::Builtin(name) => OpenedScene {
             scene: test_scenes::find(name)
@@ -328,6 +338,7 @@ pub fn open_scene(src: &SceneSource) -> Result<OpenedScene, SceneError> {
             camera_name: None,
             exposure_ev: 0.0,
             source: src.clone(),
+            file: None,
         },
         SceneSource::Gltf(p) if p.extension().is_none() && !p.exists() => {
             return Err(SceneError::UnknownScene {
@@ -335,21 +346,32 @@ pub fn open_scene(src: &SceneSource) -> Result<OpenedScene, SceneError> {
                 builtin: test_scenes::names(),
             });
         }
-        SceneSource::Gltf(p) => OpenedScene {
-            scene: load_gltf(p)?,
-            camera_name: None,
-            exposure_ev: 0.0,
-            source: src.clone(),
-        },
+        SceneSource::Gltf(p) => {
+            // A path that does not exist as given is looked up in the scene search path
+            // (`--scene sponza/Sponza.gltf` opens the fetched Sponza).
+            let file = super::scene_path::find(p, None).map_err(|message| SceneError::MissingScene {
+                path: p.clone(),
+                message,
+            })?;
+            OpenedScene {
+                scene: load_gltf(&file)?,
+                camera_name: None,
+                exposure_ev: 0.0,
+                source: src.clone(),
+                file: Some(file),
+            }
+        }
         SceneSource::Preset(p) => {
             let preset = load_preset(p)?;
-            let mut scene = load_gltf(&preset.gltf_path(p))?;
+            let file = preset.gltf_path(p)?;
+            let mut scene = load_gltf(&file)?;
             let camera_name = apply_preset(&preset, &mut scene, p)?;
             OpenedScene {
                 scene,
                 camera_name,
                 exposure_ev: preset.exposure_ev,
                 source: src.clone(),
+                file: Some(file),
             }
         }
     };

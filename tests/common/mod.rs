@@ -23,19 +23,17 @@ pub fn gpu() -> Option<GpuContext> {
     }
 }
 
-/// `../shared/scenes` beside the repository (or `LIGHTCUT_SHARED_SCENES`), if present.
+/// The folder holding the reference scenes (`sponza/`, `breakfast_room/`), found through the
+/// scene search path presets use (`LIGHTCUT_SCENES`, the user data folder `fetch-scenes`
+/// fills, `../shared/scenes` beside the repository), if present.
 pub fn shared_scenes() -> Option<PathBuf> {
-    let p = std::env::var_os("LIGHTCUT_SHARED_SCENES")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/scenes"));
-    if p.is_dir() {
-        Some(p)
-    } else {
-        eprintln!(
-            "SKIPPED: shared scenes not found at {} (set LIGHTCUT_SHARED_SCENES)",
-            p.display()
-        );
-        None
+    let presets = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    match lightcut::scene::scene_path::find(std::path::Path::new("sponza/Sponza.gltf"), Some(&presets)) {
+        Ok(p) => p.parent().and_then(|d| d.parent()).map(|d| d.to_path_buf()),
+        Err(e) => {
+            eprintln!("SKIPPED: {e}");
+            None
+        }
     }
 }
 

@@ -19,7 +19,17 @@ struct GtParams {
     shadow_rays: u32, // 1 trace shadow rays, 0 every VPL visible
     brdf: u32,        // BRDF_LAMBERT / BRDF_GGX
     eye: vec4<f32>,   // xyz camera position
+    // Step i evaluates VPL (i * order.x) % order.y: a stride coprime with the count, so that
+    // the sum so far covers the whole set while it converges (GpuGtParams::order).
+    order: vec4<u32>,
 };
+
+fn vpl_at(i: u32) -> Vpl {
+    if params.order.y == 0u {
+        return vpls[i];
+    }
+    return vpls[(i * params.order.x) % params.order.y];
+}
 
 @group(0) @binding(0) var<uniform> params: GtParams;
 @group(0) @binding(1) var<storage, read> bvh_nodes: array<BvhNode>;
@@ -59,7 +69,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if params.brdf == BRDF_LAMBERT {
         var sum = vec3<f32>(0.0);
         for (var i = params.begin; i < params.end; i++) {
-            sum += vpl_irradiance_term(vpls[i], g.xyz, nx);
+            sum += vpl_irradiance_term(vpl_at(i), g.xyz, nx);
         }
         accum[k] += vec4<f32>(albedo.rgb / PI * sum, 0.0);
         return;
@@ -68,7 +78,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let v = normalize(params.eye.xyz - g.xyz);
     var sum = vec3<f32>(0.0);
     for (var i = params.begin; i < params.end; i++) {
-        let vp = vpls[i];
+        let vp = vpl_at(i);
         let t = vpl_irradiance_term(vp, g.xyz, nx);
         if any(t > vec3<f32>(0.0)) {
             let l = normalize(vp.position.xyz - g.xyz);

@@ -617,6 +617,52 @@ fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
             egui::Color32::from_gray(220),
         );
     }
+    draw_truth_progress(cx, &painter, rect, pane);
     draw_legend(cx, &painter, rect, pane);
     response
+}
+
+/// On a view of the comparison's ground truth while it converges: how far it got, as a bar
+/// and a line across the view's top (the image meanwhile shows the VPLs so far, scaled to
+/// all of them).
+fn draw_truth_progress(cx: &PaneContext<'_>, painter: &egui::Painter, rect: egui::Rect, pane: &ViewPane) {
+    let gt = |s: AbSource| matches!(s, AbSource::GroundTruthIndirect | AbSource::GroundTruthFinal);
+    let shows_truth = matches!(
+        pane.spec.buffer,
+        ViewBuffer::GroundTruthFinal | ViewBuffer::GroundTruthIndirect
+    ) || pane.spec.effective_ab().is_some_and(|ab| gt(ab.a) || gt(ab.b));
+    if !shows_truth {
+        return;
+    }
+    let Some(p) = cx.renderer.compare_progress().filter(|p| !p.finished()) else {
+        return;
+    };
+    let f = p.fraction();
+    let bar = egui::Rect::from_min_size(
+        rect.left_top() + egui::vec2(8.0, 26.0),
+        egui::vec2(rect.width() - 16.0, 5.0),
+    );
+    painter.rect_filled(bar, 2.0, egui::Color32::from_black_alpha(160));
+    painter.rect_filled(
+        egui::Rect::from_min_size(bar.min, egui::vec2(bar.width() * f, bar.height())),
+        2.0,
+        egui::Color32::from_rgb(90, 170, 255),
+    );
+    let galley = painter.layout(
+        format!(
+            "ground truth converging: {:.0}% of {} VPLs (the VPLs so far, scaled to all)",
+            100.0 * f,
+            p.total
+        ),
+        egui::FontId::proportional(11.0),
+        egui::Color32::from_gray(235),
+        bar.width(),
+    );
+    let at = bar.left_bottom() + egui::vec2(0.0, 4.0);
+    painter.rect_filled(
+        egui::Rect::from_min_size(at, galley.size()).expand(2.0),
+        2.0,
+        egui::Color32::from_black_alpha(150),
+    );
+    painter.galley(at, galley, egui::Color32::WHITE);
 }

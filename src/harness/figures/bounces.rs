@@ -1,5 +1,5 @@
 //! Issue 23's bounce-count figure: multi-bounce VPLs (`vpl.bounces`, light paths through the
-//! BVH) at 1..=4 bounces. Per depth: the light the ground truth of the frame's VPLs gathers
+//! BVH) at 1..=4 bounces (`results --bounce-counts`). Per depth: the light the ground truth of the frame's VPLs gathers
 //! (its image mean, against one bounce), the light paths' GPU time, and every per-frame
 //! method's GI time and error (RMSE, relative RMSE, the image-mean ratio) against the ground
 //! truth of its own VPLs. Bounces 2..=N take `count / N` VPL slots each, so a method sees
@@ -10,8 +10,6 @@
 use super::*;
 use crate::harness::LIGHT_PATH_PASSES;
 
-/// The depths the figure sweeps.
-pub const BOUNCES: [u32; 4] = [1, 2, 3, 4];
 /// The path-start mixes at depths above 1: faithful first.
 const MIXES: [f32; 2] = [1.0, 0.1];
 
@@ -46,8 +44,8 @@ pub fn bounces(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         .filter(|(m, _)| m.per_frame() && m.refuses_bounces(2).is_none())
         .collect();
     let mut table = format!(
-        "bounces 1..=4 ({} VPL slots; bounces 2..N take count/N each); light paths and GI: GPU timestamps; error vs the ground truth of the same VPLs:\n",
-        b.base.vpl.count
+        "bounces {:?} ({} VPL slots; bounces 2..N take count/N each); light paths and GI: GPU timestamps; error vs the ground truth of the same VPLs:\n",
+        o.bounces, b.base.vpl.count
     );
     let mut one_bounce_mean = f64::NAN;
     // Per (mix, method): (bounces, relative RMSE) for the plot.
@@ -56,7 +54,7 @@ pub fn bounces(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     for (xi, &mix) in MIXES.iter().enumerate() {
         let mut per_method: Vec<Vec<(f64, f64)>> = vec![Vec::new(); list.len()];
         let mut gt_points = Vec::new();
-        for &n in &BOUNCES {
+        for &n in &o.bounces {
             if n == 1 && xi > 0 {
                 // One bounce has no paths: the faithful run's row stands for both.
                 for (k, pts) in per_method.iter_mut().enumerate() {

@@ -64,6 +64,8 @@ pub struct Opts {
     pub temporal_path_frames: u32,
     pub sun_sweep_deg: f32,
     pub temporal_timing_size: (u32, u32),
+    /// The bounce counts of the bounce-count figure (1 included: its reference row).
+    pub bounces: Vec<u32>,
 }
 
 impl Opts {

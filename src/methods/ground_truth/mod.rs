@@ -64,6 +64,36 @@ fn validate(s: &RenderSettings) -> Result<(), String> {
     Ok(())
 }
 
+/// The stride of the order the truth sums the VPLs in (step i: VPL i x stride mod n): near
+/// n / golden ratio (consecutive steps land far apart, as a rank-1 lattice), coprime with n
+/// (a permutation), and small enough that (n - 1) x stride fits in 32 bits.
+pub fn visit_stride(n: u32) -> u32 {
+    fn gcd(a: u64, b: u64) -> u64 {
+        if b == 0 { a } else { gcd(b, a % b) }
+    }
+    if n <= 2 {
+        return 1;
+    }
+    let golden = (n as f64 / 1.618_033_988_75).round() as u64;
+    let cap = (u32::MAX as u64 / n as u64).max(1);
+    let mut p = golden.min(cap).max(1);
+    while gcd(p, n as u64) != 1 {
+        p -= 1;
+    }
+    p as u32
+}
+
+/// The composite's scale of a sum over the first `done` of `total` VPLs: total / done, so
+/// that a view of the truth while it converges reads at its final brightness (an estimate
+/// from the VPLs so far) instead of fading in from black; 1 when finished (issue 41).
+pub fn partial_scale(p: GiProgress) -> f32 {
+    if p.done == 0 || p.done >= p.total {
+        1.0
+    } else {
+        p.total as f32 / p.done as f32
+    }
+}
+
 /// State between frames: a snapshot of the VPLs it evaluates, and how far it got. Any change
 /// of `FrameCx::key` restarts it.
 struct GtState {
@@ -129,6 +159,7 @@ impl Method for GroundTruth {
             shadow_rays: g.shadow_rays as u32,
             brdf: cx.brdf.gpu(),
             eye: cx.eye.extend(0.0).to_array(),
+            order: [visit_stride(total), total, 0, 0],
         };
         gt.progress.done = self.pass.record(
             cx.device,
@@ -142,7 +173,7 @@ impl Method for GroundTruth {
             &cx.targets.gbuffer,
             cx.gi_accum,
         );
-        1.0
+        partial_scale(gt.progress)
     }
 
     fn progress(&self) -> Option<GiProgress> {
@@ -151,5 +182,62 @@ impl Method for GroundTruth {
 
     fn reset(&mut self) {
         self.state = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_visit_order_is_a_permutation_that_spreads_and_does_not_overflow() {
+        for n in [
+            1u32,
+            2,
+            3,
+            7,
+            100,
+            1000,
+            4096,
+            4097,
+            65_536,
+            1 << 20,
+            3 * (1 << 18),
+        ] {
+            let p = visit_stride(n);
+            assert!(
+                (n as u64).saturating_sub(1) * p as u64 <= u32::MAX as u64,
+                "n {n}, stride {p}"
+            );
+            if n <= 65_536 {
+                let mut seen = vec![false; n as usize];
+                for i in 0..n {
+                    let j = ((i as u64 * p as u64) % n as u64) as usize;
+                    assert!(!std::mem::replace(&mut seen[j], true), "n {n}: {j} twice");
+                }
+            }
+        }
+        // The first tenth of 4096 VPLs reaches every tenth of the array.
+        let (n, p) = (4096u32, visit_stride(4096));
+        let mut deciles = [false; 10];
+        for i in 0..n / 10 {
+            deciles[((i * p) % n * 10 / n) as usize] = true;
+        }
+        assert!(deciles.iter().all(|&d| d), "{deciles:?}");
+        assert_eq!(
+            partial_scale(GiProgress {
+                done: 1024,
+                total: 4096
+            }),
+            4.0
+        );
+        assert_eq!(partial_scale(GiProgress { done: 0, total: 4096 }), 1.0);
+        assert_eq!(
+            partial_scale(GiProgress {
+                done: 4096,
+                total: 4096
+            }),
+            1.0
+        );
     }
 }

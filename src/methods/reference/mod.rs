@@ -213,6 +213,8 @@ impl Method for Reference {
                         shadow_rays: 1,
                         brdf: cx.brdf.gpu(),
                         eye: cx.eye.extend(0.0).to_array(),
+                        // In order: each chunk is summed whole within the frame.
+                        order: [0; 4],
                     };
                     self.shade.record(
                         cx.device,

@@ -39,6 +39,10 @@ pub enum SceneError {
         name: String,
         builtin: Vec<&'static str>,
     },
+    /// A scene file named by a preset or `--scene` is on no folder of the search path (the
+    /// message names them and, for the reference scenes, the command that fetches them).
+    #[error("{message}")]
+    MissingScene { path: PathBuf, message: String },
     /// The file (glTF, preset, ...) could not be opened or read.
     #[error("cannot read {}: {source}", path.display())]
     Io {
