@@ -150,12 +150,31 @@ impl Capture {
             driver: format!("{} {}", adapter.driver, adapter.driver_info)
                 .trim()
                 .to_string(),
-            scene: scene.into(),
+            scene: absolute_scene(scene),
             scene_file: scene_file.map(|p| p.display().to_string()).unwrap_or_default(),
             scene_sha256,
-            command: std::env::args().collect::<Vec<_>>().join(" "),
+            // The program's own path is left out (it names a folder of this machine).
+            command: std::iter::once("lightcut-workbench".to_string())
+                .chain(
+                    std::env::args_os()
+                        .skip(1)
+                        .map(|a| a.to_string_lossy().into_owned()),
+                )
+                .collect::<Vec<_>>()
+                .join(" "),
             ..Default::default()
         }
+    }
+}
+
+/// A scene argument that names a file, made absolute (a record then reproduces from any
+/// folder); built-in scene names as they are.
+fn absolute_scene(scene: &str) -> String {
+    let p = Path::new(scene);
+    if p.is_file() {
+        std::fs::canonicalize(p).map_or_else(|_| scene.to_string(), |a| a.display().to_string())
+    } else {
+        scene.to_string()
     }
 }
 

@@ -318,7 +318,7 @@ fn a_two_shard_sweep_merges_into_the_unsharded_numbers() {
     let root = tmp("shards");
     let base = [
         "results",
-        "steps,blocks,blending",
+        "steps,temporal,blocks,blending",
         "--scenes",
         "default",
         "--width",
@@ -333,6 +333,14 @@ fn a_two_shard_sweep_merges_into_the_unsharded_numbers() {
         "1,4",
         "--vpls",
         "256",
+        "--temporal-frames",
+        "3",
+        "--temporal-path-frames",
+        "30",
+        "--temporal-timing-width",
+        "32",
+        "--temporal-timing-height",
+        "24",
     ];
     let go = |extra: &[&str], out: &Path| -> Vec<String> {
         let mut a: Vec<String> = base.iter().map(|s| s.to_string()).collect();
@@ -381,8 +389,8 @@ fn a_two_shard_sweep_merges_into_the_unsharded_numbers() {
             .map(|u| u.as_str().unwrap().to_string())
             .collect()
     };
-    assert_eq!(units(&s1), ["default/Steps", "default/Blending"]);
-    assert_eq!(units(&s2), ["default/Blocks"]);
+    assert_eq!(units(&s1), ["default/Steps", "default/Blocks"]);
+    assert_eq!(units(&s2), ["default/Temporal", "default/Blending"]);
     // A merge with a shard missing is refused.
     let o = run(
         &[
@@ -399,11 +407,12 @@ fn a_two_shard_sweep_merges_into_the_unsharded_numbers() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("2/2 missing"));
     ok(
         &run(
+            // In any order: the merge orders by shard, scene and figure.
             &[
                 "results",
                 "merge",
-                s1.to_str().unwrap(),
                 s2.to_str().unwrap(),
+                s1.to_str().unwrap(),
                 "--out",
                 merged.to_str().unwrap(),
             ],
@@ -412,7 +421,7 @@ fn a_two_shard_sweep_merges_into_the_unsharded_numbers() {
         ),
         "results merge",
     );
-    assert_eq!(units(&merged).len(), 3);
+    assert_eq!(units(&merged), units(&whole));
     // The same files, and every deterministic column the same as the unsharded run's.
     let list = |d: &Path| {
         let mut v: Vec<String> = walk(d)

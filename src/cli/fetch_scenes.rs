@@ -1,9 +1,9 @@
 //! `fetch-scenes`: downloads the reference scenes (Sponza, Breakfast Room) from AMD's
 //! CapsaicinTestMedia (CC BY 3.0), checks every file's size and SHA-256 against the files
 //! the measurements used (`scenes/reference/manifest.toml`), and puts them where presets find
-//! them ([`crate::scene::scene_path`]). A file is only ever placed after its checksum
-//! matched (downloaded to `<file>.part`, checked, renamed); files already present and right
-//! are kept.
+//! them ([`crate::scene::scene_path`]). A file is only ever placed after its size and
+//! checksum matched (checked in memory, written to `<file>.part`, renamed); files already
+//! present and right are kept.
 
 use std::path::{Path, PathBuf};
 
@@ -141,10 +141,8 @@ fn fetch_one(f: &ManifestFile, from: &str, into: &Path, check_only: bool) -> any
     }
     let parent = dest.parent().unwrap_or(into);
     std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
-    let part = dest.with_extension(format!(
-        "{}.part",
-        dest.extension().and_then(|e| e.to_str()).unwrap_or("")
-    ));
+    let name = dest.file_name().and_then(|n| n.to_str()).unwrap_or("file");
+    let part = dest.with_file_name(format!("{name}.{}.part", std::process::id()));
     std::fs::write(&part, &bytes).with_context(|| format!("cannot write {}", part.display()))?;
     std::fs::rename(&part, &dest).with_context(|| format!("cannot place {}", dest.display()))?;
     Ok(outcome)
@@ -160,7 +158,19 @@ fn read_source(from: &str, rel: &str) -> anyhow::Result<Vec<u8>> {
     }
     let url = format!("{}/{}", from.trim_end_matches('/'), rel);
     let out = std::process::Command::new("curl")
-        .args(["-fsSL", "--retry", "3", "--connect-timeout", "20", &url])
+        // A stalled download (under 1 kB/s for a minute) fails instead of hanging.
+        .args([
+            "-fsSL",
+            "--retry",
+            "3",
+            "--connect-timeout",
+            "20",
+            "--speed-limit",
+            "1000",
+            "--speed-time",
+            "60",
+            &url,
+        ])
         .output()
         .map_err(|e| {
             anyhow!(
@@ -280,7 +290,11 @@ mod tests {
             "{e}"
         );
         assert!(!into.join("room/tex.png").exists());
-        assert!(!into.join("room/tex.png.part").exists());
+        assert!(
+            std::fs::read_dir(into.join("room"))
+                .unwrap()
+                .all(|e| { !e.unwrap().file_name().to_string_lossy().ends_with(".part") })
+        );
         // A file missing from the mirror fails the same way; an unknown scene is refused.
         m.files.push(file("room/gone.bin", b"x"));
         let e = fetch(&m, &from, &into, &[], false, &mut log)

@@ -156,7 +156,8 @@ pub struct Renderer {
     /// The other kind of tree over the same VPLs, for the overlay's side-by-side comparison
     /// (`display.tree_compare`), built untimed (`quiet_timer`).
     tree_other: Option<TreeBuffers>,
-    /// A timer never begun: passes recorded with it take no timestamps.
+    /// A timer that never times (begun untimed once): passes recorded with it take no
+    /// timestamps.
     quiet_timer: GpuTimer,
     sst_overlay: SstOverlayPass,
     /// One GPU instance per method module (`methods::modules()`), by module name.
@@ -291,7 +292,12 @@ impl Renderer {
             sst_build: BuildPass::new(device)?,
             tree: TreeBuffers::new(device, settings.vpl.count, settings.tree.kind),
             tree_other: None,
-            quiet_timer: GpuTimer::new(device, &ctx.queue),
+            quiet_timer: {
+                let mut t = GpuTimer::new(device, &ctx.queue);
+                // Never timed: its passes write no timestamps.
+                t.begin_frame(false);
+                t
+            },
             sst_overlay: SstOverlayPass::new(device)?,
             methods: create_methods(device)?,
             selected_block: None,

@@ -73,12 +73,12 @@ impl Manifest {
 
     /// The scene folders named in the manifest (`sponza`, `breakfast_room`).
     pub fn scenes(&self) -> Vec<String> {
-        let mut v: Vec<String> = self
-            .files
-            .iter()
-            .filter_map(|f| f.path.split('/').next().map(str::to_string))
-            .collect();
-        v.dedup();
+        let mut v: Vec<String> = Vec::new();
+        for s in self.files.iter().filter_map(|f| f.path.split('/').next()) {
+            if !v.iter().any(|x| x == s) {
+                v.push(s.to_string());
+            }
+        }
         v
     }
 
