@@ -1,6 +1,7 @@
 //! Embeds the commit the binary is built from (`LIGHTCUT_COMMIT`, read by capture records):
 //! `git rev-parse HEAD`, with `-dirty` when tracked files differ from it; `unknown` without git.
 
+use std::path::Path;
 use std::process::Command;
 
 fn git(args: &[&str]) -> Option<String> {
@@ -19,7 +20,17 @@ fn main() {
         None => "unknown".to_string(),
     };
     println!("cargo:rustc-env=LIGHTCUT_COMMIT={value}");
-    for p in [".git/HEAD", ".git/index", "src", "shaders", "Cargo.toml"] {
+    // Rerun when HEAD moves (a checkout: HEAD; a commit: the branch's ref), the index changes,
+    // or the sources do. Only paths that exist (a missing one reruns it at every build), and
+    // git's own paths (a worktree's `.git` is a file).
+    let mut watch: Vec<String> = ["src", "shaders", "Cargo.toml"].map(String::from).to_vec();
+    for p in ["HEAD", "index", "packed-refs"] {
+        watch.extend(git(&["rev-parse", "--git-path", p]));
+    }
+    if let Some(r) = git(&["symbolic-ref", "-q", "HEAD"]) {
+        watch.extend(git(&["rev-parse", "--git-path", &r]));
+    }
+    for p in watch.iter().filter(|p| Path::new(p).exists()) {
         println!("cargo:rerun-if-changed={p}");
     }
 }
