@@ -13,18 +13,26 @@ fn git(args: &[&str]) -> Option<String> {
 
 fn main() {
     let commit = git(&["rev-parse", "HEAD"]).filter(|c| !c.is_empty());
-    let dirty = git(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
+    // `--no-optional-locks`: status must not rewrite the index (a rewritten index would
+    // rerun this script, and rebuild the crate, at every cargo command).
+    let dirty = git(&[
+        "--no-optional-locks",
+        "status",
+        "--porcelain",
+        "--untracked-files=no",
+    ])
+    .is_some_and(|s| !s.is_empty());
     let value = match commit {
         Some(c) if dirty => format!("{c}-dirty"),
         Some(c) => c,
         None => "unknown".to_string(),
     };
     println!("cargo:rustc-env=LIGHTCUT_COMMIT={value}");
-    // Rerun when HEAD moves (a checkout: HEAD; a commit: the branch's ref), the index changes,
-    // or the sources do. Only paths that exist (a missing one reruns it at every build), and
+    // Rerun when HEAD moves (a checkout: HEAD; a commit: the branch's ref) or the sources
+    // change (not on the index: `git add` alone changes no build). Only paths that exist (a missing one reruns it at every build), and
     // git's own paths (a worktree's `.git` is a file).
     let mut watch: Vec<String> = ["src", "shaders", "Cargo.toml"].map(String::from).to_vec();
-    for p in ["HEAD", "index", "packed-refs"] {
+    for p in ["HEAD", "packed-refs"] {
         watch.extend(git(&["rev-parse", "--git-path", p]));
     }
     if let Some(r) = git(&["symbolic-ref", "-q", "HEAD"]) {
