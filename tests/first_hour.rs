@@ -95,76 +95,34 @@ fn scenes_are_fetched_from_a_mirror_checked_and_found_by_presets() {
     let Some(shared) = common::shared_scenes() else {
         return;
     };
+    // `fetch-scenes` of the Breakfast Room with `extra` options, in `cwd`.
+    let fetch = |extra: &[&str]| {
+        let mut a = vec!["fetch-scenes", "--scenes", "breakfast_room"];
+        a.extend(extra);
+        run(&a, &cwd, &base_env)
+    };
+    let from = ["--from", shared.to_str().unwrap()];
     // Fetched from a local mirror into the user data folder (the default --into), every
     // file's SHA-256 checked against the manifest.
-    let out = ok(
-        &run(
-            &[
-                "fetch-scenes",
-                "--from",
-                shared.to_str().unwrap(),
-                "--scenes",
-                "breakfast_room",
-            ],
-            &cwd,
-            &base_env,
-        ),
-        "fetch-scenes",
-    );
+    let out = ok(&fetch(&from), "fetch-scenes");
     assert!(out.contains("6 file(s) ok (6 placed now"), "{out}");
     assert!(out.contains("presets find them now"), "{out}");
     let placed = home.join(".local/share/lightcut-workbench/scenes/breakfast_room/BreakfastRoom.gltf");
     assert!(placed.is_file());
     // The preset finds it there; a second fetch keeps every file.
     ok(&render(&base_env), "render after fetch-scenes");
-    let again = ok(
-        &run(
-            &["fetch-scenes", "--check", "--scenes", "breakfast_room"],
-            &cwd,
-            &base_env,
-        ),
-        "fetch-scenes --check",
-    );
+    let again = ok(&fetch(&["--check"]), "fetch-scenes --check");
     assert!(again.contains("0 placed now, 6 already present"), "{again}");
     // A damaged file fails --check, naming it; fetching again repairs it.
     std::fs::write(&placed, "{}").unwrap();
-    let o = run(
-        &["fetch-scenes", "--check", "--scenes", "breakfast_room"],
-        &cwd,
-        &base_env,
-    );
+    let o = fetch(&["--check"]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("BreakfastRoom.gltf"));
-    ok(
-        &run(
-            &[
-                "fetch-scenes",
-                "--from",
-                shared.to_str().unwrap(),
-                "--scenes",
-                "breakfast_room",
-            ],
-            &cwd,
-            &base_env,
-        ),
-        "fetch-scenes repair",
-    );
+    ok(&fetch(&from), "fetch-scenes repair");
     // Another folder through LIGHTCUT_SCENES.
     let other = root.join("other");
     ok(
-        &run(
-            &[
-                "fetch-scenes",
-                "--from",
-                shared.to_str().unwrap(),
-                "--scenes",
-                "breakfast_room",
-                "--into",
-                other.to_str().unwrap(),
-            ],
-            &cwd,
-            &base_env,
-        ),
+        &fetch(&[from[0], from[1], "--into", other.to_str().unwrap()]),
         "fetch-scenes --into",
     );
     std::fs::remove_dir_all(home.join(".local")).unwrap();

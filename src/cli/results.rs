@@ -416,15 +416,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
                 Figure::EqualTime => figures::equal_time(&mut b, &o, &dir)?,
                 Figure::Culling => figures::culling(&mut b, &o, &dir)?,
                 Figure::Val => figures::val(&mut b, &o, &dir)?,
-                Figure::Temporal => {
-                    let rep = figures::temporal(&mut b, &o, &dir)?;
-                    // The temporal figure's sequences leave renderer state behind that changed
-                    // the errors of the figures after it (blocks' mean ratio 0.79 instead of
-                    // 1.03 at 32x24; found by the shard test): the figures after it get a
-                    // fresh renderer, as a shard without it has.
-                    b.r = Renderer::new(b.r.ctx.clone(), &sc.scene, o.size, b.base.clone())?;
-                    rep
-                }
+                Figure::Temporal => figures::temporal(&mut b, &o, &dir)?,
                 Figure::Trees => figures::trees(&mut b, &o, &dir)?,
                 Figure::Bounces => figures::bounces(&mut b, &o, &dir)?,
                 Figure::Steps => figures::steps(&mut b, &o, &dir)?,
@@ -478,16 +470,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
     }
     let mut csv = Csv::new(&CHECKS_HEADER);
     for (f, c) in &checks {
-        csv.row(vec![
-            c.scene.clone(),
-            f.clone(),
-            c.name.clone(),
-            num(c.value),
-            num(c.limit),
-            if c.at_least { "at least" } else { "at most" }.into(),
-            c.pass().to_string(),
-            c.detail.clone(),
-        ]);
+        csv.row(check_row(f, c));
     }
     if !checks.is_empty() {
         csv.write(&args.out.join("checks.csv"))?;
@@ -548,6 +531,20 @@ const CHECKS_HEADER: [&str; 8] = [
 ];
 /// The `figure` of the timing-agreement checks (a scene's last rows).
 const AGREEMENT_FIGURE: &str = "agreement";
+
+/// A row of checks.csv: `c` made by `figure`.
+fn check_row(figure: &str, c: &Check) -> Vec<String> {
+    vec![
+        c.scene.clone(),
+        figure.to_string(),
+        c.name.clone(),
+        num(c.value),
+        num(c.limit),
+        if c.at_least { "at least" } else { "at most" }.into(),
+        c.pass().to_string(),
+        c.detail.clone(),
+    ]
+}
 
 /// Every option of a `results` run but `--shard` and `--out` (shards of one sweep agree on it).
 fn options_key(args: &ResultsArgs) -> String {
@@ -942,18 +939,7 @@ pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
             );
         }
     }
-    for c in &agreement {
-        rows.push(vec![
-            c.scene.clone(),
-            AGREEMENT_FIGURE.to_string(),
-            c.name.clone(),
-            num(c.value),
-            num(c.limit),
-            if c.at_least { "at least" } else { "at most" }.into(),
-            c.pass().to_string(),
-            c.detail.clone(),
-        ]);
-    }
+    rows.extend(agreement.iter().map(|c| check_row(AGREEMENT_FIGURE, c)));
     // A stable sort: within a figure, its checks keep their order.
     rows.sort_by_key(|r| {
         (

@@ -499,6 +499,10 @@ impl Renderer {
         let Some((_, m)) = self.methods.iter_mut().find(|(n, _)| *n == module) else {
             return 0.0;
         };
+        if self.accum_owner != Some(method) {
+            m.reset();
+            self.accum_owner = Some(method);
+        }
         let mut cx = frame_cx!(
             self,
             method,

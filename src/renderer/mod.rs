@@ -192,6 +192,10 @@ pub struct Renderer {
     lights_buf: wgpu::Buffer,
     timer: GpuTimer,
     frames: u64,
+    /// The method whose passes wrote the GI accumulation last: a method taking it over is
+    /// reset first (a finished progressive method would otherwise keep showing, and report
+    /// as its result, what another method wrote there).
+    accum_owner: Option<crate::methods::MethodId>,
     frame_mode: FrameMode,
     /// Whether the last frame recorded diagnostics (else it was timed).
     last_diagnostic: bool,
@@ -325,6 +329,7 @@ impl Renderer {
             timer: GpuTimer::new(device, &ctx.queue),
             settings,
             frames: 0,
+            accum_owner: None,
             frame_mode: FrameMode::Diagnostic,
             last_diagnostic: false,
             diagnostic_requested: false,
