@@ -7,11 +7,11 @@ use lightcut::{
     cli::bench::{probe_rays, shadow_rays},
     renderer::{
         bvh_trace::{BvhTracer, TraceMode, to_gpu_ray},
-        scene_gpu::upload_bvh,
+        scene_gpu::{upload_binary_bvh, upload_bvh},
     },
     scene::{
         Scene,
-        bvh::{Bvh, Ray, brute_force_any, brute_force_closest, random_shadow_rays},
+        bvh::{Bvh, Ray, WideBvh, brute_force_any, brute_force_closest, random_shadow_rays},
         default_scene,
         gltf_load::load_gltf,
     },
@@ -32,11 +32,14 @@ fn test_rays(scene: &Scene, n: usize, seed: u64) -> Vec<Ray> {
 
 fn check_cpu_against_brute_force(scene: &Scene, n: usize) {
     let bvh = Bvh::build(&scene.positions, &scene.indices);
+    let wide = WideBvh::from_binary(&bvh);
     let rays = test_rays(scene, n, 7);
     let mut hits = 0;
     for (i, r) in rays.iter().enumerate() {
         let bf = brute_force_closest(&scene.positions, &scene.indices, r);
         let got = bvh.closest_hit(r);
+        assert_eq!(wide.closest_hit(r), got, "ray {i}: the wide BVH's closest hit");
+        assert_eq!(wide.any_hit(r), bf.is_some(), "ray {i}: the wide BVH's any hit");
         match (bf, got) {
             (None, None) => {}
             (Some(a), Some(b)) => {
@@ -70,18 +73,35 @@ fn cpu_bvh_matches_brute_force_on_sponza() {
     check_cpu_against_brute_force(&s, 150);
 }
 
+/// Both GPU layouts (the frames' wide BVH, `common/bvh.wgsl`, and the binary one,
+/// `common/bvh_binary.wgsl`) against the CPU's binary traversal.
 fn check_gpu_against_cpu(scene: &Scene, n: usize) {
     let Some(ctx) = common::gpu() else { return };
     let bvh = Bvh::build(&scene.positions, &scene.indices);
-    let (nodes, tris) = upload_bvh(&ctx.device, &bvh);
-    let tracer = BvhTracer::new(&ctx.device).expect("shader");
     let rays = test_rays(scene, n, 11);
+    let wide = WideBvh::from_binary(&bvh);
+    let (nodes, tris) = upload_bvh(&ctx.device, &wide);
+    let tracer = BvhTracer::new(&ctx.device).expect("shader");
+    check_layout(&ctx, &bvh, &rays, &tracer, &nodes, &tris);
+    let (nodes, tris) = upload_binary_bvh(&ctx.device, &bvh);
+    let tracer = BvhTracer::new_binary(&ctx.device).expect("shader");
+    check_layout(&ctx, &bvh, &rays, &tracer, &nodes, &tris);
+}
+
+fn check_layout(
+    ctx: &lightcut::renderer::context::GpuContext,
+    bvh: &Bvh,
+    rays: &[Ray],
+    tracer: &BvhTracer,
+    nodes: &wgpu::Buffer,
+    tris: &wgpu::Buffer,
+) {
     let gpu_rays: Vec<_> = rays.iter().map(to_gpu_ray).collect();
     let (any, _) = tracer
-        .trace(&ctx, &nodes, &tris, &gpu_rays, TraceMode::AnyHit, 1)
+        .trace(ctx, nodes, tris, &gpu_rays, TraceMode::AnyHit, 1)
         .unwrap();
     let (closest, _) = tracer
-        .trace(&ctx, &nodes, &tris, &gpu_rays, TraceMode::ClosestHit, 1)
+        .trace(ctx, nodes, tris, &gpu_rays, TraceMode::ClosestHit, 1)
         .unwrap();
     assert!(ctx.errors.take().is_empty());
     let mut occluded = 0;
@@ -195,4 +215,54 @@ fn gpu_hit_surfaces_equal_the_cpu_twin_on_default_scene() {
 fn gpu_hit_surfaces_equal_the_cpu_twin_on_sponza() {
     let Some(s) = sponza() else { return };
     check_surfaces(&s, 2000);
+}
+
+fn breakfast_room() -> Option<Scene> {
+    let dir = common::shared_scenes()?;
+    Some(load_gltf(&dir.join("breakfast_room/BreakfastRoom.gltf")).expect("the Breakfast Room loads"))
+}
+
+/// Issue 40: the wide BVH answers every ray as the binary BVH does (hit/miss; closest
+/// triangle and t bit for bit, the same triangle arithmetic), on the reference scenes and the
+/// test scenes, for surface-to-surface shadow rays, probes and random segments.
+fn check_wide_against_binary(scene: &Scene, n: usize) {
+    let bvh = Bvh::build(&scene.positions, &scene.indices);
+    let wide = WideBvh::from_binary(&bvh);
+    let rays = test_rays(scene, n, 40);
+    let (mut hits, mut occluded) = (0, 0);
+    for (i, r) in rays.iter().enumerate() {
+        let b = bvh.closest_hit(r);
+        assert_eq!(wide.closest_hit(r), b, "ray {i} {r:?}: closest hit");
+        let any = bvh.any_hit(r);
+        assert_eq!(wide.any_hit(r), any, "ray {i} {r:?}: any hit");
+        hits += b.is_some() as usize;
+        occluded += any as usize;
+    }
+    assert!(hits > rays.len() / 10 && occluded > 0 && occluded < rays.len());
+}
+
+#[test]
+fn wide_bvh_matches_binary_on_the_test_scenes() {
+    use lightcut::scene::test_scenes;
+    check_wide_against_binary(&default_scene::build(), 4000);
+    for s in [
+        test_scenes::window_box(),
+        test_scenes::corridor(),
+        test_scenes::glossy_thin(),
+    ] {
+        check_wide_against_binary(&s, 4000);
+    }
+}
+
+#[test]
+fn wide_bvh_matches_binary_on_the_reference_scenes() {
+    for s in [sponza(), breakfast_room()].into_iter().flatten() {
+        check_wide_against_binary(&s, 20000);
+    }
+}
+
+#[test]
+fn gpu_traversal_matches_cpu_on_breakfast_room() {
+    let Some(s) = breakfast_room() else { return };
+    check_gpu_against_cpu(&s, 4096);
 }

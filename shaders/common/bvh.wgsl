@@ -1,4 +1,7 @@
-// BVH traversal for shadow rays and ray casts (software ray tracing in compute shaders).
+// BVH traversal for shadow rays and ray casts (software ray tracing in compute shaders): the
+// compressed 8-wide BVH of Ylitie, Karras & Laine 2017 (80-byte nodes with child boxes
+// quantised to 8 bits per axis on a power-of-two grid, children ordered by ray octant),
+// src/scene/bvh/wide.rs (`WideBvh`, whose CPU traversal this mirrors op for op).
 //
 // INCLUDE CONTRACT
 // ----------------
@@ -8,10 +11,10 @@
 //     @group(G) @binding(B0) var<storage, read> bvh_nodes: array<BvhNode>;
 //     @group(G) @binding(B1) var<storage, read> bvh_triangles: array<BvhTriangle>;
 //
-// filled with the bytes of `Bvh::nodes` / `Bvh::triangles` (src/scene/bvh/mod.rs, `bytemuck::cast_slice`).
-// WGSL allows module-scope declarations to be used before they appear, so the declarations may
-// come before or after this file's text. Every name declared here starts with `bvh_`, `Bvh` or
-// `BVH_`.
+// filled with the bytes of `WideBvh::nodes` / `WideBvh::triangles` (`SceneGpu::bvh_nodes` /
+// `bvh_triangles`). WGSL allows module-scope declarations to be used before they appear, so the
+// declarations may come before or after this file's text. Every name declared here starts with
+// `bvh_`, `Bvh` or `BVH_`. common/bvh_binary.wgsl has the same contract over the binary BVH.
 //
 // Functions:
 //     fn bvh_any_hit(origin: vec3<f32>, dir: vec3<f32>, tmin: f32, tmax: f32) -> bool
@@ -23,21 +26,24 @@
 // unbounded ray. bvh_closest_hit returns the hit with the smallest (t, original triangle index);
 // BvhHit.triangle is the ORIGINAL triangle index, or BVH_NO_HIT (0xffffffffu) with t = tmax.
 //
-// The algorithm and the triangle arithmetic mirror `Bvh::traverse` / `intersect_triangle` in
-// bvh.rs op for op (a GPU compiler may still fuse multiply-adds).
-//
 // LAYOUTS (byte for byte the Rust #[repr(C)] structs)
-//   BvhNode (32 B) = GpuBvhNode: bmin.xyz, left_or_first | bmax.xyz, count_axis
-//     count_axis & 3u == 3u  -> leaf with triangles [left_or_first, left_or_first + (count_axis >> 2u))
-//     otherwise              -> interior, split axis = count_axis & 3u, left child = index + 1,
-//                               right child = left_or_first
+//   BvhNode (80 B) = GpuWideNode, read as five vec4<u32>:
+//     w0 = origin.xyz (f32 bits), exponent bytes ex | ey << 8 | ez << 16 | imask << 24
+//     w1 = child_base, tri_base, meta[0..4], meta[4..8]
+//     w2 = qlo.x[0..4], qlo.x[4..8], qlo.y[0..4], qlo.y[4..8]
+//     w3 = qlo.z[0..4], qlo.z[4..8], qhi.x[0..4], qhi.x[4..8]
+//     w4 = qhi.y[0..4], qhi.y[4..8], qhi.z[0..4], qhi.z[4..8]
+//   slot s: interior iff imask bit s (node child_base + popcount(imask below s)); else a leaf
+//   iff meta[s] != 0 (triangles [tri_base + (meta & 31), + (meta >> 5))); else empty. Its box is
+//   origin + q * 2^(e - 127) per axis (exact product, one rounding).
 //   BvhTriangle (48 B) = GpuTriangle: v0.xyz, id | e1.xyz, pad | e2.xyz, pad   (e1 = v1 - v0, e2 = v2 - v0)
 
 struct BvhNode {
-    bmin: vec3<f32>,
-    left_or_first: u32,
-    bmax: vec3<f32>,
-    count_axis: u32,
+    w0: vec4<u32>,
+    w1: vec4<u32>,
+    w2: vec4<u32>,
+    w3: vec4<u32>,
+    w4: vec4<u32>,
 }
 
 struct BvhTriangle {
@@ -63,10 +69,9 @@ struct BvhHit {
     v: f32,
 }
 
-// Must equal bvh::BVH_STACK_SIZE (the builder bounds the tree depth by it).
+// Must equal bvh::BVH_STACK_SIZE: one entry per level of the tree (the builder checks the depth).
 const BVH_STACK_SIZE: u32 = 32u;
 const BVH_NO_HIT: u32 = 0xffffffffu;
-const BVH_LEAF_TAG: u32 = 3u;
 const BVH_MIN_DIR: f32 = 1e-20;
 
 // Moller-Trumbore; returns (t, u, v, 1.0) on a hit with tmin < t < tmax, else w = 0.0.
@@ -129,25 +134,54 @@ fn bvh_slab(bmin: vec3<f32>, bmax: vec3<f32>, origin: vec3<f32>, inv: vec3<f32>,
     return vec2<f32>(near, far);
 }
 
+// Byte k (0..8) of a pair of words (lo = bytes 0..4, hi = bytes 4..8).
+fn bvh_byte8(lo: u32, hi: u32, k: u32) -> u32 {
+    return (select(lo, hi, k >= 4u) >> (8u * (k & 3u))) & 0xffu;
+}
+
 // Shared traversal; any_hit = true returns at the first hit (BvhHit.triangle != BVH_NO_HIT).
 fn bvh_traverse(origin: vec3<f32>, dir: vec3<f32>, tmin: f32, tmax: f32, any_hit: bool) -> BvhHit {
     var best = BvhHit(tmax, BVH_NO_HIT, 0.0, 0.0);
     let inv = bvh_safe_inv(dir);
-    let root = bvh_nodes[0];
-    let rs = bvh_slab(root.bmin, root.bmax, origin, inv, tmin, tmax);
-    if (!(rs.x <= rs.y)) {
-        return best;
-    }
-    var stack: array<u32, BVH_STACK_SIZE>;
+    let oct = select(0u, 1u, dir.x < 0.0) | select(0u, 2u, dir.y < 0.0) | select(0u, 4u, dir.z < 0.0);
+    // (child_base, pending positions | imask << 8): one entry per node on the current path.
+    var stack: array<vec2<u32>, BVH_STACK_SIZE>;
     var sp = 0u;
     var node = 0u;
     loop {
         let n = bvh_nodes[node];
-        if ((n.count_axis & 3u) == BVH_LEAF_TAG) {
-            let first = n.left_or_first;
-            let end = first + (n.count_axis >> 2u);
-            for (var i = first; i < end; i += 1u) {
-                let tri = bvh_triangles[i];
+        let grid = bitcast<vec3<f32>>(n.w0.xyz);
+        let e = n.w0.w;
+        let scale = vec3<f32>(
+            bitcast<f32>((e & 0xffu) << 23u),
+            bitcast<f32>(((e >> 8u) & 0xffu) << 23u),
+            bitcast<f32>(((e >> 16u) & 0xffu) << 23u),
+        );
+        let imask = e >> 24u;
+        var pending = 0u;
+        for (var i = 0u; i < 8u; i += 1u) {
+            let s = i ^ oct;
+            let mbyte = bvh_byte8(n.w1.z, n.w1.w, s);
+            let interior = ((imask >> s) & 1u) == 1u;
+            if (!interior && mbyte == 0u) {
+                continue;
+            }
+            let qlo = vec3<u32>(bvh_byte8(n.w2.x, n.w2.y, s), bvh_byte8(n.w2.z, n.w2.w, s), bvh_byte8(n.w3.x, n.w3.y, s));
+            let qhi = vec3<u32>(bvh_byte8(n.w3.z, n.w3.w, s), bvh_byte8(n.w4.x, n.w4.y, s), bvh_byte8(n.w4.z, n.w4.w, s));
+            let lo = grid + vec3<f32>(qlo) * scale;
+            let hi = grid + vec3<f32>(qhi) * scale;
+            let sl = bvh_slab(lo, hi, origin, inv, tmin, best.t);
+            if (!(sl.x <= sl.y)) {
+                continue;
+            }
+            if (interior) {
+                pending |= 1u << i;
+                continue;
+            }
+            let first = n.w1.y + (mbyte & 31u);
+            let end = first + (mbyte >> 5u);
+            for (var t = first; t < end; t += 1u) {
+                let tri = bvh_triangles[t];
                 let h = bvh_intersect_triangle(tri, origin, dir, tmin, tmax);
                 if (h.w != 0.0) {
                     if (any_hit) {
@@ -158,41 +192,30 @@ fn bvh_traverse(origin: vec3<f32>, dir: vec3<f32>, tmin: f32, tmax: f32, any_hit
                     }
                 }
             }
-            if (sp == 0u) {
-                break;
+        }
+        if (pending != 0u) {
+            let i = firstTrailingBit(pending);
+            let rest = pending & (pending - 1u);
+            if (rest != 0u) {
+                stack[sp] = vec2<u32>(n.w1.x, rest | (imask << 8u));
+                sp += 1u;
             }
-            sp -= 1u;
-            node = stack[sp];
+            node = n.w1.x + countOneBits(imask & ((1u << (i ^ oct)) - 1u));
             continue;
         }
-        let li = node + 1u;
-        let ri = n.left_or_first;
-        let l = bvh_nodes[li];
-        let r = bvh_nodes[ri];
-        let ls = bvh_slab(l.bmin, l.bmax, origin, inv, tmin, best.t);
-        let rs2 = bvh_slab(r.bmin, r.bmax, origin, inv, tmin, best.t);
-        let hit_l = ls.x <= ls.y;
-        let hit_r = rs2.x <= rs2.y;
-        if (hit_l && hit_r) {
-            if (rs2.x < ls.x) {
-                stack[sp] = li;
-                node = ri;
-            } else {
-                stack[sp] = ri;
-                node = li;
-            }
-            sp += 1u;
-        } else if (hit_l) {
-            node = li;
-        } else if (hit_r) {
-            node = ri;
-        } else {
-            if (sp == 0u) {
-                break;
-            }
-            sp -= 1u;
-            node = stack[sp];
+        if (sp == 0u) {
+            break;
         }
+        let top = stack[sp - 1u];
+        let mask = top.y & 0xffu;
+        let i = firstTrailingBit(mask);
+        let rest = mask & (mask - 1u);
+        if (rest == 0u) {
+            sp -= 1u;
+        } else {
+            stack[sp - 1u] = vec2<u32>(top.x, rest | (top.y & 0xff00u));
+        }
+        node = top.x + countOneBits((top.y >> 8u) & ((1u << (i ^ oct)) - 1u));
     }
     return best;
 }

@@ -38,8 +38,20 @@ pub fn to_gpu_ray(r: &Ray) -> GpuRay {
 }
 
 impl BvhTracer {
+    /// Traces through the wide BVH (`common/bvh.wgsl`, the frame's; buffers from
+    /// `scene_gpu::upload_bvh`).
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "bvh_rays.wgsl")?;
+        Self::with_shader(device, "bvh_rays.wgsl")
+    }
+
+    /// Traces through the binary BVH (`common/bvh_binary.wgsl`; buffers from
+    /// `scene_gpu::upload_binary_bvh`), for comparisons.
+    pub fn new_binary(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        Self::with_shader(device, "bvh_rays_binary.wgsl")
+    }
+
+    fn with_shader(device: &wgpu::Device, file: &str) -> Result<Self, shaders::ShaderError> {
+        let module = shaders::create_module(device, file)?;
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = crate::renderer::passes::bind_group_layout(
             device,

@@ -5,7 +5,7 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use super::gpu_data::{GpuMaterial, GpuVertex};
-use crate::scene::{Aabb, Bvh, Scene, TextureImage};
+use crate::scene::{Aabb, Bvh, Scene, TextureImage, bvh::WideBvh};
 
 pub struct SceneGpu {
     pub vertices: wgpu::Buffer,
@@ -287,7 +287,10 @@ impl SceneGpu {
         });
 
         let bvh = Bvh::build(&scene.positions, &scene.indices);
-        let (bvh_nodes, bvh_triangles) = upload_bvh(device, &bvh);
+        let (bvh_nodes, bvh_triangles) = match frame_bvh_layout() {
+            BvhLayout::Wide => upload_bvh(device, &WideBvh::from_binary(&bvh)),
+            BvhLayout::Binary => upload_binary_bvh(device, &bvh),
+        };
         SceneGpu {
             vertices,
             indices: index_buffer,
@@ -322,18 +325,61 @@ pub fn texture_sampler(device: &wgpu::Device, anisotropy: u16) -> wgpu::Sampler 
     })
 }
 
-/// Uploads a BVH's nodes and triangles as storage buffers (never empty: wgpu forbids
-/// zero-sized bindings, so an empty BVH gets one inert element each).
-pub fn upload_bvh(device: &wgpu::Device, bvh: &Bvh) -> (wgpu::Buffer, wgpu::Buffer) {
-    let nodes: Vec<u8> = if bvh.nodes.is_empty() {
-        vec![0; std::mem::size_of::<crate::scene::bvh::GpuBvhNode>()]
+/// The BVH layout that frames trace: the compressed 8-wide BVH (`common/bvh.wgsl`), or the
+/// binary one it is collapsed from (`common/bvh_binary.wgsl`) for `bench rays`, which measures
+/// both in one run. Process-wide: it decides what `SceneGpu::new` uploads and which file
+/// `#include "common/bvh.wgsl"` reads (`shaders::preprocess`), so set it before creating a
+/// renderer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BvhLayout {
+    Wide,
+    Binary,
+}
+
+static BINARY_FRAMES: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// See [`BvhLayout`].
+pub fn set_frame_bvh_layout(layout: BvhLayout) {
+    BINARY_FRAMES.store(layout == BvhLayout::Binary, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// See [`BvhLayout`].
+pub fn frame_bvh_layout() -> BvhLayout {
+    if BINARY_FRAMES.load(std::sync::atomic::Ordering::Relaxed) {
+        BvhLayout::Binary
     } else {
-        bytemuck::cast_slice(&bvh.nodes).to_vec()
+        BvhLayout::Wide
+    }
+}
+
+/// Uploads the wide BVH's nodes and triangles (what `common/bvh.wgsl` reads) as storage
+/// buffers.
+pub fn upload_bvh(device: &wgpu::Device, bvh: &WideBvh) -> (wgpu::Buffer, wgpu::Buffer) {
+    upload_bvh_bytes(device, bytemuck::cast_slice(&bvh.nodes), &bvh.triangles)
+}
+
+/// Uploads the binary BVH (what `common/bvh_binary.wgsl` reads; `bench rays` compares).
+pub fn upload_binary_bvh(device: &wgpu::Device, bvh: &Bvh) -> (wgpu::Buffer, wgpu::Buffer) {
+    upload_bvh_bytes(device, bytemuck::cast_slice(&bvh.nodes), &bvh.triangles)
+}
+
+/// Node and triangle buffers, never empty: wgpu forbids zero-sized bindings, so an empty BVH
+/// gets one inert (all-zero) element each (a zero wide node has no children; a zero binary
+/// node is never read past the root test of an empty box).
+fn upload_bvh_bytes(
+    device: &wgpu::Device,
+    nodes: &[u8],
+    triangles: &[crate::scene::bvh::GpuTriangle],
+) -> (wgpu::Buffer, wgpu::Buffer) {
+    let nodes: Vec<u8> = if nodes.is_empty() {
+        vec![0; crate::scene::bvh::wide::WIDE_NODE_BYTES]
+    } else {
+        nodes.to_vec()
     };
-    let tris: Vec<u8> = if bvh.triangles.is_empty() {
+    let tris: Vec<u8> = if triangles.is_empty() {
         vec![0; std::mem::size_of::<crate::scene::bvh::GpuTriangle>()]
     } else {
-        bytemuck::cast_slice(&bvh.triangles).to_vec()
+        bytemuck::cast_slice(triangles).to_vec()
     };
     let n = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("scene::bvh_nodes"),

@@ -15,6 +15,10 @@ use thiserror::Error;
 pub const SHADER_FILES: &[(&str, &str)] = &[
     ("common/bvh.wgsl", include_str!("../../shaders/common/bvh.wgsl")),
     (
+        "common/bvh_binary.wgsl",
+        include_str!("../../shaders/common/bvh_binary.wgsl"),
+    ),
+    (
         "common/camera.wgsl",
         include_str!("../../shaders/common/camera.wgsl"),
     ),
@@ -102,6 +106,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("visualise.wgsl", include_str!("../../shaders/visualise.wgsl")),
     ("bvh_rays.wgsl", include_str!("../../shaders/bvh_rays.wgsl")),
     (
+        "bvh_rays_binary.wgsl",
+        include_str!("../../shaders/bvh_rays_binary.wgsl"),
+    ),
+    (
         "interleave_filter.wgsl",
         include_str!("../../shaders/interleave_filter.wgsl"),
     ),
@@ -138,6 +146,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "display.wgsl",
     "visualise.wgsl",
     "bvh_rays.wgsl",
+    "bvh_rays_binary.wgsl",
     "vpl_gen.wgsl",
     "light_paths.wgsl",
     "brdf_eval.wgsl",
@@ -251,6 +260,14 @@ fn expand(
                     file: name.to_string(),
                     line: i + 1,
                 })?;
+            // The frames' BVH layout (`scene_gpu::BvhLayout`; binary only for `bench rays`).
+            let inc = if inc == "common/bvh.wgsl"
+                && super::scene_gpu::frame_bvh_layout() == super::scene_gpu::BvhLayout::Binary
+            {
+                "common/bvh_binary.wgsl"
+            } else {
+                inc
+            };
             expand(source, inc, seen, out)?;
         } else {
             out.push_str(line);

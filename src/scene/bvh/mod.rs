@@ -34,9 +34,11 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::manual_range_contains)]
 
 mod build;
+pub mod wide;
 
 use build::*;
 use std::time::Instant;
+pub use wide::{GpuWideNode, TraceCounters, WideBvh};
 
 use glam::{UVec3, Vec3, Vec3A};
 
@@ -464,18 +466,35 @@ impl Bvh {
 
     /// Closest hit with `tmin < t < tmax` (ties in `t` go to the smaller original index).
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
-        self.traverse::<false>(ray)
+        self.traverse::<false, false>(ray, &mut TraceCounters::default())
     }
 
     /// Occlusion test for shadow rays: is there any hit with `tmin < t < tmax`?
     pub fn any_hit(&self, ray: &Ray) -> bool {
-        self.traverse::<true>(ray).is_some()
+        self.traverse::<true, false>(ray, &mut TraceCounters::default())
+            .is_some()
     }
 
-    /// The traversal loop of `bvh.wgsl` (`bvh_closest_hit` / `bvh_any_hit`).
+    /// [`Self::any_hit`] / [`Self::closest_hit`] counting what the traversal reads: every
+    /// visit reads its node (32 bytes), an interior visit also both children's boxes (64
+    /// bytes), a leaf its triangles (48 bytes each) — what `bvh_binary.wgsl` loads.
+    pub fn trace_counted(&self, ray: &Ray, any: bool, c: &mut TraceCounters) -> Option<Hit> {
+        if any {
+            self.traverse::<true, true>(ray, c)
+        } else {
+            self.traverse::<false, true>(ray, c)
+        }
+    }
+
+    /// The traversal loop of `bvh_binary.wgsl` (`bvh_closest_hit` / `bvh_any_hit`).
     #[inline(always)]
-    fn traverse<const ANY: bool>(&self, ray: &Ray) -> Option<Hit> {
+    fn traverse<const ANY: bool, const COUNT: bool>(&self, ray: &Ray, c: &mut TraceCounters) -> Option<Hit> {
         let nodes = &self.nodes[..];
+        if COUNT {
+            c.rays += 1;
+            c.boxes += 1;
+            c.bytes += wide::BINARY_NODE_BYTES as u64;
+        }
         let o = Vec3A::from(ray.origin);
         let inv = Vec3A::from(safe_inv(ray.dir));
         let mut best = Hit {
@@ -493,10 +512,18 @@ impl Bvh {
         let mut node = 0usize;
         loop {
             let n = &nodes[node];
+            if COUNT {
+                c.nodes += 1;
+                c.bytes += wide::BINARY_NODE_BYTES as u64;
+            }
             if n.is_leaf() {
                 let first = n.left_or_first as usize;
                 let end = first + n.tri_count() as usize;
                 for tri in &self.triangles[first..end] {
+                    if COUNT {
+                        c.triangles += 1;
+                        c.bytes += wide::TRIANGLE_BYTES as u64;
+                    }
                     if let Some((t, u, v)) = intersect_triangle(tri, ray) {
                         if ANY {
                             return Some(Hit {
@@ -525,6 +552,10 @@ impl Bvh {
             }
             let li = node + 1;
             let ri = n.left_or_first as usize;
+            if COUNT {
+                c.boxes += 2;
+                c.bytes += 2 * wide::BINARY_NODE_BYTES as u64;
+            }
             let (ln, lf) = slab(&nodes[li], o, inv, ray.tmin, best.t);
             let (rn, rf) = slab(&nodes[ri], o, inv, ray.tmin, best.t);
             let hit_l = ln <= lf;
@@ -533,6 +564,9 @@ impl Bvh {
                 let (first, second) = if rn < ln { (ri, li) } else { (li, ri) };
                 stack[sp] = second as u32;
                 sp += 1;
+                if COUNT {
+                    c.max_stack = c.max_stack.max(sp as u64);
+                }
                 node = first;
             } else if hit_l {
                 node = li;
@@ -875,11 +909,22 @@ mod tests {
     }
 
     /// Asserts BVH == brute force for every ray; returns (closest hits, any hits).
+    /// The binary BVH and its wide collapse against brute force: identical hits, bit for bit.
     fn check_against_brute_force(m: &Mesh, bvh: &Bvh, rays: &[Ray]) -> (usize, usize) {
+        let wide = WideBvh::from_binary(bvh);
+        check_wide_structure(bvh, &wide);
         let (mut closest_hits, mut any_hits) = (0, 0);
         for (i, ray) in rays.iter().enumerate() {
             let got = bvh.closest_hit(ray);
             let want = brute_force_closest(&m.positions, &m.indices, ray);
+            assert_eq!(wide.closest_hit(ray), want, "wide, ray {i} {ray:?}");
+            assert_eq!(wide.any_hit(ray), want.is_some(), "wide any-hit, ray {i} {ray:?}");
+            let mut c = TraceCounters::default();
+            assert_eq!(wide.trace_counted(ray, false, &mut c), want, "counted, ray {i}");
+            assert_eq!(bvh.trace_counted(ray, false, &mut c), want, "counted, ray {i}");
+            assert_eq!(wide.trace_counted(ray, true, &mut c).is_some(), want.is_some());
+            assert_eq!(bvh.trace_counted(ray, true, &mut c).is_some(), want.is_some());
+            assert!(c.max_stack as usize <= BVH_STACK_SIZE);
             match (got, want) {
                 (None, None) => {}
                 (Some(g), Some(w)) => {
@@ -897,6 +942,49 @@ mod tests {
             any_hits += any as usize;
         }
         (closest_hits, any_hits)
+    }
+
+    /// Every triangle once; every binary node's box inside the decoded box of the wide slot
+    /// that stands for it (checked through the leaves: each leaf child's box contains its
+    /// triangles); depth within the stack; children inside the parent's grid.
+    fn check_wide_structure(bvh: &Bvh, wide: &WideBvh) {
+        let mut ids: Vec<u32> = wide.triangles.iter().map(|t| t.id).collect();
+        ids.sort_unstable();
+        let mut want: Vec<u32> = bvh.triangles.iter().map(|t| t.id).collect();
+        want.sort_unstable();
+        assert_eq!(ids, want, "the wide BVH holds every triangle once");
+        assert!(wide.stats.depth <= BVH_STACK_SIZE);
+        let mut reached = vec![0u32; wide.nodes.len()];
+        reached[0] = 1;
+        for (i, n) in wide.nodes.iter().enumerate() {
+            for s in 0..wide::WIDE {
+                if !n.occupied(s) {
+                    continue;
+                }
+                let (lo, hi) = n.child_box(s);
+                assert!(lo.cmple(hi).all(), "node {i} slot {s}: inverted box");
+                if (n.imask() >> s) & 1 == 1 {
+                    let c = n.child_index(s as u32) as usize;
+                    assert!(c > i && c < wide.nodes.len());
+                    reached[c] += 1;
+                } else {
+                    let m = n.meta[s] as usize;
+                    let first = n.tri_base as usize + (m & 31);
+                    for t in &wide.triangles[first..first + (m >> 5)] {
+                        for v in t.vertices() {
+                            let v = Vec3A::from(v);
+                            let slack = 1e-5 * v.abs().max_element().max(1.0);
+                            assert!(
+                                (lo - slack).cmple(v).all() && v.cmple(hi + slack).all(),
+                                "node {i} slot {s}: triangle {} outside its box",
+                                t.id
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        assert!(reached.iter().all(|&r| r == 1), "every node has one parent");
     }
 
     fn check_structure(m: &Mesh, bvh: &Bvh) {
@@ -1151,6 +1239,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 "#;
 
     const BVH_WGSL: &str = include_str!("../../../shaders/common/bvh.wgsl");
+    const BVH_BINARY_WGSL: &str = include_str!("../../../shaders/common/bvh_binary.wgsl");
 
     fn struct_layout(module: &naga::Module, name: &str) -> (u32, Vec<u32>) {
         let (_, ty) = module
@@ -1166,15 +1255,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 
     #[test]
     fn wgsl_validates_and_layouts_match() {
+        for (file, wide) in [(BVH_WGSL, true), (BVH_BINARY_WGSL, false)] {
+            check_wgsl(file, wide);
+        }
+    }
+
+    fn check_wgsl(file: &str, wide: bool) {
         // No bindings and no `enable` directives outside comments.
-        let code: Vec<&str> = BVH_WGSL.lines().map(|l| l.split("//").next().unwrap()).collect();
+        let code: Vec<&str> = file.lines().map(|l| l.split("//").next().unwrap()).collect();
         assert!(code.iter().all(|l| !l.contains('@')), "bindings in bvh.wgsl");
         assert!(!code.iter().any(|l| l.trim_start().starts_with("enable")));
         // Declarations before and after the include must both work.
-        for src in [
-            format!("{TEST_SHADER}\n{BVH_WGSL}"),
-            format!("{BVH_WGSL}\n{TEST_SHADER}"),
-        ] {
+        for src in [format!("{TEST_SHADER}\n{file}"), format!("{file}\n{TEST_SHADER}")] {
             let module =
                 naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
             naga::valid::Validator::new(
@@ -1190,11 +1282,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 .types
                 .iter()
                 .find(|(_, t)| t.name.as_deref() == Some("BvhNode"));
-            assert_eq!(layouter[node.unwrap().0].size, 32);
-
             let (size, offsets) = struct_layout(&module, "BvhNode");
-            assert_eq!(size as usize, std::mem::size_of::<GpuBvhNode>());
-            assert_eq!(offsets, [0, 12, 16, 28]);
+            if wide {
+                assert_eq!(layouter[node.unwrap().0].size, 80);
+                assert_eq!(size as usize, std::mem::size_of::<GpuWideNode>());
+                assert_eq!(offsets, [0, 16, 32, 48, 64]);
+            } else {
+                assert_eq!(layouter[node.unwrap().0].size, 32);
+                assert_eq!(size as usize, std::mem::size_of::<GpuBvhNode>());
+                assert_eq!(offsets, [0, 12, 16, 28]);
+            }
             let (size, offsets) = struct_layout(&module, "BvhTriangle");
             assert_eq!(size as usize, std::mem::size_of::<GpuTriangle>());
             assert_eq!(offsets, [0, 12, 16, 28, 32, 44]);
