@@ -11,6 +11,17 @@ fn main() {
             .default_filter_or("info,wgpu_core=warn,wgpu_hal=warn,naga=warn,eframe=warn,egui_wgpu=warn"),
     )
     .init();
+    // The BVH layout frames trace (`scene_gpu::BvhLayout`): LIGHTCUT_BVH=wide|binary.
+    match std::env::var("LIGHTCUT_BVH").as_deref() {
+        Err(_) | Ok("") => {}
+        Ok(v) => match lightcut::renderer::scene_gpu::BvhLayout::parse(v) {
+            Some(l) => lightcut::renderer::scene_gpu::set_frame_bvh_layout(l),
+            None => {
+                eprintln!("error: LIGHTCUT_BVH={v}: expected `wide` or `binary`");
+                std::process::exit(2);
+            }
+        },
+    }
     let matches = <Cli as clap::CommandFactory>::command().get_matches();
     let mut cli = <Cli as clap::FromArgMatches>::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     // `render --settings <capture record>`: the record fills what the command line leaves out.

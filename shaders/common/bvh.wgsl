@@ -144,8 +144,8 @@ fn bvh_traverse(origin: vec3<f32>, dir: vec3<f32>, tmin: f32, tmax: f32, any_hit
     var best = BvhHit(tmax, BVH_NO_HIT, 0.0, 0.0);
     let inv = bvh_safe_inv(dir);
     let oct = select(0u, 1u, dir.x < 0.0) | select(0u, 2u, dir.y < 0.0) | select(0u, 4u, dir.z < 0.0);
-    // (child_base, pending positions | imask << 8): one entry per node on the current path.
-    var stack: array<vec2<u32>, BVH_STACK_SIZE>;
+    // (node << 8) | pending positions of its children: one entry per node on the current path.
+    var stack: array<u32, BVH_STACK_SIZE>;
     var sp = 0u;
     var node = 0u;
     loop {
@@ -159,6 +159,8 @@ fn bvh_traverse(origin: vec3<f32>, dir: vec3<f32>, tmin: f32, tmax: f32, any_hit
         );
         let imask = e >> 24u;
         var pending = 0u;
+        // Triangles of the hit leaf children, as bits relative to tri_base (at most 32).
+        var tris = 0u;
         for (var i = 0u; i < 8u; i += 1u) {
             let s = i ^ oct;
             let mbyte = bvh_byte8(n.w1.z, n.w1.w, s);
@@ -176,20 +178,25 @@ fn bvh_traverse(origin: vec3<f32>, dir: vec3<f32>, tmin: f32, tmax: f32, any_hit
             }
             if (interior) {
                 pending |= 1u << i;
-                continue;
+            } else {
+                tris |= ((1u << (mbyte >> 5u)) - 1u) << (mbyte & 31u);
             }
-            let first = n.w1.y + (mbyte & 31u);
-            let end = first + (mbyte >> 5u);
-            for (var t = first; t < end; t += 1u) {
-                let tri = bvh_triangles[t];
-                let h = bvh_intersect_triangle(tri, origin, dir, tmin, tmax);
-                if (h.w != 0.0) {
-                    if (any_hit) {
-                        return BvhHit(h.x, tri.id, h.y, h.z);
-                    }
-                    if (h.x < best.t || (h.x == best.t && tri.id < best.triangle)) {
-                        best = BvhHit(h.x, tri.id, h.y, h.z);
-                    }
+        }
+        // One flat loop over the node's hit triangles (threads of a subgroup stay together).
+        loop {
+            if (tris == 0u) {
+                break;
+            }
+            let t = n.w1.y + firstTrailingBit(tris);
+            tris &= tris - 1u;
+            let tri = bvh_triangles[t];
+            let h = bvh_intersect_triangle(tri, origin, dir, tmin, tmax);
+            if (h.w != 0.0) {
+                if (any_hit) {
+                    return BvhHit(h.x, tri.id, h.y, h.z);
+                }
+                if (h.x < best.t || (h.x == best.t && tri.id < best.triangle)) {
+                    best = BvhHit(h.x, tri.id, h.y, h.z);
                 }
             }
         }
@@ -197,7 +204,7 @@ fn bvh_traverse(origin: vec3<f32>, dir: vec3<f32>, tmin: f32, tmax: f32, any_hit
             let i = firstTrailingBit(pending);
             let rest = pending & (pending - 1u);
             if (rest != 0u) {
-                stack[sp] = vec2<u32>(n.w1.x, rest | (imask << 8u));
+                stack[sp] = (node << 8u) | rest;
                 sp += 1u;
             }
             node = n.w1.x + countOneBits(imask & ((1u << (i ^ oct)) - 1u));
@@ -207,15 +214,17 @@ fn bvh_traverse(origin: vec3<f32>, dir: vec3<f32>, tmin: f32, tmax: f32, any_hit
             break;
         }
         let top = stack[sp - 1u];
-        let mask = top.y & 0xffu;
+        let mask = top & 0xffu;
         let i = firstTrailingBit(mask);
         let rest = mask & (mask - 1u);
         if (rest == 0u) {
             sp -= 1u;
         } else {
-            stack[sp - 1u] = vec2<u32>(top.x, rest | (top.y & 0xff00u));
+            stack[sp - 1u] = (top & 0xffffff00u) | rest;
         }
-        node = top.x + countOneBits((top.y >> 8u) & ((1u << (i ^ oct)) - 1u));
+        let parent = top >> 8u;
+        let pimask = bvh_nodes[parent].w0.w >> 24u;
+        node = bvh_nodes[parent].w1.x + countOneBits(pimask & ((1u << (i ^ oct)) - 1u));
     }
     return best;
 }

@@ -336,6 +336,17 @@ pub enum BvhLayout {
     Binary,
 }
 
+impl BvhLayout {
+    /// `wide` / `binary` (the `LIGHTCUT_BVH` environment variable's values).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "wide" => Some(Self::Wide),
+            "binary" => Some(Self::Binary),
+            _ => None,
+        }
+    }
+}
+
 static BINARY_FRAMES: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// See [`BvhLayout`].

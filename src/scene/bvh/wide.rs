@@ -37,10 +37,12 @@
 //! where rounding would cut a box.
 //!
 //! # Traversal (CPU and WGSL, identical algorithm)
-//! A node visit slab-tests its children in the ray's order (`i ^ octant`), tests the triangles
-//! of every hit leaf child at once (any-hit returns at the first hit), and descends into the
-//! first hit interior child; the remaining hit interior children go on the stack as one entry
-//! (`child_base`, the pending mask and `imask`), popped in order. An entry stands for one node
+//! A node visit slab-tests its children in the ray's order (`i ^ octant`), then tests the
+//! triangles of every hit leaf child in one flat loop over a 32-bit mask (threads of a
+//! subgroup stay in step; any-hit returns at the first hit), and descends into the first hit
+//! interior child; the remaining hit interior children go on the stack as one entry (the
+//! node's index and the pending mask; the parent's `imask` and `child_base` are read again on
+//! a pop), popped in order. An entry stands for one node
 //! on the current path, so the stack never holds more than the tree's depth
 //! ([`BVH_STACK_SIZE`]). Closest-hit keeps the smallest `(t, original index)` and culls boxes
 //! against the current best `t`, like the binary traversal.
@@ -59,7 +61,8 @@ pub const BINARY_NODE_BYTES: usize = 32;
 /// Bytes of one triangle.
 pub const TRIANGLE_BYTES: usize = 48;
 
-const _: () = assert!(MAX_LEAF_TRIS <= 7 && WIDE * MAX_LEAF_TRIS <= 32 + MAX_LEAF_TRIS);
+// A node's leaf triangles are bits of one u32 (at most 8 leaves of MAX_LEAF_TRIS).
+const _: () = assert!(MAX_LEAF_TRIS <= 7 && WIDE * MAX_LEAF_TRIS <= 32);
 
 /// One wide node as stored in the GPU buffer (see the module's table).
 #[repr(C)]
@@ -318,6 +321,7 @@ impl WideBvh {
             nodes[wi] = node;
         }
         assert!(depth <= BVH_STACK_SIZE, "wide BVH deeper than the stack");
+        assert!(nodes.len() < 1 << 24, "too many wide nodes for the stack encoding");
         let stats = WideStats {
             nodes: nodes.len(),
             depth,
@@ -367,8 +371,8 @@ impl WideBvh {
             u: 0.0,
             v: 0.0,
         };
-        // (child_base, pending positions | imask << 8)
-        let mut stack = [(0u32, 0u32); BVH_STACK_SIZE];
+        // (node << 8) | pending positions of its children
+        let mut stack = [0u32; BVH_STACK_SIZE];
         let mut sp = 0usize;
         let mut node = 0u32;
         loop {
@@ -379,6 +383,7 @@ impl WideBvh {
             }
             let imask = n.imask();
             let mut pending = 0u32;
+            let mut tris = 0u32;
             for i in 0..WIDE as u32 {
                 let s = (i ^ oct) as usize;
                 if !n.occupied(s) {
@@ -394,28 +399,30 @@ impl WideBvh {
                 }
                 if (imask >> s) & 1 == 1 {
                     pending |= 1 << i;
-                    continue;
+                } else {
+                    let m = n.meta[s] as u32;
+                    tris |= ((1u32 << (m >> 5)) - 1) << (m & 31);
                 }
-                let m = n.meta[s] as usize;
-                let first = n.tri_base as usize + (m & 31);
-                for tri in &self.triangles[first..first + (m >> 5)] {
-                    if COUNT {
-                        c.triangles += 1;
-                        c.bytes += TRIANGLE_BYTES as u64;
+            }
+            while tris != 0 {
+                let tri = &self.triangles[n.tri_base as usize + tris.trailing_zeros() as usize];
+                tris &= tris - 1;
+                if COUNT {
+                    c.triangles += 1;
+                    c.bytes += TRIANGLE_BYTES as u64;
+                }
+                if let Some((t, u, v)) = intersect_triangle(tri, ray) {
+                    let h = Hit {
+                        t,
+                        triangle: tri.id,
+                        u,
+                        v,
+                    };
+                    if ANY {
+                        return Some(h);
                     }
-                    if let Some((t, u, v)) = intersect_triangle(tri, ray) {
-                        let h = Hit {
-                            t,
-                            triangle: tri.id,
-                            u,
-                            v,
-                        };
-                        if ANY {
-                            return Some(h);
-                        }
-                        if better(t, tri.id, best.t, best.triangle) {
-                            best = h;
-                        }
+                    if better(t, tri.id, best.t, best.triangle) {
+                        best = h;
                     }
                 }
             }
@@ -423,7 +430,7 @@ impl WideBvh {
                 let i = pending.trailing_zeros();
                 let rest = pending & (pending - 1);
                 if rest != 0 {
-                    stack[sp] = (n.child_base, rest | (imask << 8));
+                    stack[sp] = (node << 8) | rest;
                     sp += 1;
                     if COUNT {
                         c.max_stack = c.max_stack.max(sp as u64);
@@ -435,17 +442,20 @@ impl WideBvh {
             if sp == 0 {
                 break;
             }
-            let (base, packed) = stack[sp - 1];
-            let mask = packed & 0xff;
+            let top = stack[sp - 1];
+            let mask = top & 0xff;
             let i = mask.trailing_zeros();
             let rest = mask & (mask - 1);
             if rest == 0 {
                 sp -= 1;
             } else {
-                stack[sp - 1].1 = rest | (packed & 0xff00);
+                stack[sp - 1] = (top & !0xff) | rest;
             }
-            let s = i ^ oct;
-            node = base + ((packed >> 8) & ((1u32 << s) - 1)).count_ones();
+            if COUNT {
+                // The parent's imask and child_base (8 bytes, read again).
+                c.bytes += 8;
+            }
+            node = self.nodes[(top >> 8) as usize].child_index(i ^ oct);
         }
         (best.triangle != NO_TRIANGLE).then_some(best)
     }
