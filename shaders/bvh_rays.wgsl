@@ -1,5 +1,5 @@
 // Traces a buffer of rays through the scene BVH (tests and the rays/s benchmark).
-#include "common/bvh.wgsl"
+#include "common/bvh_binary.wgsl"
 
 struct RayIn {
     origin: vec4<f32>, // xyz origin, w tmin

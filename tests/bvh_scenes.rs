@@ -7,7 +7,7 @@ use lightcut::{
     cli::bench::{probe_rays, shadow_rays},
     renderer::{
         bvh_trace::{BvhTracer, TraceMode, to_gpu_ray},
-        scene_gpu::{upload_binary_bvh, upload_bvh},
+        scene_gpu::{upload_bvh, upload_wide_bvh},
     },
     scene::{
         Scene,
@@ -73,18 +73,18 @@ fn cpu_bvh_matches_brute_force_on_sponza() {
     check_cpu_against_brute_force(&s, 150);
 }
 
-/// Both GPU layouts (the frames' wide BVH, `common/bvh.wgsl`, and the binary one,
-/// `common/bvh_binary.wgsl`) against the CPU's binary traversal.
+/// Both GPU layouts (the binary BVH, `common/bvh_binary.wgsl`, and the compressed 8-wide one,
+/// `common/bvh_wide.wgsl`) against the CPU's binary traversal.
 fn check_gpu_against_cpu(scene: &Scene, n: usize) {
     let Some(ctx) = common::gpu() else { return };
     let bvh = Bvh::build(&scene.positions, &scene.indices);
     let rays = test_rays(scene, n, 11);
     let wide = WideBvh::from_binary(&bvh);
-    let (nodes, tris) = upload_bvh(&ctx.device, &wide);
-    let tracer = BvhTracer::new(&ctx.device).expect("shader");
+    let (nodes, tris) = upload_wide_bvh(&ctx.device, &wide);
+    let tracer = BvhTracer::new_wide(&ctx.device).expect("shader");
     check_layout(&ctx, &bvh, &rays, &tracer, &nodes, &tris);
-    let (nodes, tris) = upload_binary_bvh(&ctx.device, &bvh);
-    let tracer = BvhTracer::new_binary(&ctx.device).expect("shader");
+    let (nodes, tris) = upload_bvh(&ctx.device, &bvh);
+    let tracer = BvhTracer::new(&ctx.device).expect("shader");
     check_layout(&ctx, &bvh, &rays, &tracer, &nodes, &tris);
 }
 
@@ -265,4 +265,51 @@ fn wide_bvh_matches_binary_on_the_reference_scenes() {
 fn gpu_traversal_matches_cpu_on_breakfast_room() {
     let Some(s) = breakfast_room() else { return };
     check_gpu_against_cpu(&s, 4096);
+}
+
+/// The frames trace either layout (`LIGHTCUT_BVH`): SLC's and Lightcuts' images are the same
+/// bytes with the wide BVH as with the binary one (every shadow ray answered alike), and a bad
+/// value is refused in one line. Runs the binary, since the layout is process-wide.
+#[test]
+fn frames_are_identical_with_either_bvh_layout() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("lightcut-bvh-layout-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let render = |method: &str, layout: &str| {
+        let out = dir.join(format!("{method}-{layout}"));
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_lightcut-workbench"))
+            .args([
+                "render", "--method", method, "--width", "48", "--height", "32", "--out",
+            ])
+            .arg(&out)
+            .env("LIGHTCUT_BVH", layout)
+            .output()
+            .expect("run the binary");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        out
+    };
+    for method in ["slc", "lightcuts"] {
+        let (a, b) = (render(method, "binary"), render(method, "wide"));
+        for f in ["indirect.exr", "final.exr"] {
+            let (x, y) = (
+                std::fs::read(a.join(f)).unwrap(),
+                std::fs::read(b.join(f)).unwrap(),
+            );
+            assert!(x == y, "{method}: {f} differs between the BVH layouts");
+        }
+    }
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_lightcut-workbench"))
+        .args(["render", "--width", "8", "--height", "8"])
+        .env("LIGHTCUT_BVH", "octree")
+        .output()
+        .expect("run the binary");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        err.contains("LIGHTCUT_BVH=octree") && err.lines().count() == 1,
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,5 +1,5 @@
-// The BINARY BVH's traversal (Aila & Laine 2009 style, 32-byte nodes): kept for `bench rays`,
-// which compares it with the compressed 8-wide BVH of common/bvh.wgsl that the frame uses.
+// The BINARY BVH traversal (Aila & Laine 2009 style, 32-byte nodes): the frames' default layout
+// (common/bvh.wgsl is its alias); common/bvh_wide.wgsl is the compressed 8-wide alternative.
 //
 // INCLUDE CONTRACT
 // ----------------

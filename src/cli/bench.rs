@@ -25,7 +25,7 @@ use crate::{
             sst_build::{BuildPass, TreeBuffers},
             sst_sort::{SORT_TILE, SortBuffers, SortPass, SortVariant},
         },
-        scene_gpu::{BvhLayout, SceneGpu, set_frame_bvh_layout, upload_binary_bvh, upload_bvh},
+        scene_gpu::{BvhLayout, SceneGpu, set_frame_bvh_layout, upload_bvh, upload_wide_bvh},
         settings::{RenderSettings, ViewBuffer},
         timing::GpuTimer,
     },
@@ -570,10 +570,10 @@ fn run_rays(args: &BenchArgs) -> anyhow::Result<()> {
         wide.stats.depth,
         wide.stats.build_ms
     );
-    let (bin_nodes, bin_tris) = upload_binary_bvh(&ctx.device, &bvh);
-    let (wide_nodes, wide_tris) = upload_bvh(&ctx.device, &wide);
-    let bin_tracer = BvhTracer::new_binary(&ctx.device)?;
-    let wide_tracer = BvhTracer::new(&ctx.device)?;
+    let (bin_nodes, bin_tris) = upload_bvh(&ctx.device, &bvh);
+    let (wide_nodes, wide_tris) = upload_wide_bvh(&ctx.device, &wide);
+    let bin_tracer = BvhTracer::new(&ctx.device)?;
+    let wide_tracer = BvhTracer::new_wide(&ctx.device)?;
     let mut disagreements = 0usize;
     for (label, rays, mode) in [
         (
@@ -639,10 +639,11 @@ fn run_rays(args: &BenchArgs) -> anyhow::Result<()> {
     }
     drop(ctx);
     let mut per_layout = Vec::new();
+    let frames = crate::renderer::scene_gpu::frame_bvh_layout();
     for layout in [BvhLayout::Binary, BvhLayout::Wide] {
         set_frame_bvh_layout(layout);
         let r = in_frame_rays(args, &opened, layout);
-        set_frame_bvh_layout(BvhLayout::Wide);
+        set_frame_bvh_layout(frames);
         per_layout.push(r?);
     }
     if let (Some(b), Some(w)) = (&per_layout[0].timing, &per_layout[1].timing) {

@@ -11,7 +11,8 @@
 //! | `display.wgsl` | `base::display::encode` |
 //! | `visualise.wgsl` (`vis_uint`) | `base::colormap::{id_color, false_color}` |
 //! | `methods/lightcuts/{lc_build, lightcuts}.wgsl` | [`lightcuts::build`], [`lightcuts::lightcut`] (and the error bound) |
-//! | `common/bvh.wgsl` | `scene::bvh::Bvh::{closest_hit, any_hit}` (and brute force) |
+//! | `common/bvh_binary.wgsl` (`common/bvh.wgsl`) | `scene::bvh::Bvh::{closest_hit, any_hit}` (and brute force) |
+//! | `common/bvh_wide.wgsl` | `scene::bvh::WideBvh::{closest_hit, any_hit}` |
 
 pub mod brdf;
 pub mod direct;

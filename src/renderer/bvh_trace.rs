@@ -1,6 +1,6 @@
 //! Traces batches of rays through the scene BVH on the GPU (`shaders/bvh_rays.wgsl`): used by
 //! the GPU-vs-CPU tests and the shadow-ray benchmark. Frame passes use the same WGSL traversal
-//! (`shaders/common/bvh.wgsl`) inline.
+//! (`shaders/common/bvh.wgsl`, the layout of `scene_gpu::BvhLayout`) inline.
 
 use wgpu::util::DeviceExt;
 
@@ -38,16 +38,16 @@ pub fn to_gpu_ray(r: &Ray) -> GpuRay {
 }
 
 impl BvhTracer {
-    /// Traces through the wide BVH (`common/bvh.wgsl`, the frame's; buffers from
-    /// `scene_gpu::upload_bvh`).
+    /// Traces through the binary BVH (`common/bvh_binary.wgsl`, the frames' default; buffers
+    /// from `scene_gpu::upload_bvh`).
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         Self::with_shader(device, "bvh_rays.wgsl")
     }
 
-    /// Traces through the binary BVH (`common/bvh_binary.wgsl`; buffers from
-    /// `scene_gpu::upload_binary_bvh`), for comparisons.
-    pub fn new_binary(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        Self::with_shader(device, "bvh_rays_binary.wgsl")
+    /// Traces through the compressed 8-wide BVH (`common/bvh_wide.wgsl`; buffers from
+    /// `scene_gpu::upload_wide_bvh`).
+    pub fn new_wide(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
+        Self::with_shader(device, "bvh_rays_wide.wgsl")
     }
 
     fn with_shader(device: &wgpu::Device, file: &str) -> Result<Self, shaders::ShaderError> {

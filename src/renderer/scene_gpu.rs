@@ -288,8 +288,8 @@ impl SceneGpu {
 
         let bvh = Bvh::build(&scene.positions, &scene.indices);
         let (bvh_nodes, bvh_triangles) = match frame_bvh_layout() {
-            BvhLayout::Wide => upload_bvh(device, &WideBvh::from_binary(&bvh)),
-            BvhLayout::Binary => upload_binary_bvh(device, &bvh),
+            BvhLayout::Binary => upload_bvh(device, &bvh),
+            BvhLayout::Wide => upload_wide_bvh(device, &WideBvh::from_binary(&bvh)),
         };
         SceneGpu {
             vertices,
@@ -325,9 +325,11 @@ pub fn texture_sampler(device: &wgpu::Device, anisotropy: u16) -> wgpu::Sampler 
     })
 }
 
-/// The BVH layout that frames trace: the compressed 8-wide BVH (`common/bvh.wgsl`), or the
-/// binary one it is collapsed from (`common/bvh_binary.wgsl`) for `bench rays`, which measures
-/// both in one run. Process-wide: it decides what `SceneGpu::new` uploads and which file
+/// The BVH layout that frames trace: the binned-SAH binary BVH (`common/bvh_binary.wgsl`, the
+/// default: on an NVIDIA H200 its in-frame shadow rays ran 1.7x faster than the wide one's,
+/// docs/measurements/h200-2026-11-27-wide-bvh) or the compressed 8-wide BVH collapsed from it
+/// (`common/bvh_wide.wgsl`; `LIGHTCUT_BVH=wide`). `bench rays` measures both in one run.
+/// Process-wide: it decides what `SceneGpu::new` uploads and which file
 /// `#include "common/bvh.wgsl"` reads (`shaders::preprocess`), so set it before creating a
 /// renderer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -347,30 +349,30 @@ impl BvhLayout {
     }
 }
 
-static BINARY_FRAMES: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+static WIDE_FRAMES: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// See [`BvhLayout`].
 pub fn set_frame_bvh_layout(layout: BvhLayout) {
-    BINARY_FRAMES.store(layout == BvhLayout::Binary, std::sync::atomic::Ordering::Relaxed);
+    WIDE_FRAMES.store(layout == BvhLayout::Wide, std::sync::atomic::Ordering::Relaxed);
 }
 
 /// See [`BvhLayout`].
 pub fn frame_bvh_layout() -> BvhLayout {
-    if BINARY_FRAMES.load(std::sync::atomic::Ordering::Relaxed) {
-        BvhLayout::Binary
-    } else {
+    if WIDE_FRAMES.load(std::sync::atomic::Ordering::Relaxed) {
         BvhLayout::Wide
+    } else {
+        BvhLayout::Binary
     }
 }
 
-/// Uploads the wide BVH's nodes and triangles (what `common/bvh.wgsl` reads) as storage
-/// buffers.
-pub fn upload_bvh(device: &wgpu::Device, bvh: &WideBvh) -> (wgpu::Buffer, wgpu::Buffer) {
+/// Uploads the binary BVH's nodes and triangles (what `common/bvh_binary.wgsl` reads) as
+/// storage buffers.
+pub fn upload_bvh(device: &wgpu::Device, bvh: &Bvh) -> (wgpu::Buffer, wgpu::Buffer) {
     upload_bvh_bytes(device, bytemuck::cast_slice(&bvh.nodes), &bvh.triangles)
 }
 
-/// Uploads the binary BVH (what `common/bvh_binary.wgsl` reads; `bench rays` compares).
-pub fn upload_binary_bvh(device: &wgpu::Device, bvh: &Bvh) -> (wgpu::Buffer, wgpu::Buffer) {
+/// Uploads the wide BVH (what `common/bvh_wide.wgsl` reads).
+pub fn upload_wide_bvh(device: &wgpu::Device, bvh: &WideBvh) -> (wgpu::Buffer, wgpu::Buffer) {
     upload_bvh_bytes(device, bytemuck::cast_slice(&bvh.nodes), &bvh.triangles)
 }
 

@@ -19,6 +19,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         include_str!("../../shaders/common/bvh_binary.wgsl"),
     ),
     (
+        "common/bvh_wide.wgsl",
+        include_str!("../../shaders/common/bvh_wide.wgsl"),
+    ),
+    (
         "common/camera.wgsl",
         include_str!("../../shaders/common/camera.wgsl"),
     ),
@@ -106,8 +110,8 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("visualise.wgsl", include_str!("../../shaders/visualise.wgsl")),
     ("bvh_rays.wgsl", include_str!("../../shaders/bvh_rays.wgsl")),
     (
-        "bvh_rays_binary.wgsl",
-        include_str!("../../shaders/bvh_rays_binary.wgsl"),
+        "bvh_rays_wide.wgsl",
+        include_str!("../../shaders/bvh_rays_wide.wgsl"),
     ),
     (
         "interleave_filter.wgsl",
@@ -146,7 +150,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "display.wgsl",
     "visualise.wgsl",
     "bvh_rays.wgsl",
-    "bvh_rays_binary.wgsl",
+    "bvh_rays_wide.wgsl",
     "vpl_gen.wgsl",
     "light_paths.wgsl",
     "brdf_eval.wgsl",
@@ -260,11 +264,11 @@ fn expand(
                     file: name.to_string(),
                     line: i + 1,
                 })?;
-            // The frames' BVH layout (`scene_gpu::BvhLayout`; binary only for `bench rays`).
+            // `common/bvh.wgsl` is the frames' BVH layout (`scene_gpu::BvhLayout`).
             let inc = if inc == "common/bvh.wgsl"
-                && super::scene_gpu::frame_bvh_layout() == super::scene_gpu::BvhLayout::Binary
+                && super::scene_gpu::frame_bvh_layout() == super::scene_gpu::BvhLayout::Wide
             {
-                "common/bvh_binary.wgsl"
+                "common/bvh_wide.wgsl"
             } else {
                 inc
             };

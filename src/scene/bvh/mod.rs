@@ -1,7 +1,7 @@
 //! Bounding volume hierarchy over world-space triangles, for shadow rays and ray casts.
 //!
 //! Hardware ray queries are not available, so the GPU traverses this BVH in a compute shader
-//! (`shaders/common/bvh.wgsl`); this module builds it on the CPU, flattens it into GPU-ready
+//! (`shaders/common/bvh_binary.wgsl`, or the wide collapse of [`wide`]); this module builds it on the CPU, flattens it into GPU-ready
 //! buffers and provides a CPU traversal that mirrors the WGSL one (plus brute-force references
 //! for tests).
 //!
@@ -1238,7 +1238,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 }
 "#;
 
-    const BVH_WGSL: &str = include_str!("../../../shaders/common/bvh.wgsl");
+    const BVH_WGSL: &str = include_str!("../../../shaders/common/bvh_wide.wgsl");
     const BVH_BINARY_WGSL: &str = include_str!("../../../shaders/common/bvh_binary.wgsl");
 
     fn struct_layout(module: &naga::Module, name: &str) -> (u32, Vec<u32>) {

@@ -1,6 +1,6 @@
 //! The compressed 8-wide BVH the GPU traverses (Ylitie, Karras & Laine 2017, "Efficient
 //! Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", sections 3-4), collapsed
-//! from the binned-SAH binary BVH, and its CPU twin (`shaders/common/bvh.wgsl` op for op).
+//! from the binned-SAH binary BVH, and its CPU twin (`shaders/common/bvh_wide.wgsl` op for op).
 //!
 //! # Collapse
 //! Every wide node starts from one binary node and opens, greedily, the interior child of the
@@ -321,7 +321,10 @@ impl WideBvh {
             nodes[wi] = node;
         }
         assert!(depth <= BVH_STACK_SIZE, "wide BVH deeper than the stack");
-        assert!(nodes.len() < 1 << 24, "too many wide nodes for the stack encoding");
+        assert!(
+            nodes.len() < 1 << 24,
+            "too many wide nodes for the stack encoding"
+        );
         let stats = WideStats {
             nodes: nodes.len(),
             depth,
@@ -355,7 +358,7 @@ impl WideBvh {
         }
     }
 
-    /// The traversal loop of `bvh.wgsl` (`bvh_traverse`).
+    /// The traversal loop of `bvh_wide.wgsl` (`bvh_traverse`).
     #[inline(always)]
     fn traverse<const ANY: bool, const COUNT: bool>(&self, ray: &Ray, c: &mut TraceCounters) -> Option<Hit> {
         if COUNT {

@@ -1,5 +1,5 @@
-// Traces a buffer of rays through the BINARY BVH (`bench rays` compares it with the wide one).
-#include "common/bvh_binary.wgsl"
+// Traces a buffer of rays through the compressed 8-wide BVH (`bench rays` compares it with the binary one).
+#include "common/bvh_wide.wgsl"
 
 struct RayIn {
     origin: vec4<f32>, // xyz origin, w tmin
