@@ -53,6 +53,9 @@ impl WorkbenchApp {
                     open.scene.materials.len(),
                     open.scene.textures.len()
                 ));
+                for note in &open.scene.load_notes {
+                    ui.label(format!("decoded: {note}"));
+                }
                 if !open.scene.warnings.is_empty() {
                     ui.collapsing(format!("{} load warnings", open.scene.warnings.len()), |ui| {
                         for w in &open.scene.warnings {

@@ -33,6 +33,18 @@ pub struct ExportSceneArgs {
     pub camera: Option<String>,
     #[arg(long)]
     pub out: PathBuf,
+    /// `ply`: PLY meshes + scene.json (for independent renderers); `gltf`: scene.gltf +
+    /// scene.bin + textures/ (world space, a primitive per material, every camera, the suns as
+    /// KHR_lights_punctual): the built-in scenes as files other tools (glTF-Transform,
+    /// gltfpack, Blender) can read.
+    #[arg(long, value_enum, default_value = "ply")]
+    pub format: ExportFormat,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExportFormat {
+    Ply,
+    Gltf,
 }
 
 /// One material's triangles with their own compact vertex list.
@@ -291,6 +303,14 @@ pub fn run(args: &ExportSceneArgs) -> anyhow::Result<()> {
 
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let (parts, skipped) = split_by_material(scene);
+    if args.format == ExportFormat::Gltf {
+        write_gltf(scene, &cam, &parts, &args.out)?;
+        if skipped > 0 {
+            println!("warning: skipped {skipped} triangle(s) with an invalid material or vertex index");
+        }
+        println!("wrote {}", args.out.join("scene.gltf").display());
+        return Ok(());
+    }
 
     let mut entries = Vec::with_capacity(scene.materials.len());
     let mut written: Vec<usize> = Vec::new();
@@ -371,5 +391,171 @@ pub fn run(args: &ExportSceneArgs) -> anyhow::Result<()> {
         println!("warning: skipped {skipped} triangle(s) with an invalid material or vertex index");
     }
     println!("wrote {}", args.out.display());
+    Ok(())
+}
+
+/// Writes `scene.gltf`, `scene.bin` and `textures/tex_<i>.png`: one mesh with a primitive per
+/// used material (POSITION with min/max, NORMAL, TEXCOORD_0, u32 indices; world space, so every
+/// node is at the identity), metallic-roughness materials with their base colour factor and
+/// texture (roughness / metallic textures are not written: the scene holds them re-encoded),
+/// every camera (the chosen one first) and every sun as a KHR_lights_punctual directional light
+/// whose `intensity` x `color` is its irradiance in W/m^2.
+fn write_gltf(scene: &Scene, cam: &Camera, parts: &[MeshPart], out: &Path) -> anyhow::Result<()> {
+    use glam::{Mat3, Quat};
+    use serde_json::{Value, json};
+    let mut bin: Vec<u8> = Vec::new();
+    let mut views: Vec<Value> = Vec::new();
+    let mut accessors: Vec<Value> = Vec::new();
+    let mut view = |bin: &mut Vec<u8>, bytes: &[u8], target: u32| -> usize {
+        let offset = bin.len();
+        bin.extend_from_slice(bytes);
+        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len(), "target": target}));
+        views.len() - 1
+    };
+    let f32_bytes = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+    let mut textures: Vec<usize> = Vec::new();
+    let mut materials: Vec<Value> = Vec::new();
+    let mut primitives: Vec<Value> = Vec::new();
+    for (m, part) in scene.materials.iter().zip(parts) {
+        if part.faces.is_empty() {
+            continue;
+        }
+        let mut pbr = json!({
+            "baseColorFactor": m.base_color_factor,
+            "metallicFactor": m.metallic,
+            "roughnessFactor": m.roughness,
+        });
+        if let Some(t) = m.base_color_texture.filter(|&t| t < scene.textures.len()) {
+            let i = textures.iter().position(|&x| x == t).unwrap_or_else(|| {
+                textures.push(t);
+                textures.len() - 1
+            });
+            pbr["baseColorTexture"] = json!({"index": i});
+        }
+        materials.push(json!({"name": m.name, "pbrMetallicRoughness": pbr, "doubleSided": true}));
+        let flat = |v: &[[f32; 3]]| v.iter().flatten().copied().collect::<Vec<f32>>();
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for p in &part.positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let n = part.positions.len();
+        let pv = view(&mut bin, &f32_bytes(&flat(&part.positions)), 34962);
+        accessors.push(json!({"bufferView": pv, "componentType": 5126, "count": n, "type": "VEC3", "min": lo, "max": hi}));
+        let nv = view(&mut bin, &f32_bytes(&flat(&part.normals)), 34962);
+        accessors.push(json!({"bufferView": nv, "componentType": 5126, "count": n, "type": "VEC3"}));
+        let uvs: Vec<f32> = part.uvs.iter().flatten().copied().collect();
+        let tv = view(&mut bin, &f32_bytes(&uvs), 34962);
+        accessors.push(json!({"bufferView": tv, "componentType": 5126, "count": n, "type": "VEC2"}));
+        let idx: Vec<u8> = part
+            .faces
+            .iter()
+            .flatten()
+            .flat_map(|i| i.to_le_bytes())
+            .collect();
+        let iv = view(&mut bin, &idx, 34963);
+        accessors.push(
+            json!({"bufferView": iv, "componentType": 5125, "count": part.faces.len() * 3, "type": "SCALAR"}),
+        );
+        let a = accessors.len();
+        primitives.push(json!({
+            "attributes": {"POSITION": a - 4, "NORMAL": a - 3, "TEXCOORD_0": a - 2},
+            "indices": a - 1,
+            "material": materials.len() - 1,
+        }));
+    }
+    let mut nodes: Vec<Value> = vec![json!({"name": scene.name, "mesh": 0})];
+    let mut cameras: Vec<Value> = Vec::new();
+    let mut cams: Vec<&Camera> = vec![cam];
+    cams.extend(scene.cameras.iter().filter(|c| c.name != cam.name));
+    for c in cams {
+        let f = c.forward.normalize_or(Vec3::NEG_Z);
+        let r = f.cross(c.up).normalize_or(Vec3::X);
+        let u = r.cross(f);
+        let q = Quat::from_mat3(&Mat3::from_cols(r, u, -f)).normalize();
+        cameras.push(json!({"name": c.name, "type": "perspective",
+            "perspective": {"yfov": c.yfov, "znear": c.znear, "zfar": c.zfar}}));
+        nodes.push(json!({"name": c.name, "camera": cameras.len() - 1,
+            "translation": c.position.to_array(), "rotation": q.to_array()}));
+    }
+    let mut lights: Vec<Value> = Vec::new();
+    for l in &scene.lights {
+        let z = -l.direction.normalize_or(Vec3::NEG_Y);
+        let x = if z.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+        let y = z.cross(x).normalize();
+        let x = y.cross(z);
+        let q = Quat::from_mat3(&Mat3::from_cols(x, y, z)).normalize();
+        let intensity = l.irradiance.max_element().max(0.0);
+        let color = if intensity > 0.0 {
+            l.irradiance / intensity
+        } else {
+            Vec3::ONE
+        };
+        lights.push(
+            json!({"name": l.name, "type": "directional", "color": color.to_array(), "intensity": intensity}),
+        );
+        nodes.push(json!({"name": l.name, "rotation": q.to_array(),
+            "extensions": {"KHR_lights_punctual": {"light": lights.len() - 1}}}));
+    }
+    let mut images: Vec<Value> = Vec::new();
+    if !textures.is_empty() {
+        std::fs::create_dir_all(out.join("textures"))
+            .with_context(|| format!("cannot create {}", out.join("textures").display()))?;
+    }
+    for &t in &textures {
+        let tex = &scene.textures[t];
+        if tex.rgba8.len() != (tex.width as usize) * (tex.height as usize) * 4 {
+            return Err(anyhow!(
+                "texture '{}' is not {}x{} RGBA8",
+                tex.name,
+                tex.width,
+                tex.height
+            ));
+        }
+        let rel = format!("textures/tex_{t}.png");
+        write_png(&out.join(&rel), tex.width, tex.height, &tex.rgba8).map_err(|e| anyhow!("{e}"))?;
+        images.push(json!({"uri": rel, "name": tex.name}));
+    }
+    let mut doc = json!({
+        "asset": {"version": "2.0", "generator": "lightcut-workbench export-scene"},
+        "scene": 0,
+        "scenes": [{"name": scene.name, "nodes": (0..nodes.len()).collect::<Vec<_>>()}],
+        "nodes": nodes,
+        "meshes": [{"name": scene.name, "primitives": primitives}],
+        "materials": materials,
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"uri": "scene.bin", "byteLength": bin.len()}],
+    });
+    if !cameras.is_empty() {
+        doc["cameras"] = json!(cameras);
+    }
+    if !textures.is_empty() {
+        doc["images"] = json!(images);
+        doc["samplers"] = json!([{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]);
+        doc["textures"] = json!(
+            (0..textures.len())
+                .map(|i| json!({"source": i, "sampler": 0}))
+                .collect::<Vec<_>>()
+        );
+    }
+    if !lights.is_empty() {
+        doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+        doc["extensions"] = json!({"KHR_lights_punctual": {"lights": lights}});
+    }
+    write_file(&out.join("scene.bin"), &bin)?;
+    let text = serde_json::to_string_pretty(&doc).context("cannot encode the glTF JSON")?;
+    write_file(&out.join("scene.gltf"), text.as_bytes())?;
+    println!(
+        "scene: {} ({} triangles, {} primitives, {} texture(s), {} camera(s), {} sun(s))",
+        scene.name,
+        scene.triangle_count(),
+        primitives.len(),
+        textures.len(),
+        cameras.len(),
+        lights.len()
+    );
     Ok(())
 }

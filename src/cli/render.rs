@@ -1002,6 +1002,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         args.width,
         args.height
     );
+    for note in &opened.scene.load_notes {
+        println!("  decoded: {note}");
+    }
     println!(
         "mean direct radiance (linear RGB): {:.5} {:.5} {:.5}",
         mean[0], mean[1], mean[2]

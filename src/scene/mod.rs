@@ -200,6 +200,10 @@ pub struct Scene {
     pub bounds: Aabb,
     /// Non-fatal problems met while loading (unsupported extensions, missing images, ...).
     pub warnings: Vec<String>,
+    /// What the loader decoded beyond plain glTF (one line per extension: compressed buffer
+    /// views and primitives, instances expanded, quantisation, texture transforms), for the
+    /// load summary.
+    pub load_notes: Vec<String>,
 }
 
 impl Scene {

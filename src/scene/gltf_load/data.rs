@@ -60,6 +60,25 @@ pub(super) fn decode_data_uri(uri: &str) -> Result<Vec<u8>, String> {
         .map_err(|e| format!("bad data URI: {}", one_line(&e.to_string())))
 }
 
+/// The file's buffers, and the buffer views decoded from EXT_meshopt_compression (by view
+/// index; [`view_slice`] reads those instead of the view's own, fallback, bytes).
+pub(super) struct Buffers {
+    pub(super) data: Vec<Vec<u8>>,
+    pub(super) decoded: HashMap<usize, Vec<u8>>,
+}
+
+/// Whether a buffer is an EXT_meshopt_compression fallback that the file leaves without data
+/// (`"extensions": {"EXT_meshopt_compression": {"fallback": true}}` and no `uri`): its views
+/// are all compressed, so it is never read.
+fn is_empty_fallback(buffer: &gltf::Buffer) -> bool {
+    matches!(buffer.source(), gltf::buffer::Source::Bin)
+        && buffer
+            .extension_value("EXT_meshopt_compression")
+            .and_then(|e| e.get("fallback"))
+            .and_then(|v| v.as_bool())
+            == Some(true)
+}
+
 pub(super) fn load_buffers(
     doc: &gltf::Document,
     path: &Path,
@@ -74,6 +93,10 @@ pub(super) fn load_buffers(
             index,
             message,
         };
+        if is_empty_fallback(&buffer) {
+            out.push(Vec::new());
+            continue;
+        }
         let (data, name) = match buffer.source() {
             gltf::buffer::Source::Bin => match blob.take() {
                 Some(b) => (b, "GLB BIN chunk".to_string()),
@@ -181,7 +204,7 @@ pub(super) fn dds_sibling(base_dir: &Path, dds_uri: &str) -> Option<PathBuf> {
 #[allow(clippy::type_complexity)]
 pub(super) fn load_textures(
     doc: &gltf::Document,
-    buffers: &[Vec<u8>],
+    buffers: &Buffers,
     base_dir: &Path,
     users: &BTreeMap<(TexSource, TexKind), Vec<String>>,
     warnings: &mut Warnings,
@@ -285,7 +308,7 @@ fn decode_bytes(b: &[u8], name: String) -> Result<TextureImage, String> {
 
 pub(super) fn decode_image(
     img: &gltf::Image,
-    buffers: &[Vec<u8>],
+    buffers: &Buffers,
     base_dir: &Path,
 ) -> (String, Result<TextureImage, String>) {
     let (label, bytes): (String, Result<Vec<u8>, String>) = match img.source() {
@@ -313,8 +336,13 @@ pub(super) fn decode_image(
     (label, res)
 }
 
-pub(super) fn view_slice<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) -> Result<&'b [u8], String> {
+pub(super) fn view_slice<'b>(view: &gltf::buffer::View, buffers: &'b Buffers) -> Result<&'b [u8], String> {
+    // A view compressed with EXT_meshopt_compression: its decoded bytes.
+    if let Some(d) = buffers.decoded.get(&view.index()) {
+        return Ok(d.get(..view.length()).unwrap_or(d));
+    }
     let buf = buffers
+        .data
         .get(view.buffer().index())
         .ok_or_else(|| format!("buffer view {} names a missing buffer", view.index()))?;
     let end = view
@@ -333,7 +361,7 @@ pub(super) fn view_slice<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) 
 
 pub(super) fn read_primitive(
     prim: &gltf::Primitive,
-    buffers: &[Vec<u8>],
+    buffers: &Buffers,
     uv_set: u32,
 ) -> Result<(PrimData, bool), String> {
     let pos_acc = prim
@@ -403,7 +431,7 @@ pub(super) fn component_size(t: DataType) -> usize {
 /// which turns the bytes of one component into a value. Every range is checked.
 pub(super) fn read_accessor<T: Copy + Default>(
     acc: &gltf::Accessor,
-    buffers: &[Vec<u8>],
+    buffers: &Buffers,
     conv: &dyn Fn(&[u8], DataType) -> T,
 ) -> Result<Vec<T>, String> {
     let comps = match acc.dimensions() {
@@ -501,7 +529,7 @@ pub(super) fn read_accessor<T: Copy + Default>(
     Ok(out)
 }
 
-pub(super) fn read_floats(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<f32>, String> {
+pub(super) fn read_floats(acc: &gltf::Accessor, buffers: &Buffers) -> Result<Vec<f32>, String> {
     let norm = acc.normalized();
     read_accessor(acc, buffers, &|b: &[u8], t: DataType| match t {
         DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
@@ -525,7 +553,7 @@ pub(super) fn read_floats(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<V
     })
 }
 
-pub(super) fn read_indices(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>, String> {
+pub(super) fn read_indices(acc: &gltf::Accessor, buffers: &Buffers) -> Result<Vec<u32>, String> {
     if acc.dimensions() != Dimensions::Scalar {
         return Err("index accessor is not SCALAR".into());
     }
@@ -538,4 +566,124 @@ pub(super) fn read_indices(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<
         DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as u32,
         _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
     })
+}
+
+/// Decodes every buffer view compressed with EXT_meshopt_compression (its extension object:
+/// `buffer`, `byteOffset`, `byteLength`, `byteStride`, `count`, `mode`, `filter`) with
+/// meshoptimizer-rs (a Rust port of meshoptimizer's decoders: the vertex codec, the index
+/// codecs and the OCTAHEDRAL / QUATERNION / EXPONENTIAL filters). Returns the decoded views
+/// and how many there were; a view that fails to decode is an error naming it.
+pub(super) fn decode_meshopt_views(
+    doc: &gltf::Document,
+    data: &[Vec<u8>],
+) -> Result<HashMap<usize, Vec<u8>>, String> {
+    use meshoptimizer_rs::codec::{Filter, Mode, decode_buffer_view};
+    let mut out = HashMap::new();
+    let mut workspace = meshoptimizer_rs::Workspace::default();
+    for view in doc.views() {
+        let Some(ext) = view.extension_value("EXT_meshopt_compression") else {
+            continue;
+        };
+        let i = view.index();
+        let num = |k: &str| ext.get(k).and_then(|v| v.as_u64()).map(|v| v as usize);
+        let (Some(buffer), Some(length), Some(stride), Some(count)) =
+            (num("buffer"), num("byteLength"), num("byteStride"), num("count"))
+        else {
+            return Err(format!(
+                "buffer view {i}: EXT_meshopt_compression lacks buffer, byteLength, byteStride or count"
+            ));
+        };
+        let offset = num("byteOffset").unwrap_or(0);
+        let text = |k: &str, d: &'static str| ext.get(k).and_then(|v| v.as_str()).unwrap_or(d).to_string();
+        let mode = Mode::parse(&text("mode", "")).map_err(|_| {
+            format!(
+                "buffer view {i}: EXT_meshopt_compression mode '{}' is not ATTRIBUTES, TRIANGLES or INDICES",
+                text("mode", "")
+            )
+        })?;
+        let filter = Filter::parse(&text("filter", "NONE")).map_err(|_| {
+            format!(
+                "buffer view {i}: unknown EXT_meshopt_compression filter '{}'",
+                text("filter", "NONE")
+            )
+        })?;
+        let src = data
+            .get(buffer)
+            .and_then(|b| b.get(offset..offset.checked_add(length)?))
+            .ok_or_else(|| format!("buffer view {i}: its compressed bytes lie outside buffer {buffer}"))?;
+        let decoded = decode_buffer_view(mode, filter, count, stride, src, &mut workspace)
+            .map_err(|e| format!("buffer view {i}: EXT_meshopt_compression data does not decode ({e:?})"))?;
+        if decoded.len() < view.length() {
+            return Err(format!(
+                "buffer view {i}: decoded {} bytes, the view declares {}",
+                decoded.len(),
+                view.length()
+            ));
+        }
+        out.insert(i, decoded);
+    }
+    Ok(out)
+}
+
+/// A primitive compressed with KHR_draco_mesh_compression (`bufferView` and `attributes`:
+/// glTF attribute name to Draco unique id), decoded with draco-core (a pure-Rust Draco
+/// decoder: sequential and EdgeBreaker connectivity, the quantisation and octahedral
+/// transforms, as Draco 1.5 writes them). The attributes come out dequantised, as floats.
+pub(super) fn read_draco_primitive(
+    doc: &gltf::Document,
+    prim: &gltf::Primitive,
+    ext: &serde_json::Value,
+    buffers: &Buffers,
+    uv_set: u32,
+) -> Result<(PrimData, bool), String> {
+    let doc_view = ext
+        .get("bufferView")
+        .and_then(|v| v.as_u64())
+        .ok_or("KHR_draco_mesh_compression has no bufferView")? as usize;
+    let view = doc
+        .views()
+        .nth(doc_view)
+        .ok_or_else(|| format!("KHR_draco_mesh_compression names missing buffer view {doc_view}"))?;
+    let bytes = view_slice(&view, buffers)?;
+    let mut mesh = draco_core::Mesh::new();
+    draco_core::MeshDecoder::new()
+        .decode(&mut draco_core::DecoderBuffer::new(bytes), &mut mesh)
+        .map_err(|e| format!("the Draco data does not decode ({e})"))?;
+    let n = mesh.num_points();
+    let attr = |name: &str, comps: usize| -> Option<Vec<f32>> {
+        let id = ext.get("attributes")?.get(name)?.as_u64()?;
+        let a = mesh.attribute_by_unique_id(id as u32)?;
+        (a.num_components() as usize >= comps).then(|| a.read_f32s(n, comps))
+    };
+    let positions: Vec<Vec3> = attr("POSITION", 3)
+        .ok_or("the Draco data has no POSITION attribute")?
+        .chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect();
+    let normals = attr("NORMAL", 3).map(|v| v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect());
+    let set = format!("TEXCOORD_{uv_set}");
+    let uvs: Option<Vec<Vec2>> = attr(&set, 2).map(|v| {
+        v.chunks_exact(2)
+            .map(|c| {
+                let uv = Vec2::new(c[0], c[1]);
+                if uv.is_finite() { uv } else { Vec2::ZERO }
+            })
+            .collect()
+    });
+    let uv_missing = uvs.is_none()
+        && prim
+            .material()
+            .pbr_metallic_roughness()
+            .base_color_texture()
+            .is_some();
+    let indices: Vec<u32> = mesh.faces().iter().flat_map(|f| f.iter().map(|p| p.0)).collect();
+    Ok((
+        PrimData {
+            positions,
+            normals,
+            uvs,
+            indices,
+        },
+        uv_missing,
+    ))
 }

@@ -123,9 +123,10 @@ fn ext_policy(name: &str) -> ExtPolicy {
             "its roughness / metallic textures are read (G / B channels; shading with --brdf ggx); \
              DDS-only ones through the PNG/JPG beside their .dds",
         ),
-        "KHR_texture_transform" => ExtPolicy::Ignored(
-            "texture transforms are ignored: transformed base colour textures may look misplaced",
-        ),
+        // Offset, rotation and scale applied to the UVs of the base colour texture's set
+        // (`texture_transform`); a different transform on a material's other textures is
+        // warned about.
+        "KHR_texture_transform" => ExtPolicy::Supported,
         "KHR_texture_basisu" | "EXT_texture_webp" | "EXT_texture_avif" => ExtPolicy::Ignored(
             "only PNG/JPG texture sources are decoded; other textures fall back to the colour factor",
         ),
@@ -133,14 +134,19 @@ fn ext_policy(name: &str) -> ExtPolicy {
             ExtPolicy::Ignored("material variants are ignored; the default materials are used")
         }
         "KHR_xmp_json_ld" | "KHR_animation_pointer" => ExtPolicy::Ignored("metadata/animation is not used"),
-        "KHR_draco_mesh_compression" => ExtPolicy::Geometry("Draco-compressed geometry cannot be decoded"),
-        "EXT_meshopt_compression" => ExtPolicy::Geometry("meshopt-compressed buffers cannot be decoded"),
-        "KHR_mesh_quantization" => {
-            ExtPolicy::Geometry("quantised vertex attributes would change the geometry")
-        }
-        "EXT_mesh_gpu_instancing" => {
-            ExtPolicy::Geometry("GPU instancing would add mesh copies that are not loaded")
-        }
+        // Decoded with draco-core (`data::read_draco_primitive`).
+        "KHR_draco_mesh_compression" => ExtPolicy::Supported,
+        // Decoded with meshoptimizer-rs (`data::decode_meshopt_views`).
+        "EXT_meshopt_compression" => ExtPolicy::Supported,
+        // Normalised and integer accessors are dequantised by `data::read_floats`; node
+        // transforms carry the scale.
+        "KHR_mesh_quantization" => ExtPolicy::Supported,
+        // Instances expanded into the scene (`instance_transforms`).
+        "EXT_mesh_gpu_instancing" => ExtPolicy::Supported,
+        "KHR_meshopt_compression" => ExtPolicy::Geometry(
+            "its buffer views are not decoded (EXT_meshopt_compression is: write the file with \
+             `gltf-transform meshopt` or `gltfpack -c`)",
+        ),
         n if n.starts_with("KHR_materials_") => {
             ExtPolicy::Ignored("only the base colour of materials is used")
         }
@@ -251,6 +257,37 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
         }
     }
 
+    // KHR_draco_mesh_compression: the primitive's accessors have no buffer view (their data
+    // is in the Draco stream, `data::read_draco_primitive`), which the gltf crate's validation
+    // rejects; they are pointed at the Draco buffer view, and never read through it.
+    for mesh in &root.meshes {
+        for prim in &mesh.primitives {
+            let Some(view) = prim
+                .extensions
+                .as_ref()
+                .and_then(|e| e.others.get("KHR_draco_mesh_compression"))
+                .and_then(|d| d.get("bufferView"))
+                .and_then(|v| v.as_u64())
+            else {
+                continue;
+            };
+            let accessors = prim
+                .attributes
+                .values()
+                .map(|a| a.value())
+                .chain(prim.indices.map(|i| i.value()));
+            for a in accessors {
+                if let Some(acc) = root.accessors.get_mut(a)
+                    && acc.buffer_view.is_none()
+                    && acc.sparse.is_none()
+                {
+                    acc.buffer_view = Some(gltf::json::Index::new(view as u32));
+                    acc.byte_offset = None;
+                }
+            }
+        }
+    }
+
     // POSITION min/max are required by the spec but unused here: do not reject files that
     // lack them or get them wrong.
     let position_accessors: Vec<usize> = root
@@ -278,7 +315,16 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
         .map_err(|e| invalid(validation_message(&e)))?;
     let base_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
 
-    let buffers = load_buffers(&doc, path, &base_dir, blob)?;
+    let data = load_buffers(&doc, path, &base_dir, blob)?;
+    let decoded = decode_meshopt_views(&doc, &data).map_err(invalid)?;
+    let mut info: Vec<String> = Vec::new();
+    if !decoded.is_empty() {
+        info.push(format!(
+            "EXT_meshopt_compression: {} buffer view(s) decoded (meshoptimizer-rs)",
+            decoded.len()
+        ));
+    }
+    let buffers = Buffers { data, decoded };
 
     // Materials and their textures: base colour, and metallic-roughness (glTF's
     // `metallicRoughnessTexture`, or AMD_split_roughnessMetallic's separate roughness and
@@ -390,6 +436,8 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
     let (textures, texture_of) = load_textures(&doc, &buffers, &base_dir, &users, &mut warnings);
     let mut materials: Vec<Material> = Vec::new();
     let mut material_uv_set: Vec<u32> = Vec::new();
+    let mut material_uv_transform: Vec<Option<Mat3>> = Vec::new();
+    let mut used_transform = false;
     for ((i, m), req) in doc.materials().enumerate().zip(requests) {
         let pbr = m.pbr_metallic_roughness();
         let factor = pbr.base_color_factor();
@@ -429,10 +477,34 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
             .first()
             .copied()
             .unwrap_or_else(|| pbr.base_color_texture().map(|t| t.tex_coord()).unwrap_or(0));
+        // KHR_texture_transform may name another set than the texture info.
+        let set = pbr
+            .base_color_texture()
+            .and_then(|t| t.extension_value("KHR_texture_transform").cloned())
+            .and_then(|v| v.get("texCoord").and_then(|c| c.as_u64()))
+            .map_or(set, |c| c as u32);
         if sets.iter().any(|&s| s != set) {
             warnings.push(format!(
                 "material '{name}': its textures use different TEXCOORD sets; all read set {set}"
             ));
+        }
+        // KHR_texture_transform on the texture whose UV set the vertices carry.
+        let transforms: Vec<Option<Mat3>> = [pbr.base_color_texture(), pbr.metallic_roughness_texture()]
+            .into_iter()
+            .flatten()
+            .map(|t| texture_transform(&t))
+            .collect();
+        let transform = transforms.first().copied().flatten();
+        if transforms.iter().any(|t| *t != transform) {
+            warnings.push(format!(
+                "material '{name}': its textures have different KHR_texture_transforms; the base colour's is used for all"
+            ));
+        }
+        if let Some(t) = transform.filter(|t| *t != Mat3::IDENTITY) {
+            material_uv_transform.push(Some(t));
+            used_transform = true;
+        } else {
+            material_uv_transform.push(None);
         }
         materials.push(Material {
             name,
@@ -492,6 +564,25 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
         }
 
         if let Some(mesh) = node.mesh() {
+            // EXT_mesh_gpu_instancing: the mesh once per instance (each instance's TRS after
+            // the node's transform), else once.
+            let instances = match node.extension_value("EXT_mesh_gpu_instancing") {
+                Some(ext) => match instance_transforms(&doc, ext, &buffers) {
+                    Ok(v) => {
+                        stats.instanced_nodes += 1;
+                        stats.instances += v.len();
+                        v
+                    }
+                    Err(e) => {
+                        warnings.push(format!(
+                            "node {}: EXT_mesh_gpu_instancing: {e}; its mesh is loaded once",
+                            node.index()
+                        ));
+                        vec![Mat4::IDENTITY]
+                    }
+                },
+                None => vec![Mat4::IDENTITY],
+            };
             for (pi, prim) in mesh.primitives().enumerate() {
                 if prim.mode() != Mode::Triangles {
                     *stats
@@ -505,6 +596,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                     None => *default_material.get_or_insert_with(|| {
                         materials.push(Material::default());
                         material_uv_set.push(0);
+                        material_uv_transform.push(None);
                         (materials.len() - 1) as u32
                     }),
                 };
@@ -514,12 +606,30 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                     mesh.index(),
                     mesh.name().unwrap_or("")
                 );
-                match read_primitive(&prim, &buffers, uv_set) {
-                    Ok((data, uv_missing)) => {
+                let draco = prim.extension_value("KHR_draco_mesh_compression");
+                let read = match draco {
+                    Some(ext) => {
+                        stats.draco += 1;
+                        read_draco_primitive(&doc, &prim, ext, &buffers, uv_set)
+                    }
+                    None => read_primitive(&prim, &buffers, uv_set),
+                };
+                match read {
+                    Ok((mut data, uv_missing)) => {
                         if uv_missing {
                             stats.uv_missing.insert(label.clone());
                         }
-                        append_primitive(&mut scene, &data, &world, mat, &mut stats);
+                        if let (Some(t), Some(uvs)) = (
+                            material_uv_transform.get(mat as usize).copied().flatten(),
+                            data.uvs.as_mut(),
+                        ) {
+                            for uv in uvs.iter_mut() {
+                                *uv = t.transform_point2(*uv);
+                            }
+                        }
+                        for inst in &instances {
+                            append_primitive(&mut scene, &data, &(world * *inst), mat, &mut stats);
+                        }
                     }
                     Err(e) => warnings.push(format!("{label} skipped: {e}")),
                 }
@@ -601,6 +711,26 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                 None => warnings.push(format!("node {} references missing light {li}", node.index())),
             }
         }
+    }
+
+    // What was decoded (the load summary's extension lines).
+    if stats.draco > 0 {
+        info.push(format!(
+            "KHR_draco_mesh_compression: {} primitive(s) decoded (draco-core)",
+            stats.draco
+        ));
+    }
+    if stats.instanced_nodes > 0 {
+        info.push(format!(
+            "EXT_mesh_gpu_instancing: {} instance(s) of {} node(s) expanded",
+            stats.instances, stats.instanced_nodes
+        ));
+    }
+    if doc.extensions_used().any(|e| e == "KHR_mesh_quantization") {
+        info.push("KHR_mesh_quantization: quantised attributes dequantised".into());
+    }
+    if used_transform {
+        info.push("KHR_texture_transform: applied to the UVs of the transformed textures' sets".into());
     }
 
     // Summaries of skipped/dropped things, one warning each.
@@ -686,7 +816,87 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
         log::warn!("{}: {w}", path.display());
     }
     scene.warnings = warnings.0;
+    for i in &info {
+        log::info!("{}: {i}", path.display());
+    }
+    scene.load_notes = info;
     Ok(scene)
+}
+
+/// KHR_texture_transform of a texture reference as the 3x3 matrix T * R * S of the extension's
+/// specification (uv' = offset + R(rotation) * (scale * uv), R = [[cos, sin], [-sin, cos]] in
+/// row-major order); `None` without the extension.
+fn texture_transform(info: &gltf::texture::Info) -> Option<Mat3> {
+    let ext = info.extension_value("KHR_texture_transform")?;
+    let pair = |k: &str, d: [f32; 2]| {
+        ext.get(k)
+            .and_then(|v| v.as_array())
+            .filter(|a| a.len() == 2)
+            .map(|a| {
+                [
+                    a[0].as_f64().unwrap_or(d[0] as f64) as f32,
+                    a[1].as_f64().unwrap_or(d[1] as f64) as f32,
+                ]
+            })
+            .unwrap_or(d)
+    };
+    let [ox, oy] = pair("offset", [0.0, 0.0]);
+    let [sx, sy] = pair("scale", [1.0, 1.0]);
+    let r = ext.get("rotation").and_then(|v| v.as_f64()).unwrap_or(0.0) as f32;
+    let (s, c) = r.sin_cos();
+    // Columns of T * R * S (glam is column-major): x' = c sx x + s sy y + ox,
+    // y' = -s sx x + c sy y + oy.
+    let m = Mat3::from_cols(
+        Vec3::new(c * sx, -s * sx, 0.0),
+        Vec3::new(s * sy, c * sy, 0.0),
+        Vec3::new(ox, oy, 1.0),
+    );
+    m.is_finite().then_some(m)
+}
+
+/// EXT_mesh_gpu_instancing's per-instance transforms (TRANSLATION, ROTATION, SCALE accessors,
+/// each optional; float or normalised integer components as the extension allows).
+fn instance_transforms(
+    doc: &gltf::Document,
+    ext: &serde_json::Value,
+    buffers: &Buffers,
+) -> Result<Vec<Mat4>, String> {
+    let attrs = ext.get("attributes").ok_or("no attributes")?;
+    let read = |name: &str, comps: usize| -> Result<Option<Vec<f32>>, String> {
+        let Some(i) = attrs.get(name).and_then(|v| v.as_u64()) else {
+            return Ok(None);
+        };
+        let acc = doc
+            .accessors()
+            .nth(i as usize)
+            .ok_or_else(|| format!("{name} names missing accessor {i}"))?;
+        let v = read_floats(&acc, buffers).map_err(|e| format!("{name}: {e}"))?;
+        if v.len() != acc.count() * comps {
+            return Err(format!("{name} is not a {comps}-component accessor"));
+        }
+        Ok(Some(v))
+    };
+    let t = read("TRANSLATION", 3)?;
+    let r = read("ROTATION", 4)?;
+    let s = read("SCALE", 3)?;
+    let counts: Vec<usize> = [(&t, 3), (&r, 4), (&s, 3)]
+        .iter()
+        .filter_map(|(v, c)| v.as_ref().map(|v| v.len() / c))
+        .collect();
+    let n = *counts.first().ok_or("no TRANSLATION, ROTATION or SCALE")?;
+    if counts.iter().any(|&c| c != n) {
+        return Err("its accessors have different counts".into());
+    }
+    Ok((0..n)
+        .map(|i| {
+            let tr = t.as_ref().map_or(Vec3::ZERO, |v| Vec3::from_slice(&v[3 * i..]));
+            let ro = r.as_ref().map_or(glam::Quat::IDENTITY, |v| {
+                glam::Quat::from_slice(&v[4 * i..]).normalize()
+            });
+            let sc = s.as_ref().map_or(Vec3::ONE, |v| Vec3::from_slice(&v[3 * i..]));
+            Mat4::from_scale_rotation_translation(sc, ro, tr)
+        })
+        .collect())
 }
 
 #[derive(Default)]
@@ -706,6 +916,11 @@ struct GeomStats {
     skipped_modes: BTreeMap<String, usize>,
     skipped_lights: BTreeMap<String, usize>,
     uv_missing: BTreeSet<String>,
+    /// KHR_draco_mesh_compression primitives decoded (counted per node that draws them).
+    draco: usize,
+    /// EXT_mesh_gpu_instancing: nodes and their instances.
+    instanced_nodes: usize,
+    instances: usize,
 }
 
 fn one_line(s: &str) -> String {
