@@ -57,6 +57,12 @@ const CASES: &[Case] = &[
         original: "room",
         decoded: &["KHR_draco_mesh_compression: 7 primitive"],
     },
+    // Sequential connectivity (`gltf-transform draco --method sequential`).
+    Case {
+        name: "room_draco_sequential",
+        original: "room",
+        decoded: &["KHR_draco_mesh_compression: 7 primitive"],
+    },
     Case {
         name: "room_gltfpack",
         original: "room",
@@ -140,7 +146,7 @@ fn every_fixture_loads_with_its_extensions_decoded_and_matches_its_original_geom
         let (w, h) = (96, 72);
         let (gs, go) = (gbuffer(&s, w, h), gbuffer(&o, w, h));
         let (mut alike, mut hits) = (0usize, 0usize);
-        let (mut max_dp, mut min_dot) = (0.0f32, 1.0f32);
+        let (mut max_dp, mut min_dot, mut max_duv, mut textured) = (0.0f32, 1.0f32, 0.0f32, 0usize);
         let cos3 = 3f32.to_radians().cos();
         for (a, b) in gs.iter().zip(&go) {
             match (a, b) {
@@ -148,10 +154,20 @@ fn every_fixture_loads_with_its_extensions_decoded_and_matches_its_original_geom
                 (Some(a), Some(b)) => {
                     hits += 1;
                     let (dp, dot) = ((a.position - b.position).length(), a.normal.dot(b.normal));
-                    if a.material == b.material && dp < 2e-3 && dot > cos3 {
+                    // The texture coordinate at the hit (dequantised, transformed): the same
+                    // within 2e-3 where the material is textured.
+                    let tex = o.materials[b.material as usize].base_color_texture.is_some();
+                    let duv = if tex {
+                        (uv_at(&s, a) - uv_at(&o, b)).abs().max_element()
+                    } else {
+                        0.0
+                    };
+                    if a.material == b.material && dp < 2e-3 && dot > cos3 && duv < 2e-3 {
                         alike += 1;
                         max_dp = max_dp.max(dp);
                         min_dot = min_dot.min(dot);
+                        max_duv = max_duv.max(duv);
+                        textured += tex as usize;
                     }
                 }
                 _ => {}
@@ -159,15 +175,65 @@ fn every_fixture_loads_with_its_extensions_decoded_and_matches_its_original_geom
         }
         let n = (w * h) as usize;
         eprintln!(
-            "{}: {alike}/{n} pixels alike (same material, hit points within 2 mm, normals within 3 degrees), \
-             {hits} hits; among them, hit points up to {max_dp:.2e} m apart, normal dot >= {min_dot:.6}",
+            "{}: {alike}/{n} pixels alike (same material, hit points within 2 mm, normals within 3 degrees, \
+             textured UVs within 2e-3), {hits} hits; among them, hit points up to {max_dp:.2e} m apart, \
+             normal dot >= {min_dot:.6}, UVs up to {max_duv:.1e} apart at {textured} textured pixels",
             case.name
         );
-        if alike * 100 < n * 99 || hits <= n / 2 {
+        let has_texture = o.materials.iter().any(|m| m.base_color_texture.is_some());
+        if alike * 100 < n * 99 || hits <= n / 2 || (has_texture && textured < n / 20) {
             failures.push(format!("{}: {alike} of {n} pixels alike, {hits} hits", case.name));
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The interpolated texture coordinate of a G-buffer hit (barycentrics from the hit point).
+fn uv_at(scene: &Scene, smp: &Sample) -> glam::Vec2 {
+    let t = smp.triangle as usize;
+    let [a, b, c] = scene.triangle(t);
+    let idx = &scene.indices[3 * t..3 * t + 3];
+    let n = (b - a).cross(c - a);
+    let w = |p: glam::Vec3, q: glam::Vec3| (q - p).cross(smp.position - p).dot(n) / n.length_squared();
+    let (wa, wb, wc) = (w(b, c), w(c, a), w(a, b));
+    wa * scene.uvs[idx[0] as usize] + wb * scene.uvs[idx[1] as usize] + wc * scene.uvs[idx[2] as usize]
+}
+
+/// EXT_mesh_gpu_instancing: the three instances (one turned 30 degrees) are the same
+/// world-space triangles as the same mesh under three nodes, corner for corner.
+#[test]
+fn instances_are_the_same_triangles_as_copies_under_nodes() {
+    let (s, o) = (load("room_instanced"), load("room_instanced_flat"));
+    let corners = |sc: &Scene| {
+        let mut v: Vec<[i64; 9]> = (0..sc.triangle_count())
+            .map(|t| {
+                let mut k = [0i64; 9];
+                for (i, p) in sc.triangle(t).iter().enumerate() {
+                    for c in 0..3 {
+                        k[3 * i + c] = (p[c] as f64 * 1e4).round() as i64;
+                    }
+                }
+                k
+            })
+            .collect();
+        v.sort_unstable();
+        v
+    };
+    let (a, b) = (corners(&s), corners(&o));
+    assert_eq!(a.len(), 3 * 972);
+    let differ = a
+        .iter()
+        .zip(&b)
+        .filter(|(x, y)| x.iter().zip(y.iter()).any(|(p, q)| (p - q).abs() > 1))
+        .count();
+    assert_eq!(differ, 0, "{differ} triangles differ (0.1 mm grid)");
+    // Copies 1 and 2 lie 12 and 24 m along x.
+    for x in [12.0f32, 24.0] {
+        assert!(
+            s.positions.iter().any(|p| (p.x - x).abs() < 3.0),
+            "no instance near x = {x}"
+        );
+    }
 }
 
 /// The G-buffer: (buffer, largest per-pixel difference of a pixel counted alike); at least
@@ -364,6 +430,71 @@ fn export_scene_writes_the_built_in_scenes_as_gltf() {
             assert!(a.direction.dot(b.direction) > 0.99999);
         }
         assert_eq!(s.lights.len(), built.lights.len());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// EXT_meshopt_compression's fallback buffer is never read: gltfpack's has no `uri`; one that
+/// names a file that is not there (as `gltfpack -cf` output without its .fallback.bin) loads,
+/// and so does an untagged placeholder without a `uri`. A view that would read the
+/// placeholder is refused in one line naming it.
+#[test]
+fn meshopt_fallback_buffers_are_never_read() {
+    let src = fixture("room_gltfpack_c");
+    let dir = std::env::temp_dir().join(format!("lightcut-fallback-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(src.with_file_name("scene.bin"), dir.join("scene.bin")).unwrap();
+    std::fs::copy(src.with_file_name("tex_0.png"), dir.join("tex_0.png")).unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(&src).unwrap()).unwrap();
+    let fallback = json["buffers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|b| b["extensions"]["EXT_meshopt_compression"]["fallback"] == true)
+        .expect("a fallback buffer");
+    type Edit<'a> = Box<dyn Fn(&mut serde_json::Value) + 'a>;
+    let variants: [(&str, Edit); 2] = [
+        (
+            "with_uri",
+            Box::new(|j| j["buffers"][fallback]["uri"] = "scene.fallback.bin".into()),
+        ),
+        (
+            "untagged",
+            Box::new(|j| {
+                j["buffers"][fallback]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove("extensions")
+                    .map(drop)
+                    .unwrap_or(())
+            }),
+        ),
+    ];
+    for (name, edit) in variants {
+        let mut j = json.clone();
+        edit(&mut j);
+        let path = dir.join(format!("{name}.gltf"));
+        std::fs::write(&path, serde_json::to_vec(&j).unwrap()).unwrap();
+        let s = load_gltf(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(s.triangle_count(), 972, "{name}");
+    }
+    // A plain (uncompressed) view on the placeholder: refused, naming it.
+    let mut j = json.clone();
+    let views = j["bufferViews"].as_array_mut().unwrap();
+    let v = views
+        .iter()
+        .position(|v| v.get("extensions").is_some())
+        .expect("a compressed view");
+    views[v].as_object_mut().unwrap().remove("extensions");
+    let path = dir.join("plain_view.gltf");
+    std::fs::write(&path, serde_json::to_vec(&j).unwrap()).unwrap();
+    match load_gltf(&path) {
+        Ok(s) => assert!(
+            s.warnings.iter().any(|w| w.contains("holds no data")),
+            "{:?}",
+            s.warnings
+        ),
+        Err(e) => assert!(e.to_string().contains("holds no data"), "{e}"),
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -67,16 +67,15 @@ pub(super) struct Buffers {
     pub(super) decoded: HashMap<usize, Vec<u8>>,
 }
 
-/// Whether a buffer is an EXT_meshopt_compression fallback that the file leaves without data
-/// (`"extensions": {"EXT_meshopt_compression": {"fallback": true}}` and no `uri`): its views
-/// are all compressed, so it is never read.
-fn is_empty_fallback(buffer: &gltf::Buffer) -> bool {
-    matches!(buffer.source(), gltf::buffer::Source::Bin)
-        && buffer
-            .extension_value("EXT_meshopt_compression")
-            .and_then(|e| e.get("fallback"))
-            .and_then(|v| v.as_bool())
-            == Some(true)
+/// Whether a buffer is an EXT_meshopt_compression fallback
+/// (`"extensions": {"EXT_meshopt_compression": {"fallback": true}}`): the extension's schema
+/// says it need not be loaded, with or without a `uri` (its views are all compressed).
+fn is_meshopt_fallback(buffer: &gltf::Buffer) -> bool {
+    buffer
+        .extension_value("EXT_meshopt_compression")
+        .and_then(|e| e.get("fallback"))
+        .and_then(|v| v.as_bool())
+        == Some(true)
 }
 
 pub(super) fn load_buffers(
@@ -93,7 +92,15 @@ pub(super) fn load_buffers(
             index,
             message,
         };
-        if is_empty_fallback(&buffer) {
+        // A meshopt fallback is never read; nor is a buffer without a `uri` other than a
+        // GLB's first (its BIN chunk): EXT_meshopt_compression allows such placeholders, and a
+        // view that reads one is refused by `view_slice`.
+        let placeholder =
+            matches!(buffer.source(), gltf::buffer::Source::Bin) && (index > 0 || blob.is_none());
+        if is_meshopt_fallback(&buffer) || placeholder {
+            if index == 0 {
+                blob = None;
+            }
             out.push(Vec::new());
             continue;
         }
@@ -345,6 +352,14 @@ pub(super) fn view_slice<'b>(view: &gltf::buffer::View, buffers: &'b Buffers) ->
         .data
         .get(view.buffer().index())
         .ok_or_else(|| format!("buffer view {} names a missing buffer", view.index()))?;
+    if buf.is_empty() && view.length() > 0 {
+        return Err(format!(
+            "buffer view {} reads buffer {}, which holds no data (a meshopt fallback or a \
+             placeholder without a uri)",
+            view.index(),
+            view.buffer().index()
+        ));
+    }
     let end = view
         .offset()
         .checked_add(view.length())
@@ -611,12 +626,21 @@ pub(super) fn decode_meshopt_views(
             .get(buffer)
             .and_then(|b| b.get(offset..offset.checked_add(length)?))
             .ok_or_else(|| format!("buffer view {i}: its compressed bytes lie outside buffer {buffer}"))?;
-        let decoded = decode_buffer_view(mode, filter, count, stride, src, &mut workspace)
-            .map_err(|e| format!("buffer view {i}: EXT_meshopt_compression data does not decode ({e:?})"))?;
-        if decoded.len() < view.length() {
+        if mode == Mode::Attributes && view.stride().is_some_and(|s| s != stride) {
             return Err(format!(
-                "buffer view {i}: decoded {} bytes, the view declares {}",
-                decoded.len(),
+                "buffer view {i}: byteStride {:?} differs from EXT_meshopt_compression's {stride}",
+                view.stride()
+            ));
+        }
+        // Both decoders are written for untrusted input; a panic still becomes an error.
+        let decoded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            decode_buffer_view(mode, filter, count, stride, src, &mut workspace)
+        }))
+        .map_err(|_| format!("buffer view {i}: the meshopt decoder failed"))?
+        .map_err(|e| format!("buffer view {i}: EXT_meshopt_compression data does not decode ({e:?})"))?;
+        if count.checked_mul(stride) != Some(view.length()) || decoded.len() < view.length() {
+            return Err(format!(
+                "buffer view {i}: {count} x {stride} decoded bytes, the view declares {}",
                 view.length()
             ));
         }
@@ -646,23 +670,60 @@ pub(super) fn read_draco_primitive(
         .ok_or_else(|| format!("KHR_draco_mesh_compression names missing buffer view {doc_view}"))?;
     let bytes = view_slice(&view, buffers)?;
     let mut mesh = draco_core::Mesh::new();
-    draco_core::MeshDecoder::new()
-        .decode(&mut draco_core::DecoderBuffer::new(bytes), &mut mesh)
-        .map_err(|e| format!("the Draco data does not decode ({e})"))?;
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        draco_core::MeshDecoder::new().decode(&mut draco_core::DecoderBuffer::new(bytes), &mut mesh)
+    }))
+    .map_err(|_| "the Draco decoder failed".to_string())?
+    .map_err(|e| format!("the Draco data does not decode ({e})"))?;
     let n = mesh.num_points();
-    let attr = |name: &str, comps: usize| -> Option<Vec<f32>> {
-        let id = ext.get("attributes")?.get(name)?.as_u64()?;
-        let a = mesh.attribute_by_unique_id(id as u32)?;
-        (a.num_components() as usize >= comps).then(|| a.read_f32s(n, comps))
+    // An attribute from the Draco stream (integer data normalised as its accessor says), or,
+    // where the extension does not list it, from its own accessor as usual (the spec).
+    let attr = |name: &str, semantic: gltf::Semantic, comps: usize| -> Result<Option<Vec<f32>>, String> {
+        let acc = prim.get(&semantic);
+        let Some(id) = ext
+            .get("attributes")
+            .and_then(|a| a.get(name))
+            .and_then(|v| v.as_u64())
+        else {
+            return match acc {
+                Some(acc) if acc.count() == n => read_floats(&acc, buffers)
+                    .map(Some)
+                    .map_err(|e| format!("{name}: {e}")),
+                _ => Ok(None),
+            };
+        };
+        let Some(a) = mesh.attribute_by_unique_id(id as u32) else {
+            return Err(format!("{name}: Draco attribute {id} is not in the stream"));
+        };
+        if (a.num_components() as usize) < comps {
+            return Ok(None);
+        }
+        let mut v = a.read_f32s(n, comps);
+        if let Some(acc) = acc.filter(|a| a.normalized()) {
+            let scale = match acc.data_type() {
+                DataType::I8 => Some(127.0),
+                DataType::U8 => Some(255.0),
+                DataType::I16 => Some(32767.0),
+                DataType::U16 => Some(65535.0),
+                _ => None,
+            };
+            if let (Some(k), false) = (scale, a.data_type() == draco_core::DataType::Float32) {
+                for x in &mut v {
+                    *x = (*x / k).max(-1.0);
+                }
+            }
+        }
+        Ok(Some(v))
     };
-    let positions: Vec<Vec3> = attr("POSITION", 3)
+    let positions: Vec<Vec3> = attr("POSITION", gltf::Semantic::Positions, 3)?
         .ok_or("the Draco data has no POSITION attribute")?
         .chunks_exact(3)
         .map(|c| Vec3::new(c[0], c[1], c[2]))
         .collect();
-    let normals = attr("NORMAL", 3).map(|v| v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect());
+    let normals = attr("NORMAL", gltf::Semantic::Normals, 3)?
+        .map(|v| v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect());
     let set = format!("TEXCOORD_{uv_set}");
-    let uvs: Option<Vec<Vec2>> = attr(&set, 2).map(|v| {
+    let uvs: Option<Vec<Vec2>> = attr(&set, gltf::Semantic::TexCoords(uv_set), 2)?.map(|v| {
         v.chunks_exact(2)
             .map(|c| {
                 let uv = Vec2::new(c[0], c[1]);

@@ -97,6 +97,9 @@ pub enum SceneError {
     Preset { path: PathBuf, message: String },
 }
 
+/// The most vertices a scene may have (indices are u32; instancing must not get past it).
+const MAX_VERTICES: usize = 1 << 31;
+
 /// What the loader does with a glTF extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum ExtPolicy {
@@ -373,7 +376,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                 "base colour",
                 &mut warnings,
             )
-            .map(|src| (src, info.tex_coord()));
+            .map(|src| (src, tex_coord(&info)));
         }
         if let Some(info) = pbr.metallic_roughness_texture() {
             let src = source(
@@ -382,8 +385,8 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                 "metallic-roughness",
                 &mut warnings,
             );
-            req.roughness = src.clone().map(|s| (s, info.tex_coord()));
-            req.metallic = src.map(|s| (s, info.tex_coord()));
+            req.roughness = src.clone().map(|s| (s, tex_coord(&info)));
+            req.metallic = src.map(|s| (s, tex_coord(&info)));
         }
         if let Some(split) = m.extension_value("AMD_split_roughnessMetallic") {
             for (key, what) in [("roughnessTexture", "roughness"), ("metallicTexture", "metallic")] {
@@ -476,13 +479,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
         let set = sets
             .first()
             .copied()
-            .unwrap_or_else(|| pbr.base_color_texture().map(|t| t.tex_coord()).unwrap_or(0));
-        // KHR_texture_transform may name another set than the texture info.
-        let set = pbr
-            .base_color_texture()
-            .and_then(|t| t.extension_value("KHR_texture_transform").cloned())
-            .and_then(|v| v.get("texCoord").and_then(|c| c.as_u64()))
-            .map_or(set, |c| c as u32);
+            .unwrap_or_else(|| pbr.base_color_texture().map(|t| tex_coord(&t)).unwrap_or(0));
         if sets.iter().any(|&s| s != set) {
             warnings.push(format!(
                 "material '{name}': its textures use different TEXCOORD sets; all read set {set}"
@@ -494,10 +491,11 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
             .flatten()
             .map(|t| texture_transform(&t))
             .collect();
+        // The base colour's, else the metallic-roughness texture's (the vertices carry one set).
         let transform = transforms.first().copied().flatten();
         if transforms.iter().any(|t| *t != transform) {
             warnings.push(format!(
-                "material '{name}': its textures have different KHR_texture_transforms; the base colour's is used for all"
+                "material '{name}': its textures have different KHR_texture_transforms; the first's (base colour, else metallic-roughness) is used for all"
             ));
         }
         if let Some(t) = transform.filter(|t| *t != Mat3::IDENTITY) {
@@ -609,8 +607,9 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                 let draco = prim.extension_value("KHR_draco_mesh_compression");
                 let read = match draco {
                     Some(ext) => {
-                        stats.draco += 1;
-                        read_draco_primitive(&doc, &prim, ext, &buffers, uv_set)
+                        let r = read_draco_primitive(&doc, &prim, ext, &buffers, uv_set);
+                        stats.draco += r.is_ok() as usize;
+                        r
                     }
                     None => read_primitive(&prim, &buffers, uv_set),
                 };
@@ -626,6 +625,15 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                             for uv in uvs.iter_mut() {
                                 *uv = t.transform_point2(*uv);
                             }
+                        }
+                        // Instancing multiplies the geometry: a budget keeps a small file from
+                        // asking for more vertices than the u32 indices address.
+                        let adds = data.positions.len().saturating_mul(instances.len());
+                        if scene.positions.len().saturating_add(adds) > MAX_VERTICES {
+                            return Err(invalid(format!(
+                                "{label} with {} instance(s) would make the scene more than {MAX_VERTICES} vertices",
+                                instances.len()
+                            )));
                         }
                         for inst in &instances {
                             append_primitive(&mut scene, &data, &(world * *inst), mat, &mut stats);
@@ -782,6 +790,10 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
             let modes: Vec<&str> = stats.skipped_modes.keys().map(String::as_str).collect();
             let _ = write!(details, "; non-triangle primitives skipped: {}", modes.join(", "));
         }
+        // Why primitives were skipped (their data unreadable), the first of them.
+        if let Some(w) = warnings.0.iter().find(|w| w.contains(" skipped: ")) {
+            let _ = write!(details, "; {w}");
+        }
         return Err(SceneError::NoTriangles {
             path: path.to_path_buf(),
             details,
@@ -821,6 +833,15 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
     }
     scene.load_notes = info;
     Ok(scene)
+}
+
+/// The TEXCOORD set a texture reads: KHR_texture_transform's `texCoord` override, else the
+/// texture info's.
+fn tex_coord(info: &gltf::texture::Info) -> u32 {
+    info.extension_value("KHR_texture_transform")
+        .and_then(|v| v.get("texCoord"))
+        .and_then(|c| c.as_u64())
+        .map_or(info.tex_coord(), |c| c as u32)
 }
 
 /// KHR_texture_transform of a texture reference as the 3x3 matrix T * R * S of the extension's
@@ -890,8 +911,14 @@ fn instance_transforms(
     Ok((0..n)
         .map(|i| {
             let tr = t.as_ref().map_or(Vec3::ZERO, |v| Vec3::from_slice(&v[3 * i..]));
+            // A zero quaternion would be NaN: the identity, as for a missing ROTATION.
             let ro = r.as_ref().map_or(glam::Quat::IDENTITY, |v| {
-                glam::Quat::from_slice(&v[4 * i..]).normalize()
+                let q = glam::Quat::from_slice(&v[4 * i..]);
+                if q.is_finite() && q.length_squared() > 0.0 {
+                    q.normalize()
+                } else {
+                    glam::Quat::IDENTITY
+                }
             });
             let sc = s.as_ref().map_or(Vec3::ONE, |v| Vec3::from_slice(&v[3 * i..]));
             Mat4::from_scale_rotation_translation(sc, ro, tr)
