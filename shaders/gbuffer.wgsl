@@ -15,9 +15,20 @@
 
 
 
+// VertexOut plus the metallic-roughness textures' UVs (`material_mr_uv`, per vertex).
+struct GbufferVertexOut {
+    @builtin(position) @invariant clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) @interpolate(flat) material: u32,
+    @location(4) uv_mr: vec2<f32>,
+};
+
 @vertex
-fn vs_main(v: VertexIn) -> VertexOut {
-    return transform_vertex(v, camera.view_proj);
+fn vs_main(v: VertexIn) -> GbufferVertexOut {
+    let o = transform_vertex(v, camera.view_proj);
+    return GbufferVertexOut(o.clip, o.world, o.normal, o.uv, o.material, material_mr_uv(o.material, o.uv));
 }
 
 struct GbufferOut {
@@ -27,7 +38,7 @@ struct GbufferOut {
 };
 
 @fragment
-fn fs_main(i: VertexOut, @builtin(front_facing) front: bool) -> GbufferOut {
+fn fs_main(i: GbufferVertexOut, @builtin(front_facing) front: bool) -> GbufferOut {
     let albedo = material_albedo(i.material, i.uv);
     // Two-sided: shade the side the camera sees.
     var n = normalize(i.normal);
@@ -36,7 +47,7 @@ fn fs_main(i: VertexOut, @builtin(front_facing) front: bool) -> GbufferOut {
     }
     var o: GbufferOut;
     o.position = vec4<f32>(i.world, f32(i.material + 1u));
-    let mr = material_metal_rough(i.material, i.uv);
+    let mr = material_metal_rough(i.material, i.uv_mr);
     o.normal = vec4<f32>(n, mr.y);
     o.albedo = vec4<f32>(albedo.rgb, mr.x);
     return o;

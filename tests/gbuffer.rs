@@ -143,6 +143,63 @@ fn fragment_counts_of_stacked_quads() {
     assert!(ctx.errors.take().is_empty());
 }
 
+/// KHR_texture_transform on the metallic-roughness texture (`Material::metal_rough_uv`, the
+/// map from the vertex UVs, applied per vertex): the quad's UVs are all 0, so the roughness it
+/// reads is the texel column at the map's offset: columns [A x 8, B x 8] give A at u = 0.25
+/// and B at u = 0.75, at every pixel (2x2 quads along the triangles' shared edge included).
+#[test]
+fn metallic_roughness_texture_reads_through_its_uv_transform() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut scene = stacked_quads(1, true);
+    let (ga, gb) = (40u8, 200u8);
+    let mut rgba = Vec::new();
+    for _ in 0..16 {
+        for x in 0..16 {
+            let g = if x < 8 { ga } else { gb };
+            rgba.extend_from_slice(&[255, g, 255, 255]);
+        }
+    }
+    let mut tex = lightcut::scene::TextureImage {
+        name: "columns".into(),
+        width: 16,
+        height: 16,
+        rgba8: rgba,
+    };
+    tex.encode_linear_as_srgb();
+    scene.textures.push(tex);
+    let size = (16, 16);
+    let cam = Camera {
+        position: Vec3::new(0.0, 0.0, 0.0),
+        forward: Vec3::NEG_Z,
+        up: Vec3::Y,
+        ..scene.camera_or_default(None).unwrap()
+    };
+    let camera = camera_buffer(&ctx, &cam, size);
+    for (u, g) in [(0.25f32, ga), (0.75, gb)] {
+        let m = &mut scene.materials[0];
+        (m.metallic, m.roughness) = (1.0, 1.0);
+        m.roughness_texture = Some(0);
+        m.metal_rough_uv = [[1.0, 0.0, u], [0.0, 1.0, 0.5]];
+        let gs = gpu_scene(&ctx, &scene);
+        let out = gbuffer(&ctx, &gs, &camera, size, false);
+        let want = g as f32 / 255.0;
+        let mut covered = 0;
+        for (i, (p, (n, a))) in out[0].iter().zip(out[1].iter().zip(&out[2])).enumerate() {
+            if p[3] > 0.0 {
+                covered += 1;
+                assert!(
+                    (n[3] - want).abs() < 4e-3,
+                    "u = {u}, pixel {i}: roughness {} vs {want}",
+                    n[3]
+                );
+                assert!((a[3] - 1.0).abs() < 4e-3, "u = {u}, pixel {i}: metallic {}", a[3]);
+            }
+        }
+        assert_eq!(covered, size.0 * size.1);
+    }
+    assert!(ctx.errors.take().is_empty());
+}
+
 /// Metallic and roughness in the G-buffer are glTF's factors times the metallic-roughness
 /// texture's B and G (stored sRGB-encoded, sampled back to linear), beside an untextured
 /// material that keeps its factors.

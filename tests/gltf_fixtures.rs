@@ -498,3 +498,63 @@ fn meshopt_fallback_buffers_are_never_read() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A metallic-roughness texture with its own KHR_texture_transform (other than the base
+/// colour's, which the vertex UVs carry) reads through the map from the vertex UVs to its own:
+/// `Material::metal_rough_uv` = its transform x the inverse of the base colour's.
+#[test]
+fn a_metallic_roughness_texture_keeps_its_own_transform() {
+    use glam::{Mat3, Vec2};
+    let src = fixture("room_texture_transform");
+    let dir = std::env::temp_dir().join(format!("lightcut-mr-transform-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("textures")).unwrap();
+    std::fs::copy(src.with_file_name("scene.bin"), dir.join("scene.bin")).unwrap();
+    std::fs::copy(
+        src.parent().unwrap().join("textures/tex_0.png"),
+        dir.join("textures/tex_0.png"),
+    )
+    .unwrap();
+    let mut j: serde_json::Value = serde_json::from_slice(&std::fs::read(&src).unwrap()).unwrap();
+    let floor = j["materials"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|m| m["pbrMetallicRoughness"].get("baseColorTexture").is_some())
+        .unwrap();
+    let tex = j["materials"][floor]["pbrMetallicRoughness"]["baseColorTexture"]["index"].clone();
+    j["materials"][floor]["pbrMetallicRoughness"]["metallicRoughnessTexture"] = serde_json::json!({
+        "index": tex,
+        "extensions": {"KHR_texture_transform": {"offset": [0.5, 0.0], "scale": [3.0, 3.0]}}
+    });
+    let path = dir.join("scene.gltf");
+    std::fs::write(&path, serde_json::to_vec(&j).unwrap()).unwrap();
+    let s = load_gltf(&path).unwrap();
+    let m = &s.materials[floor];
+    assert!(m.roughness_texture.is_some());
+    // The spec's T * R * S (R = [[cos, sin], [-sin, cos]] row-major), built independently.
+    let trs = |o: Vec2, r: f32, k: Vec2| {
+        let rot = Mat3::from_cols_array(&[r.cos(), -r.sin(), 0.0, r.sin(), r.cos(), 0.0, 0.0, 0.0, 1.0]);
+        Mat3::from_translation(o) * rot * Mat3::from_scale(k)
+    };
+    let base = &j["materials"][floor]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"];
+    let f = |v: &serde_json::Value| v.as_f64().unwrap() as f32;
+    let b = trs(
+        Vec2::new(f(&base["offset"][0]), f(&base["offset"][1])),
+        f(&base["rotation"]),
+        Vec2::new(f(&base["scale"][0]), f(&base["scale"][1])),
+    );
+    let want = trs(Vec2::new(0.5, 0.0), 0.0, Vec2::splat(3.0)) * b.inverse();
+    for (r, row) in m.metal_rough_uv.iter().enumerate() {
+        for (c, v) in row.iter().enumerate() {
+            assert!(
+                (v - want.col(c)[r]).abs() < 1e-5,
+                "metal_rough_uv {:?} vs {want:?}",
+                m.metal_rough_uv
+            );
+        }
+    }
+    // Without a transform of its own it reads the vertex UVs (the base colour's) as they are.
+    let s = load_gltf(&src).unwrap();
+    assert_eq!(s.materials[floor].metal_rough_uv, lightcut::scene::UV_IDENTITY);
+    let _ = std::fs::remove_dir_all(&dir);
+}

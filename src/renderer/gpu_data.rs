@@ -206,6 +206,8 @@ pub struct GpuMaterial {
     pub texture: [i32; 4],
     /// x = metallic, y = roughness (glTF factors), zw unused.
     pub params: [f32; 4],
+    /// `Material::metal_rough_uv`'s rows (w unused): the metallic-roughness textures' UVs.
+    pub mr_uv: [[f32; 4]; 2],
 }
 
 /// Twin: `Vertex` inputs of `shaders/gbuffer.wgsl` (vertex buffer, not a uniform).
@@ -453,6 +455,7 @@ mod tests {
                     offset_of!(GpuMaterial, base_color),
                     offset_of!(GpuMaterial, texture),
                     offset_of!(GpuMaterial, params),
+                    offset_of!(GpuMaterial, mr_uv),
                 ],
             ),
             (

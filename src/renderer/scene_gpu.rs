@@ -271,6 +271,7 @@ impl SceneGpu {
                 ],
                 // In [0, 1] whatever built the scene (the GGX bounds assume alpha <= 1).
                 params: [m.metallic.clamp(0.0, 1.0), m.roughness.clamp(0.0, 1.0), 0.0, 0.0],
+                mr_uv: m.metal_rough_uv.map(|[a, b, c]| [a, b, c, 0.0]),
             })
             .collect();
         if mats.is_empty() {
@@ -278,6 +279,7 @@ impl SceneGpu {
                 base_color: [0.8, 0.8, 0.8, 1.0],
                 texture: [-1, -1, -1, 0],
                 params: [0.0, 1.0, 0.0, 0.0],
+                mr_uv: crate::scene::UV_IDENTITY.map(|[a, b, c]| [a, b, c, 0.0]),
             });
         }
         let materials = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

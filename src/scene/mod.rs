@@ -94,7 +94,15 @@ pub struct Material {
     pub roughness_texture: Option<usize>,
     /// Likewise, the texture whose B channel multiplies `metallic`.
     pub metallic_texture: Option<usize>,
+    /// The affine map from the vertex texture coordinates to those the metallic-roughness
+    /// textures read, rows (a, b, c) and (d, e, f): u' = a u + b v + c, v' = d u + e v + f.
+    /// The identity unless glTF's KHR_texture_transform gives that texture another transform
+    /// than the one already applied to the vertices (the base colour's).
+    pub metal_rough_uv: [[f32; 3]; 2],
 }
+
+/// [`Material::metal_rough_uv`]'s identity.
+pub const UV_IDENTITY: [[f32; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
 
 impl Default for Material {
     fn default() -> Self {
@@ -106,6 +114,7 @@ impl Default for Material {
             roughness: 1.0,
             roughness_texture: None,
             metallic_texture: None,
+            metal_rough_uv: UV_IDENTITY,
         }
     }
 }

@@ -81,7 +81,8 @@ impl GbufferPass {
                 label: Some("gbuffer::layout"),
                 entries: &[
                     uniform_entry(0, vis),
-                    storage_entry(1, wgpu::ShaderStages::FRAGMENT, true),
+                    // The vertex stage reads the materials' metallic-roughness UV maps.
+                    storage_entry(1, wgpu::ShaderStages::VERTEX_FRAGMENT, true),
                     texture_entry(
                         2,
                         wgpu::ShaderStages::FRAGMENT,

@@ -485,19 +485,31 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
                 "material '{name}': its textures use different TEXCOORD sets; all read set {set}"
             ));
         }
-        // KHR_texture_transform on the texture whose UV set the vertices carry.
-        let transforms: Vec<Option<Mat3>> = [pbr.base_color_texture(), pbr.metallic_roughness_texture()]
-            .into_iter()
-            .flatten()
-            .map(|t| texture_transform(&t))
-            .collect();
-        // The base colour's, else the metallic-roughness texture's (the vertices carry one set).
-        let transform = transforms.first().copied().flatten();
-        if transforms.iter().any(|t| *t != transform) {
-            warnings.push(format!(
-                "material '{name}': its textures have different KHR_texture_transforms; the first's (base colour, else metallic-roughness) is used for all"
-            ));
-        }
+        // KHR_texture_transform: the base colour's (else the metallic-roughness texture's)
+        // goes into the vertex UVs; the metallic-roughness texture reads through its own
+        // transform relative to that one (`Material::metal_rough_uv`).
+        let base_t = pbr.base_color_texture().and_then(|t| texture_transform(&t));
+        let mr_t = pbr
+            .metallic_roughness_texture()
+            .and_then(|t| texture_transform(&t));
+        let transform = if pbr.base_color_texture().is_some() {
+            base_t
+        } else {
+            mr_t
+        };
+        let relative = mr_t.unwrap_or(Mat3::IDENTITY) * transform.unwrap_or(Mat3::IDENTITY).inverse();
+        let metal_rough_uv = if pbr.metallic_roughness_texture().is_some()
+            && relative.is_finite()
+            && !relative.abs_diff_eq(Mat3::IDENTITY, 1e-7)
+        {
+            used_transform = true;
+            [
+                [relative.x_axis.x, relative.y_axis.x, relative.z_axis.x],
+                [relative.x_axis.y, relative.y_axis.y, relative.z_axis.y],
+            ]
+        } else {
+            crate::scene::UV_IDENTITY
+        };
         if let Some(t) = transform.filter(|t| *t != Mat3::IDENTITY) {
             material_uv_transform.push(Some(t));
             used_transform = true;
@@ -514,6 +526,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
             roughness: clamp_factor(pbr.roughness_factor()),
             roughness_texture: roughness_tex,
             metallic_texture: metallic_tex,
+            metal_rough_uv,
         });
         material_uv_set.push(set);
     }
