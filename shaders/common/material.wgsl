@@ -27,9 +27,10 @@ fn material_albedo(material: u32, uv: vec2<f32>) -> vec4<f32> {
 }
 
 // The metallic-roughness textures' UVs from the vertex UVs (`mr_uv`). Call it in the vertex
-// stage and interpolate the result: the map is affine, so that is exact, and a fragment shader
-// that computed it would take derivatives of storage-buffer data that helper invocations need
-// not load (lavapipe's did not: 2x2 quads along triangle edges read blurred texels).
+// stage and interpolate the result: the map is affine, so that is exact. (Mapped in the
+// fragment shader from the storage buffer, lavapipe read blurred texels in the 2x2 quads along
+// triangle edges, with implicit or explicit derivatives alike, and exact ones with the same map
+// as a constant: the likely cause is helper invocations that do not load storage data.)
 fn material_mr_uv(material: u32, uv: vec2<f32>) -> vec2<f32> {
     let m = materials[material];
     let h = vec3<f32>(uv, 1.0);

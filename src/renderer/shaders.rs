@@ -23,6 +23,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
         include_str!("../../shaders/common/bvh_wide.wgsl"),
     ),
     (
+        "common/bvh_triangle.wgsl",
+        include_str!("../../shaders/common/bvh_triangle.wgsl"),
+    ),
+    (
         "common/camera.wgsl",
         include_str!("../../shaders/common/camera.wgsl"),
     ),
@@ -112,6 +116,10 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     (
         "bvh_rays_wide.wgsl",
         include_str!("../../shaders/bvh_rays_wide.wgsl"),
+    ),
+    (
+        "bvh_rays_entries.wgsl",
+        include_str!("../../shaders/bvh_rays_entries.wgsl"),
     ),
     (
         "interleave_filter.wgsl",

@@ -346,8 +346,22 @@ fn safe_inv(d: Vec3) -> Vec3 {
 /// evaluation order gives identical values).
 #[inline(always)]
 fn slab(n: &GpuBvhNode, o: Vec3A, inv: Vec3A, tmin: f32, tmax: f32) -> (f32, f32) {
-    let t0 = (Vec3A::from_array(n.min) - o) * inv;
-    let t1 = (Vec3A::from_array(n.max) - o) * inv;
+    slab_box(
+        Vec3A::from_array(n.min),
+        Vec3A::from_array(n.max),
+        o,
+        inv,
+        tmin,
+        tmax,
+    )
+}
+
+/// [`slab`] on a box's corners (`bvh_slab` in `common/bvh_triangle.wgsl`; the wide BVH's
+/// decoded child boxes).
+#[inline(always)]
+fn slab_box(lo: Vec3A, hi: Vec3A, o: Vec3A, inv: Vec3A, tmin: f32, tmax: f32) -> (f32, f32) {
+    let t0 = (lo - o) * inv;
+    let t1 = (hi - o) * inv;
     let near = t0.min(t1).max_element().max(tmin);
     let far = t0.max(t1).min_element().min(tmax);
     (near, far)
@@ -1240,6 +1254,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 
     const BVH_WGSL: &str = include_str!("../../../shaders/common/bvh_wide.wgsl");
     const BVH_BINARY_WGSL: &str = include_str!("../../../shaders/common/bvh_binary.wgsl");
+    const BVH_TRIANGLE_WGSL: &str = include_str!("../../../shaders/common/bvh_triangle.wgsl");
 
     fn struct_layout(module: &naga::Module, name: &str) -> (u32, Vec<u32>) {
         let (_, ty) = module
@@ -1261,6 +1276,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 
     fn check_wgsl(file: &str, wide: bool) {
+        // The shared part, included as the shader preprocessor would.
+        let file = &file.replace("#include \"common/bvh_triangle.wgsl\"", BVH_TRIANGLE_WGSL);
+        assert!(!file.contains("#include"));
         // No bindings and no `enable` directives outside comments.
         let code: Vec<&str> = file.lines().map(|l| l.split("//").next().unwrap()).collect();
         assert!(code.iter().all(|l| !l.contains('@')), "bindings in bvh.wgsl");

@@ -463,13 +463,3 @@ impl WideBvh {
         (best.triangle != NO_TRIANGLE).then_some(best)
     }
 }
-
-/// The slab test of [`slab`] on decoded corners.
-#[inline(always)]
-fn slab_box(lo: Vec3A, hi: Vec3A, o: Vec3A, inv: Vec3A, tmin: f32, tmax: f32) -> (f32, f32) {
-    let t0 = (lo - o) * inv;
-    let t1 = (hi - o) * inv;
-    let near = t0.min(t1).max_element().max(tmin);
-    let far = t0.max(t1).min_element().min(tmax);
-    (near, far)
-}

@@ -544,27 +544,30 @@ pub(super) fn read_accessor<T: Copy + Default>(
     Ok(out)
 }
 
+/// A normalised integer component of type `t` as a float (glTF 2.0's accessor rule, as
+/// KHR_mesh_quantization: c / max, signed ones clamped at -1); floats and u32 unchanged.
+pub(super) fn unnormalize(v: f32, t: DataType) -> f32 {
+    match t {
+        DataType::U8 => v / 255.0,
+        DataType::I8 => (v / 127.0).max(-1.0),
+        DataType::U16 => v / 65535.0,
+        DataType::I16 => (v / 32767.0).max(-1.0),
+        DataType::U32 | DataType::F32 => v,
+    }
+}
+
 pub(super) fn read_floats(acc: &gltf::Accessor, buffers: &Buffers) -> Result<Vec<f32>, String> {
     let norm = acc.normalized();
-    read_accessor(acc, buffers, &|b: &[u8], t: DataType| match t {
-        DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
-        DataType::U8 => {
-            let v = b[0] as f32;
-            if norm { v / 255.0 } else { v }
-        }
-        DataType::I8 => {
-            let v = b[0] as i8 as f32;
-            if norm { (v / 127.0).max(-1.0) } else { v }
-        }
-        DataType::U16 => {
-            let v = u16::from_le_bytes([b[0], b[1]]) as f32;
-            if norm { v / 65535.0 } else { v }
-        }
-        DataType::I16 => {
-            let v = i16::from_le_bytes([b[0], b[1]]) as f32;
-            if norm { (v / 32767.0).max(-1.0) } else { v }
-        }
-        DataType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+    read_accessor(acc, buffers, &|b: &[u8], t: DataType| {
+        let v = match t {
+            DataType::F32 => return f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            DataType::U8 => b[0] as f32,
+            DataType::I8 => b[0] as i8 as f32,
+            DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as f32,
+            DataType::I16 => i16::from_le_bytes([b[0], b[1]]) as f32,
+            DataType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+        };
+        if norm { unnormalize(v, t) } else { v }
     })
 }
 
@@ -699,18 +702,11 @@ pub(super) fn read_draco_primitive(
             return Ok(None);
         }
         let mut v = a.read_f32s(n, comps);
-        if let Some(acc) = acc.filter(|a| a.normalized()) {
-            let scale = match acc.data_type() {
-                DataType::I8 => Some(127.0),
-                DataType::U8 => Some(255.0),
-                DataType::I16 => Some(32767.0),
-                DataType::U16 => Some(65535.0),
-                _ => None,
-            };
-            if let (Some(k), false) = (scale, a.data_type() == draco_core::DataType::Float32) {
-                for x in &mut v {
-                    *x = (*x / k).max(-1.0);
-                }
+        if let Some(acc) = acc.filter(|acc| acc.normalized())
+            && a.data_type() != draco_core::DataType::Float32
+        {
+            for x in &mut v {
+                *x = unnormalize(*x, acc.data_type());
             }
         }
         Ok(Some(v))
