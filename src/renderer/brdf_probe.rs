@@ -1,12 +1,13 @@
 //! Evaluates the shaders' BRDF (`shaders/common/brdf.wgsl`) for a batch of cases on the GPU
 //! (`shaders/brdf_eval.wgsl`): the test of the BRDF against its CPU twin `reference::brdf`.
 
+use crate::renderer::kernel::{Kernel, KernelOptions, buf};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 use super::{
     context::{GpuContext, GpuError},
-    passes::{WG_1D, bind_group_seq, compute_pipeline, storage_buffer, storage_entry},
+    passes::{WG_1D, storage_buffer},
     readback, shaders,
 };
 
@@ -29,23 +30,15 @@ pub type BrdfParts = ([f32; 3], [f32; 3]);
 
 pub struct BrdfProbe {
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
 }
 
 impl BrdfProbe {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "brdf_eval.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("brdf_eval::layout"),
-                entries: &[storage_entry(0, c, true), storage_entry(1, c, false)],
-            },
-        );
+        let kernel = Kernel::new(device, "brdf_eval.wgsl", &["main"], KernelOptions::default())?;
         Ok(Self {
-            pipeline: compute_pipeline(device, "brdf_eval", &[Some(&layout)], &module, "main"),
-            layout,
+            pipeline: kernel.compute(device, "brdf_eval", "main"),
+            kernel,
         })
     }
 
@@ -61,12 +54,9 @@ impl BrdfProbe {
             usage: wgpu::BufferUsages::STORAGE,
         });
         let out = storage_buffer(device, "brdf_eval::out", 32 * cases.len() as u64);
-        let bind = bind_group_seq(
-            device,
-            "brdf_eval::bind_group",
-            &self.layout,
-            &[input.as_entire_binding(), out.as_entire_binding()],
-        );
+        let bind = self
+            .kernel
+            .bind(device, 0, &[("cases", buf(&input)), ("out", buf(&out))]);
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("brdf_eval::encoder"),
         });

@@ -7,7 +7,8 @@ use wgpu::util::DeviceExt;
 use super::{
     context::{GpuContext, GpuError},
     gpu_data::{GpuHit, GpuRay},
-    passes::{WG_1D, compute_pipeline, storage_entry},
+    kernel::{Kernel, KernelOptions, buf, tex},
+    passes::WG_1D,
     readback, shaders,
     timing::GpuTimer,
 };
@@ -24,7 +25,7 @@ pub enum TraceMode {
 pub struct BvhTracer {
     any: wgpu::ComputePipeline,
     closest: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
 }
 
 /// Most rays per dispatch row (dispatches are split in 2D when larger).
@@ -51,36 +52,16 @@ impl BvhTracer {
     }
 
     fn with_shader(device: &wgpu::Device, file: &str) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, file)?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("bvh_rays::layout"),
-                entries: &[
-                    storage_entry(0, c, true),
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, true),
-                    storage_entry(3, c, false),
-                ],
-            },
-        );
+            file,
+            &["any_hit_main", "closest_hit_main"],
+            KernelOptions::default(),
+        )?;
         Ok(Self {
-            any: compute_pipeline(
-                device,
-                "bvh_rays::any_hit",
-                &[Some(&layout)],
-                &module,
-                "any_hit_main",
-            ),
-            closest: compute_pipeline(
-                device,
-                "bvh_rays::closest_hit",
-                &[Some(&layout)],
-                &module,
-                "closest_hit_main",
-            ),
-            layout,
+            any: kernel.compute(device, "bvh_rays::any_hit", "any_hit_main"),
+            closest: kernel.compute(device, "bvh_rays::closest_hit", "closest_hit_main"),
+            kernel,
         })
     }
 
@@ -110,28 +91,16 @@ impl BvhTracer {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("bvh_rays::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: nodes.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: triangles.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: ray_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: hit_buf.as_entire_binding(),
-                },
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                ("bvh_nodes", buf(nodes)),
+                ("bvh_triangles", buf(triangles)),
+                ("rays", buf(&ray_buf)),
+                ("hits", buf(&hit_buf)),
             ],
-        });
+        );
         let pipeline = match mode {
             TraceMode::AnyHit => &self.any,
             TraceMode::ClosestHit => &self.closest,
@@ -195,34 +164,15 @@ pub struct GpuSurface {
 /// `common/surface.wgsl`): the GPU side of the light paths' hit surfaces, for the tests.
 pub struct SurfaceProbe {
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
 }
 
 impl SurfaceProbe {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        use super::passes::{float_array_texture_entry, uniform_entry};
-        let module = shaders::create_module(device, "surface_rays.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("surface_rays::layout"),
-                entries: &[
-                    storage_entry(0, c, true),
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, true),
-                    storage_entry(3, c, false),
-                    storage_entry(4, c, true),
-                    storage_entry(5, c, true),
-                    storage_entry(6, c, true),
-                    float_array_texture_entry(7),
-                    uniform_entry(8, c),
-                ],
-            },
-        );
+        let kernel = Kernel::new(device, "surface_rays.wgsl", &["main"], KernelOptions::default())?;
         Ok(Self {
-            pipeline: compute_pipeline(device, "surface_rays", &[Some(&layout)], &module, "main"),
-            layout,
+            pipeline: kernel.compute(device, "surface_rays", "main"),
+            kernel,
         })
     }
 
@@ -259,20 +209,19 @@ impl SurfaceProbe {
             contents: bytemuck::cast_slice(&[lod, 0, 0, 0]),
             usage: crate::renderer::passes::PARAMS_USAGE,
         });
-        let bind = super::passes::bind_group_seq(
+        let bind = self.kernel.bind(
             device,
-            "surface_rays::bind_group",
-            &self.layout,
+            0,
             &[
-                scene.bvh_nodes.as_entire_binding(),
-                scene.bvh_triangles.as_entire_binding(),
-                ray_buf.as_entire_binding(),
-                out.as_entire_binding(),
-                scene.vertices.as_entire_binding(),
-                scene.indices.as_entire_binding(),
-                scene.materials.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&scene.textures_view),
-                params.as_entire_binding(),
+                ("bvh_nodes", buf(&scene.bvh_nodes)),
+                ("bvh_triangles", buf(&scene.bvh_triangles)),
+                ("rays", buf(&ray_buf)),
+                ("out", buf(&out)),
+                ("scene_vertices", buf(&scene.vertices)),
+                ("scene_indices", buf(&scene.indices)),
+                ("materials", buf(&scene.materials)),
+                ("textures", tex(&scene.textures_view)),
+                ("pp", buf(&params)),
             ],
         );
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {

@@ -145,15 +145,17 @@ impl Renderer {
         self.direct.record(
             &device,
             &queue,
-            self.frame_brdf.gpu(),
             &mut enc,
             &mut self.timer,
-            &self.camera_buf,
-            &self.lights_buf,
-            &t.shadow,
-            &t.gbuffer,
-            &t.lighting.direct_view,
-            size,
+            &crate::renderer::passes::direct::DirectInputs {
+                brdf: self.frame_brdf.gpu(),
+                camera: &self.camera_buf,
+                lights: &self.lights_buf,
+                shadow: &t.shadow,
+                gbuffer: &t.gbuffer,
+                out: &t.lighting.direct_view,
+                size,
+            },
         );
         // VPLs (thesis 4.1): resources follow the RSM resolution, light count and VPL budget.
         let vb = &self.vpl_buffers;

@@ -8,6 +8,7 @@ pub mod bvh_trace;
 pub mod context;
 pub mod frame;
 pub mod gpu_data;
+pub mod kernel;
 pub mod passes;
 pub mod readback;
 pub mod scene_gpu;

@@ -298,11 +298,20 @@ pub fn load_validated(source: &dyn ShaderSource, name: &str) -> Result<String, S
 
 /// Parses and validates WGSL with naga (all capabilities: the device decides what it accepts).
 pub fn validate(name: &str, text: &str) -> Result<naga::Module, ShaderError> {
+    parse_validated(name, text).map(|(module, _)| module)
+}
+
+/// [`validate`], keeping naga's analysis (which globals each entry point uses: the kernels'
+/// reflection, `kernel::reflect`).
+pub fn parse_validated(
+    name: &str,
+    text: &str,
+) -> Result<(naga::Module, naga::valid::ModuleInfo), ShaderError> {
     let module = naga::front::wgsl::parse_str(text).map_err(|e| ShaderError::Parse {
         file: name.to_string(),
         message: e.emit_to_string(text),
     })?;
-    naga::valid::Validator::new(
+    let info = naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::all(),
     )
@@ -311,7 +320,17 @@ pub fn validate(name: &str, text: &str) -> Result<naga::Module, ShaderError> {
         file: name.to_string(),
         message: e.emit_to_string(text),
     })?;
-    Ok(module)
+    Ok((module, info))
+}
+
+/// The preprocessed text of `name`: from `shaders/` on disk in builds that hot-reload, else
+/// the embedded copy.
+pub fn preprocessed(name: &str) -> Result<String, ShaderError> {
+    if ShaderSourceDisk::reload_from_disk() {
+        preprocess(&ShaderSourceDisk, name)
+    } else {
+        preprocess(&Embedded, name)
+    }
 }
 
 /// `var<uniform>` declarations read as `var<storage, read>` (the same struct layout).
@@ -321,11 +340,13 @@ pub fn uniforms_to_storage(text: &str) -> String {
 
 /// Creates a wgpu shader module from a (preprocessed) shader.
 pub fn create_module(device: &wgpu::Device, name: &str) -> Result<wgpu::ShaderModule, ShaderError> {
-    let text = if ShaderSourceDisk::reload_from_disk() {
-        load_validated(&ShaderSourceDisk, name)?
-    } else {
-        load_validated(&Embedded, name)?
-    };
+    let text = preprocessed(name)?;
+    validate(name, &text)?;
+    Ok(module_from_text(device, name, text))
+}
+
+/// The wgpu shader module of a preprocessed, validated shader's text.
+pub fn module_from_text(device: &wgpu::Device, name: &str, text: String) -> wgpu::ShaderModule {
     // Parameter blocks as read-only storage where the layouts make them so (lavapipe; see
     // `passes::uniforms_as_storage`).
     let text = if super::passes::uniforms_as_storage(device) {
@@ -333,10 +354,10 @@ pub fn create_module(device: &wgpu::Device, name: &str) -> Result<wgpu::ShaderMo
     } else {
         text
     };
-    Ok(device.create_shader_module(wgpu::ShaderModuleDescriptor {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(name),
         source: wgpu::ShaderSource::Wgsl(text.into()),
-    }))
+    })
 }
 
 #[cfg(test)]

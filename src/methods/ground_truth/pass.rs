@@ -3,50 +3,35 @@
 //! Reads: BVH, a VPL array, G-buffer. Writes: an accumulation buffer (rgb sum per pixel).
 
 use crate::renderer::{
-    frame::GbufferTargets, gpu_data::GpuGtParams, scene_gpu::SceneGpu, shaders, timing::GpuTimer,
+    frame::GbufferTargets,
+    gpu_data::GpuGtParams,
+    kernel::{Kernel, KernelOptions, buf, tex},
+    scene_gpu::SceneGpu,
+    shaders,
+    timing::GpuTimer,
 };
 
-use crate::renderer::passes::{
-    compute_pipeline, dynamic_uniform_entry, float_texture_entry, groups_2d, storage_entry,
-};
+use crate::renderer::passes::groups_2d;
 
 /// Dynamic-offset stride of the per-batch uniforms; most batches per recorded call.
 const STRIDE: u64 = 256;
 pub const MAX_BATCHES: u32 = 64;
 
 pub struct GroundTruthPass {
+    kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
 }
 
 impl GroundTruthPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "methods/ground_truth/ground_truth.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("ground_truth::layout"),
-                entries: &[
-                    dynamic_uniform_entry(0, c, std::mem::size_of::<GpuGtParams>() as u64),
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, true),
-                    storage_entry(3, c, true),
-                    float_texture_entry(4),
-                    float_texture_entry(5),
-                    float_texture_entry(6),
-                    storage_entry(7, c, false),
-                ],
-            },
-        );
-        let pipeline = compute_pipeline(
-            device,
-            "ground_truth::pipeline",
-            &[Some(&layout)],
-            &module,
-            "main",
-        );
+            "methods/ground_truth/ground_truth.wgsl",
+            &["main"],
+            KernelOptions { dynamic: &["params"] },
+        )?;
+        let pipeline = kernel.compute(device, "ground_truth::pipeline", "main");
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("ground_truth::params"),
             size: STRIDE * MAX_BATCHES as u64,
@@ -54,8 +39,8 @@ impl GroundTruthPass {
             mapped_at_creation: false,
         });
         Ok(Self {
+            kernel,
             pipeline,
-            layout,
             params,
         })
     }
@@ -90,49 +75,27 @@ impl GroundTruthPass {
             b = e;
             n += 1;
         }
-        let tv = wgpu::BindingResource::TextureView;
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ground_truth::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                (
+                    "params",
+                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                         buffer: &self.params,
                         offset: 0,
                         size: wgpu::BufferSize::new(std::mem::size_of::<GpuGtParams>() as u64),
                     }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: scene.bvh_nodes.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: scene.bvh_triangles.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: vpls.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: tv(&gbuffer.position_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: tv(&gbuffer.normal_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: tv(&gbuffer.albedo_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: accum.as_entire_binding(),
-                },
+                ),
+                ("bvh_nodes", buf(&scene.bvh_nodes)),
+                ("bvh_triangles", buf(&scene.bvh_triangles)),
+                ("vpls", buf(vpls)),
+                ("gb_position", tex(&gbuffer.position_view)),
+                ("gb_normal", tex(&gbuffer.normal_view)),
+                ("gb_albedo", tex(&gbuffer.albedo_view)),
+                ("accum", buf(accum)),
             ],
-        });
+        );
         encoder.push_debug_group("ground_truth");
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

@@ -13,11 +13,12 @@ use super::settings::{IsmAdaptive, IsmSettings};
 use crate::methods::lightcut_interpolation::pass::groups_1d_as_2d;
 use crate::renderer::{
     frame::GbufferTargets,
+    kernel::{Kernel, KernelOptions, buf, tex},
     passes::{
-        WG_1D, bind_group_seq, compute_pipeline_with, float_texture_entry, groups_image,
+        WG_1D, groups_image,
         interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
         ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
-        run_compute, storage_buffer, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
+        run_compute, storage_buffer, uniform_buffer,
     },
     readback::CounterReadback,
     scene_gpu::SceneGpu,
@@ -303,24 +304,24 @@ const COMPANION_PASSES: [&str; 5] = [
 pub struct LcullPass {
     params: wgpu::Buffer,
     companion_params: wgpu::Buffer,
-    ranges_layout: wgpu::BindGroupLayout,
+    ranges_kernel: Kernel,
     ranges: wgpu::ComputePipeline,
-    tiles_layout: wgpu::BindGroupLayout,
+    tiles_kernel: Kernel,
     tiles: wgpu::ComputePipeline,
     tiles_timed: wgpu::ComputePipeline,
-    shade_layout: wgpu::BindGroupLayout,
+    shade_kernel: Kernel,
     shade: wgpu::ComputePipeline,
     shade_timed: wgpu::ComputePipeline,
     filter: InterleaveFilter,
     filter_params: FilterUniform,
     companion_filter_params: FilterUniform,
-    tree_layout: wgpu::BindGroupLayout,
+    tree_kernel: Kernel,
     tree_leaves: wgpu::ComputePipeline,
     tree_traverse: wgpu::ComputePipeline,
     tree_traverse_timed: wgpu::ComputePipeline,
     tree_shade: wgpu::ComputePipeline,
     tree_shade_timed: wgpu::ComputePipeline,
-    views_layout: wgpu::BindGroupLayout,
+    views_kernel: Kernel,
     views: wgpu::ComputePipeline,
     view_params: wgpu::Buffer,
     pub stats: CounterReadback<LcullStats>,
@@ -334,117 +335,64 @@ pub struct LcullPass {
 
 impl LcullPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let rmod = shaders::create_module(device, "methods/light_culling/lcull_ranges.wgsl")?;
-        let tmod = shaders::create_module(device, "methods/light_culling/lcull_tiles.wgsl")?;
-        let smod = shaders::create_module(device, "methods/light_culling/lcull_shade.wgsl")?;
-        let vmod = shaders::create_module(device, "methods/light_culling/lcull_views.wgsl")?;
-        let trmod = shaders::create_module(device, "methods/light_culling/lcull_tree.wgsl")?;
-        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            crate::renderer::passes::bind_group_layout(
-                device,
-                &wgpu::BindGroupLayoutDescriptor {
-                    label: Some(label),
-                    entries,
-                },
-            )
-        };
-        let ranges_layout = layout(
-            "lcull_ranges::layout",
-            &[
-                uniform_entry(0, c),
-                storage_entry(1, c, true),
-                storage_entry(2, c, false),
-                storage_entry(3, c, false),
-            ],
-        );
-        let tiles_layout = layout(
-            "lcull_tiles::layout",
-            &[
-                uniform_entry(0, c),
-                uniform_entry(1, c),
-                float_texture_entry(2),
-                storage_entry(3, c, true),
-                storage_entry(4, c, false),
-                storage_entry(5, c, false),
-                storage_entry(6, c, false),
-            ],
-        );
-        let mut se = vec![uniform_entry(0, c)];
-        se.extend((1..=2).map(float_texture_entry));
-        se.extend((3..=8).map(|b| storage_entry(b, c, true)));
-        se.extend((9..=11).map(|b| storage_entry(b, c, false)));
-        se.extend([uniform_entry(12, c), storage_entry(13, c, true)]);
-        se.push(float_texture_entry(14));
-        let shade_layout = layout("lcull_shade::layout", &se);
-        let mut te = vec![
-            uniform_entry(0, c),
-            float_texture_entry(1),
-            float_texture_entry(2),
-        ];
-        te.extend((3..=6).map(|b| storage_entry(b, c, true)));
-        te.extend((7..=13).map(|b| storage_entry(b, c, false)));
-        te.extend([
-            uniform_entry(14, c),
-            storage_entry(15, c, true),
-            storage_entry(16, c, false),
-            float_texture_entry(17),
-        ]);
-        let tree_layout = layout("lcull_tree::layout", &te);
-        let views_layout = layout(
-            "lcull_views::layout",
-            &[
-                uniform_entry(0, c),
-                float_texture_entry(1),
-                float_texture_entry(2),
-                storage_entry(3, c, true),
-                storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm),
-                storage_entry(5, c, true),
-                storage_entry(6, c, true),
-                storage_entry(7, c, false),
-            ],
-        );
-        let pipe =
-            |label: &str,
-             l: &wgpu::BindGroupLayout,
-             m: &wgpu::ShaderModule,
-             entry: &str,
-             k: &[(&str, f64)]| { compute_pipeline_with(device, label, &[Some(l)], m, entry, k) };
+        let ranges_kernel = Kernel::new(
+            device,
+            "methods/light_culling/lcull_ranges.wgsl",
+            &["main"],
+            KernelOptions::default(),
+        )?;
+        let tiles_kernel = Kernel::new(
+            device,
+            "methods/light_culling/lcull_tiles.wgsl",
+            &["main"],
+            KernelOptions::default(),
+        )?;
+        let shade_kernel = Kernel::new(
+            device,
+            "methods/light_culling/lcull_shade.wgsl",
+            &["shade_main"],
+            KernelOptions::default(),
+        )?;
+        let views_kernel = Kernel::new(
+            device,
+            "methods/light_culling/lcull_views.wgsl",
+            &["main"],
+            KernelOptions::default(),
+        )?;
+        let tree_kernel = Kernel::new(
+            device,
+            "methods/light_culling/lcull_tree.wgsl",
+            &["leaves_main", "traverse_main", "shade_main"],
+            KernelOptions::default(),
+        )?;
         let timed = &[("DIAGNOSTICS", 0.0)];
         Ok(Self {
             params: uniform_buffer::<GpuLcullParams>(device, "lcull::params"),
             companion_params: uniform_buffer::<GpuLcullParams>(device, "lcull::companion_params"),
-            ranges: pipe("lcull_ranges", &ranges_layout, &rmod, "main", &[]),
-            ranges_layout,
-            tiles: pipe("lcull_tiles", &tiles_layout, &tmod, "main", &[]),
-            tiles_timed: pipe("lcull_tiles_timed", &tiles_layout, &tmod, "main", timed),
-            tiles_layout,
-            shade: pipe("lcull_shade", &shade_layout, &smod, "shade_main", &[]),
-            shade_timed: pipe("lcull_shade_timed", &shade_layout, &smod, "shade_main", timed),
+            ranges: ranges_kernel.compute(device, "lcull_ranges", "main"),
+            ranges_kernel,
+            tiles: tiles_kernel.compute(device, "lcull_tiles", "main"),
+            tiles_timed: tiles_kernel.compute_with(device, "lcull_tiles_timed", "main", timed),
+            tiles_kernel,
+            shade: shade_kernel.compute(device, "lcull_shade", "shade_main"),
+            shade_timed: shade_kernel.compute_with(device, "lcull_shade_timed", "shade_main", timed),
             filter: InterleaveFilter::new(device)?,
             filter_params: FilterUniform::new(device, "lcull::filter_params"),
             companion_filter_params: FilterUniform::new(device, "lcull::companion_filter_params"),
-            shade_layout,
-            tree_leaves: pipe("lcull_tree_leaves", &tree_layout, &trmod, "leaves_main", &[]),
-            tree_traverse: pipe("lcull_tree_traverse", &tree_layout, &trmod, "traverse_main", &[]),
-            tree_traverse_timed: pipe(
+            shade_kernel,
+            tree_leaves: tree_kernel.compute(device, "lcull_tree_leaves", "leaves_main"),
+            tree_traverse: tree_kernel.compute(device, "lcull_tree_traverse", "traverse_main"),
+            tree_traverse_timed: tree_kernel.compute_with(
+                device,
                 "lcull_tree_traverse_timed",
-                &tree_layout,
-                &trmod,
                 "traverse_main",
                 timed,
             ),
-            tree_shade: pipe("lcull_tree_shade", &tree_layout, &trmod, "shade_main", &[]),
-            tree_shade_timed: pipe(
-                "lcull_tree_shade_timed",
-                &tree_layout,
-                &trmod,
-                "shade_main",
-                timed,
-            ),
-            tree_layout,
-            views: pipe("lcull_views", &views_layout, &vmod, "main", &[]),
-            views_layout,
+            tree_shade: tree_kernel.compute(device, "lcull_tree_shade", "shade_main"),
+            tree_shade_timed: tree_kernel.compute_with(device, "lcull_tree_shade_timed", "shade_main", timed),
+            tree_kernel,
+            views: views_kernel.compute(device, "lcull_views", "main"),
+            views_kernel,
             view_params: uniform_buffer::<GpuLcullViewParams>(device, "lcull_views::params"),
             stats: CounterReadback::new(
                 device,
@@ -508,18 +456,16 @@ impl LcullPass {
             (&self.params, &self.filter_params, OWN_PASSES)
         };
         queue.write_buffer(params, 0, bytemuck::bytes_of(&p));
-        let tv = wgpu::BindingResource::TextureView;
         let g = f.gbuffer;
         let (ism_depth, ism_lights) = self.ism_bindings(queue, ism);
-        let rbind = bind_group_seq(
+        let rbind = self.ranges_kernel.bind(
             device,
-            "lcull_ranges::bind_group",
-            &self.ranges_layout,
+            0,
             &[
-                params.as_entire_binding(),
-                f.vpls.as_entire_binding(),
-                b.lights.as_entire_binding(),
-                ism_lights.as_entire_binding(),
+                ("params", buf(params)),
+                ("vpls", buf(f.vpls)),
+                ("lights", buf(&b.lights)),
+                ("ism_lights", buf(ism_lights)),
             ],
         );
         let (gx, gy) = groups_1d_as_2d(p.count.div_ceil(WG_1D).max(1));
@@ -534,18 +480,17 @@ impl LcullPass {
         if diagnostics {
             encoder.clear_buffer(&b.stats, 0, None);
         }
-        let tbind = bind_group_seq(
+        let tbind = self.tiles_kernel.bind(
             device,
-            "lcull_tiles::bind_group",
-            &self.tiles_layout,
+            0,
             &[
-                params.as_entire_binding(),
-                f.camera.as_entire_binding(),
-                tv(&g.position_view),
-                b.lights.as_entire_binding(),
-                b.tile_count.as_entire_binding(),
-                b.tile_lists.as_entire_binding(),
-                b.stats.as_entire_binding(),
+                ("params", buf(params)),
+                ("camera", buf(f.camera)),
+                ("gb_position", tex(&g.position_view)),
+                ("lights", buf(&b.lights)),
+                ("tile_count", buf(&b.tile_count)),
+                ("tile_lists", buf(&b.tile_lists)),
+                ("stats", buf(&b.stats)),
             ],
         );
         let (tx, ty) = groups_1d_as_2d(p.tiles);
@@ -588,28 +533,26 @@ impl LcullPass {
         b: &LcullBuffers,
         ism_depth: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
-        let tv = wgpu::BindingResource::TextureView;
         let g = f.gbuffer;
-        bind_group_seq(
+        self.shade_kernel.bind(
             device,
-            "lcull_shade::bind_group",
-            &self.shade_layout,
+            0,
             &[
-                params.as_entire_binding(),
-                tv(&g.position_view),
-                tv(&g.normal_view),
-                f.scene.bvh_nodes.as_entire_binding(),
-                f.scene.bvh_triangles.as_entire_binding(),
-                f.vpls.as_entire_binding(),
-                b.lights.as_entire_binding(),
-                b.tile_count.as_entire_binding(),
-                b.tile_lists.as_entire_binding(),
-                b.raw.as_entire_binding(),
-                b.diag.as_entire_binding(),
-                b.stats.as_entire_binding(),
-                self.ism_params.as_entire_binding(),
-                ism_depth.as_entire_binding(),
-                tv(&g.albedo_view),
+                ("params", buf(params)),
+                ("gb_position", tex(&g.position_view)),
+                ("gb_normal", tex(&g.normal_view)),
+                ("bvh_nodes", buf(&f.scene.bvh_nodes)),
+                ("bvh_triangles", buf(&f.scene.bvh_triangles)),
+                ("vpls", buf(f.vpls)),
+                ("lights", buf(&b.lights)),
+                ("tile_count", buf(&b.tile_count)),
+                ("tile_lists", buf(&b.tile_lists)),
+                ("raw", buf(&b.raw)),
+                ("diag", buf(&b.diag)),
+                ("stats", buf(&b.stats)),
+                ("ism", buf(&self.ism_params)),
+                ("ism_depth", buf(ism_depth)),
+                ("gb_albedo", tex(&g.albedo_view)),
             ],
         )
     }
@@ -635,35 +578,33 @@ impl LcullPass {
     ) {
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         let (ism_depth, ism_lights) = self.ism_bindings(queue, ism);
-        let tv = wgpu::BindingResource::TextureView;
         let g = f.gbuffer;
         encoder.clear_buffer(&t.max_range, 0, None);
         if diagnostics {
             encoder.clear_buffer(&b.stats, 0, None);
         }
-        let bind = bind_group_seq(
+        let bind = self.tree_kernel.bind(
             device,
-            "lcull_tree::bind_group",
-            &self.tree_layout,
+            0,
             &[
-                self.params.as_entire_binding(),
-                tv(&g.position_view),
-                tv(&g.normal_view),
-                f.scene.bvh_nodes.as_entire_binding(),
-                f.scene.bvh_triangles.as_entire_binding(),
-                tree.sorted_vpls.as_entire_binding(),
-                tree.nodes.as_entire_binding(),
-                t.lights.as_entire_binding(),
-                t.max_range.as_entire_binding(),
-                t.list.as_entire_binding(),
-                t.m.as_entire_binding(),
-                b.raw.as_entire_binding(),
-                b.diag.as_entire_binding(),
-                b.stats.as_entire_binding(),
-                self.ism_params.as_entire_binding(),
-                ism_depth.as_entire_binding(),
-                ism_lights.as_entire_binding(),
-                tv(&g.albedo_view),
+                ("params", buf(&self.params)),
+                ("gb_position", tex(&g.position_view)),
+                ("gb_normal", tex(&g.normal_view)),
+                ("bvh_nodes", buf(&f.scene.bvh_nodes)),
+                ("bvh_triangles", buf(&f.scene.bvh_triangles)),
+                ("vpls", buf(tree.sorted_vpls)),
+                ("nodes", buf(tree.nodes)),
+                ("lights", buf(&t.lights)),
+                ("max_range", buf(&t.max_range)),
+                ("tree_list", buf(&t.list)),
+                ("tree_m", buf(&t.m)),
+                ("raw", buf(&b.raw)),
+                ("diag", buf(&b.diag)),
+                ("stats", buf(&b.stats)),
+                ("ism", buf(&self.ism_params)),
+                ("ism_depth", buf(ism_depth)),
+                ("ism_lights", buf(ism_lights)),
+                ("gb_albedo", tex(&g.albedo_view)),
             ],
         );
         let (gx, gy) = groups_1d_as_2d(p.leaves.div_ceil(WG_1D).max(1));
@@ -719,23 +660,26 @@ impl LcullPass {
         dst: &wgpu::TextureView,
     ) {
         queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
-        let entries = [
-            self.view_params.as_entire_binding(),
-            wgpu::BindingResource::TextureView(final_image),
-            wgpu::BindingResource::TextureView(gb_position),
-            b.diag.as_entire_binding(),
-            wgpu::BindingResource::TextureView(dst),
-            own_accum.as_entire_binding(),
-            b.companion
-                .as_ref()
-                .map_or(&b.dummy[0], |c| &c.accum)
-                .as_entire_binding(),
-            b.companion
-                .as_ref()
-                .map_or(&b.dummy[1], |c| &c.difference)
-                .as_entire_binding(),
-        ];
-        let bind = bind_group_seq(device, "lcull_views::bind_group", &self.views_layout, &entries);
+        let bind = self.views_kernel.bind(
+            device,
+            0,
+            &[
+                ("vp", buf(&self.view_params)),
+                ("final_image", tex(final_image)),
+                ("gb_position", tex(gb_position)),
+                ("diag", buf(&b.diag)),
+                ("dst", tex(dst)),
+                ("own_accum", buf(own_accum)),
+                (
+                    "companion_accum",
+                    buf(b.companion.as_ref().map_or(&b.dummy[0], |c| &c.accum)),
+                ),
+                (
+                    "difference",
+                    buf(b.companion.as_ref().map_or(&b.dummy[1], |c| &c.difference)),
+                ),
+            ],
+        );
         run_compute(
             encoder,
             timer,

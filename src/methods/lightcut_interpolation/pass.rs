@@ -12,12 +12,9 @@ use crate::methods::lightcuts::pass::{BuildKernel, CutBindings, CutKernel, GpuLc
 use crate::reference::lightcut_interpolation::{TILE, TILE_CAP};
 use crate::renderer::{
     frame::GbufferTargets,
+    kernel::{Kernel, KernelOptions, buf, tex},
     passes::sst_build::TreeBuffers,
-    passes::{
-        StridedUniforms, WG_1D, bind_group_seq, compute_pipeline_with, dynamic_uniform_entry,
-        float_texture_entry, groups_image, run_compute, storage_buffer, storage_entry, storage_texture_entry,
-        uniform_buffer, uniform_entry,
-    },
+    passes::{StridedUniforms, WG_1D, groups_image, run_compute, storage_buffer, uniform_buffer},
     readback::CounterReadback,
     scene_gpu::SceneGpu,
     shaders,
@@ -319,18 +316,18 @@ pub struct LiPass {
     build: BuildKernel,
     record_cuts: CutKernel,
     fallback: CutKernel,
-    records_layout: wgpu::BindGroupLayout,
+    records_kernel: Kernel,
     radius: wgpu::ComputePipeline,
     place: wgpu::ComputePipeline,
     compact: wgpu::ComputePipeline,
-    select_layout: wgpu::BindGroupLayout,
+    select_kernel: Kernel,
     select: wgpu::ComputePipeline,
-    interp_layout: wgpu::BindGroupLayout,
+    interp_kernel: Kernel,
     interp: wgpu::ComputePipeline,
     interp_timed: wgpu::ComputePipeline,
     /// Uniforms: 0 the records' and selection's; 1.. the walk's dispatches.
     params: StridedUniforms<GpuLiParams>,
-    views_layout: wgpu::BindGroupLayout,
+    views_kernel: Kernel,
     views: wgpu::ComputePipeline,
     view_params: wgpu::Buffer,
     /// The frame counters (diagnostic frames).
@@ -346,79 +343,52 @@ pub fn groups_1d_as_2d(n: u32) -> (u32, u32) {
 
 impl LiPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let rmod = shaders::create_module(device, "methods/lightcut_interpolation/li_records.wgsl")?;
-        let smod = shaders::create_module(device, "methods/lightcut_interpolation/li_select.wgsl")?;
-        let imod = shaders::create_module(device, "methods/lightcut_interpolation/li_interp.wgsl")?;
-        let vmod = shaders::create_module(device, "methods/lightcut_interpolation/li_views.wgsl")?;
-        let psize = std::mem::size_of::<GpuLiParams>() as u64;
-        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            crate::renderer::passes::bind_group_layout(
-                device,
-                &wgpu::BindGroupLayoutDescriptor {
-                    label: Some(label),
-                    entries,
-                },
-            )
-        };
-        let mut re = vec![
-            dynamic_uniform_entry(0, c, psize),
-            float_texture_entry(1),
-            float_texture_entry(2),
-        ];
-        re.push(uniform_entry(3, c));
-        re.extend([storage_entry(4, c, true), storage_entry(5, c, true)]);
-        re.extend((6..=11).map(|b| storage_entry(b, c, false)));
-        let records_layout = layout("li_records::layout", &re);
-        let mut se = vec![
-            dynamic_uniform_entry(0, c, psize),
-            float_texture_entry(1),
-            float_texture_entry(2),
-        ];
-        se.extend((3..=7).map(|b| storage_entry(b, c, true)));
-        se.push(storage_entry(8, c, false));
-        let select_layout = layout("li_select::layout", &se);
-        let mut ie = vec![dynamic_uniform_entry(0, c, psize)];
-        ie.extend((1..=3).map(float_texture_entry));
-        ie.extend((4..=11).map(|b| storage_entry(b, c, true)));
-        ie.extend((12..=16).map(|b| storage_entry(b, c, false)));
-        let interp_layout = layout("li_interp::layout", &ie);
-        let mut ve = vec![
-            uniform_entry(0, c),
-            float_texture_entry(1),
-            float_texture_entry(2),
-        ];
-        ve.extend((3..=9).map(|b| storage_entry(b, c, true)));
-        ve.push(storage_texture_entry(10, wgpu::TextureFormat::Rgba8Unorm));
-        let views_layout = layout("li_views::layout", &ve);
-        let pipe =
-            |label: &str,
-             l: &wgpu::BindGroupLayout,
-             m: &wgpu::ShaderModule,
-             entry: &str,
-             k: &[(&str, f64)]| { compute_pipeline_with(device, label, &[Some(l)], m, entry, k) };
+        let dynamic = KernelOptions { dynamic: &["lp"] };
+        let records_kernel = Kernel::new(
+            device,
+            "methods/lightcut_interpolation/li_records.wgsl",
+            &["radius_main", "place_main", "compact_main"],
+            dynamic,
+        )?;
+        let select_kernel = Kernel::new(
+            device,
+            "methods/lightcut_interpolation/li_select.wgsl",
+            &["main"],
+            dynamic,
+        )?;
+        let interp_kernel = Kernel::new(
+            device,
+            "methods/lightcut_interpolation/li_interp.wgsl",
+            &["main"],
+            dynamic,
+        )?;
+        let views_kernel = Kernel::new(
+            device,
+            "methods/lightcut_interpolation/li_views.wgsl",
+            &["main"],
+            KernelOptions::default(),
+        )?;
         Ok(Self {
             build: BuildKernel::new(device)?,
             record_cuts: CutKernel::new(device, 1, 8)?,
             fallback: CutKernel::new(device, 2, 16)?,
-            radius: pipe("li_radius", &records_layout, &rmod, "radius_main", &[]),
-            place: pipe("li_place", &records_layout, &rmod, "place_main", &[]),
-            compact: pipe("li_compact", &records_layout, &rmod, "compact_main", &[]),
-            records_layout,
-            select: pipe("li_select", &select_layout, &smod, "main", &[]),
-            select_layout,
-            interp: pipe("li_interp", &interp_layout, &imod, "main", &[]),
-            interp_timed: pipe(
+            radius: records_kernel.compute(device, "li_radius", "radius_main"),
+            place: records_kernel.compute(device, "li_place", "place_main"),
+            compact: records_kernel.compute(device, "li_compact", "compact_main"),
+            records_kernel,
+            select: select_kernel.compute(device, "li_select", "main"),
+            select_kernel,
+            interp: interp_kernel.compute(device, "li_interp", "main"),
+            interp_timed: interp_kernel.compute_with(
+                device,
                 "li_interp_timed",
-                &interp_layout,
-                &imod,
                 "main",
                 &[("DIAGNOSTICS", 0.0)],
             ),
-            interp_layout,
+            interp_kernel,
             params: StridedUniforms::new(device, "li::params", 4),
-            views: pipe("li_views", &views_layout, &vmod, "main", &[]),
-            views_layout,
+            views: views_kernel.compute(device, "li_views", "main"),
+            views_kernel,
             view_params: uniform_buffer::<GpuLiViewParams>(device, "li_views::params"),
             stats: CounterReadback::new(
                 device,
@@ -462,28 +432,30 @@ impl LiPass {
             })
             .collect();
         self.params.write(device, queue, &all);
-        let tv = wgpu::BindingResource::TextureView;
         let g = f.gbuffer;
 
         self.build.record(
             device, queue, encoder, timer, "li_build", seed, f.tree, &b.cones, &b.reps,
         );
 
-        let rentries = [
-            self.params.binding(),
-            tv(&g.position_view),
-            tv(&g.normal_view),
-            f.camera.as_entire_binding(),
-            f.scene.bvh_nodes.as_entire_binding(),
-            f.scene.bvh_triangles.as_entire_binding(),
-            b.radius.as_entire_binding(),
-            b.tile_count.as_entire_binding(),
-            b.tile_recs.as_entire_binding(),
-            b.tile_offset.as_entire_binding(),
-            b.records.as_entire_binding(),
-            b.rec_meta.as_entire_binding(),
-        ];
-        let rbind = bind_group_seq(device, "li_records::bind_group", &self.records_layout, &rentries);
+        let rbind = self.records_kernel.bind(
+            device,
+            0,
+            &[
+                ("lp", self.params.binding()),
+                ("gb_position", tex(&g.position_view)),
+                ("gb_normal", tex(&g.normal_view)),
+                ("camera", buf(f.camera)),
+                ("bvh_nodes", buf(&f.scene.bvh_nodes)),
+                ("bvh_triangles", buf(&f.scene.bvh_triangles)),
+                ("radius", buf(&b.radius)),
+                ("tile_count", buf(&b.tile_count)),
+                ("tile_recs", buf(&b.tile_recs)),
+                ("tile_offset", buf(&b.tile_offset)),
+                ("records", buf(&b.records)),
+                ("rec_meta", buf(&b.rec_meta)),
+            ],
+        );
         let tiles = b.tiles.0 * b.tiles.1;
         for (name, pipe, groups) in [
             ("li_radius", &self.radius, groups_image(p.width, p.height)),
@@ -550,18 +522,21 @@ impl LiPass {
             &rb,
         );
 
-        let sentries = [
-            self.params.binding(),
-            tv(&g.position_view),
-            tv(&g.normal_view),
-            b.radius.as_entire_binding(),
-            b.tile_count.as_entire_binding(),
-            b.tile_offset.as_entire_binding(),
-            b.records.as_entire_binding(),
-            b.rec_meta.as_entire_binding(),
-            b.sel.as_entire_binding(),
-        ];
-        let sbind = bind_group_seq(device, "li_select::bind_group", &self.select_layout, &sentries);
+        let sbind = self.select_kernel.bind(
+            device,
+            0,
+            &[
+                ("lp", self.params.binding()),
+                ("gb_position", tex(&g.position_view)),
+                ("gb_normal", tex(&g.normal_view)),
+                ("radius", buf(&b.radius)),
+                ("tile_count", buf(&b.tile_count)),
+                ("tile_offset", buf(&b.tile_offset)),
+                ("records", buf(&b.records)),
+                ("rec_meta", buf(&b.rec_meta)),
+                ("sel", buf(&b.sel)),
+            ],
+        );
         encoder.push_debug_group("li_select");
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -575,26 +550,29 @@ impl LiPass {
         }
         encoder.pop_debug_group();
 
-        let ientries = [
-            self.params.binding(),
-            tv(&g.position_view),
-            tv(&g.normal_view),
-            tv(&g.albedo_view),
-            b.rec_meta.as_entire_binding(),
-            b.record_cuts.as_entire_binding(),
-            b.sel.as_entire_binding(),
-            f.tree.nodes.as_entire_binding(),
-            f.tree.sorted_vpls.as_entire_binding(),
-            b.reps.as_entire_binding(),
-            f.scene.bvh_nodes.as_entire_binding(),
-            f.scene.bvh_triangles.as_entire_binding(),
-            f.accum.as_entire_binding(),
-            b.diag.as_entire_binding(),
-            b.stats.as_entire_binding(),
-            b.trace.as_entire_binding(),
-            b.walk_state.as_entire_binding(),
-        ];
-        let ibind = bind_group_seq(device, "li_interp::bind_group", &self.interp_layout, &ientries);
+        let ibind = self.interp_kernel.bind(
+            device,
+            0,
+            &[
+                ("lp", self.params.binding()),
+                ("gb_position", tex(&g.position_view)),
+                ("gb_normal", tex(&g.normal_view)),
+                ("gb_albedo", tex(&g.albedo_view)),
+                ("rec_meta", buf(&b.rec_meta)),
+                ("record_cuts", buf(&b.record_cuts)),
+                ("sel", buf(&b.sel)),
+                ("tree", buf(&f.tree.nodes)),
+                ("sorted_vpls", buf(&f.tree.sorted_vpls)),
+                ("reps", buf(&b.reps)),
+                ("bvh_nodes", buf(&f.scene.bvh_nodes)),
+                ("bvh_triangles", buf(&f.scene.bvh_triangles)),
+                ("accum", buf(f.accum)),
+                ("diag", buf(&b.diag)),
+                ("stats", buf(&b.stats)),
+                ("trace", buf(&b.trace)),
+                ("state", buf(&b.walk_state)),
+            ],
+        );
         encoder.push_debug_group("li_interp");
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -650,20 +628,23 @@ impl LiPass {
         dst: &wgpu::TextureView,
     ) {
         queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
-        let entries = [
-            self.view_params.as_entire_binding(),
-            wgpu::BindingResource::TextureView(final_image),
-            wgpu::BindingResource::TextureView(gb_position),
-            b.diag.as_entire_binding(),
-            b.sel.as_entire_binding(),
-            b.radius.as_entire_binding(),
-            b.tile_count.as_entire_binding(),
-            b.tile_offset.as_entire_binding(),
-            b.records.as_entire_binding(),
-            b.rec_meta.as_entire_binding(),
-            wgpu::BindingResource::TextureView(dst),
-        ];
-        let bind = bind_group_seq(device, "li_views::bind_group", &self.views_layout, &entries);
+        let bind = self.views_kernel.bind(
+            device,
+            0,
+            &[
+                ("vp", buf(&self.view_params)),
+                ("final_image", tex(final_image)),
+                ("gb_position", tex(gb_position)),
+                ("diag", buf(&b.diag)),
+                ("sel", buf(&b.sel)),
+                ("radius", buf(&b.radius)),
+                ("tile_count", buf(&b.tile_count)),
+                ("tile_offset", buf(&b.tile_offset)),
+                ("records", buf(&b.records)),
+                ("rec_meta", buf(&b.rec_meta)),
+                ("dst", tex(dst)),
+            ],
+        );
         run_compute(
             encoder,
             timer,

@@ -9,12 +9,9 @@ use crate::reference::lightcuts::{Cone, LcTree, MAX_CUT};
 use crate::renderer::{
     context::{GpuContext, GpuError},
     frame::GbufferTargets,
+    kernel::{Kernel, KernelOptions, buf, tex},
     passes::sst_build::TreeBuffers,
-    passes::{
-        StridedUniforms, WG_1D, bind_group_seq, compute_pipeline_with, dynamic_uniform_entry,
-        float_texture_entry, groups_image, run_compute, storage_buffer, storage_entry, storage_texture_entry,
-        uniform_buffer, uniform_entry,
-    },
+    passes::{StridedUniforms, WG_1D, groups_image, run_compute, storage_buffer, uniform_buffer},
     readback::{self, CounterReadback},
     scene_gpu::SceneGpu,
     shaders,
@@ -255,7 +252,7 @@ pub struct CutKernel {
     mode: u32,
     cut: wgpu::ComputePipeline,
     cut_timed: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     /// Per-dispatch uniforms.
     params: StridedUniforms<GpuLcParams>,
 }
@@ -281,42 +278,20 @@ pub struct CutBindings<'a> {
 
 impl CutKernel {
     pub fn new(device: &wgpu::Device, mode: u32, stats_base: u32) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let module = shaders::create_module(device, "methods/lightcuts/lightcuts.wgsl")?;
-        let mut entries = vec![dynamic_uniform_entry(
-            0,
-            c,
-            std::mem::size_of::<GpuLcParams>() as u64,
-        )];
-        entries.extend((1..=6).map(|b| storage_entry(b, c, true)));
-        entries.extend((7..=9).map(float_texture_entry));
-        entries.extend((10..=15).map(|b| storage_entry(b, c, false)));
-        entries.push(storage_entry(16, c, true));
-        entries.push(storage_entry(17, c, false));
-        entries.push(storage_entry(18, c, false));
-        entries.push(storage_entry(19, c, true));
-        let layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("lightcuts::layout"),
-                entries: &entries,
-            },
-        );
+            "methods/lightcuts/lightcuts.wgsl",
+            &["main"],
+            KernelOptions { dynamic: &["lp"] },
+        )?;
         let (mode_f, base_f) = (mode as f64, stats_base as f64);
         let consts = [("MODE", mode_f), ("STATS_BASE", base_f)];
         let timed = [("DIAGNOSTICS", 0.0), ("MODE", mode_f), ("STATS_BASE", base_f)];
         Ok(Self {
             mode,
-            cut: compute_pipeline_with(device, "lightcuts", &[Some(&layout)], &module, "main", &consts),
-            cut_timed: compute_pipeline_with(
-                device,
-                "lightcuts_timed",
-                &[Some(&layout)],
-                &module,
-                "main",
-                &timed,
-            ),
-            layout,
+            cut: kernel.compute_with(device, "lightcuts", "main", &consts),
+            cut_timed: kernel.compute_with(device, "lightcuts_timed", "main", &timed),
+            kernel,
             params: StridedUniforms::new(device, "lightcuts::params", 1),
         })
     }
@@ -358,30 +333,32 @@ impl CutKernel {
             }
         }
         self.params.write(device, queue, &all);
-        let tv = wgpu::BindingResource::TextureView;
-        let entries = [
-            self.params.binding(),
-            b.tree.nodes.as_entire_binding(),
-            b.tree.sorted_vpls.as_entire_binding(),
-            b.cones.as_entire_binding(),
-            b.reps.as_entire_binding(),
-            b.scene.bvh_nodes.as_entire_binding(),
-            b.scene.bvh_triangles.as_entire_binding(),
-            tv(&b.gbuffer.position_view),
-            tv(&b.gbuffer.normal_view),
-            tv(&b.gbuffer.albedo_view),
-            b.accum.as_entire_binding(),
-            b.diag.as_entire_binding(),
-            b.stats.as_entire_binding(),
-            b.trace.as_entire_binding(),
-            b.scratch.as_entire_binding(),
-            b.state.as_entire_binding(),
-            b.lanes.as_entire_binding(),
-            b.record_cuts.as_entire_binding(),
-            b.rec_meta.as_entire_binding(),
-            b.tree.links.as_entire_binding(),
-        ];
-        let bind = bind_group_seq(device, "lightcuts::bind_group", &self.layout, &entries);
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                ("lp", self.params.binding()),
+                ("tree", buf(&b.tree.nodes)),
+                ("sorted_vpls", buf(&b.tree.sorted_vpls)),
+                ("cones", buf(b.cones)),
+                ("reps", buf(b.reps)),
+                ("bvh_nodes", buf(&b.scene.bvh_nodes)),
+                ("bvh_triangles", buf(&b.scene.bvh_triangles)),
+                ("gb_position", tex(&b.gbuffer.position_view)),
+                ("gb_normal", tex(&b.gbuffer.normal_view)),
+                ("gb_albedo", tex(&b.gbuffer.albedo_view)),
+                ("accum", buf(b.accum)),
+                ("diag", buf(b.diag)),
+                ("stats", buf(b.stats)),
+                ("trace", buf(b.trace)),
+                ("scratch", buf(b.scratch)),
+                ("state", buf(b.state)),
+                ("lanes", buf(b.lanes)),
+                ("record_cuts", buf(b.record_cuts)),
+                ("rec_meta", buf(b.rec_meta)),
+                ("tree_links", buf(&b.tree.links)),
+            ],
+        );
         encoder.push_debug_group(name);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -403,9 +380,9 @@ impl CutKernel {
 /// thread per leaf with arrival counters.
 pub struct BuildKernel {
     build: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     radix: wgpu::ComputePipeline,
-    radix_layout: wgpu::BindGroupLayout,
+    radix_kernel: Kernel,
     /// The radix build's arrival counters (one per node; grown on demand).
     counters: Option<wgpu::Buffer>,
     /// One per level.
@@ -414,52 +391,24 @@ pub struct BuildKernel {
 
 impl BuildKernel {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let module = shaders::create_module(device, "methods/lightcuts/lc_build.wgsl")?;
-        let uniform = dynamic_uniform_entry(0, c, std::mem::size_of::<GpuLcBuildParams>() as u64);
-        let layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("lightcuts_build::layout"),
-                entries: &[
-                    uniform,
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, true),
-                    storage_entry(3, c, false),
-                    storage_entry(4, c, false),
-                ],
-            },
-        );
-        let rmodule = shaders::create_module(device, "methods/lightcuts/lc_build_radix.wgsl")?;
-        let radix_layout = crate::renderer::passes::bind_group_layout(
+            "methods/lightcuts/lc_build.wgsl",
+            &["main"],
+            KernelOptions { dynamic: &["bp"] },
+        )?;
+        let radix_kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("lightcuts_build_radix::layout"),
-                entries: &[
-                    uniform,
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, true),
-                    storage_entry(3, c, false),
-                    storage_entry(4, c, false),
-                    storage_entry(5, c, true),
-                    storage_entry(6, c, true),
-                    storage_entry(7, c, false),
-                ],
-            },
-        );
+            "methods/lightcuts/lc_build_radix.wgsl",
+            &["main"],
+            KernelOptions { dynamic: &["bp"] },
+        )?;
         Ok(Self {
-            build: compute_pipeline_with(device, "lightcuts_build", &[Some(&layout)], &module, "main", &[]),
-            radix: compute_pipeline_with(
-                device,
-                "lightcuts_build_radix",
-                &[Some(&radix_layout)],
-                &rmodule,
-                "main",
-                &[],
-            ),
+            build: kernel.compute(device, "lightcuts_build", "main"),
+            radix: radix_kernel.compute(device, "lightcuts_build_radix", "main"),
             params: StridedUniforms::new(device, "lightcuts_build::params", MAX_LEVELS),
-            layout,
-            radix_layout,
+            kernel,
+            radix_kernel,
             counters: None,
         })
     }
@@ -501,14 +450,7 @@ impl BuildKernel {
                 .collect()
         };
         self.params.write(device, queue, &dispatches);
-        let mut entries = vec![
-            self.params.binding(),
-            tree.nodes.as_entire_binding(),
-            tree.sorted_vpls.as_entire_binding(),
-            cones.as_entire_binding(),
-            reps.as_entire_binding(),
-        ];
-        if radix {
+        let bind = if radix {
             let need = 4 * tree.leaves.max(4) as u64;
             if self.counters.as_ref().is_none_or(|c| c.size() < need) {
                 self.counters = Some(crate::renderer::passes::storage_buffer(
@@ -519,17 +461,34 @@ impl BuildKernel {
             }
             let Some(counters) = &self.counters else { return };
             encoder.clear_buffer(counters, 0, None);
-            entries.extend([
-                tree.links.as_entire_binding(),
-                tree.parents.as_entire_binding(),
-                counters.as_entire_binding(),
-            ]);
-        }
-        let (pipeline, layout) = match radix {
-            true => (&self.radix, &self.radix_layout),
-            false => (&self.build, &self.layout),
+            self.radix_kernel.bind(
+                device,
+                0,
+                &[
+                    ("bp", self.params.binding()),
+                    ("nodes", buf(&tree.nodes)),
+                    ("sorted_vpls", buf(&tree.sorted_vpls)),
+                    ("cones", buf(cones)),
+                    ("reps", buf(reps)),
+                    ("links", buf(&tree.links)),
+                    ("parents", buf(&tree.parents)),
+                    ("counters", buf(counters)),
+                ],
+            )
+        } else {
+            self.kernel.bind(
+                device,
+                0,
+                &[
+                    ("bp", self.params.binding()),
+                    ("nodes", buf(&tree.nodes)),
+                    ("sorted_vpls", buf(&tree.sorted_vpls)),
+                    ("cones", buf(cones)),
+                    ("reps", buf(reps)),
+                ],
+            )
         };
-        let bind = bind_group_seq(device, "lightcuts_build::bind_group", layout, &entries);
+        let pipeline = if radix { &self.radix } else { &self.build };
         encoder.push_debug_group(name);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -550,7 +509,7 @@ pub struct LightcutsPass {
     build: BuildKernel,
     cut: CutKernel,
     views: wgpu::ComputePipeline,
-    views_layout: wgpu::BindGroupLayout,
+    views_kernel: Kernel,
     view_params: wgpu::Buffer,
     /// The frame counters (diagnostic frames).
     pub stats: CounterReadback<LcStats>,
@@ -558,33 +517,17 @@ pub struct LightcutsPass {
 
 impl LightcutsPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let vmod = shaders::create_module(device, "methods/lightcuts/lc_views.wgsl")?;
-        let views_layout = crate::renderer::passes::bind_group_layout(
+        let views_kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("lightcuts_views::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    float_texture_entry(1),
-                    float_texture_entry(2),
-                    storage_entry(3, c, true),
-                    storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm),
-                ],
-            },
-        );
+            "methods/lightcuts/lc_views.wgsl",
+            &["main"],
+            KernelOptions::default(),
+        )?;
         Ok(Self {
             build: BuildKernel::new(device)?,
             cut: CutKernel::new(device, 0, 0)?,
-            views: compute_pipeline_with(
-                device,
-                "lightcuts_views",
-                &[Some(&views_layout)],
-                &vmod,
-                "main",
-                &[],
-            ),
-            views_layout,
+            views: views_kernel.compute(device, "lightcuts_views", "main"),
+            views_kernel,
             view_params: uniform_buffer::<GpuLcViewParams>(device, "lightcuts_views::params"),
             stats: CounterReadback::new(
                 device,
@@ -676,18 +619,16 @@ impl LightcutsPass {
         dst: &wgpu::TextureView,
     ) {
         queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
-        let entries = [
-            self.view_params.as_entire_binding(),
-            wgpu::BindingResource::TextureView(final_image),
-            wgpu::BindingResource::TextureView(gb_position),
-            out.diag.as_entire_binding(),
-            wgpu::BindingResource::TextureView(dst),
-        ];
-        let bind = bind_group_seq(
+        let bind = self.views_kernel.bind(
             device,
-            "lightcuts_views::bind_group",
-            &self.views_layout,
-            &entries,
+            0,
+            &[
+                ("vp", buf(&self.view_params)),
+                ("final_image", tex(final_image)),
+                ("gb_position", tex(gb_position)),
+                ("diag", buf(&out.diag)),
+                ("dst", tex(dst)),
+            ],
         );
         run_compute(
             encoder,

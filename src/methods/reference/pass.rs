@@ -6,15 +6,13 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::renderer::{
     frame::{GbufferTargets, ShadowTargets},
+    kernel::{Kernel, KernelOptions, buf, tex},
     scene_gpu::SceneGpu,
     shaders,
     timing::GpuTimer,
 };
 
-use crate::renderer::passes::{
-    compute_pipeline, float_array_texture_entry, float_texture_entry, groups_image, run_compute,
-    storage_entry, uniform_buffer, uniform_entry, vpl_gen::VplBuffers,
-};
+use crate::renderer::passes::{groups_image, run_compute, uniform_buffer, vpl_gen::VplBuffers};
 
 /// Twin: `RefParams` in `shaders/methods/reference/reference.wgsl`.
 #[repr(C)]
@@ -36,42 +34,24 @@ pub struct GpuRefParams {
 }
 
 pub struct ReferencePass {
+    kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
 }
 
 impl ReferencePass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "methods/reference/reference.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("reference::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    uniform_entry(1, c),
-                    float_array_texture_entry(2),
-                    float_array_texture_entry(3),
-                    float_array_texture_entry(4),
-                    float_texture_entry(5),
-                    float_texture_entry(6),
-                    float_texture_entry(7),
-                    storage_entry(8, c, true),
-                    storage_entry(9, c, true),
-                    storage_entry(10, c, true),
-                    storage_entry(11, c, true),
-                    storage_entry(12, c, true),
-                    storage_entry(13, c, false),
-                ],
-            },
-        );
-        let pipeline = compute_pipeline(device, "reference::pipeline", &[Some(&layout)], &module, "main");
+            "methods/reference/reference.wgsl",
+            &["main"],
+            KernelOptions::default(),
+        )?;
+        let pipeline = kernel.compute(device, "reference::pipeline", "main");
         let params = uniform_buffer::<GpuRefParams>(device, "reference::params");
         Ok(Self {
+            kernel,
             pipeline,
-            layout,
             params,
         })
     }
@@ -93,36 +73,26 @@ impl ReferencePass {
         accum: &wgpu::Buffer,
     ) {
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        let tv = wgpu::BindingResource::TextureView;
-        let entries = [
-            vpl_params.as_entire_binding(),
-            self.params.as_entire_binding(),
-            tv(&rsm.position_array),
-            tv(&rsm.normal_array),
-            tv(&rsm.flux_array),
-            tv(&gbuffer.position_view),
-            tv(&gbuffer.normal_view),
-            tv(&gbuffer.albedo_view),
-            vpl.importance_pyramid.as_entire_binding(),
-            vpl.flux_pyramid.as_entire_binding(),
-            vpl.bounds_pyramid.as_entire_binding(),
-            scene.bvh_nodes.as_entire_binding(),
-            scene.bvh_triangles.as_entire_binding(),
-            accum.as_entire_binding(),
-        ];
-        let entries: Vec<wgpu::BindGroupEntry<'_>> = entries
-            .into_iter()
-            .enumerate()
-            .map(|(i, resource)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource,
-            })
-            .collect();
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("reference::bind_group"),
-            layout: &self.layout,
-            entries: &entries,
-        });
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                ("params", buf(vpl_params)),
+                ("rp", buf(&self.params)),
+                ("rsm_position", tex(&rsm.position_array)),
+                ("rsm_normal", tex(&rsm.normal_array)),
+                ("rsm_flux", tex(&rsm.flux_array)),
+                ("gb_position", tex(&gbuffer.position_view)),
+                ("gb_normal", tex(&gbuffer.normal_view)),
+                ("gb_albedo", tex(&gbuffer.albedo_view)),
+                ("importance_pyramid", buf(&vpl.importance_pyramid)),
+                ("flux_pyramid", buf(&vpl.flux_pyramid)),
+                ("bounds_pyramid", buf(&vpl.bounds_pyramid)),
+                ("bvh_nodes", buf(&scene.bvh_nodes)),
+                ("bvh_triangles", buf(&scene.bvh_triangles)),
+                ("accum", buf(accum)),
+            ],
+        );
         run_compute(
             encoder,
             timer,

@@ -8,12 +8,14 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::renderer::{frame::GbufferTargets, shaders, timing::GpuTimer};
-
-use crate::renderer::passes::{
-    bind_group_seq, compute_pipeline, float_texture_entry, groups_image, run_compute, storage_entry,
-    storage_texture_entry, uniform_buffer, uniform_entry,
+use crate::renderer::{
+    frame::GbufferTargets,
+    kernel::{Kernel, KernelOptions, buf, tex},
+    shaders,
+    timing::GpuTimer,
 };
+
+use crate::renderer::passes::{groups_image, run_compute, uniform_buffer};
 
 /// Twin: `HalfParams` in `shaders/methods/tree_samplers/slc_half.wgsl` and `slc_upsample.wgsl`.
 #[repr(C)]
@@ -60,54 +62,32 @@ impl HalfTargets {
 
 pub struct HalfPass {
     down: wgpu::ComputePipeline,
-    down_layout: wgpu::BindGroupLayout,
+    down_kernel: Kernel,
     up: wgpu::ComputePipeline,
-    up_layout: wgpu::BindGroupLayout,
+    up_kernel: Kernel,
     params: wgpu::Buffer,
 }
 
 impl HalfPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let dmod = shaders::create_module(device, "methods/tree_samplers/slc_half.wgsl")?;
-        let down_layout = crate::renderer::passes::bind_group_layout(
+        let down_kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("slc_half::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    float_texture_entry(1),
-                    float_texture_entry(2),
-                    float_texture_entry(3),
-                    storage_texture_entry(4, crate::renderer::passes::gbuffer::POSITION_FORMAT),
-                    storage_texture_entry(5, crate::renderer::passes::gbuffer::NORMAL_FORMAT),
-                    storage_texture_entry(6, crate::renderer::passes::gbuffer::ALBEDO_FORMAT),
-                ],
-            },
-        );
-        let umod = shaders::create_module(device, "methods/tree_samplers/slc_upsample.wgsl")?;
-        let up_layout = crate::renderer::passes::bind_group_layout(
+            "methods/tree_samplers/slc_half.wgsl",
+            &["downsample"],
+            KernelOptions::default(),
+        )?;
+        let up_kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("slc_upsample::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    float_texture_entry(1),
-                    float_texture_entry(2),
-                    float_texture_entry(3),
-                    float_texture_entry(4),
-                    float_texture_entry(5),
-                    storage_entry(6, c, true),
-                    storage_entry(7, c, false),
-                ],
-            },
-        );
+            "methods/tree_samplers/slc_upsample.wgsl",
+            &["upsample"],
+            KernelOptions::default(),
+        )?;
         Ok(Self {
-            down: compute_pipeline(device, "slc_half", &[Some(&down_layout)], &dmod, "downsample"),
-            up: compute_pipeline(device, "slc_upsample", &[Some(&up_layout)], &umod, "upsample"),
+            down: down_kernel.compute(device, "slc_half", "downsample"),
+            up: up_kernel.compute(device, "slc_upsample", "upsample"),
             params: uniform_buffer::<GpuHalfParams>(device, "slc_half::params"),
-            down_layout,
-            up_layout,
+            down_kernel,
+            up_kernel,
         })
     }
 
@@ -146,17 +126,19 @@ impl HalfPass {
         d_max: f32,
     ) {
         self.write_params(queue, full_size, half, n_min, d_max);
-        let tv = wgpu::BindingResource::TextureView;
-        let entries = [
-            self.params.as_entire_binding(),
-            tv(&full.position_view),
-            tv(&full.normal_view),
-            tv(&full.albedo_view),
-            tv(&half.gbuffer.position_view),
-            tv(&half.gbuffer.normal_view),
-            tv(&half.gbuffer.albedo_view),
-        ];
-        let bind = bind_group_seq(device, "slc_half::bind_group", &self.down_layout, &entries);
+        let bind = self.down_kernel.bind(
+            device,
+            0,
+            &[
+                ("hp", buf(&self.params)),
+                ("full_position", tex(&full.position_view)),
+                ("full_normal", tex(&full.normal_view)),
+                ("full_albedo", tex(&full.albedo_view)),
+                ("half_position", tex(&half.gbuffer.position_view)),
+                ("half_normal", tex(&half.gbuffer.normal_view)),
+                ("half_albedo", tex(&half.gbuffer.albedo_view)),
+            ],
+        );
         run_compute(
             encoder,
             timer,
@@ -179,18 +161,20 @@ impl HalfPass {
         half: &HalfTargets,
         accum: &wgpu::Buffer,
     ) {
-        let tv = wgpu::BindingResource::TextureView;
-        let entries = [
-            self.params.as_entire_binding(),
-            tv(&full.position_view),
-            tv(&full.normal_view),
-            tv(&full.albedo_view),
-            tv(&half.gbuffer.position_view),
-            tv(&half.gbuffer.normal_view),
-            half.accum.as_entire_binding(),
-            accum.as_entire_binding(),
-        ];
-        let bind = bind_group_seq(device, "slc_upsample::bind_group", &self.up_layout, &entries);
+        let bind = self.up_kernel.bind(
+            device,
+            0,
+            &[
+                ("hp", buf(&self.params)),
+                ("full_position", tex(&full.position_view)),
+                ("full_normal", tex(&full.normal_view)),
+                ("full_albedo", tex(&full.albedo_view)),
+                ("half_position", tex(&half.gbuffer.position_view)),
+                ("half_normal", tex(&half.gbuffer.normal_view)),
+                ("half_accum", buf(&half.accum)),
+                ("accum", buf(accum)),
+            ],
+        );
         run_compute(
             encoder,
             timer,

@@ -8,16 +8,20 @@
 //! `DIAGNOSTICS = false` (same estimate, none of that work, no readback).
 
 use crate::renderer::{
-    frame::GbufferTargets, gpu_data::GpuSlcParams, readback::CounterReadback, scene_gpu::SceneGpu, shaders,
+    frame::GbufferTargets,
+    gpu_data::GpuSlcParams,
+    kernel::{Kernel, KernelOptions, buf, tex},
+    readback::CounterReadback,
+    scene_gpu::SceneGpu,
+    shaders,
     timing::GpuTimer,
 };
 
 use crate::renderer::passes::{
-    WG_1D, bind_group_seq, compute_pipeline, compute_pipeline_with, float_texture_entry, groups_image,
+    WG_1D, groups_image,
     ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
     run_compute,
     sst_build::TreeBuffers,
-    storage_entry, storage_texture_entry, uniform_entry,
 };
 
 /// Frame counter words written by `slc_sample`: two 32-bit counters, then four 64-bit ones
@@ -365,15 +369,15 @@ pub struct SlcPass {
     ism_params: wgpu::Buffer,
     /// Bound in the maps' place without ISM visibility: depth (read), lights (written).
     ism_dummy: [wgpu::Buffer; 2],
-    views_layout: wgpu::BindGroupLayout,
+    views_kernel: Kernel,
     view_params: wgpu::Buffer,
     cuts: wgpu::ComputePipeline,
-    cuts_layout: wgpu::BindGroupLayout,
+    cuts_kernel: Kernel,
     /// The sampling pass with diagnostics (counters, per-pixel diagnostics, story) and
     /// without (timed frames).
     sample: wgpu::ComputePipeline,
     sample_timed: wgpu::ComputePipeline,
-    sample_layout: wgpu::BindGroupLayout,
+    sample_kernel: Kernel,
     params: wgpu::Buffer,
     /// The counters of a recent frame, read back without blocking.
     /// The frame counters (diagnostic frames).
@@ -382,92 +386,43 @@ pub struct SlcPass {
 
 impl SlcPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let cmod = shaders::create_module(device, "methods/tree_samplers/slc_cuts.wgsl")?;
-        let cuts_layout = crate::renderer::passes::bind_group_layout(
+        let cuts_kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("slc_cuts::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    storage_entry(1, c, true),
-                    float_texture_entry(2),
-                    float_texture_entry(3),
-                    storage_entry(4, c, false),
-                    storage_entry(5, c, true),
-                ],
-            },
-        );
-        let smod = shaders::create_module(device, "methods/tree_samplers/slc_sample.wgsl")?;
-        let sample_layout = crate::renderer::passes::bind_group_layout(
+            "methods/tree_samplers/slc_cuts.wgsl",
+            &["build_cuts"],
+            KernelOptions::default(),
+        )?;
+        let sample_kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("slc_sample::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, true),
-                    storage_entry(3, c, true),
-                    storage_entry(4, c, true),
-                    storage_entry(5, c, true),
-                    storage_entry(6, c, true),
-                    float_texture_entry(7),
-                    float_texture_entry(8),
-                    float_texture_entry(9),
-                    storage_entry(10, c, false),
-                    storage_entry(11, c, false),
-                    storage_entry(12, c, false),
-                    storage_entry(13, c, false),
-                    uniform_entry(14, c),
-                    storage_entry(15, c, true),
-                    storage_entry(16, c, false),
-                    storage_entry(17, c, true),
-                ],
-            },
-        );
-        let vmod = shaders::create_module(device, "methods/tree_samplers/slc_views.wgsl")?;
-        let views_layout = crate::renderer::passes::bind_group_layout(
+            "methods/tree_samplers/slc_sample.wgsl",
+            &["main", "ism_leaves_main"],
+            KernelOptions::default(),
+        )?;
+        let views_kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("slc_views::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    float_texture_entry(1),
-                    float_texture_entry(2),
-                    storage_entry(3, c, true),
-                    storage_entry(4, c, true),
-                    storage_texture_entry(5, crate::renderer::passes::display::VIEW_FORMAT),
-                    storage_entry(6, c, true),
-                ],
-            },
-        );
+            "methods/tree_samplers/slc_views.wgsl",
+            &["main"],
+            KernelOptions::default(),
+        )?;
         Ok(Self {
-            views: compute_pipeline(device, "slc_views", &[Some(&views_layout)], &vmod, "main"),
-            views_layout,
+            views: views_kernel.compute(device, "slc_views", "main"),
+            views_kernel,
             view_params: crate::renderer::passes::uniform_buffer::<GpuSlcViewParams>(
                 device,
                 "slc_views::params",
             ),
-            cuts: compute_pipeline(device, "slc_cuts", &[Some(&cuts_layout)], &cmod, "build_cuts"),
-            sample: compute_pipeline(device, "slc_sample", &[Some(&sample_layout)], &smod, "main"),
-            ism_leaves: compute_pipeline(
-                device,
-                "slc_ism_lights",
-                &[Some(&sample_layout)],
-                &smod,
-                "ism_leaves_main",
-            ),
+            cuts: cuts_kernel.compute(device, "slc_cuts", "build_cuts"),
+            sample: sample_kernel.compute(device, "slc_sample", "main"),
+            ism_leaves: sample_kernel.compute(device, "slc_ism_lights", "ism_leaves_main"),
             ism: IsmPass::new(device)?,
             ism_params: crate::renderer::passes::uniform_buffer::<GpuIsmParams>(device, "slc::ism_params"),
             ism_dummy: [
                 crate::renderer::passes::storage_buffer(device, "slc::ism_dummy_depth", 16),
                 crate::renderer::passes::storage_buffer(device, "slc::ism_dummy_lights", 32),
             ],
-            sample_timed: compute_pipeline_with(
+            sample_timed: sample_kernel.compute_with(
                 device,
                 "slc_sample::timed",
-                &[Some(&sample_layout)],
-                &smod,
                 "main",
                 &[("DIAGNOSTICS", 0.0)],
             ),
@@ -478,8 +433,8 @@ impl SlcPass {
                 (STATS * 4) as u64,
                 SamplingStats::from_words,
             ),
-            cuts_layout,
-            sample_layout,
+            cuts_kernel,
+            sample_kernel,
         })
     }
 
@@ -511,17 +466,19 @@ impl SlcPass {
             }
             None => (&self.ism_dummy[0], &self.ism_dummy[1]),
         };
-        let tv = wgpu::BindingResource::TextureView;
         if p.method != 1 {
-            let entries = [
-                self.params.as_entire_binding(),
-                tree.nodes.as_entire_binding(),
-                tv(&gbuffer.position_view),
-                tv(&gbuffer.normal_view),
-                out.cuts.as_entire_binding(),
-                tree.links.as_entire_binding(),
-            ];
-            let bind = bind_group_seq(device, "slc_cuts::bind_group", &self.cuts_layout, &entries);
+            let bind = self.cuts_kernel.bind(
+                device,
+                0,
+                &[
+                    ("sp", buf(&self.params)),
+                    ("tree", buf(&tree.nodes)),
+                    ("gb_position", tex(&gbuffer.position_view)),
+                    ("gb_normal", tex(&gbuffer.normal_view)),
+                    ("cuts", buf(&out.cuts)),
+                    ("tree_links", buf(&tree.links)),
+                ],
+            );
             run_compute(
                 encoder,
                 timer,
@@ -531,27 +488,30 @@ impl SlcPass {
                 ((p.grid_x * p.grid_y).div_ceil(WG_1D), 1, 1),
             );
         }
-        let entries = [
-            self.params.as_entire_binding(),
-            tree.nodes.as_entire_binding(),
-            tree.flags.as_entire_binding(),
-            tree.sorted_vpls.as_entire_binding(),
-            out.cuts.as_entire_binding(),
-            scene.bvh_nodes.as_entire_binding(),
-            scene.bvh_triangles.as_entire_binding(),
-            tv(&gbuffer.position_view),
-            tv(&gbuffer.normal_view),
-            tv(&gbuffer.albedo_view),
-            accum.as_entire_binding(),
-            out.diag.as_entire_binding(),
-            out.stats.as_entire_binding(),
-            out.trace.as_entire_binding(),
-            self.ism_params.as_entire_binding(),
-            ism_depth.as_entire_binding(),
-            ism_lights.as_entire_binding(),
-            tree.links.as_entire_binding(),
-        ];
-        let bind = bind_group_seq(device, "slc_sample::bind_group", &self.sample_layout, &entries);
+        let bind = self.sample_kernel.bind(
+            device,
+            0,
+            &[
+                ("sp", buf(&self.params)),
+                ("tree", buf(&tree.nodes)),
+                ("flags", buf(&tree.flags)),
+                ("sorted_vpls", buf(&tree.sorted_vpls)),
+                ("cuts", buf(&out.cuts)),
+                ("bvh_nodes", buf(&scene.bvh_nodes)),
+                ("bvh_triangles", buf(&scene.bvh_triangles)),
+                ("gb_position", tex(&gbuffer.position_view)),
+                ("gb_normal", tex(&gbuffer.normal_view)),
+                ("gb_albedo", tex(&gbuffer.albedo_view)),
+                ("accum", buf(accum)),
+                ("diag", buf(&out.diag)),
+                ("stats", buf(&out.stats)),
+                ("trace", buf(&out.trace)),
+                ("ism", buf(&self.ism_params)),
+                ("ism_depth", buf(ism_depth)),
+                ("ism_lights", buf(ism_lights)),
+                ("tree_links", buf(&tree.links)),
+            ],
+        );
         if let Some(m) = ism {
             // The leaves' map lights, then the maps (the shared component).
             run_compute(
@@ -609,16 +569,19 @@ impl SlcPass {
         dst: &wgpu::TextureView,
     ) {
         queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
-        let entries = [
-            self.view_params.as_entire_binding(),
-            wgpu::BindingResource::TextureView(final_image),
-            wgpu::BindingResource::TextureView(gb_position),
-            out.diag.as_entire_binding(),
-            out.cuts.as_entire_binding(),
-            wgpu::BindingResource::TextureView(dst),
-            tree_links.as_entire_binding(),
-        ];
-        let bind = bind_group_seq(device, "slc_views::bind_group", &self.views_layout, &entries);
+        let bind = self.views_kernel.bind(
+            device,
+            0,
+            &[
+                ("vp", buf(&self.view_params)),
+                ("final_image", tex(final_image)),
+                ("gb_position", tex(gb_position)),
+                ("diag", buf(&out.diag)),
+                ("cuts", buf(&out.cuts)),
+                ("dst", tex(dst)),
+                ("tree_links", buf(tree_links)),
+            ],
+        );
         run_compute(
             encoder,
             timer,

@@ -14,12 +14,12 @@ use bytemuck::{Pod, Zeroable};
 use super::settings::{IsmSettings, IsmVal};
 use crate::renderer::{
     frame::GbufferTargets,
+    kernel::{Kernel, KernelOptions, buf, tex},
     passes::{
-        WG_1D, bind_group_seq, compute_pipeline_with, float_array_texture_entry, float_texture_entry,
-        groups_image,
+        WG_1D, groups_image,
         interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
         ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
-        run_compute, storage_buffer, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
+        run_compute, storage_buffer, uniform_buffer,
         val_cluster::{GpuValParams, ValClusterPass, ValSeeds, ValTargets},
     },
     scene_gpu::SceneGpu,
@@ -207,9 +207,9 @@ pub struct ValPass {
     claim: wgpu::ComputePipeline,
     unique: wgpu::ComputePipeline,
     down_params: wgpu::Buffer,
-    down_layout: wgpu::BindGroupLayout,
+    down_kernel: Kernel,
     down: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     seeds: wgpu::ComputePipeline,
     lights: wgpu::ComputePipeline,
     shade: wgpu::ComputePipeline,
@@ -221,7 +221,7 @@ pub struct ValPass {
     ism_dummy: [wgpu::Buffer; 2],
     filter: InterleaveFilter,
     filter_params: FilterUniform,
-    views_layout: wgpu::BindGroupLayout,
+    views_kernel: Kernel,
     views: wgpu::ComputePipeline,
     view_params: wgpu::Buffer,
     view_ism_params: wgpu::Buffer,
@@ -229,83 +229,43 @@ pub struct ValPass {
 
 impl ValPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let smod = shaders::create_module(device, "methods/val/val_shade.wgsl")?;
-        let vmod = shaders::create_module(device, "methods/val/val_views.wgsl")?;
-        let dmod = shaders::create_module(device, "methods/val/val_downsample.wgsl")?;
-        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            crate::renderer::passes::bind_group_layout(
-                device,
-                &wgpu::BindGroupLayoutDescriptor {
-                    label: Some(label),
-                    entries,
-                },
-            )
-        };
-        let mut se = vec![
-            uniform_entry(0, c),
-            float_texture_entry(1),
-            float_texture_entry(2),
-        ];
-        se.extend((3..=6).map(|b| storage_entry(b, c, true)));
-        se.extend((7..=10).map(|b| storage_entry(b, c, false)));
-        se.extend([
-            uniform_entry(11, c),
-            storage_entry(12, c, true),
-            storage_entry(13, c, false),
-            storage_entry(14, c, false),
-        ]);
-        let shade_layout = layout("val_shade::layout", &se);
-        let rgba32 = wgpu::TextureFormat::Rgba32Float;
-        let down_layout = layout(
-            "val_downsample::layout",
+        let kernel = Kernel::new(
+            device,
+            "methods/val/val_shade.wgsl",
             &[
-                uniform_entry(0, c),
-                float_array_texture_entry(1),
-                float_array_texture_entry(2),
-                float_array_texture_entry(3),
-                storage_texture_entry(4, rgba32),
-                storage_texture_entry(5, rgba32),
-                storage_texture_entry(6, rgba32),
+                "claim_main",
+                "unique_main",
+                "seeds_main",
+                "lights_main",
+                "shade_main",
             ],
-        );
-        let views_layout = layout(
-            "val_views::layout",
-            &[
-                uniform_entry(0, c),
-                float_texture_entry(1),
-                float_texture_entry(2),
-                storage_entry(3, c, true),
-                storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm),
-                storage_entry(5, c, true),
-                storage_entry(6, c, true),
-                uniform_entry(7, c),
-                storage_entry(8, c, true),
-                storage_entry(9, c, true),
-                storage_entry(10, c, true),
-                storage_entry(11, c, false),
-                uniform_entry(12, c),
-            ],
-        );
-        let pipe =
-            |label: &str,
-             l: &wgpu::BindGroupLayout,
-             m: &wgpu::ShaderModule,
-             entry: &str,
-             k: &[(&str, f64)]| { compute_pipeline_with(device, label, &[Some(l)], m, entry, k) };
+            KernelOptions::default(),
+        )?;
+        let views_kernel = Kernel::new(
+            device,
+            "methods/val/val_views.wgsl",
+            &["main"],
+            KernelOptions::default(),
+        )?;
+        let down_kernel = Kernel::new(
+            device,
+            "methods/val/val_downsample.wgsl",
+            &["main"],
+            KernelOptions::default(),
+        )?;
         let timed = &[("DIAGNOSTICS", 0.0)];
         Ok(Self {
             params: uniform_buffer::<GpuValShadeParams>(device, "val::params"),
             down_params: uniform_buffer::<GpuDownParams>(device, "val::down_params"),
-            down: pipe("val_downsample", &down_layout, &dmod, "main", &[]),
-            down_layout,
-            claim: pipe("val_seed_claim", &shade_layout, &smod, "claim_main", &[]),
-            unique: pipe("val_seed_unique", &shade_layout, &smod, "unique_main", &[]),
-            seeds: pipe("val_seeds", &shade_layout, &smod, "seeds_main", &[]),
-            lights: pipe("val_ism_lights", &shade_layout, &smod, "lights_main", &[]),
-            shade: pipe("val_shade", &shade_layout, &smod, "shade_main", &[]),
-            shade_timed: pipe("val_shade_timed", &shade_layout, &smod, "shade_main", timed),
-            layout: shade_layout,
+            down: down_kernel.compute(device, "val_downsample", "main"),
+            down_kernel,
+            claim: kernel.compute(device, "val_seed_claim", "claim_main"),
+            unique: kernel.compute(device, "val_seed_unique", "unique_main"),
+            seeds: kernel.compute(device, "val_seeds", "seeds_main"),
+            lights: kernel.compute(device, "val_ism_lights", "lights_main"),
+            shade: kernel.compute(device, "val_shade", "shade_main"),
+            shade_timed: kernel.compute_with(device, "val_shade_timed", "shade_main", timed),
+            kernel,
             cluster: ValClusterPass::new(device)?,
             ism: IsmPass::new(device)?,
             ism_params: uniform_buffer::<GpuIsmParams>(device, "val::ism_params"),
@@ -315,8 +275,8 @@ impl ValPass {
             ],
             filter: InterleaveFilter::new(device)?,
             filter_params: FilterUniform::new(device, "val::filter_params"),
-            views: pipe("val_views", &views_layout, &vmod, "main", &[]),
-            views_layout,
+            views: views_kernel.compute(device, "val_views", "main"),
+            views_kernel,
             view_params: uniform_buffer::<GpuValViewParams>(device, "val_views::params"),
             view_ism_params: uniform_buffer::<GpuIsmParams>(device, "val_views::ism_params"),
         })
@@ -359,47 +319,44 @@ impl ValPass {
             }
             None => (&self.ism_dummy[0], &self.ism_dummy[1]),
         };
-        let tv = wgpu::BindingResource::TextureView;
         let g = f.gbuffer;
         let bind = |vals: &wgpu::Buffer, seeds: &wgpu::Buffer| {
-            bind_group_seq(
+            self.kernel.bind(
                 device,
-                "val_shade::bind_group",
-                &self.layout,
+                0,
                 &[
-                    self.params.as_entire_binding(),
-                    tv(&g.position_view),
-                    tv(&g.normal_view),
-                    f.scene.bvh_nodes.as_entire_binding(),
-                    f.scene.bvh_triangles.as_entire_binding(),
-                    f.vpls.as_entire_binding(),
-                    vals.as_entire_binding(),
-                    seeds.as_entire_binding(),
-                    ism_lights.as_entire_binding(),
-                    b.raw.as_entire_binding(),
-                    b.diag.as_entire_binding(),
-                    self.ism_params.as_entire_binding(),
-                    ism_depth.as_entire_binding(),
-                    f.coarse.claim.as_entire_binding(),
-                    f.seed_list.as_entire_binding(),
+                    ("params", buf(&self.params)),
+                    ("gb_position", tex(&g.position_view)),
+                    ("gb_normal", tex(&g.normal_view)),
+                    ("bvh_nodes", buf(&f.scene.bvh_nodes)),
+                    ("bvh_triangles", buf(&f.scene.bvh_triangles)),
+                    ("vpls", buf(f.vpls)),
+                    ("vals", buf(vals)),
+                    ("seeds", buf(seeds)),
+                    ("ism_lights", buf(ism_lights)),
+                    ("raw", buf(&b.raw)),
+                    ("diag", buf(&b.diag)),
+                    ("ism", buf(&self.ism_params)),
+                    ("ism_depth", buf(ism_depth)),
+                    ("claim", buf(&f.coarse.claim)),
+                    ("list", buf(f.seed_list)),
                 ],
             )
         };
         let per_cluster = (p.clusters.div_ceil(WG_1D), 1, 1);
         // The clustering RSM.
         queue.write_buffer(&self.down_params, 0, bytemuck::bytes_of(&f.down));
-        let down = bind_group_seq(
+        let down = self.down_kernel.bind(
             device,
-            "val_downsample::bind_group",
-            &self.down_layout,
+            0,
             &[
-                self.down_params.as_entire_binding(),
-                tv(f.rsm[0]),
-                tv(f.rsm[1]),
-                tv(f.rsm[2]),
-                tv(&f.coarse.storage[0]),
-                tv(&f.coarse.storage[1]),
-                tv(&f.coarse.storage[2]),
+                ("dp", buf(&self.down_params)),
+                ("rsm_position", tex(f.rsm[0])),
+                ("rsm_normal", tex(f.rsm[1])),
+                ("rsm_flux", tex(f.rsm[2])),
+                ("out_position", tex(&f.coarse.storage[0])),
+                ("out_normal", tex(&f.coarse.storage[1])),
+                ("out_flux", tex(&f.coarse.storage[2])),
             ],
         );
         run_compute(
@@ -515,25 +472,23 @@ impl ValPass {
             }
             None => &self.ism_dummy[0],
         };
-        let tv = wgpu::BindingResource::TextureView;
-        let bind = bind_group_seq(
+        let bind = self.views_kernel.bind(
             device,
-            "val_views::bind_group",
-            &self.views_layout,
+            0,
             &[
-                self.view_params.as_entire_binding(),
-                tv(final_image),
-                tv(gb_position),
-                b.diag.as_entire_binding(),
-                tv(dst),
-                t.vals().as_entire_binding(),
-                t.keys.as_entire_binding(),
-                self.view_ism_params.as_entire_binding(),
-                depth.as_entire_binding(),
-                scene.bvh_nodes.as_entire_binding(),
-                scene.bvh_triangles.as_entire_binding(),
-                data.as_entire_binding(),
-                camera.as_entire_binding(),
+                ("vp", buf(&self.view_params)),
+                ("final_image", tex(final_image)),
+                ("gb_position", tex(gb_position)),
+                ("diag", buf(&b.diag)),
+                ("dst", tex(dst)),
+                ("vals", buf(t.vals())),
+                ("keys", buf(&t.keys)),
+                ("ism", buf(&self.view_ism_params)),
+                ("ism_depth", buf(depth)),
+                ("bvh_nodes", buf(&scene.bvh_nodes)),
+                ("bvh_triangles", buf(&scene.bvh_triangles)),
+                ("data", buf(data)),
+                ("camera", buf(camera)),
             ],
         );
         run_compute(

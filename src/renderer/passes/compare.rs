@@ -5,12 +5,13 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::renderer::{shaders, timing::GpuTimer};
-
-use super::{
-    bind_group_seq, compute_pipeline, display::VIEW_FORMAT, float_texture_entry, groups_image, run_compute,
-    storage_texture_entry, uniform_buffer, uniform_entry,
+use crate::renderer::{
+    kernel::{Kernel, KernelOptions, buf, tex},
+    shaders,
+    timing::GpuTimer,
 };
+
+use super::{groups_image, run_compute, uniform_buffer};
 
 /// Twin: `CmpParams` in `shaders/compare_views.wgsl`.
 #[repr(C)]
@@ -27,31 +28,18 @@ pub struct GpuCmpParams {
 }
 
 pub struct CompareViewsPass {
+    kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
 }
 
 impl CompareViewsPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "compare_views.wgsl")?;
-        let layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("compare_views::layout"),
-                entries: &[
-                    uniform_entry(0, wgpu::ShaderStages::COMPUTE),
-                    float_texture_entry(1),
-                    float_texture_entry(2),
-                    float_texture_entry(3),
-                    storage_texture_entry(4, VIEW_FORMAT),
-                ],
-            },
-        );
+        let kernel = Kernel::new(device, "compare_views.wgsl", &["main"], KernelOptions::default())?;
         Ok(Self {
-            pipeline: compute_pipeline(device, "compare_views", &[Some(&layout)], &module, "main"),
+            pipeline: kernel.compute(device, "compare_views", "main"),
             params: uniform_buffer::<GpuCmpParams>(device, "compare_views::params"),
-            layout,
+            kernel,
         })
     }
 
@@ -70,14 +58,17 @@ impl CompareViewsPass {
         size: (u32, u32),
     ) {
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        let entries = [
-            self.params.as_entire_binding(),
-            wgpu::BindingResource::TextureView(method_image),
-            wgpu::BindingResource::TextureView(reference_image),
-            wgpu::BindingResource::TextureView(gb_position),
-            wgpu::BindingResource::TextureView(dst),
-        ];
-        let bind = bind_group_seq(device, "compare_views::bind_group", &self.layout, &entries);
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                ("cp", buf(&self.params)),
+                ("image_a", tex(method_image)),
+                ("image_b", tex(reference_image)),
+                ("gb_position", tex(gb_position)),
+                ("dst", tex(dst)),
+            ],
+        );
         run_compute(
             encoder,
             timer,

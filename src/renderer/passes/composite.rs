@@ -3,12 +3,13 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::renderer::{shaders, timing::GpuTimer};
-
-use super::{
-    compute_pipeline, direct::RADIANCE_FORMAT, float_texture_entry, groups_image, run_compute, storage_entry,
-    storage_texture_entry, uniform_buffer, uniform_entry,
+use crate::renderer::{
+    kernel::{Kernel, KernelOptions, buf, tex},
+    shaders,
+    timing::GpuTimer,
 };
+
+use super::{groups_image, run_compute, uniform_buffer};
 
 /// Twin: `CompositeParams` in `shaders/composite.wgsl`.
 #[repr(C)]
@@ -21,33 +22,19 @@ pub struct GpuCompositeParams {
 }
 
 pub struct CompositePass {
+    kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
 }
 
 impl CompositePass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "composite.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("composite::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    float_texture_entry(1),
-                    storage_entry(2, c, true),
-                    storage_texture_entry(3, RADIANCE_FORMAT),
-                    storage_texture_entry(4, RADIANCE_FORMAT),
-                ],
-            },
-        );
-        let pipeline = compute_pipeline(device, "composite::pipeline", &[Some(&layout)], &module, "main");
+        let kernel = Kernel::new(device, "composite.wgsl", &["main"], KernelOptions::default())?;
+        let pipeline = kernel.compute(device, "composite::pipeline", "main");
         let params = uniform_buffer::<GpuCompositeParams>(device, "composite::params");
         Ok(Self {
+            kernel,
             pipeline,
-            layout,
             params,
         })
     }
@@ -73,33 +60,17 @@ impl CompositePass {
             _pad: 0,
         };
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        let tv = wgpu::BindingResource::TextureView;
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("composite::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: tv(direct),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: accum.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: tv(out_indirect),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: tv(out_final),
-                },
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                ("params", buf(&self.params)),
+                ("direct", tex(direct)),
+                ("accum", buf(accum)),
+                ("out_indirect", tex(out_indirect)),
+                ("out_final", tex(out_final)),
             ],
-        });
+        );
         run_compute(
             encoder,
             timer,

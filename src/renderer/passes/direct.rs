@@ -3,125 +3,76 @@
 
 use crate::renderer::{
     frame::{GbufferTargets, ShadowTargets},
+    kernel::{Kernel, KernelOptions, buf, tex},
     shaders,
     timing::GpuTimer,
 };
 
-use super::{
-    compute_pipeline, float_texture_entry, groups_image, run_compute, storage_texture_entry, texture_entry,
-    uniform_entry,
-};
+use super::{groups_image, run_compute};
 
 pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 pub struct DirectPass {
+    kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
     /// `DirectParams`: x = the BRDF model (`Brdf::gpu`).
     params: wgpu::Buffer,
 }
 
+/// What the direct pass reads and writes.
+pub struct DirectInputs<'a> {
+    /// The BRDF model (`Brdf::gpu`).
+    pub brdf: u32,
+    pub camera: &'a wgpu::Buffer,
+    pub lights: &'a wgpu::Buffer,
+    pub shadow: &'a ShadowTargets,
+    pub gbuffer: &'a GbufferTargets,
+    pub out: &'a wgpu::TextureView,
+    pub size: (u32, u32),
+}
+
 impl DirectPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "direct.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("direct::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    uniform_entry(1, c),
-                    texture_entry(
-                        2,
-                        c,
-                        wgpu::TextureSampleType::Depth,
-                        wgpu::TextureViewDimension::D2Array,
-                    ),
-                    float_texture_entry(3),
-                    float_texture_entry(4),
-                    float_texture_entry(5),
-                    storage_texture_entry(6, RADIANCE_FORMAT),
-                    uniform_entry(7, c),
-                ],
-            },
-        );
-        let pipeline = compute_pipeline(device, "direct::pipeline", &[Some(&layout)], &module, "main");
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("direct::params"),
-            size: 16,
-            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let kernel = Kernel::new(device, "direct.wgsl", &["main"], KernelOptions::default())?;
+        let pipeline = kernel.compute(device, "direct::pipeline", "main");
+        let params = super::uniform_buffer::<[u32; 4]>(device, "direct::params");
         Ok(Self {
+            kernel,
             pipeline,
-            layout,
             params,
         })
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        brdf: u32,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        camera: &wgpu::Buffer,
-        lights: &wgpu::Buffer,
-        shadow: &ShadowTargets,
-        gbuffer: &GbufferTargets,
-        out: &wgpu::TextureView,
-        size: (u32, u32),
+        i: &DirectInputs<'_>,
     ) {
-        queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&[brdf, 0u32, 0, 0]));
-        let tv = wgpu::BindingResource::TextureView;
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("direct::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: lights.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: tv(&shadow.array_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: tv(&gbuffer.position_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: tv(&gbuffer.normal_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: tv(&gbuffer.albedo_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: tv(out),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: self.params.as_entire_binding(),
-                },
+        queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&[i.brdf, 0u32, 0, 0]));
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                ("camera", buf(i.camera)),
+                ("lights", buf(i.lights)),
+                ("shadow_maps", tex(&i.shadow.array_view)),
+                ("gb_position", tex(&i.gbuffer.position_view)),
+                ("gb_normal", tex(&i.gbuffer.normal_view)),
+                ("gb_albedo", tex(&i.gbuffer.albedo_view)),
+                ("out_direct", tex(i.out)),
+                ("dp", buf(&self.params)),
             ],
-        });
+        );
         run_compute(
             encoder,
             timer,
             "direct",
             &self.pipeline,
             &bind,
-            groups_image(size.0, size.1),
+            groups_image(i.size.0, i.size.1),
         );
     }
 }

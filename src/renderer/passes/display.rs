@@ -1,40 +1,32 @@
 //! Display: exposure (2^EV), tonemap and sRGB encoding of a linear-radiance buffer into the
 //! `Rgba8Unorm` view texture, with the view's look (channel, false colour, NaN highlight). Reads: one radiance buffer. Writes: the view texture.
 
-use crate::renderer::{gpu_data::DisplayParams, shaders, timing::GpuTimer, views::ViewLook};
-
-use super::{
-    compute_pipeline, float_texture_entry, groups_image, run_compute, storage_texture_entry, uniform_buffer,
-    uniform_entry,
+use crate::renderer::{
+    gpu_data::DisplayParams,
+    kernel::{Kernel, KernelOptions, buf, tex},
+    shaders,
+    timing::GpuTimer,
+    views::ViewLook,
 };
+
+use super::{groups_image, run_compute, uniform_buffer};
 
 pub const VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 pub struct DisplayPass {
+    kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
 }
 
 impl DisplayPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "display.wgsl")?;
-        let layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("display::layout"),
-                entries: &[
-                    uniform_entry(0, wgpu::ShaderStages::COMPUTE),
-                    float_texture_entry(1),
-                    storage_texture_entry(2, VIEW_FORMAT),
-                ],
-            },
-        );
-        let pipeline = compute_pipeline(device, "display::pipeline", &[Some(&layout)], &module, "main");
+        let kernel = Kernel::new(device, "display.wgsl", &["main"], KernelOptions::default())?;
+        let pipeline = kernel.compute(device, "display::pipeline", "main");
         let params = uniform_buffer::<DisplayParams>(device, "display::params");
         Ok(Self {
+            kernel,
             pipeline,
-            layout,
             params,
         })
     }
@@ -53,24 +45,15 @@ impl DisplayPass {
     ) {
         let p = DisplayParams::new(look);
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("display::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(src),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(dst),
-                },
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                ("params", buf(&self.params)),
+                ("src", tex(src)),
+                ("dst", tex(dst)),
             ],
-        });
+        );
         run_compute(
             encoder,
             timer,

@@ -11,10 +11,13 @@
 //! each way (machine-independent: rasterisation rules and draw order), for `bench gbuffer`.
 
 use crate::renderer::{
-    frame::GbufferTargets, gpu_data::GpuVertex, scene_gpu::SceneGpu, shaders, timing::GpuTimer,
+    frame::GbufferTargets,
+    gpu_data::GpuVertex,
+    kernel::{Kernel, KernelOptions, buf, sampler, tex},
+    scene_gpu::SceneGpu,
+    shaders,
+    timing::GpuTimer,
 };
-
-use super::{storage_entry, texture_entry, uniform_entry};
 
 pub const POSITION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -44,7 +47,7 @@ pub struct GbufferPass {
     depth_only: wgpu::RenderPipeline,
     /// Shading after the pre-pass: depth test Equal, no depth writes.
     pipeline_equal: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     /// Depth pre-pass on (the frame's default); off is the single pass of before issue 18,
     /// which `bench gbuffer` measures beside it.
     pub prepass: bool,
@@ -73,36 +76,14 @@ fn primitive() -> wgpu::PrimitiveState {
 
 impl GbufferPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "gbuffer.wgsl")?;
-        let vis = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("gbuffer::layout"),
-                entries: &[
-                    uniform_entry(0, vis),
-                    // The vertex stage reads the materials' metallic-roughness UV maps.
-                    storage_entry(1, wgpu::ShaderStages::VERTEX_FRAGMENT, true),
-                    texture_entry(
-                        2,
-                        wgpu::ShaderStages::FRAGMENT,
-                        wgpu::TextureSampleType::Float { filterable: true },
-                        wgpu::TextureViewDimension::D2Array,
-                    ),
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 3,
-                        visibility: wgpu::ShaderStages::FRAGMENT,
-                        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                        count: None,
-                    },
-                ],
-            },
-        );
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("gbuffer::pipeline_layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+            "gbuffer.wgsl",
+            &["vs_main", "fs_main"],
+            KernelOptions::default(),
+        )?;
+        let pl = kernel.pipeline_layout(device, &["vs_main", "fs_main"]);
+        let module = &kernel.module;
         let targets = [POSITION_FORMAT, NORMAL_FORMAT, ALBEDO_FORMAT].map(|format| {
             Some(wgpu::ColorTargetState {
                 format,
@@ -115,7 +96,7 @@ impl GbufferPass {
                 label: Some(label),
                 layout: Some(&pl),
                 vertex: wgpu::VertexState {
-                    module: &module,
+                    module,
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
                     buffers: &[Some(vertex_layout())],
@@ -124,7 +105,7 @@ impl GbufferPass {
                 depth_stencil: Some(depth),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
-                    module: &module,
+                    module,
                     entry_point: Some("fs_main"),
                     compilation_options: Default::default(),
                     targets: &targets,
@@ -141,12 +122,12 @@ impl GbufferPass {
             "gbuffer::pipeline_equal",
             depth_state(wgpu::CompareFunction::Equal, false),
         );
-        let depth_only = depth_only_pipeline(device, "gbuffer::depth_only", &pl, &module);
+        let depth_only = depth_only_pipeline(device, "gbuffer::depth_only", &pl, module);
         Ok(Self {
             pipeline,
             depth_only,
             pipeline_equal,
-            layout,
+            kernel,
             prepass: true,
         })
     }
@@ -160,28 +141,16 @@ impl GbufferPass {
         scene: &SceneGpu,
         out: &GbufferTargets,
     ) {
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gbuffer::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: scene.materials.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&scene.textures_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::Sampler(&scene.sampler),
-                },
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                ("camera", buf(camera)),
+                ("materials", buf(&scene.materials)),
+                ("textures", tex(&scene.textures_view)),
+                ("tex_sampler", sampler(&scene.sampler)),
             ],
-        });
+        );
         encoder.push_debug_group("gbuffer");
         let clear = |view| {
             Some(wgpu::RenderPassColorAttachment {
@@ -325,26 +294,21 @@ pub struct OverdrawCounter {
     count_less: wgpu::RenderPipeline,
     count_equal: wgpu::RenderPipeline,
     depth_only: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
 }
 
 const COUNT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 impl OverdrawCounter {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "gbuffer_overdraw.wgsl")?;
-        let layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("overdraw::layout"),
-                entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
-            },
-        );
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("overdraw::pipeline_layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+            "gbuffer_overdraw.wgsl",
+            &["vs_main", "fs_count"],
+            KernelOptions::default(),
+        )?;
+        let pl = kernel.pipeline_layout(device, &["vs_main", "fs_count"]);
+        let module = &kernel.module;
         let add = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
             dst_factor: wgpu::BlendFactor::One,
@@ -363,7 +327,7 @@ impl OverdrawCounter {
                 label: Some(label),
                 layout: Some(&pl),
                 vertex: wgpu::VertexState {
-                    module: &module,
+                    module,
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
                     buffers: &[Some(vertex_layout())],
@@ -372,7 +336,7 @@ impl OverdrawCounter {
                 depth_stencil: depth,
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
-                    module: &module,
+                    module,
                     entry_point: Some("fs_count"),
                     compilation_options: Default::default(),
                     targets: &targets,
@@ -391,8 +355,8 @@ impl OverdrawCounter {
                 "overdraw::equal",
                 Some(depth_state(wgpu::CompareFunction::Equal, false)),
             ),
-            depth_only: depth_only_pipeline(device, "overdraw::depth_only", &pl, &module),
-            layout,
+            depth_only: depth_only_pipeline(device, "overdraw::depth_only", &pl, module),
+            kernel,
         })
     }
 
@@ -434,14 +398,7 @@ impl OverdrawCounter {
         );
         let cv = counter.create_view(&Default::default());
         let dv = depth.create_view(&Default::default());
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("overdraw::bind_group"),
-            layout: &self.layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: camera.as_entire_binding(),
-            }],
-        });
+        let bind = self.kernel.bind(device, 0, &[("camera", buf(camera))]);
         // One count: optionally the depth pre-pass (its own pass, no colour target), then
         // `pipeline` into the cleared counter (depth cleared, or loaded after the pre-pass).
         let run = |pipeline: &wgpu::RenderPipeline, with_depth: bool, prepass: bool| {

@@ -4,12 +4,10 @@
 //! G-buffer it was computed on, the camera. Writes: an accumulation buffer. Settings:
 //! `settings::InterleaveSettings`. Twin: `reference::interleave::filter_pixel`.
 
+use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 
-use super::{
-    bind_group_seq, compute_pipeline, float_texture_entry, groups_image, run_compute, storage_entry,
-    uniform_buffer, uniform_entry,
-};
+use super::{groups_image, run_compute, uniform_buffer};
 use crate::renderer::{
     frame::GbufferTargets,
     settings::{InterleaveSettings, PatternDefault},
@@ -91,32 +89,22 @@ pub struct FilterInputs<'a> {
 }
 
 pub struct InterleaveFilter {
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
 }
 
 impl InterleaveFilter {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let module = shaders::create_module(device, "interleave_filter.wgsl")?;
-        let layout = crate::renderer::passes::bind_group_layout(
+        let _c = wgpu::ShaderStages::COMPUTE;
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("interleave_filter::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    uniform_entry(1, c),
-                    float_texture_entry(2),
-                    float_texture_entry(3),
-                    float_texture_entry(4),
-                    storage_entry(5, c, true),
-                    storage_entry(6, c, false),
-                ],
-            },
-        );
+            "interleave_filter.wgsl",
+            &["main"],
+            KernelOptions::default(),
+        )?;
         Ok(Self {
-            pipeline: compute_pipeline(device, "interleave_filter", &[Some(&layout)], &module, "main"),
-            layout,
+            pipeline: kernel.compute(device, "interleave_filter", "main"),
+            kernel,
         })
     }
 
@@ -135,19 +123,17 @@ impl InterleaveFilter {
         f: &FilterInputs<'_>,
     ) {
         queue.write_buffer(&uniform.0, 0, bytemuck::bytes_of(&p));
-        let tv = wgpu::BindingResource::TextureView;
-        let bind = bind_group_seq(
+        let bind = self.kernel.bind(
             device,
-            "interleave_filter::bind_group",
-            &self.layout,
+            0,
             &[
-                uniform.0.as_entire_binding(),
-                f.camera.as_entire_binding(),
-                tv(&f.gbuffer.position_view),
-                tv(&f.gbuffer.normal_view),
-                tv(&f.gbuffer.albedo_view),
-                f.raw.as_entire_binding(),
-                f.accum.as_entire_binding(),
+                ("fp", buf(&uniform.0)),
+                ("camera", buf(f.camera)),
+                ("gb_position", tex(&f.gbuffer.position_view)),
+                ("gb_normal", tex(&f.gbuffer.normal_view)),
+                ("gb_albedo", tex(&f.gbuffer.albedo_view)),
+                ("raw", buf(f.raw)),
+                ("accum", buf(f.accum)),
             ],
         );
         run_compute(

@@ -8,13 +8,11 @@
 //! `settings::IsmSettings`. Twin: `reference::ism`. `ism_view.wgsl` draws the atlas as a view
 //! ([`IsmPass::record_view`]).
 
+use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-use super::{
-    StridedUniforms, WG_1D, WG_2D, bind_group_seq, compute_pipeline, dynamic_uniform_entry, groups_image,
-    run_compute, storage_buffer, storage_entry, storage_texture_entry, uniform_buffer, uniform_entry,
-};
+use super::{StridedUniforms, WG_1D, WG_2D, groups_image, run_compute, storage_buffer, uniform_buffer};
 use crate::reference::ism::{IsmLayout, IsmLight, sample_oriented_points};
 use crate::renderer::{
     settings::{IsmDefault, IsmSettings},
@@ -236,60 +234,37 @@ impl IsmTargets {
 }
 
 pub struct IsmPass {
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     splat: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
     pull: wgpu::ComputePipeline,
     push: wgpu::ComputePipeline,
     params: StridedUniforms<GpuIsmParams>,
-    view_layout: wgpu::BindGroupLayout,
+    view_kernel: Kernel,
     view: wgpu::ComputePipeline,
     view_params: wgpu::Buffer,
 }
 
 impl IsmPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let module = shaders::create_module(device, "ism.wgsl")?;
-        let layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("ism::layout"),
-                entries: &[
-                    dynamic_uniform_entry(0, c, std::mem::size_of::<GpuIsmParams>() as u64),
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, true),
-                    storage_entry(3, c, false),
-                    storage_entry(4, c, false),
-                    storage_entry(5, c, false),
-                ],
-            },
-        );
-        let pipe = |entry: &str| compute_pipeline(device, entry, &[Some(&layout)], &module, entry);
-        let view_module = shaders::create_module(device, "ism_view.wgsl")?;
-        let view_layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("ism_view::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, true),
-                    storage_texture_entry(3, wgpu::TextureFormat::Rgba8Unorm),
-                    storage_entry(4, c, false),
-                ],
-            },
-        );
+            "ism.wgsl",
+            &["splat_main", "resolve_main", "pull_main", "push_main"],
+            KernelOptions { dynamic: &["ism"] },
+        )?;
+        let pipe = |entry: &str| kernel.compute(device, entry, entry);
+        let view_kernel = Kernel::new(device, "ism_view.wgsl", &["main"], KernelOptions::default())?;
         Ok(Self {
-            view: compute_pipeline(device, "ism_view", &[Some(&view_layout)], &view_module, "main"),
-            view_layout,
+            view: view_kernel.compute(device, "ism_view", "main"),
+            view_kernel,
             view_params: uniform_buffer::<GpuIsmViewParams>(device, "ism_view::params"),
             splat: pipe("splat_main"),
             resolve: pipe("resolve_main"),
             pull: pipe("pull_main"),
             push: pipe("push_main"),
             params: StridedUniforms::new(device, "ism::params", 8),
-            layout,
+            kernel,
         })
     }
 
@@ -362,17 +337,16 @@ impl IsmPass {
             });
         }
         self.params.write(device, queue, &items);
-        let bind = bind_group_seq(
+        let bind = self.kernel.bind(
             device,
-            "ism::bind_group",
-            &self.layout,
+            0,
             &[
-                self.params.binding(),
-                points.buffer.as_entire_binding(),
-                t.lights.as_entire_binding(),
-                t.keys.as_entire_binding(),
-                t.depth.as_entire_binding(),
-                t.pyramid.as_entire_binding(),
+                ("ism", self.params.binding()),
+                ("points", buf(&points.buffer)),
+                ("lights", buf(&t.lights)),
+                ("keys", buf(&t.keys)),
+                ("ism_depth", buf(&t.depth)),
+                ("pyramid", buf(&t.pyramid)),
             ],
         );
         // Only the atlas rows of the maps in use (their keys; the rest is never read).
@@ -450,16 +424,15 @@ impl IsmPass {
             cols,
         };
         queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
-        let bind = bind_group_seq(
+        let bind = self.view_kernel.bind(
             device,
-            "ism_view::bind_group",
-            &self.view_layout,
+            0,
             &[
-                self.view_params.as_entire_binding(),
-                t.depth.as_entire_binding(),
-                t.keys.as_entire_binding(),
-                wgpu::BindingResource::TextureView(dst),
-                data.as_entire_binding(),
+                ("vp", buf(&self.view_params)),
+                ("depth", buf(&t.depth)),
+                ("keys", buf(&t.keys)),
+                ("dst", tex(dst)),
+                ("data", buf(data)),
             ],
         );
         run_compute(

@@ -7,11 +7,10 @@
 //! sampler_layout}`. `sst_build::BuildPass` runs it when `tree.kind` is `lbvh`; `bench tree`
 //! times both trees and checks the topology against the twin.
 
+use crate::renderer::kernel::{Kernel, KernelOptions, buf};
 use bytemuck::{Pod, Zeroable};
 
-use super::{
-    WG_1D, bind_group_seq, compute_pipeline, run_compute, storage_entry, uniform_buffer, uniform_entry,
-};
+use super::{WG_1D, run_compute, uniform_buffer};
 use crate::reference::lbvh::{Child, Internal};
 use crate::renderer::{
     context::{GpuContext, GpuError},
@@ -78,56 +77,23 @@ pub fn read_parents(ctx: &GpuContext, tree: &TreeBuffers) -> Result<Vec<u32>, Gp
 
 pub struct LbvhPass {
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     node_pipeline: wgpu::ComputePipeline,
-    node_layout: wgpu::BindGroupLayout,
+    node_kernel: Kernel,
     params: wgpu::Buffer,
 }
 
 impl LbvhPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "lbvh.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("lbvh::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, false),
-                    storage_entry(3, c, false),
-                ],
-            },
-        );
-        let node_layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("lbvh::node_layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, false),
-                    storage_entry(3, c, false),
-                    storage_entry(4, c, true),
-                    storage_entry(5, c, false),
-                    storage_entry(6, c, false),
-                    storage_entry(7, c, false),
-                ],
-            },
-        );
+        // The two entry points read different parts of group 0: a kernel each.
+        let kernel = Kernel::new(device, "lbvh.wgsl", &["build"], KernelOptions::default())?;
+        let node_kernel = Kernel::new(device, "lbvh.wgsl", &["node_data"], KernelOptions::default())?;
         Ok(Self {
-            pipeline: compute_pipeline(device, "lbvh::build", &[Some(&layout)], &module, "build"),
-            node_pipeline: compute_pipeline(
-                device,
-                "lbvh::node_data",
-                &[Some(&node_layout)],
-                &module,
-                "node_data",
-            ),
+            pipeline: kernel.compute(device, "lbvh::build", "build"),
+            node_pipeline: node_kernel.compute(device, "lbvh::node_data", "node_data"),
             params: uniform_buffer::<GpuLbvhParams>(device, "lbvh::params"),
-            layout,
-            node_layout,
+            kernel,
+            node_kernel,
         })
     }
 
@@ -153,15 +119,14 @@ impl LbvhPass {
         out: &TreeBuffers,
     ) {
         let p = self.write_params(queue, keys, out);
-        let bind = bind_group_seq(
+        let bind = self.kernel.bind(
             device,
-            "lbvh::bind_group",
-            &self.layout,
+            0,
             &[
-                self.params.as_entire_binding(),
-                keys.keys.as_entire_binding(),
-                out.links.as_entire_binding(),
-                out.parents.as_entire_binding(),
+                ("params", buf(&self.params)),
+                ("keys", buf(&keys.keys)),
+                ("links", buf(&out.links)),
+                ("parents", buf(&out.parents)),
             ],
         );
         run_compute(
@@ -189,19 +154,18 @@ impl LbvhPass {
     ) {
         let p = self.write_params(queue, keys, out);
         encoder.clear_buffer(&out.counters, 0, None);
-        let bind = bind_group_seq(
+        let bind = self.node_kernel.bind(
             device,
-            "lbvh::node_bind_group",
-            &self.node_layout,
+            0,
             &[
-                self.params.as_entire_binding(),
-                keys.keys.as_entire_binding(),
-                out.links.as_entire_binding(),
-                out.parents.as_entire_binding(),
-                vpls.as_entire_binding(),
-                out.nodes.as_entire_binding(),
-                out.counters.as_entire_binding(),
-                out.sorted_vpls.as_entire_binding(),
+                ("params", buf(&self.params)),
+                ("keys", buf(&keys.keys)),
+                ("links", buf(&out.links)),
+                ("parents", buf(&out.parents)),
+                ("vpls", buf(vpls)),
+                ("nodes", buf(&out.nodes)),
+                ("counters", buf(&out.counters)),
+                ("sorted_vpls", buf(&out.sorted_vpls)),
             ],
         );
         run_compute(

@@ -12,6 +12,7 @@ use crate::{
         context::{GpuContext, GpuError},
         frame::ShadowTargets,
         gpu_data::GpuVpl,
+        kernel::{Kernel, KernelOptions, buf, tex},
         readback,
         scene_gpu::SceneGpu,
         shaders,
@@ -21,8 +22,7 @@ use crate::{
 };
 
 use super::{
-    WG_1D, bind_group_seq, compute_pipeline, float_array_texture_entry, storage_buffer, storage_entry,
-    uniform_entry,
+    WG_1D, storage_buffer,
     vpl_gen::{VplBuffers, split_budget},
 };
 
@@ -106,10 +106,9 @@ impl PathJob {
 pub struct LightPathPass {
     starts_pipeline: wgpu::ComputePipeline,
     trace_pipeline: wgpu::ComputePipeline,
-    /// Group 0: the VPL stage's uniform, the RSMs and pyramids (the starts).
-    rsm_layout: wgpu::BindGroupLayout,
-    /// Group 1: the paths' uniform, starts, output and the scene.
-    path_layout: wgpu::BindGroupLayout,
+    /// Group 0: the VPL stage's uniform, the RSMs and pyramids (the starts); group 1: the
+    /// paths' uniform, starts, output and the scene.
+    kernel: Kernel,
     params: wgpu::Buffer,
     /// Each path's start (bounce-1 vertex) as a VPL record.
     starts: wgpu::Buffer,
@@ -118,56 +117,16 @@ pub struct LightPathPass {
 
 impl LightPathPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "light_paths.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let rsm_layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("light_paths::rsm_layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    float_array_texture_entry(1),
-                    float_array_texture_entry(2),
-                    float_array_texture_entry(3),
-                    storage_entry(4, c, true),
-                    storage_entry(5, c, true),
-                ],
-            },
-        );
-        let path_layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("light_paths::path_layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    storage_entry(1, c, false),
-                    storage_entry(2, c, false),
-                    storage_entry(3, c, true),
-                    storage_entry(4, c, true),
-                    storage_entry(5, c, true),
-                    storage_entry(6, c, true),
-                    storage_entry(7, c, true),
-                    float_array_texture_entry(8),
-                ],
-            },
-        );
+            "light_paths.wgsl",
+            &["path_starts", "trace_paths"],
+            KernelOptions::default(),
+        )?;
         Ok(Self {
-            starts_pipeline: compute_pipeline(
-                device,
-                "light_paths::starts",
-                &[Some(&rsm_layout), Some(&path_layout)],
-                &module,
-                "path_starts",
-            ),
-            trace_pipeline: compute_pipeline(
-                device,
-                "light_paths::trace",
-                &[None, Some(&path_layout)],
-                &module,
-                "trace_paths",
-            ),
-            rsm_layout,
-            path_layout,
+            starts_pipeline: kernel.compute(device, "light_paths::starts", "path_starts"),
+            trace_pipeline: kernel.compute(device, "light_paths::trace", "trace_paths"),
+            kernel,
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("light_paths::params"),
                 size: std::mem::size_of::<GpuPathParams>() as u64,
@@ -198,20 +157,19 @@ impl LightPathPass {
     }
 
     fn path_bind(&self, device: &wgpu::Device, scene: &SceneGpu, out: &wgpu::Buffer) -> wgpu::BindGroup {
-        bind_group_seq(
+        self.kernel.bind(
             device,
-            "light_paths::path_bind_group",
-            &self.path_layout,
+            1,
             &[
-                self.params.as_entire_binding(),
-                self.starts.as_entire_binding(),
-                out.as_entire_binding(),
-                scene.bvh_nodes.as_entire_binding(),
-                scene.bvh_triangles.as_entire_binding(),
-                scene.vertices.as_entire_binding(),
-                scene.indices.as_entire_binding(),
-                scene.materials.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&scene.textures_view),
+                ("pp", buf(&self.params)),
+                ("starts", buf(&self.starts)),
+                ("vpls", buf(out)),
+                ("bvh_nodes", buf(&scene.bvh_nodes)),
+                ("bvh_triangles", buf(&scene.bvh_triangles)),
+                ("scene_vertices", buf(&scene.vertices)),
+                ("scene_indices", buf(&scene.indices)),
+                ("materials", buf(&scene.materials)),
+                ("textures", tex(&scene.textures_view)),
             ],
         )
     }
@@ -238,18 +196,16 @@ impl LightPathPass {
         }
         self.ensure_starts(device, job.paths);
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&job.params(lights)));
-        let tv = wgpu::BindingResource::TextureView;
-        let rsm_bind = bind_group_seq(
+        let rsm_bind = self.kernel.bind(
             device,
-            "light_paths::rsm_bind_group",
-            &self.rsm_layout,
+            0,
             &[
-                vpl_params.as_entire_binding(),
-                tv(&rsm.position_array),
-                tv(&rsm.normal_array),
-                tv(&rsm.flux_array),
-                pyramids.importance_pyramid.as_entire_binding(),
-                pyramids.flux_pyramid.as_entire_binding(),
+                ("params", buf(vpl_params)),
+                ("rsm_position", tex(&rsm.position_array)),
+                ("rsm_normal", tex(&rsm.normal_array)),
+                ("rsm_flux", tex(&rsm.flux_array)),
+                ("importance_pyramid", buf(&pyramids.importance_pyramid)),
+                ("flux_pyramid", buf(&pyramids.flux_pyramid)),
             ],
         );
         let path_bind = self.path_bind(device, scene, out);

@@ -88,19 +88,6 @@ pub fn bind_group_layout(
 /// that read parameters as storage ([`uniforms_as_storage`]).
 pub const PARAMS_USAGE: wgpu::BufferUsages = wgpu::BufferUsages::UNIFORM.union(wgpu::BufferUsages::STORAGE);
 
-pub fn uniform_entry(binding: u32, vis: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: vis,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 pub fn storage_entry(binding: u32, vis: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
@@ -109,74 +96,6 @@ pub fn storage_entry(binding: u32, vis: wgpu::ShaderStages, read_only: bool) -> 
             ty: wgpu::BufferBindingType::Storage { read_only },
             has_dynamic_offset: false,
             min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-pub(crate) fn texture_entry(
-    binding: u32,
-    vis: wgpu::ShaderStages,
-    sample_type: wgpu::TextureSampleType,
-    dim: wgpu::TextureViewDimension,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: vis,
-        ty: wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: dim,
-            multisampled: false,
-        },
-        count: None,
-    }
-}
-
-/// A uniform read with a dynamic offset (per-step/per-light parameters in one buffer).
-pub(crate) fn dynamic_uniform_entry(
-    binding: u32,
-    vis: wgpu::ShaderStages,
-    size: u64,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: vis,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: true,
-            min_binding_size: wgpu::BufferSize::new(size),
-        },
-        count: None,
-    }
-}
-
-/// An unfilterable float 2D-array texture read by compute shaders (RSM layers).
-pub(crate) fn float_array_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    texture_entry(
-        binding,
-        wgpu::ShaderStages::COMPUTE,
-        wgpu::TextureSampleType::Float { filterable: false },
-        wgpu::TextureViewDimension::D2Array,
-    )
-}
-
-pub(crate) fn float_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    texture_entry(
-        binding,
-        wgpu::ShaderStages::COMPUTE,
-        wgpu::TextureSampleType::Float { filterable: false },
-        wgpu::TextureViewDimension::D2,
-    )
-}
-
-pub(crate) fn storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format,
-            view_dimension: wgpu::TextureViewDimension::D2,
         },
         count: None,
     }
@@ -279,65 +198,6 @@ pub(crate) fn run_compute(
         pass.dispatch_workgroups(groups.0, groups.1, groups.2);
     }
     encoder.pop_debug_group();
-}
-
-pub(crate) fn compute_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    layouts: &[Option<&wgpu::BindGroupLayout>],
-    module: &wgpu::ShaderModule,
-    entry: &str,
-) -> wgpu::ComputePipeline {
-    compute_pipeline_with(device, label, layouts, module, entry, &[])
-}
-
-/// [`compute_pipeline`] with values of the shader's pipeline-overridable constants.
-pub(crate) fn compute_pipeline_with(
-    device: &wgpu::Device,
-    label: &str,
-    layouts: &[Option<&wgpu::BindGroupLayout>],
-    module: &wgpu::ShaderModule,
-    entry: &str,
-    constants: &[(&str, f64)],
-) -> wgpu::ComputePipeline {
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: layouts,
-        immediate_size: 0,
-    });
-    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some(label),
-        layout: Some(&layout),
-        module,
-        entry_point: Some(entry),
-        compilation_options: wgpu::PipelineCompilationOptions {
-            constants,
-            ..Default::default()
-        },
-        cache: None,
-    })
-}
-
-/// A bind group whose entries are `resources` at bindings 0, 1, 2, ...
-pub(crate) fn bind_group_seq(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::BindGroupLayout,
-    resources: &[wgpu::BindingResource<'_>],
-) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
-        .iter()
-        .enumerate()
-        .map(|(i, r)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: r.clone(),
-        })
-        .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(label),
-        layout,
-        entries: &entries,
-    })
 }
 
 #[cfg(test)]

@@ -7,16 +7,13 @@ use bytemuck::{Pod, Zeroable};
 use crate::renderer::{
     frame::{RSM_FLUX_FORMAT, RSM_NORMAL_FORMAT, RSM_POSITION_FORMAT, ShadowTargets},
     gpu_data::{GpuLights, MAX_LIGHTS},
+    kernel::{Kernel, KernelOptions, buf, sampler, tex},
     scene_gpu::SceneGpu,
     shaders,
     timing::GpuTimer,
 };
 
-use super::{
-    dynamic_uniform_entry,
-    gbuffer::{DEPTH_FORMAT, vertex_layout},
-    storage_entry, texture_entry,
-};
+use super::gbuffer::{DEPTH_FORMAT, vertex_layout};
 
 /// Uniform stride per light (dynamic offsets must be 256-byte aligned).
 const STRIDE: u64 = 256;
@@ -32,44 +29,19 @@ pub struct GpuRsmLight {
 
 pub struct RsmPass {
     pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     uniforms: wgpu::Buffer,
 }
 
 impl RsmPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "rsm.wgsl")?;
-        let layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("rsm::layout"),
-                entries: &[
-                    dynamic_uniform_entry(
-                        0,
-                        wgpu::ShaderStages::VERTEX_FRAGMENT,
-                        std::mem::size_of::<GpuRsmLight>() as u64,
-                    ),
-                    storage_entry(1, wgpu::ShaderStages::FRAGMENT, true),
-                    texture_entry(
-                        2,
-                        wgpu::ShaderStages::FRAGMENT,
-                        wgpu::TextureSampleType::Float { filterable: true },
-                        wgpu::TextureViewDimension::D2Array,
-                    ),
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 3,
-                        visibility: wgpu::ShaderStages::FRAGMENT,
-                        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                        count: None,
-                    },
-                ],
-            },
-        );
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("rsm::pipeline_layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+            "rsm.wgsl",
+            &["vs_main", "fs_main"],
+            KernelOptions { dynamic: &["light"] },
+        )?;
+        let pl = kernel.pipeline_layout(device, &["vs_main", "fs_main"]);
         let targets = [RSM_POSITION_FORMAT, RSM_NORMAL_FORMAT, RSM_FLUX_FORMAT].map(|format| {
             Some(wgpu::ColorTargetState {
                 format,
@@ -81,7 +53,7 @@ impl RsmPass {
             label: Some("rsm::pipeline"),
             layout: Some(&pl),
             vertex: wgpu::VertexState {
-                module: &module,
+                module: &kernel.module,
                 entry_point: Some("vs_main"),
                 compilation_options: Default::default(),
                 buffers: &[Some(vertex_layout())],
@@ -101,7 +73,7 @@ impl RsmPass {
             }),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
-                module: &module,
+                module: &kernel.module,
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
                 targets: &targets,
@@ -117,7 +89,7 @@ impl RsmPass {
         });
         Ok(Self {
             pipeline,
-            layout,
+            kernel,
             uniforms,
         })
     }
@@ -143,32 +115,23 @@ impl RsmPass {
             };
             queue.write_buffer(&self.uniforms, i as u64 * STRIDE, bytemuck::bytes_of(&u));
         }
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("rsm::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                (
+                    "light",
+                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                         buffer: &self.uniforms,
                         offset: 0,
                         size: wgpu::BufferSize::new(std::mem::size_of::<GpuRsmLight>() as u64),
                     }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: scene.materials.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&scene.textures_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::Sampler(&scene.sampler),
-                },
+                ),
+                ("materials", buf(&scene.materials)),
+                ("textures", tex(&scene.textures_view)),
+                ("tex_sampler", sampler(&scene.sampler)),
             ],
-        });
+        );
         encoder.push_debug_group("rsm");
         let clear = |view| {
             Some(wgpu::RenderPassColorAttachment {

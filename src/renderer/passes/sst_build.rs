@@ -3,6 +3,7 @@
 //! (separate pass, so a change of v_min / sigma_max costs one tiny dispatch, not a rebuild).
 //! Reads: the VPLs and the sorted (key, index) pairs. Writes: [`TreeBuffers`].
 
+use crate::renderer::kernel::{Kernel, KernelOptions, buf};
 use bytemuck::{Pod, Zeroable};
 
 use crate::{
@@ -15,10 +16,7 @@ use crate::{
     },
 };
 
-use super::{
-    WG_1D, bind_group_seq, compute_pipeline, lbvh::LbvhPass, run_compute, sst_sort::SortBuffers,
-    storage_entry, uniform_entry,
-};
+use super::{WG_1D, lbvh::LbvhPass, run_compute, sst_sort::SortBuffers};
 
 /// Twin: `TreeParams` in `shaders/sst_build.wgsl`.
 #[repr(C)]
@@ -136,55 +134,28 @@ impl TreeBuffers {
 pub struct BuildPass {
     lbvh: LbvhPass,
     build: wgpu::ComputePipeline,
-    build_layout: wgpu::BindGroupLayout,
+    build_kernel: Kernel,
     classify: wgpu::ComputePipeline,
-    classify_layout: wgpu::BindGroupLayout,
+    classify_kernel: Kernel,
     build_params: wgpu::Buffer,
 }
 
 impl BuildPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let module = shaders::create_module(device, "sst_build.wgsl")?;
-        let build_layout = crate::renderer::passes::bind_group_layout(
+        let build_kernel = Kernel::new(device, "sst_build.wgsl", &["build"], KernelOptions::default())?;
+        let classify_kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("sst_build::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, true),
-                    storage_entry(3, c, false),
-                    storage_entry(4, c, false),
-                    storage_entry(5, c, false),
-                ],
-            },
-        );
-        let cmodule = shaders::create_module(device, "sst_classify.wgsl")?;
-        let classify_layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("sst_classify::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, false),
-                ],
-            },
-        );
+            "sst_classify.wgsl",
+            &["classify"],
+            KernelOptions::default(),
+        )?;
         Ok(Self {
             lbvh: LbvhPass::new(device)?,
-            build: compute_pipeline(device, "sst_build", &[Some(&build_layout)], &module, "build"),
-            classify: compute_pipeline(
-                device,
-                "sst_classify",
-                &[Some(&classify_layout)],
-                &cmodule,
-                "classify",
-            ),
+            build: build_kernel.compute(device, "sst_build", "build"),
+            classify: classify_kernel.compute(device, "sst_classify", "classify"),
             build_params: super::uniform_buffer::<GpuTreeParams>(device, "sst_build::params"),
-            build_layout,
-            classify_layout,
+            build_kernel,
+            classify_kernel,
         })
     }
 
@@ -217,15 +188,18 @@ impl BuildPass {
             _pad: [0; 2],
         };
         queue.write_buffer(&self.build_params, 0, bytemuck::bytes_of(&p));
-        let entries = [
-            self.build_params.as_entire_binding(),
-            vpls.as_entire_binding(),
-            sort.keys.as_entire_binding(),
-            tree.nodes.as_entire_binding(),
-            tree.counters.as_entire_binding(),
-            tree.sorted_vpls.as_entire_binding(),
-        ];
-        let bind = bind_group_seq(device, "sst_build::bind_group", &self.build_layout, &entries);
+        let bind = self.build_kernel.bind(
+            device,
+            0,
+            &[
+                ("tp", buf(&self.build_params)),
+                ("vpls", buf(vpls)),
+                ("keys", buf(&sort.keys)),
+                ("nodes", buf(&tree.nodes)),
+                ("counters", buf(&tree.counters)),
+                ("sorted_vpls", buf(&tree.sorted_vpls)),
+            ],
+        );
         encoder.clear_buffer(&tree.counters, 0, None);
         run_compute(
             encoder,
@@ -258,16 +232,14 @@ impl BuildPass {
             _pad: 0,
         };
         queue.write_buffer(&tree.classify_params, 0, bytemuck::bytes_of(&p));
-        let entries = [
-            tree.classify_params.as_entire_binding(),
-            tree.nodes.as_entire_binding(),
-            tree.flags.as_entire_binding(),
-        ];
-        let bind = bind_group_seq(
+        let bind = self.classify_kernel.bind(
             device,
-            "sst_classify::bind_group",
-            &self.classify_layout,
-            &entries,
+            0,
+            &[
+                ("cp", buf(&tree.classify_params)),
+                ("tree", buf(&tree.nodes)),
+                ("flags", buf(&tree.flags)),
+            ],
         );
         run_compute(
             encoder,

@@ -5,6 +5,7 @@
 //! left, radix right). Reads: the tree(s), flags, parents, camera, G-buffer positions (to dim
 //! what is hidden). Writes: the view texture (alpha-blended raster).
 
+use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 
 use crate::renderer::{
@@ -13,9 +14,7 @@ use crate::renderer::{
     timing::GpuTimer,
 };
 
-use super::{
-    bind_group_seq, display::VIEW_FORMAT, sst_build::TreeBuffers, storage_entry, texture_entry, uniform_entry,
-};
+use super::{display::VIEW_FORMAT, sst_build::TreeBuffers};
 
 /// Twin: `OverlayParams` in `shaders/sst_overlay.wgsl`.
 #[repr(C)]
@@ -32,40 +31,17 @@ pub struct GpuOverlayParams {
 pub struct SstOverlayPass {
     ellipses: wgpu::RenderPipeline,
     boxes: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     params: wgpu::Buffer,
     params_b: wgpu::Buffer,
 }
 
 impl SstOverlayPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "sst_overlay.wgsl")?;
-        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("sst_overlay::layout"),
-                entries: &[
-                    uniform_entry(0, vf),
-                    uniform_entry(1, vf),
-                    storage_entry(2, wgpu::ShaderStages::VERTEX, true),
-                    storage_entry(3, wgpu::ShaderStages::VERTEX, true),
-                    texture_entry(
-                        4,
-                        wgpu::ShaderStages::FRAGMENT,
-                        wgpu::TextureSampleType::Float { filterable: false },
-                        wgpu::TextureViewDimension::D2,
-                    ),
-                    storage_entry(5, wgpu::ShaderStages::VERTEX, true),
-                    storage_entry(6, wgpu::ShaderStages::VERTEX, true),
-                ],
-            },
-        );
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("sst_overlay::pipeline_layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let entries = ["vs_ellipse", "fs_ellipse", "vs_box", "fs_box"];
+        let kernel = Kernel::new(device, "sst_overlay.wgsl", &entries, KernelOptions::default())?;
+        let pl = kernel.pipeline_layout(device, &entries);
+        let module = &kernel.module;
         let targets = [Some(wgpu::ColorTargetState {
             format: VIEW_FORMAT,
             blend: Some(wgpu::BlendState::ALPHA_BLENDING),
@@ -76,7 +52,7 @@ impl SstOverlayPass {
                 label: Some(label),
                 layout: Some(&pl),
                 vertex: wgpu::VertexState {
-                    module: &module,
+                    module,
                     entry_point: Some(vs),
                     compilation_options: Default::default(),
                     buffers: &[],
@@ -89,7 +65,7 @@ impl SstOverlayPass {
                 depth_stencil: None,
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
-                    module: &module,
+                    module,
                     entry_point: Some(fs),
                     compilation_options: Default::default(),
                     targets: &targets,
@@ -113,7 +89,7 @@ impl SstOverlayPass {
             ),
             params: super::uniform_buffer::<GpuOverlayParams>(device, "sst_overlay::params"),
             params_b: super::uniform_buffer::<GpuOverlayParams>(device, "sst_overlay::params_b"),
-            layout,
+            kernel,
         })
     }
 
@@ -184,16 +160,19 @@ impl SstOverlayPass {
         }
         encoder.push_debug_group("sst_overlay");
         for (k, ((tree, scissor), p)) in halves.iter().zip(&params).enumerate() {
-            let entries = [
-                bufs[k].as_entire_binding(),
-                camera.as_entire_binding(),
-                tree.nodes.as_entire_binding(),
-                tree.flags.as_entire_binding(),
-                wgpu::BindingResource::TextureView(gb_position),
-                tree.parents.as_entire_binding(),
-                tree.links.as_entire_binding(),
-            ];
-            let bind = bind_group_seq(device, "sst_overlay::bind_group", &self.layout, &entries);
+            let bind = self.kernel.bind(
+                device,
+                0,
+                &[
+                    ("op", buf(bufs[k])),
+                    ("camera", buf(camera)),
+                    ("tree", buf(&tree.nodes)),
+                    ("flags", buf(&tree.flags)),
+                    ("gb_position", tex(gb_position)),
+                    ("parents", buf(&tree.parents)),
+                    ("tree_links", buf(&tree.links)),
+                ],
+            );
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("sst_overlay"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {

@@ -5,6 +5,7 @@
 //! tree`'s before / after.
 //! Reads: the VPL array. Writes: [`SortBuffers`].
 
+use crate::renderer::kernel::{Kernel, KernelOptions, buf};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
@@ -14,7 +15,7 @@ use crate::renderer::{
     timing::GpuTimer,
 };
 
-use super::{WG_1D, compute_pipeline, dynamic_uniform_entry, storage_entry};
+use super::WG_1D;
 
 /// Twin: `SortParams` in `shaders/sst_sort.wgsl`.
 #[repr(C)]
@@ -180,41 +181,21 @@ pub struct SortPass {
     step: wgpu::ComputePipeline,
     pairs: wgpu::ComputePipeline,
     tile: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     params: wgpu::Buffer,
     pub variant: SortVariant,
 }
 
 impl SortPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "sst_sort.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("sst_sort::layout"),
-                entries: &[
-                    dynamic_uniform_entry(0, c, 16),
-                    storage_entry(1, c, true),
-                    storage_entry(2, c, false),
-                    storage_entry(3, c, false),
-                ],
-            },
-        );
-        let l = [Some(&layout)];
+        let kernel = Kernel::new(device, "sst_sort.wgsl", &[], KernelOptions { dynamic: &["sp"] })?;
         Ok(Self {
-            bounds: compute_pipeline(device, "sst_sort::bounds", &l, &module, "vpl_bounds"),
-            bounds_parallel: compute_pipeline(
-                device,
-                "sst_sort::bounds_parallel",
-                &l,
-                &module,
-                "vpl_bounds_parallel",
-            ),
-            keys: compute_pipeline(device, "sst_sort::keys", &l, &module, "make_keys"),
-            step: compute_pipeline(device, "sst_sort::bitonic", &l, &module, "bitonic_step"),
-            pairs: compute_pipeline(device, "sst_sort::bitonic_pairs", &l, &module, "bitonic_pairs"),
-            tile: compute_pipeline(device, "sst_sort::bitonic_tile", &l, &module, "bitonic_tile"),
+            bounds: kernel.compute(device, "sst_sort::bounds", "vpl_bounds"),
+            bounds_parallel: kernel.compute(device, "sst_sort::bounds_parallel", "vpl_bounds_parallel"),
+            keys: kernel.compute(device, "sst_sort::keys", "make_keys"),
+            step: kernel.compute(device, "sst_sort::bitonic", "bitonic_step"),
+            pairs: kernel.compute(device, "sst_sort::bitonic_pairs", "bitonic_pairs"),
+            tile: kernel.compute(device, "sst_sort::bitonic_tile", "bitonic_tile"),
             variant: SortVariant::default(),
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("sst_sort::params"),
@@ -224,37 +205,28 @@ impl SortPass {
                     | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
-            layout,
+            kernel,
         })
     }
 
     fn bind(&self, device: &wgpu::Device, vpls: &wgpu::Buffer, out: &SortBuffers) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sst_sort::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        self.kernel.bind(
+            device,
+            0,
+            &[
+                (
+                    "sp",
+                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                         buffer: &self.params,
                         offset: 0,
                         size: wgpu::BufferSize::new(16),
                     }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: vpls.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: out.keys.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: out.bounds.as_entire_binding(),
-                },
+                ),
+                ("vpls", buf(vpls)),
+                ("keys", buf(&out.keys)),
+                ("bounds", buf(&out.bounds)),
             ],
-        })
+        )
     }
 
     /// Records bounds + keys of the first `out.count` VPLs, then the sort.

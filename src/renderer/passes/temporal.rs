@@ -9,12 +9,10 @@
 //! `atrous_conserving` per iteration), then `temporal_modulate`.
 //! Settings: `settings::TemporalSettings` (`[temporal]`). Twin: `reference::temporal`.
 
+use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 
-use super::{
-    compute_pipeline, direct::RADIANCE_FORMAT, dynamic_uniform_entry, float_texture_entry, groups_image,
-    storage_buffer, storage_entry, storage_texture_entry, uniform_entry,
-};
+use super::{direct::RADIANCE_FORMAT, groups_image, storage_buffer};
 use crate::renderer::{
     frame::GbufferTargets,
     gpu_data::GpuCamera,
@@ -227,9 +225,8 @@ pub struct TemporalFrame {
 }
 
 struct Pipe {
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
-    bindings: &'static [u32],
 }
 
 pub struct TemporalPass {
@@ -255,53 +252,31 @@ pub struct TemporalPass {
     settings: TemporalSettings,
 }
 
-/// The layout entry of binding `b` (`shaders/temporal.wgsl`'s declarations).
-fn entry(b: u32) -> wgpu::BindGroupLayoutEntry {
-    let c = wgpu::ShaderStages::COMPUTE;
-    match b {
-        0 => dynamic_uniform_entry(0, c, std::mem::size_of::<GpuTemporalParams>() as u64),
-        1 | 2 => uniform_entry(b, c),
-        3..=5 => float_texture_entry(b),
-        6 | 7 | 9 | 10 | 18 => storage_entry(b, c, true),
-        23 => storage_texture_entry(b, RADIANCE_FORMAT),
-        24 => storage_texture_entry(b, wgpu::TextureFormat::Rgba8Unorm),
-        _ => storage_entry(b, c, false),
-    }
-}
-
 impl TemporalPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "temporal.wgsl")?;
-        let pipe = |entry_point: &str, bindings: &'static [u32]| {
-            let entries: Vec<_> = bindings.iter().map(|&b| entry(b)).collect();
-            let layout = crate::renderer::passes::bind_group_layout(
+        // One kernel per entry point: each binds the slots it reads of one table
+        // (`TemporalPass::bind`).
+        let pipe = |entry_point: &str| -> Result<Pipe, shaders::ShaderError> {
+            let kernel = Kernel::new(
                 device,
-                &wgpu::BindGroupLayoutDescriptor {
-                    label: Some("temporal::layout"),
-                    entries: &entries,
-                },
-            );
-            let pipeline = compute_pipeline(device, entry_point, &[Some(&layout)], &module, entry_point);
-            Pipe {
-                layout,
-                pipeline,
-                bindings,
-            }
+                "temporal.wgsl",
+                &[entry_point],
+                KernelOptions { dynamic: &["p"] },
+            )?;
+            let pipeline = kernel.compute(device, entry_point, entry_point);
+            Ok(Pipe { kernel, pipeline })
         };
         Ok(Self {
-            reproject: pipe(
-                "reproject",
-                &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 21],
-            ),
-            accumulate: pipe("accumulate", &[0, 1, 3, 4, 11, 12, 13, 14, 15, 16, 17]),
-            variance: pipe("variance", &[0, 1, 3, 4, 16, 17, 19]),
-            atrous: pipe("atrous", &[0, 1, 3, 4, 15, 18, 19, 22]),
-            atrous_prep: pipe("atrous_prep", &[0, 1, 3, 18, 25]),
-            atrous_weight: pipe("atrous_weight", &[0, 4, 25, 26]),
-            atrous_conserving: pipe("atrous_conserving", &[0, 4, 5, 15, 18, 19, 22, 25, 26]),
-            modulate: pipe("modulate", &[0, 3, 5, 18, 20]),
-            view_radiance: pipe("view_radiance", &[0, 5, 18, 23]),
-            view_heat: pipe("view_heat", &[0, 3, 18, 24]),
+            reproject: pipe("reproject")?,
+            accumulate: pipe("accumulate")?,
+            variance: pipe("variance")?,
+            atrous: pipe("atrous")?,
+            atrous_prep: pipe("atrous_prep")?,
+            atrous_weight: pipe("atrous_weight")?,
+            atrous_conserving: pipe("atrous_conserving")?,
+            modulate: pipe("modulate")?,
+            view_radiance: pipe("view_radiance")?,
+            view_heat: pipe("view_heat")?,
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("temporal::params"),
                 size: SLOTS as u64 * SLOT_STRIDE,
@@ -364,52 +339,47 @@ impl TemporalPass {
         let b = self.buffers.as_ref()?;
         let prev = 1 - parity;
         let g = i.gbuffer;
-        fn buf(x: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
-            x.as_entire_binding()
+        let params = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.params,
+            offset: 0,
+            size: wgpu::BufferSize::new(std::mem::size_of::<GpuTemporalParams>() as u64),
+        });
+        let mut table = vec![
+            ("p", params),
+            ("camera", buf(i.camera_buf)),
+            ("prev_camera", buf(&self.prev_camera)),
+            ("gb_position", tex(&g.position_view)),
+            ("gb_normal", tex(&g.normal_view)),
+            ("gb_albedo", tex(&g.albedo_view)),
+            ("accum", buf(i.accum)),
+            ("prev_gb", buf(&b.gb[prev])),
+            ("next_gb", buf(&b.gb[parity])),
+            ("hist_color_prev", buf(&b.hist_color[prev])),
+            ("hist_moments_prev", buf(&b.hist_moments[prev])),
+            ("current", buf(&b.current)),
+            ("reproj", buf(&b.reproj)),
+            ("reproj_moments", buf(&b.reproj_moments)),
+            ("motion", buf(&b.motion)),
+            ("hist_color_next", buf(&b.hist_color[parity])),
+            ("hist_moments_next", buf(&b.hist_moments[parity])),
+            ("integrated", buf(&b.integrated)),
+            ("out_radiance", buf(&b.out)),
+            ("raw", buf(&b.raw)),
+            ("iter_copy", buf(&b.iter_copy)),
+            ("view_radiance_out", tex(&b.view_tex_view)),
+            ("aux", buf(&b.aux)),
+            ("weight", buf(&b.weight)),
+        ];
+        if let Some(src) = src {
+            table.push(("src", buf(src)));
         }
-        let mut entries = Vec::new();
-        for &n in pipe.bindings {
-            let resource = match n {
-                0 => wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &self.params,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(std::mem::size_of::<GpuTemporalParams>() as u64),
-                }),
-                1 => buf(i.camera_buf),
-                2 => buf(&self.prev_camera),
-                3 => wgpu::BindingResource::TextureView(&g.position_view),
-                4 => wgpu::BindingResource::TextureView(&g.normal_view),
-                5 => wgpu::BindingResource::TextureView(&g.albedo_view),
-                6 => buf(i.accum),
-                7 => buf(&b.gb[prev]),
-                8 => buf(&b.gb[parity]),
-                9 => buf(&b.hist_color[prev]),
-                10 => buf(&b.hist_moments[prev]),
-                11 => buf(&b.current),
-                12 => buf(&b.reproj),
-                13 => buf(&b.reproj_moments),
-                14 => buf(&b.motion),
-                15 => buf(&b.hist_color[parity]),
-                16 => buf(&b.hist_moments[parity]),
-                17 => buf(&b.integrated),
-                18 => buf(src?),
-                19 => buf(dst?),
-                20 => buf(&b.out),
-                21 => buf(&b.raw),
-                22 => buf(&b.iter_copy),
-                23 => wgpu::BindingResource::TextureView(&b.view_tex_view),
-                24 => wgpu::BindingResource::TextureView(view_out?),
-                25 => buf(&b.aux),
-                26 => buf(&b.weight),
-                _ => return None,
-            };
-            entries.push(wgpu::BindGroupEntry { binding: n, resource });
+        if let Some(dst) = dst {
+            table.push(("dst", buf(dst)));
         }
-        Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("temporal::bind_group"),
-            layout: &pipe.layout,
-            entries: &entries,
-        }))
+        if let Some(v) = view_out {
+            table.push(("view_out", tex(v)));
+        }
+        pipe.kernel.bind_from(device, 0, &table)
     }
 
     /// Records one frame of the stage with `s` (mode not off) and returns the buffer the

@@ -6,13 +6,11 @@
 //! flux), the seeds. Writes: [`ValTargets`] (the clusters, each texel's key). Twin:
 //! `reference::val` (docs/val.md).
 
+use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, UVec2, Vec3};
 
-use super::{
-    WG_1D, WG_2D, bind_group_seq, compute_pipeline, float_array_texture_entry, storage_buffer, storage_entry,
-    uniform_buffer, uniform_entry,
-};
+use super::{WG_1D, WG_2D, storage_buffer, uniform_buffer};
 use crate::reference::val::{MAX_CLUSTERS, NONE, Val};
 use crate::renderer::{shaders, timing::GpuTimer};
 
@@ -170,7 +168,7 @@ impl ValSeeds<'_> {
 }
 
 pub struct ValClusterPass {
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     clear: wgpu::ComputePipeline,
     seed: wgpu::ComputePipeline,
     map: wgpu::ComputePipeline,
@@ -182,26 +180,20 @@ pub struct ValClusterPass {
 
 impl ValClusterPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let module = shaders::create_module(device, "val_cluster.wgsl")?;
-        let layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("val_cluster::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    float_array_texture_entry(1),
-                    float_array_texture_entry(2),
-                    float_array_texture_entry(3),
-                    storage_entry(4, c, true),
-                    storage_entry(5, c, false),
-                    storage_entry(6, c, false),
-                    storage_entry(7, c, false),
-                    storage_entry(8, c, true),
-                ],
-            },
-        );
-        let pipe = |entry: &str| compute_pipeline(device, entry, &[Some(&layout)], &module, entry);
+            "val_cluster.wgsl",
+            &[
+                "clear_main",
+                "seed_main",
+                "map_main",
+                "fallback_main",
+                "average_main",
+                "reseed_main",
+            ],
+            KernelOptions::default(),
+        )?;
+        let pipe = |entry: &str| kernel.compute(device, entry, entry);
         Ok(Self {
             clear: pipe("clear_main"),
             seed: pipe("seed_main"),
@@ -210,7 +202,7 @@ impl ValClusterPass {
             average: pipe("average_main"),
             reseed: pipe("reseed_main"),
             params: uniform_buffer::<GpuValParams>(device, "val_cluster::params"),
-            layout,
+            kernel,
         })
     }
 
@@ -259,20 +251,19 @@ impl ValClusterPass {
         }
         // (in, out): 0 -> 1 and 1 -> 0.
         let bind = |i: usize| {
-            bind_group_seq(
+            self.kernel.bind(
                 device,
-                "val_cluster::bind_group",
-                &self.layout,
+                0,
                 &[
-                    self.params.as_entire_binding(),
-                    wgpu::BindingResource::TextureView(rsm[0]),
-                    wgpu::BindingResource::TextureView(rsm[1]),
-                    wgpu::BindingResource::TextureView(rsm[2]),
-                    t.vals[i].as_entire_binding(),
-                    t.vals[1 - i].as_entire_binding(),
-                    t.keys.as_entire_binding(),
-                    t.fallback.as_entire_binding(),
-                    t.seeds.as_entire_binding(),
+                    ("vp", buf(&self.params)),
+                    ("rsm_position", tex(rsm[0])),
+                    ("rsm_normal", tex(rsm[1])),
+                    ("rsm_flux", tex(rsm[2])),
+                    ("vals_in", buf(&t.vals[i])),
+                    ("vals_out", t.vals[1 - i].as_entire_binding()),
+                    ("keys", buf(&t.keys)),
+                    ("fallback", buf(&t.fallback)),
+                    ("seeds", buf(&t.seeds)),
                 ],
             )
         };

@@ -1,12 +1,14 @@
 //! Visualise: maps any non-radiance buffer (normals, albedo, positions, depth, ids, shadow-map
 //! depth, integer buffers) to a viewable image in the `Rgba8Unorm` view texture.
 
-use crate::renderer::{gpu_data::VisParams, shaders, timing::GpuTimer};
-
-use super::{
-    compute_pipeline, display::VIEW_FORMAT, float_texture_entry, groups_2d, storage_texture_entry,
-    texture_entry, uniform_entry,
+use crate::renderer::{
+    gpu_data::VisParams,
+    kernel::{Kernel, KernelOptions, buf, tex},
+    shaders,
+    timing::GpuTimer,
 };
+
+use super::groups_2d;
 
 /// Twin of the mode table at the top of `shaders/visualise.wgsl`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,123 +43,30 @@ pub enum VisSource<'a> {
 }
 
 pub struct VisualisePass {
-    float_pipeline: wgpu::ComputePipeline,
-    depth_pipeline: wgpu::ComputePipeline,
-    uint_pipeline: wgpu::ComputePipeline,
-    array_pipeline: wgpu::ComputePipeline,
-    scalar_pipeline: wgpu::ComputePipeline,
-    array_layout: wgpu::BindGroupLayout,
-    scalar_layout: wgpu::BindGroupLayout,
-    common_layout: wgpu::BindGroupLayout,
-    float_layout: wgpu::BindGroupLayout,
-    depth_layout: wgpu::BindGroupLayout,
-    uint_layout: wgpu::BindGroupLayout,
+    /// One kernel per source kind (each entry point binds its source in its own group).
+    float: (Kernel, wgpu::ComputePipeline),
+    depth: (Kernel, wgpu::ComputePipeline),
+    uint: (Kernel, wgpu::ComputePipeline),
+    array: (Kernel, wgpu::ComputePipeline),
+    scalar: (Kernel, wgpu::ComputePipeline),
     params: wgpu::Buffer,
 }
 
 impl VisualisePass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "visualise.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let bgl = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
-            crate::renderer::passes::bind_group_layout(
-                device,
-                &wgpu::BindGroupLayoutDescriptor {
-                    label: Some(label),
-                    entries,
-                },
-            )
-        };
-        let common_layout = bgl(
-            "visualise::common_layout",
-            &[uniform_entry(0, c), storage_texture_entry(1, VIEW_FORMAT)],
-        );
-        let float_layout = bgl("visualise::float_layout", &[float_texture_entry(0)]);
-        let depth_layout = bgl(
-            "visualise::depth_layout",
-            &[texture_entry(
-                0,
-                c,
-                wgpu::TextureSampleType::Depth,
-                wgpu::TextureViewDimension::D2Array,
-            )],
-        );
-        let uint_layout = bgl(
-            "visualise::uint_layout",
-            &[texture_entry(
-                0,
-                c,
-                wgpu::TextureSampleType::Uint,
-                wgpu::TextureViewDimension::D2,
-            )],
-        );
-        let array_layout = bgl(
-            "visualise::array_layout",
-            &[texture_entry(
-                2,
-                c,
-                wgpu::TextureSampleType::Float { filterable: false },
-                wgpu::TextureViewDimension::D2Array,
-            )],
-        );
-        let scalar_layout = bgl(
-            "visualise::scalar_layout",
-            &[super::storage_entry(3, c, true), super::storage_entry(4, c, true)],
-        );
-        let array_pipeline = compute_pipeline(
-            device,
-            "visualise::array_pipeline",
-            &[Some(&common_layout), Some(&array_layout)],
-            &module,
-            "vis_array",
-        );
-        let scalar_pipeline = compute_pipeline(
-            device,
-            "visualise::scalar_pipeline",
-            &[Some(&common_layout), Some(&scalar_layout)],
-            &module,
-            "vis_scalar",
-        );
-        let float_pipeline = compute_pipeline(
-            device,
-            "visualise::float_pipeline",
-            &[Some(&common_layout), Some(&float_layout)],
-            &module,
-            "vis_float",
-        );
-        let depth_pipeline = compute_pipeline(
-            device,
-            "visualise::depth_pipeline",
-            &[Some(&common_layout), None, Some(&depth_layout)],
-            &module,
-            "vis_depth",
-        );
-        let uint_pipeline = compute_pipeline(
-            device,
-            "visualise::uint_pipeline",
-            &[Some(&common_layout), None, None, Some(&uint_layout)],
-            &module,
-            "vis_uint",
-        );
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("visualise::params"),
-            size: std::mem::size_of::<VisParams>() as u64,
-            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let kernel =
+            |entry: &str, label: &str| -> Result<(Kernel, wgpu::ComputePipeline), shaders::ShaderError> {
+                let k = Kernel::new(device, "visualise.wgsl", &[entry], KernelOptions::default())?;
+                let p = k.compute(device, label, entry);
+                Ok((k, p))
+            };
         Ok(Self {
-            float_pipeline,
-            depth_pipeline,
-            uint_pipeline,
-            array_pipeline,
-            scalar_pipeline,
-            array_layout,
-            scalar_layout,
-            common_layout,
-            float_layout,
-            depth_layout,
-            uint_layout,
-            params,
+            float: kernel("vis_float", "visualise::float_pipeline")?,
+            depth: kernel("vis_depth", "visualise::depth_pipeline")?,
+            uint: kernel("vis_uint", "visualise::uint_pipeline")?,
+            array: kernel("vis_array", "visualise::array_pipeline")?,
+            scalar: kernel("vis_scalar", "visualise::scalar_pipeline")?,
+            params: super::uniform_buffer::<VisParams>(device, "visualise::params"),
         })
     }
 
@@ -189,89 +98,19 @@ impl VisualisePass {
             range_max,
         };
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        let tv = wgpu::BindingResource::TextureView;
-        let common = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("visualise::common"),
-            layout: &self.common_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: tv(dst),
-                },
-            ],
-        });
-        let (pipeline, group, source) = match src {
-            VisSource::Float(view) => (
-                &self.float_pipeline,
-                1,
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("visualise::float_source"),
-                    layout: &self.float_layout,
-                    entries: &[wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: tv(view),
-                    }],
-                }),
-            ),
-            VisSource::Depth(view, _) => (
-                &self.depth_pipeline,
-                2,
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("visualise::depth_source"),
-                    layout: &self.depth_layout,
-                    entries: &[wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: tv(view),
-                    }],
-                }),
-            ),
-            VisSource::Array(view, _) => (
-                &self.array_pipeline,
-                1,
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("visualise::array_source"),
-                    layout: &self.array_layout,
-                    entries: &[wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: tv(view),
-                    }],
-                }),
-            ),
+        let ((kernel, pipeline), group, source) = match &src {
+            VisSource::Float(view) => (&self.float, 1, vec![("src_float", tex(view))]),
+            VisSource::Depth(view, _) => (&self.depth, 2, vec![("src_depth", tex(view))]),
+            VisSource::Array(view, _) => (&self.array, 1, vec![("src_array", tex(view))]),
             VisSource::Scalar(values, pyramid) => (
-                &self.scalar_pipeline,
+                &self.scalar,
                 1,
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("visualise::scalar_source"),
-                    layout: &self.scalar_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 3,
-                            resource: values.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 4,
-                            resource: pyramid.as_entire_binding(),
-                        },
-                    ],
-                }),
+                vec![("src_scalar", buf(values)), ("src_pyramid", buf(pyramid))],
             ),
-            VisSource::Uint(view) => (
-                &self.uint_pipeline,
-                3,
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("visualise::uint_source"),
-                    layout: &self.uint_layout,
-                    entries: &[wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: tv(view),
-                    }],
-                }),
-            ),
+            VisSource::Uint(view) => (&self.uint, 3, vec![("src_uint", tex(view))]),
         };
+        let common = kernel.bind(device, 0, &[("params", buf(&self.params)), ("dst", tex(dst))]);
+        let source = kernel.bind(device, group, &source);
         encoder.push_debug_group("visualise");
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

@@ -9,6 +9,7 @@ use crate::{
     renderer::{
         frame::{GbufferTargets, ShadowTargets},
         gpu_data::{GpuVpl, GpuVplParams, MAX_LIGHTS},
+        kernel::{Kernel, KernelOptions, buf, tex},
         settings::{GiSettings, VplMode, VplSettings},
         shaders,
         timing::GpuTimer,
@@ -16,10 +17,7 @@ use crate::{
     scene::DirectionalLight,
 };
 
-use super::{
-    WG_1D, compute_pipeline, dynamic_uniform_entry, float_array_texture_entry, float_texture_entry,
-    groups_2d, storage_entry, uniform_entry,
-};
+use super::{WG_1D, groups_2d};
 
 /// Dynamic-offset stride of the per-level uniforms.
 const LEVEL_STRIDE: u64 = 256;
@@ -154,46 +152,21 @@ pub struct VplGenPass {
     filter: wgpu::ComputePipeline,
     reduce: wgpu::ComputePipeline,
     warp: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
-    level_layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     params: wgpu::Buffer,
     level_params: wgpu::Buffer,
 }
 
 impl VplGenPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "vpl_gen.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = crate::renderer::passes::bind_group_layout(
+        let kernel = Kernel::new(
             device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("vpl_gen::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    uniform_entry(1, c),
-                    float_array_texture_entry(2),
-                    float_array_texture_entry(3),
-                    float_array_texture_entry(4),
-                    float_texture_entry(5),
-                    float_texture_entry(6),
-                    float_texture_entry(7),
-                    storage_entry(8, c, false),
-                    storage_entry(9, c, false),
-                    storage_entry(10, c, false),
-                    storage_entry(11, c, false),
-                    storage_entry(12, c, false),
-                ],
+            "vpl_gen.wgsl",
+            &["importance", "filter_importance", "reduce", "warp_vpls"],
+            KernelOptions {
+                dynamic: &["level_params"],
             },
-        );
-        let level_layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("vpl_gen::level_layout"),
-                entries: &[dynamic_uniform_entry(0, c, 4)],
-            },
-        );
-        let one = [Some(&layout)];
-        let two = [Some(&layout), Some(&level_layout)];
+        )?;
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("vpl_gen::params"),
             size: std::mem::size_of::<GpuVplParams>() as u64,
@@ -211,12 +184,11 @@ impl VplGenPass {
             usage: crate::renderer::passes::PARAMS_USAGE,
         });
         Ok(Self {
-            importance: compute_pipeline(device, "vpl_gen::importance", &one, &module, "importance"),
-            filter: compute_pipeline(device, "vpl_gen::filter", &one, &module, "filter_importance"),
-            reduce: compute_pipeline(device, "vpl_gen::reduce", &two, &module, "reduce"),
-            warp: compute_pipeline(device, "vpl_gen::warp", &one, &module, "warp_vpls"),
-            layout,
-            level_layout,
+            importance: kernel.compute(device, "vpl_gen::importance", "importance"),
+            filter: kernel.compute(device, "vpl_gen::filter", "filter_importance"),
+            reduce: kernel.compute(device, "vpl_gen::reduce", "reduce"),
+            warp: kernel.compute(device, "vpl_gen::warp", "warp_vpls"),
+            kernel,
             params,
             level_params,
         })
@@ -280,77 +252,37 @@ impl VplGenPass {
             p.level_offsets[l / 4][l % 4] = *o;
         }
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        let tv = wgpu::BindingResource::TextureView;
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("vpl_gen::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: tv(&rsm.position_array),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: tv(&rsm.normal_array),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: tv(&rsm.flux_array),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: tv(&gbuffer.position_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: tv(&gbuffer.normal_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: tv(&gbuffer.albedo_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 8,
-                    resource: out.importance_raw.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 9,
-                    resource: out.importance_pyramid.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 10,
-                    resource: out.flux_pyramid.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 11,
-                    resource: out.vpls.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 12,
-                    resource: out.bounds_pyramid.as_entire_binding(),
-                },
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                ("params", buf(&self.params)),
+                ("camera", buf(camera)),
+                ("rsm_position", tex(&rsm.position_array)),
+                ("rsm_normal", tex(&rsm.normal_array)),
+                ("rsm_flux", tex(&rsm.flux_array)),
+                ("gb_position", tex(&gbuffer.position_view)),
+                ("gb_normal", tex(&gbuffer.normal_view)),
+                ("gb_albedo", tex(&gbuffer.albedo_view)),
+                ("importance_raw", buf(&out.importance_raw)),
+                ("importance_pyramid", buf(&out.importance_pyramid)),
+                ("flux_pyramid", buf(&out.flux_pyramid)),
+                ("vpls", buf(&out.vpls)),
+                ("bounds_pyramid", buf(&out.bounds_pyramid)),
             ],
-        });
-        let level_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("vpl_gen::level_bind_group"),
-            layout: &self.level_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        );
+        let level_bind = self.kernel.bind(
+            device,
+            1,
+            &[(
+                "level_params",
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                     buffer: &self.level_params,
                     offset: 0,
                     size: wgpu::BufferSize::new(4),
                 }),
-            }],
-        });
+            )],
+        );
         let layers = lights.len().max(1) as u32;
         let (gx, gy) = groups_2d(res, res);
         encoder.push_debug_group("vpl_gen");

@@ -1,14 +1,12 @@
 //! VPL overlay: the frame's VPLs as discs over the view texture, coloured by flux (log scale
 //! around the mean VPL flux). Reads: VPLs, camera, G-buffer. Writes: the view texture.
 
+use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 
 use crate::renderer::{shaders, timing::GpuTimer};
 
-use super::{
-    WG_1D, compute_pipeline, display::VIEW_FORMAT, float_texture_entry, run_compute, storage_entry,
-    storage_texture_entry, uniform_buffer, uniform_entry,
-};
+use super::{WG_1D, run_compute, uniform_buffer};
 
 /// Twin: `SplatParams` in `shaders/vpl_splat.wgsl`.
 #[repr(C)]
@@ -30,33 +28,18 @@ pub struct GpuSplatParams {
 
 pub struct VplSplatPass {
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    kernel: Kernel,
     params: wgpu::Buffer,
 }
 
 impl VplSplatPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let module = shaders::create_module(device, "vpl_splat.wgsl")?;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = crate::renderer::passes::bind_group_layout(
-            device,
-            &wgpu::BindGroupLayoutDescriptor {
-                label: Some("vpl_splat::layout"),
-                entries: &[
-                    uniform_entry(0, c),
-                    uniform_entry(1, c),
-                    storage_entry(2, c, true),
-                    float_texture_entry(3),
-                    storage_texture_entry(4, VIEW_FORMAT),
-                    storage_entry(5, c, true),
-                ],
-            },
-        );
-        let pipeline = compute_pipeline(device, "vpl_splat::pipeline", &[Some(&layout)], &module, "main");
+        let kernel = Kernel::new(device, "vpl_splat.wgsl", &["main"], KernelOptions::default())?;
+        let pipeline = kernel.compute(device, "vpl_splat::pipeline", "main");
         let params = uniform_buffer::<GpuSplatParams>(device, "vpl_splat::params");
         Ok(Self {
             pipeline,
-            layout,
+            kernel,
             params,
         })
     }
@@ -79,36 +62,18 @@ impl VplSplatPass {
             return;
         }
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("vpl_splat::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: vpls.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(gb_position),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::TextureView(dst),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: flux_pyramid.as_entire_binding(),
-                },
+        let bind = self.kernel.bind(
+            device,
+            0,
+            &[
+                ("sp", buf(&self.params)),
+                ("camera", buf(camera)),
+                ("vpls", buf(vpls)),
+                ("gb_position", tex(gb_position)),
+                ("dst", tex(dst)),
+                ("flux_pyramid", buf(flux_pyramid)),
             ],
-        });
+        );
         run_compute(
             encoder,
             timer,

@@ -1,0 +1,340 @@
+//! How far a GI method is from being "one folder plus one registry line" (issue 38): for each
+//! method module (`src/methods/<folder>/`), the source files outside its folder that name it
+//! in code. Run it to see the table:
+//!
+//!     cargo test --release --test method_coupling -- --nocapture
+//!
+//! What counts as naming a module `m` (comments stripped): a path through the registry's
+//! module (`methods::m`, `methods::{.., m, ..}`, or `super::m` from a sibling under
+//! `src/methods/`), one of the module's own type names (a `pub struct` / `enum` / `trait` /
+//! `type` defined only in its folder, re-exports included), or one of its methods' CLI ids as
+//! a string literal (but for ids that are common values, `SHARED_WORDS`). The registry file (`src/methods/mod.rs`) is reported apart: its lines are
+//! the registry.
+//!
+//! The test holds each module to its count (a ratchet: it may fall, never grow); lower the
+//! numbers in `LIMITS` when a change moves code home.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Files outside its folder (registry file excluded) that may name each module today.
+const LIMITS: &[(&str, usize)] = &[
+    ("direct_only", 0),
+    ("ground_truth", 2),
+    ("light_culling", 5),
+    ("lightcut_interpolation", 4),
+    ("lightcuts", 8),
+    ("reference", 0),
+    ("tree_samplers", 16),
+    ("val", 4),
+];
+
+/// Method ids that are also other settings' values ("off": the temporal stage's mode, a
+/// view's false colour): as string literals they name no method.
+const SHARED_WORDS: &[&str] = &["off"];
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(rd) = std::fs::read_dir(dir) else { return };
+    let mut entries: Vec<_> = rd.filter_map(|e| e.ok()).map(|e| e.path()).collect();
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|e| e == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// The text with `//` and `/* */` comments blanked (string literals kept; line numbers kept).
+fn strip_comments(text: &str) -> String {
+    let b = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    let mut in_str = false;
+    while i < b.len() {
+        let c = b[i] as char;
+        if in_str {
+            out.push(c);
+            if c == '\\' && i + 1 < b.len() {
+                out.push(b[i + 1] as char);
+                i += 2;
+                continue;
+            }
+            if c == '"' {
+                in_str = false;
+            }
+            i += 1;
+        } else if c == '"' {
+            in_str = true;
+            out.push(c);
+            i += 1;
+        } else if c == '\'' && i + 2 < b.len() && (b[i + 2] == b'\'' || b[i + 1] == b'\\') {
+            // A char literal ('"', '\n'): copied whole so its quote opens no string.
+            let end = text[i + 1..].find('\'').map_or(b.len(), |k| i + 1 + k + 1);
+            let end = if b[i + 1] == b'\\' {
+                text[i + 2..].find('\'').map_or(b.len(), |k| i + 2 + k + 1)
+            } else {
+                end
+            };
+            out.push_str(&text[i..end]);
+            i = end;
+        } else if text[i..].starts_with("//") {
+            while i < b.len() && b[i] != b'\n' {
+                i += 1;
+            }
+        } else if text[i..].starts_with("/*") {
+            let end = text[i + 2..].find("*/").map_or(b.len(), |k| i + 2 + k + 2);
+            for ch in text[i..end].chars() {
+                if ch == '\n' {
+                    out.push('\n');
+                }
+            }
+            i = end;
+        } else {
+            let ch = text[i..].chars().next().unwrap_or(' ');
+            out.push(ch);
+            i += ch.len_utf8();
+        }
+    }
+    out
+}
+
+fn is_ident(c: char) -> bool {
+    c.is_ascii_alphanumeric() || c == '_'
+}
+
+/// Whether `word` occurs in `line` as a whole identifier.
+fn has_word(line: &str, word: &str) -> bool {
+    let mut from = 0;
+    while let Some(k) = line[from..].find(word) {
+        let s = from + k;
+        let e = s + word.len();
+        let before = line[..s].chars().next_back().is_none_or(|c| !is_ident(c));
+        let after = line[e..].chars().next().is_none_or(|c| !is_ident(c));
+        if before && after {
+            return true;
+        }
+        from = e;
+    }
+    false
+}
+
+/// The names a `methods::{...}` group imports at its top level (nested groups flattened).
+fn group_names(code: &str) -> Vec<(usize, String)> {
+    let mut out = Vec::new();
+    let mut from = 0;
+    while let Some(k) = code[from..].find("methods::{") {
+        let open = from + k + "methods::".len();
+        let mut depth = 0;
+        let mut end = open;
+        for (j, c) in code[open..].char_indices() {
+            match c {
+                '{' => depth += 1,
+                '}' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        end = open + j;
+                        break;
+                    }
+                }
+                _ => {}
+            }
+        }
+        let line = code[..open].matches('\n').count() + 1;
+        let inner = &code[open + 1..end.max(open + 1)];
+        let mut depth = 0;
+        let mut cur = String::new();
+        for c in inner.chars() {
+            match c {
+                '{' => depth += 1,
+                '}' => depth -= 1,
+                _ if depth == 0 && (c == ',' || c.is_whitespace()) && !cur.is_empty() => {
+                    out.push((line, std::mem::take(&mut cur)));
+                }
+                _ if depth == 0 && c != ':' => cur.push(c),
+                _ if depth == 0 && !cur.is_empty() => {
+                    out.push((line, std::mem::take(&mut cur)));
+                }
+                _ => {}
+            }
+        }
+        if !cur.is_empty() {
+            out.push((line, cur));
+        }
+        from = end.max(open + 1);
+    }
+    out
+}
+
+struct Module {
+    folder: String,
+    ids: Vec<String>,
+    types: BTreeSet<String>,
+}
+
+fn modules(root: &Path) -> Vec<Module> {
+    let methods = root.join("src/methods");
+    let mut mods = Vec::new();
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(&methods)
+        .expect("src/methods")
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.is_dir())
+        .collect();
+    dirs.sort();
+    let mut all = Vec::new();
+    rust_files(&root.join("src"), &mut all);
+    for d in dirs {
+        let folder = d.file_name().unwrap().to_string_lossy().to_string();
+        let mut files = Vec::new();
+        rust_files(&d, &mut files);
+        let mut ids = Vec::new();
+        let mut types = BTreeSet::new();
+        for f in &files {
+            let text = strip_comments(&std::fs::read_to_string(f).unwrap());
+            for part in text.split("MethodId::new(\"").skip(1) {
+                if let Some(end) = part.find('"') {
+                    ids.push(part[..end].to_string());
+                }
+            }
+            for line in text.lines() {
+                let t = line.trim_start();
+                for kw in ["pub struct ", "pub enum ", "pub trait ", "pub type "] {
+                    if let Some(rest) = t.strip_prefix(kw) {
+                        let name: String = rest.chars().take_while(|c| is_ident(*c)).collect();
+                        if name.len() >= 5 {
+                            types.insert(name);
+                        }
+                    }
+                }
+            }
+        }
+        mods.push(Module { folder, ids, types });
+    }
+    // A type name defined outside the folder too is not the module's own.
+    for f in &all {
+        let text = strip_comments(&std::fs::read_to_string(f).unwrap());
+        for m in &mut mods {
+            if f.starts_with(methods.join(&m.folder)) {
+                continue;
+            }
+            m.types.retain(|ty| {
+                !["struct ", "enum ", "trait ", "type "].iter().any(|kw| {
+                    text.lines()
+                        .any(|l| has_word(l, ty) && l.contains(&format!("{kw}{ty}")))
+                })
+            });
+        }
+    }
+    mods
+}
+
+/// Per module, per file outside its folder, the lines naming it and what they name.
+type Table = BTreeMap<String, BTreeMap<String, Vec<String>>>;
+
+/// The table and the modules it was made for.
+fn coupling(root: &Path) -> (Table, Vec<Module>) {
+    let mods = modules(root);
+    let mut files = Vec::new();
+    rust_files(&root.join("src"), &mut files);
+    let mut table = Table::new();
+    for f in &files {
+        let rel = f.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/");
+        let code = strip_comments(&std::fs::read_to_string(f).unwrap());
+        let groups = group_names(&code);
+        let in_methods = rel.starts_with("src/methods/");
+        for m in &mods {
+            if rel.starts_with(&format!("src/methods/{}/", m.folder)) {
+                continue;
+            }
+            let mut hits = Vec::new();
+            for (n, line) in code.lines().enumerate() {
+                let mut what = Vec::new();
+                if line.contains(&format!("methods::{}", m.folder)) && has_word(line, &m.folder) {
+                    what.push(format!("methods::{}", m.folder));
+                }
+                if in_methods && line.contains(&format!("super::{}", m.folder)) && has_word(line, &m.folder) {
+                    what.push(format!("super::{}", m.folder));
+                }
+                for ty in &m.types {
+                    if has_word(line, ty) {
+                        what.push(ty.clone());
+                    }
+                }
+                for id in m.ids.iter().filter(|i| !SHARED_WORDS.contains(&i.as_str())) {
+                    if line.contains(&format!("\"{id}\"")) {
+                        what.push(format!("\"{id}\""));
+                    }
+                }
+                if !what.is_empty() {
+                    hits.push(format!("{}: {}", n + 1, what.join(", ")));
+                }
+            }
+            for (n, name) in &groups {
+                if *name == m.folder {
+                    hits.push(format!("{n}: methods::{{{}}}", m.folder));
+                }
+            }
+            if !hits.is_empty() {
+                table
+                    .entry(m.folder.clone())
+                    .or_default()
+                    .insert(rel.clone(), hits);
+            }
+        }
+    }
+    (table, mods)
+}
+
+#[test]
+fn each_method_is_named_outside_its_folder_no_more_than_before() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (table, mods) = coupling(root);
+    let mut over = Vec::new();
+    println!("files outside a method's folder that name it in code (registry file apart):");
+    for m in &mods {
+        let files = table.get(&m.folder).cloned().unwrap_or_default();
+        let outside: Vec<&String> = files.keys().filter(|f| *f != "src/methods/mod.rs").collect();
+        let limit = LIMITS
+            .iter()
+            .find(|(n, _)| *n == m.folder)
+            .map(|(_, l)| *l)
+            .unwrap_or_else(|| panic!("add '{}' to LIMITS", m.folder));
+        println!(
+            "  {} ({} files, limit {limit}; ids {:?}):",
+            m.folder,
+            outside.len(),
+            m.ids
+        );
+        for (f, hits) in &files {
+            let tag = if f == "src/methods/mod.rs" {
+                " [registry]"
+            } else {
+                ""
+            };
+            println!("    {f}{tag}: {}", hits.join("; "));
+        }
+        if outside.len() > limit {
+            over.push(format!("{}: {} files > {limit}", m.folder, outside.len()));
+        }
+    }
+    assert!(
+        over.is_empty(),
+        "a method is named in more files than before: {over:?}"
+    );
+}
+
+#[test]
+fn the_scan_finds_paths_groups_types_and_ids() {
+    let code = strip_comments(
+        "use crate::methods::{self, lightcuts::pass, val};\n// methods::val in a comment\nlet x = \"slc\"; /* methods::x */\n",
+    );
+    assert!(!code.contains("comment") && !code.contains("methods::x"));
+    let g: Vec<String> = group_names(&code).into_iter().map(|(_, n)| n).collect();
+    assert!(
+        g.contains(&"lightcuts".to_string()) && g.contains(&"val".to_string()),
+        "{g:?}"
+    );
+    assert!(has_word("a TreeSamplers b", "TreeSamplers") && !has_word("TreeSamplersX", "TreeSamplers"));
+}
