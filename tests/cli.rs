@@ -451,3 +451,17 @@ fn sheet_writes_a_comparison_image_and_its_metrics() {
         "{err}"
     );
 }
+
+#[test]
+fn render_help_lists_every_registered_method() {
+    let out = bin().args(["render", "--help"]).output().expect("run");
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    for m in lightcut::methods::REGISTRY {
+        assert!(
+            text.contains(&format!("{} ({})", m.id.cli(), m.short)),
+            "`render --help` lacks {}: {text}",
+            m.id
+        );
+    }
+}

@@ -146,17 +146,15 @@ fn group_names(code: &str) -> Vec<(usize, String)> {
         let mut depth = 0;
         let mut cur = String::new();
         for c in inner.chars() {
-            match c {
-                '{' => depth += 1,
-                '}' => depth -= 1,
-                _ if depth == 0 && (c == ',' || c.is_whitespace()) && !cur.is_empty() => {
+            if c == '{' || c == '}' {
+                depth += if c == '{' { 1 } else { -1 };
+            } else if depth == 0 && (c == ',' || c == ':' || c.is_whitespace()) {
+                // A separator (comma, space, `::`) ends a name.
+                if !cur.is_empty() {
                     out.push((line, std::mem::take(&mut cur)));
                 }
-                _ if depth == 0 && c != ':' => cur.push(c),
-                _ if depth == 0 && !cur.is_empty() => {
-                    out.push((line, std::mem::take(&mut cur)));
-                }
-                _ => {}
+            } else if depth == 0 {
+                cur.push(c);
             }
         }
         if !cur.is_empty() {

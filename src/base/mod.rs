@@ -8,6 +8,7 @@
 pub mod brdf;
 pub mod colormap;
 pub mod display;
+pub mod field;
 pub mod gpu_layout;
 pub mod image;
 pub mod sampling;

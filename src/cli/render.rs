@@ -26,6 +26,20 @@ pub fn parse_method(name: &str) -> Result<MethodId, String> {
     MethodId::parse(name)
 }
 
+/// `--method`'s help: every registered method by its CLI name and label (the registry's
+/// order), so that a new method is listed without editing this text.
+pub fn method_help() -> String {
+    let names: Vec<String> = crate::methods::REGISTRY
+        .iter()
+        .map(|m| format!("{} ({})", m.id.cli(), m.short))
+        .collect();
+    format!(
+        "GI method by its CLI name: {}. Without it: the settings file's method (default slc); \
+         `lightcut-workbench methods` describes them",
+        names.join(", ")
+    )
+}
+
 /// Cut blending for `--blending`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum BlendingArg {
@@ -401,10 +415,7 @@ pub struct RenderArgs {
     /// Frames to render before reading timings (the first frames include pipeline warm-up).
     #[arg(long, default_value_t = 3)]
     pub timing_frames: u32,
-    /// GI method by its CLI name: slc (the thesis; default), sst, rtslc, lightcuts,
-    /// ground-truth, reference, off (direct light only). `lightcut-workbench methods` lists them.
-    /// Without it: the settings file's method (default slc).
-    #[arg(long, value_parser = parse_method)]
+    #[arg(long, value_parser = parse_method, help = method_help())]
     pub method: Option<MethodId>,
     /// What to write (comma-separated).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "all")]

@@ -14,6 +14,7 @@
 //! through a new one.
 
 pub mod direct_only;
+pub mod field_ui;
 pub mod ground_truth;
 pub mod interleave;
 pub mod ism_ui;
@@ -485,6 +486,10 @@ pub struct MethodInfo {
     pub glossy: bool,
     /// Checks its settings; the message names the field.
     pub validate: fn(&RenderSettings) -> Result<(), String>,
+    /// Its numeric settings as declared (`base::field`): per settings section, the specs
+    /// that drive validation, the GUI's sliders and `--set` (the registry test sets each
+    /// to its ends and beyond through `--set`'s path).
+    pub fields: fn() -> Vec<FieldSection>,
     /// Sets one of its settings out of range and returns that field's name (the registry test
     /// checks that `validate` refuses it by name); None for a method without settings.
     pub invalid_example: Option<fn(&mut RenderSettings) -> &'static str>,
@@ -504,6 +509,40 @@ pub struct MethodInfo {
     /// culling without the filter); the contract checks that `bias` then says `Unbiased` and
     /// that the N-frame means converge to the truth.
     pub unbiased: Option<Unbiased>,
+}
+
+/// Declared numeric settings of one settings section (`MethodInfo::fields`).
+pub struct FieldSection {
+    /// The section's TOML path (`methods.lightcuts`, `sampling.interleave`, `gi`).
+    pub section: String,
+    pub specs: Vec<crate::base::field::Spec>,
+    /// The section's default table when the section is the method's own (the test checks
+    /// that every number in it is declared); None for a shared or nested one.
+    pub table: Option<toml::Table>,
+}
+
+impl FieldSection {
+    /// The section `section` of `fields`, with its default table when `own`.
+    pub fn of<T: serde::Serialize + Default>(
+        section: &str,
+        fields: &[crate::base::field::Field<T>],
+        own: bool,
+    ) -> Self {
+        Self {
+            section: section.to_string(),
+            specs: crate::base::field::specs(fields),
+            table: if own {
+                toml::Table::try_from(T::default()).ok()
+            } else {
+                None
+            },
+        }
+    }
+}
+
+/// A method without settings of its own.
+pub fn no_fields() -> Vec<FieldSection> {
+    Vec::new()
 }
 
 /// A biased method's unbiased configuration (`MethodInfo::unbiased`).

@@ -3,6 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::base::field::{self, Field};
+
 /// All settings of the frame.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -507,31 +509,57 @@ impl<D: PatternDefault> InterleaveSettings<D> {
         self.n > 1 || self.filter_radius > 0
     }
     /// Every field in range (n at most `max_n`), or a message naming it under `table`.
+    /// The numeric settings, declared once (validation, the GUI's sliders, `--set`); the
+    /// pattern's largest edge is the method's.
+    pub fn fields(max_n: u32) -> Vec<Field<Self>> {
+        vec![
+            crate::field!(
+                Self,
+                n: u32,
+                "interleave n (n x n)",
+                "",
+                1,
+                max_n,
+                Linear,
+                "each pixel of an n x n pattern takes a disjoint 1/n^2 of the method's lights (x n^2), \
+                 the subsets shifted each frame; the filter then averages the pattern (1 = off)"
+            ),
+            crate::field!(
+                Self,
+                filter_radius: u32,
+                "filter radius",
+                "pixels",
+                0,
+                MAX_FILTER_RADIUS,
+                Linear,
+                "geometry-aware filter window (2r+1)^2 (the paper: 17 x 17 for 8 x 8, r = n; 0 = off)"
+            ),
+            crate::field!(
+                Self,
+                filter_normal_cos: f32,
+                "filter normal cos",
+                "",
+                -1.0,
+                1.0,
+                Linear,
+                "neighbours whose normal is farther from the pixel's than this cosine are skipped"
+            ),
+            crate::field!(
+                Self,
+                filter_plane_tolerance: f32,
+                "filter plane tolerance",
+                "x depth",
+                0.0,
+                1.0,
+                Log,
+                "neighbours farther from the pixel's tangent plane than this x depth are skipped"
+            ),
+        ]
+    }
+
+    /// Every field in range, or a message naming `table.interleave.<field>`.
     pub fn validate(&self, table: &str, max_n: u32) -> Result<(), String> {
-        let f = |name: &str, v: String, range: &str| {
-            Err(format!("{table}.interleave.{name} {v} is out of range ({range})"))
-        };
-        if !(1..=max_n).contains(&self.n) {
-            return f("n", self.n.to_string(), &format!("1..={max_n}"));
-        }
-        if self.filter_radius > MAX_FILTER_RADIUS {
-            return f(
-                "filter_radius",
-                self.filter_radius.to_string(),
-                &format!("0..={MAX_FILTER_RADIUS}"),
-            );
-        }
-        if !(-1.0..=1.0).contains(&self.filter_normal_cos) {
-            return f("filter_normal_cos", self.filter_normal_cos.to_string(), "-1..=1");
-        }
-        if !(0.0..=1.0).contains(&self.filter_plane_tolerance) {
-            return f(
-                "filter_plane_tolerance",
-                self.filter_plane_tolerance.to_string(),
-                "0..=1",
-            );
-        }
-        Ok(())
+        field::check(&format!("{table}.interleave"), &Self::fields(max_n), self)
     }
 }
 
@@ -653,43 +681,107 @@ impl<D: IsmDefault> IsmSettings<D> {
         self.pull_push_levels.min(self.tile.max(1).ilog2())
     }
     /// Every field in range, or a message naming it under `table`.
+    /// The numeric settings, declared once (validation, the GUI's sliders, `--set`).
+    pub fn fields() -> Vec<Field<Self>> {
+        vec![
+            crate::field!(
+                Self,
+                points_per_light: u32,
+                "points per map",
+                "",
+                0,
+                1 << 16,
+                Log,
+                "points splatted into each light's map (0 = the cloud shared round-robin)"
+            ),
+            crate::field!(
+                Self,
+                points: u32,
+                "cloud points",
+                "",
+                1,
+                1 << 24,
+                Log,
+                "points sampled once on the scene's triangles, uniform in area"
+            ),
+            crate::field!(
+                Self,
+                tile: u32,
+                "map size",
+                "texels",
+                8,
+                1024,
+                Pow2,
+                "one paraboloid map's edge"
+            ),
+            crate::field!(
+                Self,
+                atlas: u32,
+                "atlas size",
+                "texels",
+                8,
+                8192,
+                Pow2,
+                "the atlas holds (atlas / map)^2 maps, one per light; at least the map size, at most 255 maps a side"
+            ),
+            crate::field!(
+                Self,
+                pull_push_levels: u32,
+                "pull-push levels",
+                "",
+                0,
+                8,
+                Linear,
+                "hole filling (the VAL paper: 2)"
+            ),
+            crate::field!(
+                Self,
+                bias: f32,
+                "relative depth bias",
+                "",
+                0.0,
+                0.5,
+                Linear,
+                "a point is lit when its distance x (1 - bias) is at most the map's",
+                open_max
+            ),
+            crate::field!(
+                Self,
+                point_size: f32,
+                "point size",
+                "",
+                0.0,
+                8.0,
+                Linear,
+                "a point's world radius as a multiple of sqrt(scene area / (pi x points per map)): near \
+                 points cover several texels (the VAL paper's sized points); 0: one texel per point"
+            ),
+        ]
+    }
+
+    /// Every field in range (and the atlas at least one map, at most 255 maps a side), or a
+    /// message naming `table.ism.<field>`.
     pub fn validate(&self, table: &str) -> Result<(), String> {
-        let f = |name: &str, v: String, range: &str| {
-            Err(format!("{table}.ism.{name} {v} is out of range ({range})"))
-        };
-        if !(1..=1 << 24).contains(&self.points) {
-            return f("points", self.points.to_string(), "1..=16777216");
-        }
-        if self.points_per_light > 1 << 16 {
-            return f("points_per_light", self.points_per_light.to_string(), "0..=65536");
-        }
-        if !(self.tile.is_power_of_two() && (8..=1024).contains(&self.tile)) {
-            return f("tile", self.tile.to_string(), "a power of two in 8..=1024");
-        }
-        if !(self.atlas.is_power_of_two() && (self.tile..=8192).contains(&self.atlas)) {
-            return f("atlas", self.atlas.to_string(), "a power of two in tile..=8192");
+        let section = format!("{table}.ism");
+        field::check(&section, &Self::fields(), self)?;
+        if self.atlas < self.tile {
+            return Err(format!(
+                "{section}.atlas {} is below the map size {} (the atlas holds at least one map)",
+                self.atlas, self.tile
+            ));
         }
         // The build dispatches one workgroup layer per map (at most 65535), and its splat
         // threads (maps x points_per_light) stay within u32.
         let maps = (self.atlas / self.tile).pow(2);
         if maps > 65535 {
-            return f(
-                "atlas",
-                self.atlas.to_string(),
-                &format!("at most 65535 maps of tile {}: atlas / tile <= 255", self.tile),
-            );
-        }
-        if self.pull_push_levels > 8 {
-            return f("pull_push_levels", self.pull_push_levels.to_string(), "0..=8");
-        }
-        if !(0.0..0.5).contains(&self.bias) {
-            return f("bias", self.bias.to_string(), "0..0.5");
-        }
-        if !(0.0..=8.0).contains(&self.point_size) {
-            return f("point_size", self.point_size.to_string(), "0..=8");
+            return Err(format!(
+                "{section}.atlas {} holds {maps} maps of tile {}: at most 65535 (atlas / tile <= 255)",
+                self.atlas, self.tile
+            ));
         }
         Ok(())
     }
+
     /// A point's world radius (m) in maps of `per_map` points from a cloud on a surface of
     /// `area` m^2: point_size x sqrt(area / (pi per_map)); 0 with point_size 0 or no area.
     pub fn point_radius(&self, area: f32, per_map: u32) -> f32 {

@@ -31,6 +31,7 @@ pub static INFO: MethodInfo = MethodInfo {
     one_bounce: false,
     glossy: true,
     validate: |_: &RenderSettings| Ok(()),
+    fields: super::no_fields,
     invalid_example: None,
     ui: |_, _, _| {},
     tests: &["direct_light::lit_quad_matches_rho_over_pi_e_cos_and_shadow_is_zero"],

@@ -7,6 +7,8 @@ pub mod pass;
 mod ui;
 
 use super::{FrameCx, Kind, Method, MethodId, MethodInfo, Module, Resource};
+use crate::base::field::Field;
+use crate::renderer::settings::GiSettings;
 use crate::renderer::{
     GiProgress, gpu_data::GpuGtParams, gpu_data::GpuVpl, settings::RenderSettings, shaders::ShaderError,
 };
@@ -42,6 +44,7 @@ pub static INFO: MethodInfo = MethodInfo {
     one_bounce: false,
     glossy: true,
     validate,
+    fields,
     invalid_example: Some(|s| {
         s.gi.rays_per_frame = 0;
         "gi.rays_per_frame"
@@ -57,11 +60,20 @@ pub static INFO: MethodInfo = MethodInfo {
     unbiased: None,
 };
 
+/// Its numeric setting (in `[gi]`), declared once (validation, the GUI's slider, `--set`).
+pub static FIELDS: &[Field<GiSettings>] = &[crate::field!(
+    GiSettings,
+    rays_per_frame: u32,
+    "shadow rays / frame",
+    "",
+    1,
+    1u32 << 30,
+    Log,
+    "the progressive truth's budget: more finishes sooner, but each frame takes longer"
+)];
+
 fn validate(s: &RenderSettings) -> Result<(), String> {
-    if s.gi.rays_per_frame == 0 {
-        return Err("gi.rays_per_frame must be at least 1".into());
-    }
-    Ok(())
+    crate::base::field::check("gi", FIELDS, &s.gi)
 }
 
 /// The stride of the order the truth sums the VPLs in (step i: VPL i x stride mod n): near
@@ -183,6 +195,11 @@ impl Method for GroundTruth {
     fn reset(&mut self) {
         self.state = None;
     }
+}
+
+/// `MethodInfo::fields`.
+fn fields() -> Vec<super::FieldSection> {
+    vec![super::FieldSection::of("gi", FIELDS, false)]
 }
 
 #[cfg(test)]

@@ -212,6 +212,7 @@ pub static INFO: MethodInfo = MethodInfo {
     one_bounce: false,
     glossy: true,
     validate,
+    fields,
     invalid_example: Some(invalid_example),
     ui: ui::settings_ui,
     tests: TESTS,
@@ -248,6 +249,7 @@ pub static CLAMPED_INFO: MethodInfo = MethodInfo {
     one_bounce: false,
     glossy: true,
     validate,
+    fields,
     invalid_example: Some(invalid_example),
     ui: ui::settings_ui,
     tests: TESTS,
@@ -283,6 +285,7 @@ pub static TREE_INFO: MethodInfo = MethodInfo {
     one_bounce: false,
     glossy: true,
     validate,
+    fields,
     invalid_example: Some(invalid_example),
     ui: ui::settings_ui,
     tests: TREE_TESTS,
@@ -1332,4 +1335,22 @@ impl Method for LightCulling {
             st.rays_per_pixel()
         ))
     }
+}
+
+/// `MethodInfo::fields` (the three methods share the table).
+fn fields() -> Vec<super::FieldSection> {
+    use settings::{Interleave8, InterleaveSettings, IsmAdaptive, IsmSettings};
+    vec![
+        super::FieldSection::of("methods.light-culling", settings::FIELDS, true),
+        super::FieldSection::of(
+            "methods.light-culling.interleave",
+            &InterleaveSettings::<Interleave8>::fields(settings::MAX_INTERLEAVE),
+            false,
+        ),
+        super::FieldSection::of(
+            "methods.light-culling.ism",
+            &IsmSettings::<IsmAdaptive>::fields(),
+            false,
+        ),
+    ]
 }

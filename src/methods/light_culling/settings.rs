@@ -4,6 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::base::field::{self, Field};
+
 pub use crate::renderer::settings::{
     Interleave8, InterleaveSettings, IsmAdaptive, IsmSettings, MAX_FILTER_RADIUS,
 };
@@ -87,43 +89,69 @@ impl Default for LightCullingSettings {
     }
 }
 
+/// The numeric settings, declared once (validation, the GUI's sliders, `--set`).
+pub static FIELDS: &[Field<LightCullingSettings>] = &[
+    crate::field!(
+        LightCullingSettings,
+        epsilon_max: f32,
+        "error bound eps_max",
+        "",
+        0.0,
+        1.0,
+        Log,
+        "largest standard deviation per VPL (stochastic; in the filtered image) or total darkening \
+         (clamped) in exposed display units (paper 0.0005); shared by the variants",
+        open
+    ),
+    crate::field!(
+        LightCullingSettings,
+        tile_size: u32,
+        "tile size",
+        "pixels",
+        4,
+        32,
+        Linear,
+        "tile edge of the de-interleaved image (paper 16)"
+    ),
+    crate::field!(
+        LightCullingSettings,
+        max_lights_per_tile: u32,
+        "max lights per tile",
+        "",
+        1,
+        MAX_LIST,
+        Log,
+        "an overflowing tile is shaded by testing all its subset's VPLs (counted, shown)"
+    ),
+    crate::field!(
+        LightCullingSettings,
+        reservoir_k: u32,
+        "light list k",
+        "",
+        1,
+        MAX_RESERVOIR,
+        Log,
+        "per-pixel list filled by reservoir sampling during the tree traversal (paper 32); one \
+         listed VPL is shaded by resampled importance sampling (one shadow ray)"
+    ),
+    crate::field!(
+        LightCullingSettings,
+        tree_filter_radius: u32,
+        "filter radius",
+        "pixels",
+        0,
+        MAX_FILTER_RADIUS,
+        Linear,
+        "the tree variant's geometry-aware filter window (2r+1)^2 (0 = off, as the paper's path tracer)"
+    ),
+];
+
 impl LightCullingSettings {
     /// Every field in range, or a message naming it.
     pub fn validate(&self) -> Result<(), String> {
-        let f = |name: &str, v: String, range: &str| {
-            Err(format!(
-                "methods.light-culling.{name} {v} is out of range ({range})"
-            ))
-        };
-        if !(self.epsilon_max > 0.0 && self.epsilon_max <= 1.0) {
-            return f("epsilon_max", self.epsilon_max.to_string(), "0 < e <= 1");
-        }
-        if !(4..=32).contains(&self.tile_size) {
-            return f("tile_size", self.tile_size.to_string(), "4..=32");
-        }
-        if !(1..=MAX_LIST).contains(&self.max_lights_per_tile) {
-            return f(
-                "max_lights_per_tile",
-                self.max_lights_per_tile.to_string(),
-                &format!("1..={MAX_LIST}"),
-            );
-        }
+        field::check("methods.light-culling", FIELDS, self)?;
         self.interleave
             .validate("methods.light-culling", MAX_INTERLEAVE)?;
-        if !(1..=MAX_RESERVOIR).contains(&self.reservoir_k) {
-            return f(
-                "reservoir_k",
-                self.reservoir_k.to_string(),
-                &format!("1..={MAX_RESERVOIR}"),
-            );
-        }
-        if self.tree_filter_radius > MAX_FILTER_RADIUS {
-            return f(
-                "tree_filter_radius",
-                self.tree_filter_radius.to_string(),
-                &format!("0..={MAX_FILTER_RADIUS}"),
-            );
-        }
         self.ism.validate("methods.light-culling")
     }
 

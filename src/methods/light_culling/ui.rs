@@ -1,8 +1,6 @@
 //! Stochastic Light Culling's settings in the GUI (shared by the clamped baseline).
 
-use super::settings::{
-    CullingVisibility, LightCullingSettings, MAX_FILTER_RADIUS, MAX_INTERLEAVE, MAX_LIST, MAX_RESERVOIR,
-};
+use super::settings::{CullingVisibility, LightCullingSettings, MAX_INTERLEAVE};
 use crate::methods::MethodId;
 use crate::renderer::settings::RenderSettings;
 
@@ -21,23 +19,11 @@ pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) 
             "average the frames' estimates while the view, lights and settings stay (the \
              clamped-vs-stochastic view then compares converged means)",
         );
-    ui.add(
-        egui::Slider::new(&mut lc.epsilon_max, 1e-5..=0.05)
-            .logarithmic(true)
-            .text("error bound eps_max"),
-    )
-    .on_hover_text(
-        "largest standard deviation per VPL (stochastic; in the filtered image) or total \
-         darkening (clamped) in exposed display units (paper 0.0005); shared by the variants",
-    );
+    let field = |key: &str| crate::base::field::find(super::settings::FIELDS, key);
+    crate::methods::field_ui::slider(ui, field("epsilon_max"), &mut lc);
     if method == super::TREE {
-        ui.add(egui::Slider::new(&mut lc.reservoir_k, 1..=MAX_RESERVOIR).text("light list k"))
-            .on_hover_text(
-                "per-pixel list filled by reservoir sampling during the tree traversal (paper 32); \
-                 one listed VPL is shaded by resampled importance sampling (one shadow ray)",
-            );
-        ui.add(egui::Slider::new(&mut lc.tree_filter_radius, 0..=MAX_FILTER_RADIUS).text("filter radius"))
-            .on_hover_text("geometry-aware filter window (2r+1)^2 (0 = off, as the paper's path tracer)");
+        crate::methods::field_ui::slider(ui, field("reservoir_k"), &mut lc);
+        crate::methods::field_ui::slider(ui, field("tree_filter_radius"), &mut lc);
         visibility_ui(ui, &mut lc, s.gi.shadow_rays);
         if lc != before {
             let _ = s.set_method(id, &lc);
@@ -45,13 +31,8 @@ pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) 
         return;
     }
     crate::methods::interleave::settings_ui(ui, &mut lc.interleave, MAX_INTERLEAVE, "VPLs", "paper 8 x 8");
-    ui.add(egui::Slider::new(&mut lc.tile_size, 4..=32).text("tile size (pixels)"));
-    ui.add(
-        egui::Slider::new(&mut lc.max_lights_per_tile, 1..=MAX_LIST)
-            .logarithmic(true)
-            .text("max lights per tile"),
-    )
-    .on_hover_text("an overflowing tile is shaded by testing all its subset's VPLs (counted, shown)");
+    crate::methods::field_ui::slider(ui, field("tile_size"), &mut lc);
+    crate::methods::field_ui::slider(ui, field("max_lights_per_tile"), &mut lc);
     visibility_ui(ui, &mut lc, s.gi.shadow_rays);
     if lc != before {
         // Cannot fail: the struct serialises to a table.

@@ -146,6 +146,7 @@ pub static INFO: MethodInfo = MethodInfo {
     one_bounce: false,
     glossy: false,
     validate,
+    fields,
     invalid_example: Some(invalid_example),
     ui: ui::settings_ui,
     tests: &[
@@ -719,4 +720,13 @@ impl Method for LightcutInterpolation {
             100.0 * st.fallback_fraction()
         ))
     }
+}
+
+/// `MethodInfo::fields`.
+fn fields() -> Vec<super::FieldSection> {
+    vec![super::FieldSection::of(
+        "methods.lightcut-interpolation",
+        settings::FIELDS,
+        true,
+    )]
 }

@@ -5,6 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::base::field::{self, Field};
 use crate::reference::lightcuts::MAX_CUT;
 
 /// How an interpolated cut's nodes are shadowed (the paper evaluates both, section 6).
@@ -69,40 +70,91 @@ impl Default for LightcutInterpolationSettings {
     }
 }
 
+type Li = LightcutInterpolationSettings;
+
+/// The numeric settings, declared once (validation, the GUI's sliders, `--set`).
+pub static FIELDS: &[Field<Li>] = &[
+    crate::field!(
+        Li,
+        relative_error: f32,
+        "record relative error",
+        "",
+        0.0,
+        1.0,
+        Log,
+        "the records' (and fallback's) Lightcuts threshold (paper 1%)"
+    ),
+    crate::field!(Li, max_cut: u32, "max cut size", "nodes", 1, MAX_CUT, Log, "nodes per record or fallback pixel at most"),
+    crate::field!(
+        Li,
+        r_min_px: f32,
+        "R-",
+        "pixels",
+        0.25,
+        256.0,
+        Log,
+        "smallest record reach in pixel sizes (paper 4)"
+    ),
+    crate::field!(
+        Li,
+        r_max_px: f32,
+        "R+",
+        "pixels",
+        0.25,
+        256.0,
+        Log,
+        "largest record reach in pixel sizes (paper 15): fewer records when larger; at least R-"
+    ),
+    crate::field!(
+        Li,
+        max_angle_deg: f32,
+        "a+",
+        "degrees",
+        1.0,
+        90.0,
+        Linear,
+        "records whose normal deviates more are rejected (paper 15)"
+    ),
+    crate::field!(
+        Li,
+        epsilon: f32,
+        "fallback epsilon",
+        "",
+        0.0,
+        0.99,
+        Linear,
+        "pixels whose best record weight is below this compute a full lightcut"
+    ),
+    crate::field!(
+        Li,
+        coverage: f32,
+        "placement coverage",
+        "",
+        0.01,
+        4.0,
+        Linear,
+        "a pixel is covered once its tile's records' weights sum to this"
+    ),
+    crate::field!(
+        Li,
+        radius_rays: u32,
+        "rays for R",
+        "",
+        1,
+        256,
+        Log,
+        "hemisphere rays per pixel for the harmonic mean distance"
+    ),
+];
+
 impl LightcutInterpolationSettings {
     /// Every field in range, or a message naming it.
     pub fn validate(&self) -> Result<(), String> {
-        let f = |name: &str, v: f32, lo: f32, hi: f32| {
-            if (lo..=hi).contains(&v) {
-                Ok(())
-            } else {
-                Err(format!(
-                    "methods.lightcut-interpolation.{name} {v} is out of range ({lo}..={hi})"
-                ))
-            }
-        };
-        f("relative_error", self.relative_error, 0.0, 1.0)?;
-        if !(1..=MAX_CUT).contains(&self.max_cut) {
-            return Err(format!(
-                "methods.lightcut-interpolation.max_cut {} is out of range (1..={MAX_CUT})",
-                self.max_cut
-            ));
-        }
-        f("r_min_px", self.r_min_px, 0.25, 256.0)?;
-        f("r_max_px", self.r_max_px, 0.25, 256.0)?;
+        field::check("methods.lightcut-interpolation", FIELDS, self)?;
         if self.r_max_px < self.r_min_px {
             return Err(format!(
                 "methods.lightcut-interpolation.r_max_px {} is below r_min_px {}",
                 self.r_max_px, self.r_min_px
-            ));
-        }
-        f("max_angle_deg", self.max_angle_deg, 1.0, 90.0)?;
-        f("epsilon", self.epsilon, 0.0, 0.99)?;
-        f("coverage", self.coverage, 0.01, 4.0)?;
-        if !(1..=256).contains(&self.radius_rays) {
-            return Err(format!(
-                "methods.lightcut-interpolation.radius_rays {} is out of range (1..=256)",
-                self.radius_rays
             ));
         }
         Ok(())

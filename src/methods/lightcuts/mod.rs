@@ -126,6 +126,7 @@ pub static INFO: MethodInfo = MethodInfo {
     one_bounce: false,
     glossy: true,
     validate,
+    fields,
     invalid_example: Some(invalid_example),
     ui: ui::settings_ui,
     tests: &[
@@ -484,4 +485,13 @@ impl Method for Lightcuts {
             self.settings.max_cut
         ))
     }
+}
+
+/// `MethodInfo::fields`.
+fn fields() -> Vec<super::FieldSection> {
+    vec![super::FieldSection::of(
+        "methods.lightcuts",
+        settings::FIELDS,
+        true,
+    )]
 }

@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::base::field::{self, Field};
 use crate::reference::lightcuts::MAX_CUT;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -27,22 +28,35 @@ impl Default for LightcutsSettings {
     }
 }
 
+/// The numeric settings, declared once (validation, the GUI's sliders, `--set`).
+pub static FIELDS: &[Field<LightcutsSettings>] = &[
+    crate::field!(
+        LightcutsSettings,
+        relative_error: f32,
+        "relative error",
+        "",
+        0.0,
+        1.0,
+        Log,
+        "refine while the largest error bound exceeds this fraction of the pixel's estimate \
+         (Walter et al. 2%, the interpolation paper 1%)"
+    ),
+    crate::field!(
+        LightcutsSettings,
+        max_cut: u32,
+        "max cut size",
+        "nodes",
+        1,
+        MAX_CUT,
+        Log,
+        "nodes per pixel at most; dark pixels reach it first"
+    ),
+];
+
 impl LightcutsSettings {
     /// Every field in range, or a message naming it.
     pub fn validate(&self) -> Result<(), String> {
-        if !(0.0..=1.0).contains(&self.relative_error) {
-            return Err(format!(
-                "methods.lightcuts.relative_error {} is out of range (0..=1)",
-                self.relative_error
-            ));
-        }
-        if !(1..=MAX_CUT).contains(&self.max_cut) {
-            return Err(format!(
-                "methods.lightcuts.max_cut {} is out of range (1..={MAX_CUT})",
-                self.max_cut
-            ));
-        }
-        Ok(())
+        field::check("methods.lightcuts", FIELDS, self)
     }
 }
 

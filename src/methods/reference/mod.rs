@@ -10,7 +10,9 @@ pub mod pass;
 mod ui;
 
 use super::{FrameCx, Kind, Method, MethodId, MethodInfo, Module, Resource};
+use crate::base::field::Field;
 use crate::methods::ground_truth::pass::{GroundTruthPass, MAX_BATCHES};
+use crate::renderer::settings::GiSettings;
 use crate::renderer::{
     GiProgress,
     gpu_data::{GpuGtParams, GpuVpl},
@@ -50,6 +52,7 @@ pub static INFO: MethodInfo = MethodInfo {
     one_bounce: false,
     glossy: true,
     validate,
+    fields,
     invalid_example: Some(|s| {
         s.gi.reference_flux_mix = 0.0;
         "gi.reference_flux_mix"
@@ -66,30 +69,53 @@ pub static INFO: MethodInfo = MethodInfo {
     unbiased: None,
 };
 
+/// Its numeric settings (in `[gi]`), declared once (validation, the GUI's sliders, `--set`).
+pub static FIELDS: &[Field<GiSettings>] = &[
+    crate::field!(
+        GiSettings,
+        reference_samples: u32,
+        "samples per pixel",
+        "",
+        1,
+        1 << 24,
+        Log,
+        "the target: the reference stops when every pixel has this many samples"
+    ),
+    crate::field!(
+        GiSettings,
+        reference_spp_per_frame: u32,
+        "samples / frame",
+        "",
+        1,
+        4096,
+        Log,
+        "samples per pixel added each frame"
+    ),
+    crate::field!(
+        GiSettings,
+        reference_flux_mix: f32,
+        "reference flux mix",
+        "",
+        0.0,
+        1.0,
+        Linear,
+        "share of the texel PDF that follows flux (> 0 keeps it unbiased)",
+        open
+    ),
+    crate::field!(
+        GiSettings,
+        reference_paths_per_sample: u32,
+        "light paths / sample",
+        "",
+        1,
+        256,
+        Log,
+        "fresh light paths per sample for bounces 2..N, shaded at every pixel"
+    ),
+];
+
 fn validate(s: &RenderSettings) -> Result<(), String> {
-    let g = &s.gi;
-    if !(g.reference_flux_mix > 0.0 && g.reference_flux_mix <= 1.0) {
-        return Err(format!(
-            "gi.reference_flux_mix {} is out of range (0..=1, > 0)",
-            g.reference_flux_mix
-        ));
-    }
-    if g.reference_samples == 0 {
-        return Err("gi.reference_samples must be at least 1".into());
-    }
-    if !(1..=256).contains(&g.reference_paths_per_sample) {
-        return Err(format!(
-            "gi.reference_paths_per_sample {} is out of range (1..=256)",
-            g.reference_paths_per_sample
-        ));
-    }
-    if !(1..=4096).contains(&g.reference_spp_per_frame) {
-        return Err(format!(
-            "gi.reference_spp_per_frame {} is out of range (1..=4096)",
-            g.reference_spp_per_frame
-        ));
-    }
-    Ok(())
+    crate::base::field::check("gi", FIELDS, &s.gi)
 }
 
 pub struct Reference {
@@ -246,4 +272,9 @@ impl Method for Reference {
     fn reset(&mut self) {
         self.state = None;
     }
+}
+
+/// `MethodInfo::fields`.
+fn fields() -> Vec<super::FieldSection> {
+    vec![super::FieldSection::of("gi", FIELDS, false)]
 }

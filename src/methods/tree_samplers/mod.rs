@@ -161,6 +161,7 @@ pub static SLC_INFO: MethodInfo = MethodInfo {
     one_bounce: false,
     glossy: true,
     validate,
+    fields,
     invalid_example: Some(invalid_cut_size),
     ui: ui::settings_ui,
     tests: TESTS,
@@ -198,6 +199,7 @@ pub static SST_INFO: MethodInfo = MethodInfo {
     one_bounce: false,
     glossy: true,
     validate,
+    fields,
     invalid_example: Some(invalid_cut_size),
     ui: ui::settings_ui,
     tests: TESTS,
@@ -236,6 +238,7 @@ pub static RTSLC_INFO: MethodInfo = MethodInfo {
     one_bounce: false,
     glossy: true,
     validate,
+    fields,
     invalid_example: Some(invalid_cut_size),
     ui: ui::settings_ui,
     tests: TESTS,
@@ -327,30 +330,7 @@ fn validate(s: &RenderSettings) -> Result<(), String> {
             }
         ));
     }
-    if !(1..=64).contains(&sm.block_size) {
-        return Err(format!(
-            "sampling.block_size {} is out of range (1..=64)",
-            sm.block_size
-        ));
-    }
-    if !(1..=64).contains(&sm.cut_size) {
-        return Err(format!(
-            "sampling.cut_size {} is out of range (1..=64)",
-            sm.cut_size
-        ));
-    }
-    if !(0.0..=100.0).contains(&sm.near_field) {
-        return Err(format!(
-            "sampling.near_field {} is out of range (0..=100; 0 = off)",
-            sm.near_field
-        ));
-    }
-    if !(0.0..=1.0).contains(&sm.substitute_offset) {
-        return Err(format!(
-            "sampling.substitute_offset {} is out of range (0..=1 m; 0 = off)",
-            sm.substitute_offset
-        ));
-    }
+    crate::base::field::check("sampling", settings::FIELDS, sm)?;
     sm.interleave.validate("sampling", settings::MAX_SLOT_INTERLEAVE)
 }
 
@@ -833,4 +813,18 @@ impl Method for TreeSamplers {
 /// The top of the traversal-steps heat map: the depth of a tree of `levels` levels.
 pub fn steps_scale(levels: u32) -> f32 {
     (levels.max(2) - 1) as f32
+}
+
+/// `MethodInfo::fields` (`[sampling]`, shared by the three samplers).
+fn fields() -> Vec<super::FieldSection> {
+    use crate::renderer::settings::{InterleaveOff, InterleaveSettings, IsmAdaptive, IsmSettings};
+    vec![
+        super::FieldSection::of("sampling", settings::FIELDS, true),
+        super::FieldSection::of(
+            "sampling.interleave",
+            &InterleaveSettings::<InterleaveOff>::fields(settings::MAX_SLOT_INTERLEAVE),
+            false,
+        ),
+        super::FieldSection::of("sampling.ism", &IsmSettings::<IsmAdaptive>::fields(), false),
+    ]
 }

@@ -3,6 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::base::field::Field;
+
 pub use crate::renderer::settings::{IsmAdaptive, IsmSettings};
 
 /// How the samplers' samples are shadowed while `gi.shadow_rays` is on.
@@ -138,6 +140,53 @@ pub struct SamplingSettings {
     /// The leaves' maps (`[sampling.ism]`; light culling's adaptive-map defaults).
     pub ism: IsmSettings<IsmAdaptive>,
 }
+
+/// The numeric settings of `[sampling]`, declared once (validation, the GUI's sliders,
+/// `--set`).
+pub static FIELDS: &[Field<SamplingSettings>] = &[
+    crate::field!(
+        SamplingSettings,
+        cut_size: u32,
+        "cut size (samples per pixel)",
+        "",
+        1,
+        64,
+        Linear,
+        "nodes per cut = cluster evaluations (shadow rays) per pixel; SST: traversals from the root"
+    ),
+    crate::field!(
+        SamplingSettings,
+        block_size: u32,
+        "cut block k",
+        "pixels",
+        1,
+        64,
+        Linear,
+        "one shallow light cut per k x k block (1 = per pixel)"
+    ),
+    crate::field!(
+        SamplingSettings,
+        near_field: f32,
+        "near-field refinement",
+        "box diagonals",
+        0.0,
+        100.0,
+        Log,
+        "stop at a usable node only when the point is at least this many box diagonals from \
+         its box (0 = the thesis's rule): substitute samples next to the point turn into fireflies"
+    ),
+    crate::field!(
+        SamplingSettings,
+        substitute_offset: f32,
+        "substitute ray offset",
+        "m",
+        0.0,
+        1.0,
+        Log,
+        "substitute samples' shadow rays end this far short of the drawn point (the SST paper's \
+         scene-size epsilon; 0 = the thesis): too large leaks light through thin walls"
+    ),
+];
 
 impl Default for SamplingSettings {
     fn default() -> Self {

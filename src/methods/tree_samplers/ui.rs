@@ -8,15 +8,10 @@ use crate::renderer::settings::RenderSettings;
 
 pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) {
     let sm = &mut s.sampling;
-    let cut_label = if method == SST {
-        "samples per pixel"
-    } else {
-        "cut size (samples per pixel)"
-    };
-    ui.add(egui::Slider::new(&mut sm.cut_size, 1..=64).text(cut_label));
+    let field = |key: &str| crate::base::field::find(super::settings::FIELDS, key);
+    crate::methods::field_ui::slider(ui, field("cut_size"), sm);
     if method != SST {
-        ui.add(egui::Slider::new(&mut sm.block_size, 1..=64).text("cut block k (pixels)"))
-            .on_hover_text("one shallow light cut per k x k block (1 = per pixel)");
+        crate::methods::field_ui::slider(ui, field("block_size"), sm);
         egui::ComboBox::from_label("cut blending")
             .selected_text(sm.blending.name())
             .show_ui(ui, |ui| {
@@ -35,22 +30,8 @@ pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) 
             .on_hover_text("thesis 5.1; off keeps every cut complete (unbiased)");
     }
     if method != RTSLC {
-        ui.add(egui::Slider::new(&mut sm.near_field, 0.0..=4.0).text("near-field refinement"))
-            .on_hover_text(
-                "stop at a usable node only when the point is at least this many box \
-                 diagonals from its box (0 = the thesis's rule): substitute samples \
-                 next to the point turn into fireflies",
-            );
-        ui.add(
-            egui::Slider::new(&mut sm.substitute_offset, 0.0..=0.3)
-                .suffix(" m")
-                .text("substitute ray offset"),
-        )
-        .on_hover_text(
-            "substitute samples' shadow rays end this far short of the drawn point \
-             (the SST paper's scene-size epsilon; 0 = the thesis): drawn points land \
-             slightly inside geometry; too large leaks light through thin walls",
-        );
+        crate::methods::field_ui::slider(ui, field("near_field"), sm);
+        crate::methods::field_ui::slider(ui, field("substitute_offset"), sm);
     }
     egui::ComboBox::from_label("child probability")
         .selected_text(sm.child_probability.name())

@@ -187,6 +187,7 @@ const fn info(
         one_bounce: true,
         glossy: false,
         validate,
+        fields,
         invalid_example: Some(invalid_example),
         ui: ui::settings_ui,
         tests: TESTS,
@@ -841,4 +842,18 @@ impl Method for Vals {
             ("visibility", self.visibility as f64),
         ]
     }
+}
+
+/// `MethodInfo::fields` (`val` and `val-vpl` share the table).
+fn fields() -> Vec<super::FieldSection> {
+    use crate::renderer::settings::{InterleaveSettings, IsmSettings, IsmVal};
+    vec![
+        super::FieldSection::of("methods.val", settings::FIELDS, true),
+        super::FieldSection::of(
+            "methods.val.interleave",
+            &InterleaveSettings::<crate::renderer::settings::Interleave4>::fields(settings::MAX_INTERLEAVE),
+            false,
+        ),
+        super::FieldSection::of("methods.val.ism", &IsmSettings::<IsmVal>::fields(), false),
+    ]
 }

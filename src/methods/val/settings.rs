@@ -4,6 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::base::field::{self, Field};
+
 use crate::reference::val::{ClusterParams, MAX_CLUSTERS, MetricWeights, POISSON, Pcss};
 pub use crate::renderer::settings::{Interleave4, InterleaveSettings, IsmSettings, IsmVal};
 
@@ -95,6 +97,123 @@ impl Default for ValSettings {
     }
 }
 
+/// Samples of the PCSS Poisson disk.
+const POISSON_N: u32 = POISSON.len() as u32;
+
+/// The numeric settings, declared once (validation, the GUI's sliders, `--set`).
+pub static FIELDS: &[Field<ValSettings>] = &[
+    crate::field!(
+        ValSettings,
+        clusters: u32,
+        "VALs",
+        "",
+        1,
+        MAX_CLUSTERS,
+        Log,
+        "clusters of the RSM, one map each (paper: 64 with PCSS, 512 with simple lookups)"
+    ),
+    crate::field!(
+        ValSettings,
+        resolution: u32,
+        "clustering RSM",
+        "texels",
+        8,
+        1024,
+        Pow2,
+        "the RSM is summed down to this many texels a side before clustering (flux and area kept)"
+    ),
+    crate::field!(
+        ValSettings,
+        splat: u32,
+        "splat",
+        "RSM texels",
+        1,
+        MAX_SPLAT,
+        Log,
+        "edge of a cluster's splat window: texels beyond it join a cluster only by the fallback (paper 32 - 128)"
+    ),
+    crate::field!(
+        ValSettings,
+        iterations: u32,
+        "k-means steps",
+        "",
+        1,
+        MAX_ITERATIONS,
+        Linear,
+        "clustering steps per frame, from the frame's seeds or the last frame's clusters (the paper: one per frame, carried over)"
+    ),
+    crate::field!(
+        ValSettings,
+        weights.position: f32,
+        "eq. 1 position weight",
+        "",
+        0.0,
+        1.0,
+        Linear,
+        "eq. 1's weight of the position distance (at least one weight > 0)"
+    ),
+    crate::field!(
+        ValSettings,
+        weights.normal: f32,
+        "eq. 1 normal weight",
+        "",
+        0.0,
+        1.0,
+        Linear,
+        "eq. 1's weight of the normal distance"
+    ),
+    crate::field!(
+        ValSettings,
+        weights.flux: f32,
+        "eq. 1 flux weight",
+        "",
+        0.0,
+        1.0,
+        Linear,
+        "eq. 1's weight of the flux distance"
+    ),
+    crate::field!(
+        ValSettings,
+        pcss.blocker_samples: u32,
+        "blocker samples",
+        "",
+        1,
+        POISSON_N,
+        Linear,
+        "Poisson samples of the PCSS blocker search"
+    ),
+    crate::field!(
+        ValSettings,
+        pcss.pcf_samples: u32,
+        "PCF samples",
+        "",
+        1,
+        POISSON_N,
+        Linear,
+        "Poisson samples of the PCSS filter"
+    ),
+    crate::field!(
+        ValSettings,
+        pcss.max_radius: f32,
+        "largest filter",
+        "texels",
+        1.0,
+        64.0,
+        Linear,
+        "the PCSS filter's largest radius"
+    ),
+    crate::field!(
+        ValSettings,
+        inspect: u32,
+        "VAL inspected",
+        "",
+        0,
+        MAX_CLUSTERS - 1,
+        Linear,
+        "the VAL whose map the 'VAL ISM vs true map' view shows (below the VAL count)"
+    ),
+];
+
 impl ValSettings {
     pub fn cluster_params(&self) -> ClusterParams {
         ClusterParams {
@@ -104,67 +223,10 @@ impl ValSettings {
     }
 
     pub fn validate(&self) -> Result<(), String> {
-        let f = |name: &str, v: String, range: &str| {
-            Err(format!("methods.val.{name} {v} is out of range ({range})"))
-        };
-        if !(1..=MAX_CLUSTERS).contains(&self.clusters) {
-            return f(
-                "clusters",
-                self.clusters.to_string(),
-                &format!("1..={MAX_CLUSTERS}"),
-            );
-        }
-        if !(self.resolution.is_power_of_two() && (8..=1024).contains(&self.resolution)) {
-            return f(
-                "resolution",
-                self.resolution.to_string(),
-                "a power of two in 8..=1024",
-            );
-        }
-        if !(1..=MAX_SPLAT).contains(&self.splat) {
-            return f("splat", self.splat.to_string(), &format!("1..={MAX_SPLAT}"));
-        }
-        if !(1..=MAX_ITERATIONS).contains(&self.iterations) {
-            return f(
-                "iterations",
-                self.iterations.to_string(),
-                &format!("1..={MAX_ITERATIONS}"),
-            );
-        }
+        field::check("methods.val", FIELDS, self)?;
         let w = self.weights;
-        for (name, v) in [
-            ("weights.position", w.position),
-            ("weights.normal", w.normal),
-            ("weights.flux", w.flux),
-        ] {
-            if !(0.0..=1.0).contains(&v) {
-                return f(name, v.to_string(), "0..=1");
-            }
-        }
         if w.position + w.normal + w.flux <= 0.0 {
             return Err("methods.val.weights: at least one of position, normal, flux must be > 0".into());
-        }
-        let n = POISSON.len() as u32;
-        if !(1..=n).contains(&self.pcss.blocker_samples) {
-            return f(
-                "pcss.blocker_samples",
-                self.pcss.blocker_samples.to_string(),
-                &format!("1..={n}"),
-            );
-        }
-        if !(1..=n).contains(&self.pcss.pcf_samples) {
-            return f(
-                "pcss.pcf_samples",
-                self.pcss.pcf_samples.to_string(),
-                &format!("1..={n}"),
-            );
-        }
-        if !(self.pcss.max_radius >= 1.0 && self.pcss.max_radius <= 64.0) {
-            return f(
-                "pcss.max_radius",
-                self.pcss.max_radius.to_string(),
-                "1..=64 texels",
-            );
         }
         self.interleave.validate("methods.val", MAX_INTERLEAVE)?;
         self.ism.validate("methods.val")?;
