@@ -21,12 +21,12 @@ use std::path::{Path, PathBuf};
 const LIMITS: &[(&str, usize)] = &[
     ("direct_only", 0),
     ("ground_truth", 2),
-    ("light_culling", 5),
-    ("lightcut_interpolation", 4),
-    ("lightcuts", 8),
+    ("light_culling", 3),
+    ("lightcut_interpolation", 2),
+    ("lightcuts", 7),
     ("reference", 0),
     ("tree_samplers", 16),
-    ("val", 4),
+    ("val", 2),
 ];
 
 /// Method ids that are also other settings' values ("off": the temporal stage's mode, a

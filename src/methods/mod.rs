@@ -433,6 +433,12 @@ pub struct Module {
     pub shaders: &'static [(&'static str, &'static str)],
     /// Those of its files that are entry points.
     pub entry_shaders: &'static [&'static str],
+    /// Its `#[repr(C)]` structs shared with WGSL (`wgsl_twin!`, beside the structs): one
+    /// registry test checks them all against naga's layout.
+    pub wgsl_twins: &'static [crate::renderer::gpu_data::WgslTwin],
+    /// Its kernels dispatched with a workgroup size of their own (the registry test checks
+    /// every other compute entry point has the standard sizes).
+    pub own_workgroups: &'static [crate::renderer::passes::OwnWorkgroup],
 }
 
 /// A per-frame method's quality knob: what `results` sweeps for its RMSE-vs-GPU-time curve
@@ -735,5 +741,41 @@ pub trait Method: Any {
     /// it keeps none.
     fn stats(&mut self) -> Vec<(&'static str, f64)> {
         Vec::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// Every method's structs shared with WGSL match naga's layout (each module lists its
+    /// own, `Module::wgsl_twins`; the shared passes' are `gpu_data::TWINS`).
+    #[test]
+    fn every_methods_gpu_structs_match_their_wgsl() {
+        let mut n = 0;
+        for m in super::modules() {
+            for t in m.wgsl_twins {
+                assert!(
+                    t.file.starts_with(&format!("methods/{}/", m.name)),
+                    "{}: {} is not in its folder",
+                    m.name,
+                    t.file
+                );
+                if let Err(e) = crate::renderer::gpu_data::check_twin(t) {
+                    panic!("{}: {e}", m.name);
+                }
+                n += 1;
+            }
+        }
+        assert!(n >= 13, "only {n} method structs checked");
+    }
+
+    /// Every method's compute kernels have the standard workgroup sizes or ones it declares.
+    #[test]
+    fn every_methods_workgroup_sizes_match_their_wgsl() {
+        for m in super::modules() {
+            if let Err(e) = crate::renderer::passes::check_workgroup_sizes(m.entry_shaders, m.own_workgroups)
+            {
+                panic!("{}: {e}", m.name);
+            }
+        }
     }
 }

@@ -269,730 +269,268 @@ pub struct GpuVplParams {
     pub level_offsets: [[u32; 4]; 4],
 }
 
-/// Twin: `SlcParams` in `shaders/common/slc_params.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
-pub struct GpuSlcParams {
-    pub width: u32,
-    pub height: u32,
-    pub block: u32,
-    pub grid_x: u32,
-    pub grid_y: u32,
-    pub cut_size: u32,
-    pub leaves: u32,
-    pub levels: u32,
-    /// 0 SLC, 1 SST, 2 RTSLC.
-    pub method: u32,
-    /// 0 stochastic, 1 off.
-    pub blending: u32,
-    /// 0 mock cut, 1 average, 2 root, 3 recompute.
-    pub fallback: u32,
-    pub cull: u32,
-    pub seed: u32,
-    pub accumulate: u32,
-    pub epsilon: f32,
-    pub ray_offset: f32,
-    pub n_min: f32,
-    pub d_max: f32,
-    /// 1: the estimate without the albedo (half-resolution GI, upsampled at full resolution;
-    /// interleaving, whose filter applies it).
-    pub demodulate: u32,
-    /// x | y << 16 of the pixel whose samples are recorded (`methods::tree_samplers::pass::PixelTrace`);
-    /// `u32::MAX` = none.
-    pub trace_pixel: u32,
-    /// Near-field refinement factor (`SamplingSettings::near_field`; 0 = off).
-    pub near_field: f32,
-    /// 1: shadow rays, 0: every sample visible (`GiSettings::shadow_rays`).
-    pub shadow_rays: u32,
-    /// Metres by which substitute samples' shadow rays stop short of the drawn point
-    /// (`SamplingSettings::substitute_offset`).
-    pub substitute_offset: f32,
-    /// 0 mean position (eq. 5.5), 1 min-max box distance, 2 defensive (`ChildProbability`).
-    pub child_probability: u32,
-    /// Interleaving pattern edge n (1 = off) and the frame's subset offset
-    /// (`reference::interleave::Interleave::offset_of`).
-    pub interleave: u32,
-    pub interleave_offset: u32,
-    /// 1: the radix tree (children from its links; `TreeKind::Lbvh`), 0: the perfect tree.
-    pub radix: u32,
-    /// The BRDF model (`Brdf::gpu`).
-    pub brdf: u32,
-    /// How glossy walks weigh the children: 0 geometric, 1 the SST paper's material term,
-    /// 2 defensive (`GlossyWeights::gpu`).
-    pub glossy_material: u32,
-    pub _pad: [u32; 3],
-    /// xyz the camera's position.
-    pub eye: [f32; 4],
+/// A `#[repr(C)]` struct and the WGSL struct it mirrors (`wgsl_twin!`): [`check_twin`]
+/// compares its size and member offsets with naga's layout. The shared passes' are in
+/// [`TWINS`], each method's in its `Module::wgsl_twins` beside its structs; one test walks
+/// them all.
+pub struct WgslTwin {
+    /// The WGSL file (under `shaders/`) that declares it.
+    pub file: &'static str,
+    /// The WGSL struct's name.
+    pub name: &'static str,
+    pub size: usize,
+    /// The Rust members' offsets in the WGSL members' order.
+    pub offsets: fn() -> Vec<usize>,
 }
 
-/// Twin: `GtParams` in `shaders/methods/ground_truth/ground_truth.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuGtParams {
-    pub begin: u32,
-    pub end: u32,
-    pub width: u32,
-    pub height: u32,
-    pub epsilon: f32,
-    pub ray_offset: f32,
-    /// 1: shadow rays, 0: every VPL visible (`GiSettings::shadow_rays`).
-    pub shadow_rays: u32,
-    /// The BRDF model (`Brdf::gpu`).
-    pub brdf: u32,
-    /// xyz the camera's position (the view direction of glossy shading).
-    pub eye: [f32; 4],
-    /// The order the VPLs are summed in: step i evaluates VPL (i x order[0]) mod order[1]
-    /// (a stride coprime with the count, [`crate::methods::ground_truth::visit_stride`]), so
-    /// that every partial sum is spread over the whole set.
-    pub order: [u32; 4],
+/// `wgsl_twin!(RustType, "file.wgsl", "WgslName", [field, field, _pad, _pad + 4])`: a
+/// [`WgslTwin`] (an array member's later elements as `field + byte offset`).
+#[macro_export]
+macro_rules! wgsl_twin {
+    ($t:ty, $file:expr, $name:expr, [$($f:ident $(+ $k:literal)?),* $(,)?]) => {
+        $crate::renderer::gpu_data::WgslTwin {
+            file: $file,
+            name: $name,
+            size: std::mem::size_of::<$t>(),
+            offsets: || vec![$(std::mem::offset_of!($t, $f) $(+ $k)?),*],
+        }
+    };
 }
+
+/// Whether `t`'s size and member offsets are naga's for its WGSL struct; the message names
+/// the struct and file.
+pub fn check_twin(t: &WgslTwin) -> Result<(), String> {
+    use crate::renderer::shaders::{Embedded, preprocess, validate};
+    let text = preprocess(&Embedded, t.file).map_err(|e| e.to_string())?;
+    let module = validate(t.file, &text).map_err(|e| e.to_string())?;
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).map_err(|e| e.to_string())?;
+    for (handle, ty) in module.types.iter() {
+        if ty.name.as_deref() == Some(t.name)
+            && let naga::TypeInner::Struct { members, span } = &ty.inner
+        {
+            let size = layouter[handle].size.max(*span) as usize;
+            let offsets: Vec<usize> = members.iter().map(|m| m.offset as usize).collect();
+            if size != t.size {
+                return Err(format!(
+                    "size of {} ({}): WGSL {size}, Rust {}",
+                    t.name, t.file, t.size
+                ));
+            }
+            let rust = (t.offsets)();
+            if offsets != rust {
+                return Err(format!(
+                    "member offsets of {} ({}): WGSL {offsets:?}, Rust {rust:?}",
+                    t.name, t.file
+                ));
+            }
+            return Ok(());
+        }
+    }
+    Err(format!("struct {} not found in {}", t.name, t.file))
+}
+
+/// The shared passes' structs shared with WGSL.
+pub static TWINS: &[WgslTwin] = &[
+    crate::wgsl_twin!(
+        crate::renderer::passes::compare::GpuCmpParams,
+        "compare_views.wgsl",
+        "CmpParams",
+        [
+            mode,
+            split_x,
+            exposure,
+            tonemap,
+            diff_scale,
+            _pad,
+            _pad + 4,
+            _pad + 8
+        ]
+    ),
+    crate::wgsl_twin!(
+        GpuCamera,
+        "direct.wgsl",
+        "Camera",
+        [view_proj, position, forward, right, up, resolution]
+    ),
+    crate::wgsl_twin!(
+        GpuDirectionalLight,
+        "direct.wgsl",
+        "DirectionalLight",
+        [view_proj, direction, irradiance, shadow]
+    ),
+    crate::wgsl_twin!(GpuLights, "direct.wgsl", "Lights", [count, lights]),
+    crate::wgsl_twin!(
+        DisplayParams,
+        "display.wgsl",
+        "DisplayParams",
+        [exposure, tonemap, channel, flags, lo, hi, _pad]
+    ),
+    crate::wgsl_twin!(
+        VisParams,
+        "visualise.wgsl",
+        "VisParams",
+        [mode, layer, _pad, range_min, range_max]
+    ),
+    crate::wgsl_twin!(
+        GpuMaterial,
+        "gbuffer.wgsl",
+        "MaterialGpu",
+        [base_color, texture, params, mr_uv]
+    ),
+    crate::wgsl_twin!(
+        GpuVplParams,
+        "vpl_gen.wgsl",
+        "VplParams",
+        [
+            res,
+            levels,
+            light_count,
+            vpl_count,
+            samples,
+            filter_radius,
+            mode,
+            seed,
+            sample_radius,
+            n_min,
+            d_max,
+            flux_mix,
+            epsilon,
+            per_layer,
+            _pad,
+            _pad + 4,
+            ranges,
+            level_offsets
+        ]
+    ),
+    crate::wgsl_twin!(
+        crate::renderer::passes::light_paths::GpuPathParams,
+        "light_paths.wgsl",
+        "PathParams",
+        [
+            paths,
+            first,
+            bounces,
+            roulette,
+            seed,
+            ray_offset,
+            lod,
+            flux_scale,
+            light_count,
+            flux_mix,
+            _pad,
+            _pad + 4,
+            ranges
+        ]
+    ),
+    crate::wgsl_twin!(GpuVpl, "vpl_gen.wgsl", "Vpl", [position, normal, id, flux]),
+    crate::wgsl_twin!(
+        crate::renderer::passes::ism::GpuIsmParams,
+        "ism.wgsl",
+        "IsmParams",
+        [
+            atlas,
+            tile,
+            per_row,
+            lights,
+            points,
+            level,
+            bias,
+            level_base,
+            per_light,
+            threads,
+            front_cull,
+            point_radius
+        ]
+    ),
+    crate::wgsl_twin!(
+        crate::renderer::passes::val_cluster::GpuValParams,
+        "val_cluster.wgsl",
+        "ValParams",
+        [
+            view_proj,
+            light_dir,
+            texel_area,
+            res,
+            clusters,
+            splat,
+            layer,
+            w_p,
+            w_n,
+            w_f,
+            extent,
+            area_mode,
+            _pad,
+            _pad + 4,
+            _pad + 8
+        ]
+    ),
+    crate::wgsl_twin!(
+        crate::renderer::passes::val_cluster::GpuVal,
+        "val_cluster.wgsl",
+        "Val",
+        [position, area, normal, pixels, flux, texel]
+    ),
+    crate::wgsl_twin!(
+        crate::renderer::passes::ism::GpuIsmViewParams,
+        "ism_view.wgsl",
+        "IsmViewParams",
+        [atlas, tile, per_row, maps, lo, hi, scale, cols]
+    ),
+    crate::wgsl_twin!(
+        crate::renderer::passes::interleave_filter::GpuFilterParams,
+        "interleave_filter.wgsl",
+        "FilterParams",
+        [
+            width,
+            height,
+            radius,
+            accumulate,
+            normal_cos,
+            plane_tolerance,
+            scale,
+            modulate,
+            period,
+            _pad,
+            _pad + 4,
+            _pad + 8
+        ]
+    ),
+    crate::wgsl_twin!(
+        crate::renderer::passes::sst_overlay::GpuOverlayParams,
+        "sst_overlay.wgsl",
+        "OverlayParams",
+        [
+            level,
+            color_mode,
+            min_radius,
+            radix,
+            leaves,
+            _pad,
+            _pad + 4,
+            _pad + 8
+        ]
+    ),
+    crate::wgsl_twin!(
+        GpuSstNode,
+        "sst_build.wgsl",
+        "SstNode",
+        [position, v, intensity, normal, bbox_min, var_z, bbox_max, var_xy]
+    ),
+    crate::wgsl_twin!(GpuRay, "bvh_rays.wgsl", "RayIn", [origin, dir]),
+    crate::wgsl_twin!(GpuHit, "bvh_rays.wgsl", "HitOut", [t, triangle, u, v]),
+];
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::renderer::shaders::{Embedded, preprocess, validate};
-
-    /// (size, member offsets) of WGSL struct `name` in shader `file`, from naga's layouter.
-    fn wgsl_layout(file: &str, name: &str) -> (u32, Vec<u32>) {
-        let text = preprocess(&Embedded, file).unwrap();
-        let module = validate(file, &text).unwrap();
-        let mut layouter = naga::proc::Layouter::default();
-        layouter.update(module.to_ctx()).unwrap();
-        for (handle, ty) in module.types.iter() {
-            if ty.name.as_deref() == Some(name)
-                && let naga::TypeInner::Struct { members, span } = &ty.inner
-            {
-                assert_eq!(layouter[handle].size, *span);
-                return (*span, members.iter().map(|m| m.offset).collect());
-            }
-        }
-        panic!("struct {name} not found in {file}");
-    }
 
     #[test]
     fn layouts_match_wgsl() {
-        use std::mem::{offset_of, size_of};
-        let cases: Vec<(&str, &str, usize, Vec<usize>)> = vec![
-            (
-                "compare_views.wgsl",
-                "CmpParams",
-                size_of::<crate::renderer::passes::compare::GpuCmpParams>(),
-                {
-                    use crate::renderer::passes::compare::GpuCmpParams as P;
-                    vec![
-                        offset_of!(P, mode),
-                        offset_of!(P, split_x),
-                        offset_of!(P, exposure),
-                        offset_of!(P, tonemap),
-                        offset_of!(P, diff_scale),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                        offset_of!(P, _pad) + 8,
-                    ]
-                },
-            ),
-            (
-                "direct.wgsl",
-                "Camera",
-                size_of::<GpuCamera>(),
-                vec![
-                    offset_of!(GpuCamera, view_proj),
-                    offset_of!(GpuCamera, position),
-                    offset_of!(GpuCamera, forward),
-                    offset_of!(GpuCamera, right),
-                    offset_of!(GpuCamera, up),
-                    offset_of!(GpuCamera, resolution),
-                ],
-            ),
-            (
-                "direct.wgsl",
-                "DirectionalLight",
-                size_of::<GpuDirectionalLight>(),
-                vec![
-                    offset_of!(GpuDirectionalLight, view_proj),
-                    offset_of!(GpuDirectionalLight, direction),
-                    offset_of!(GpuDirectionalLight, irradiance),
-                    offset_of!(GpuDirectionalLight, shadow),
-                ],
-            ),
-            (
-                "direct.wgsl",
-                "Lights",
-                size_of::<GpuLights>(),
-                vec![offset_of!(GpuLights, count), offset_of!(GpuLights, lights)],
-            ),
-            (
-                "display.wgsl",
-                "DisplayParams",
-                size_of::<DisplayParams>(),
-                vec![
-                    offset_of!(DisplayParams, exposure),
-                    offset_of!(DisplayParams, tonemap),
-                    offset_of!(DisplayParams, channel),
-                    offset_of!(DisplayParams, flags),
-                    offset_of!(DisplayParams, lo),
-                    offset_of!(DisplayParams, hi),
-                    offset_of!(DisplayParams, _pad),
-                ],
-            ),
-            (
-                "visualise.wgsl",
-                "VisParams",
-                size_of::<VisParams>(),
-                vec![
-                    offset_of!(VisParams, mode),
-                    offset_of!(VisParams, layer),
-                    offset_of!(VisParams, _pad),
-                    offset_of!(VisParams, range_min),
-                    offset_of!(VisParams, range_max),
-                ],
-            ),
-            (
-                "gbuffer.wgsl",
-                "MaterialGpu",
-                size_of::<GpuMaterial>(),
-                vec![
-                    offset_of!(GpuMaterial, base_color),
-                    offset_of!(GpuMaterial, texture),
-                    offset_of!(GpuMaterial, params),
-                    offset_of!(GpuMaterial, mr_uv),
-                ],
-            ),
-            (
-                "vpl_gen.wgsl",
-                "VplParams",
-                size_of::<GpuVplParams>(),
-                vec![
-                    offset_of!(GpuVplParams, res),
-                    offset_of!(GpuVplParams, levels),
-                    offset_of!(GpuVplParams, light_count),
-                    offset_of!(GpuVplParams, vpl_count),
-                    offset_of!(GpuVplParams, samples),
-                    offset_of!(GpuVplParams, filter_radius),
-                    offset_of!(GpuVplParams, mode),
-                    offset_of!(GpuVplParams, seed),
-                    offset_of!(GpuVplParams, sample_radius),
-                    offset_of!(GpuVplParams, n_min),
-                    offset_of!(GpuVplParams, d_max),
-                    offset_of!(GpuVplParams, flux_mix),
-                    offset_of!(GpuVplParams, epsilon),
-                    offset_of!(GpuVplParams, per_layer),
-                    offset_of!(GpuVplParams, _pad),
-                    offset_of!(GpuVplParams, _pad) + 4,
-                    offset_of!(GpuVplParams, ranges),
-                    offset_of!(GpuVplParams, level_offsets),
-                ],
-            ),
-            (
-                "light_paths.wgsl",
-                "PathParams",
-                size_of::<crate::renderer::passes::light_paths::GpuPathParams>(),
-                {
-                    use crate::renderer::passes::light_paths::GpuPathParams as P;
-                    vec![
-                        offset_of!(P, paths),
-                        offset_of!(P, first),
-                        offset_of!(P, bounces),
-                        offset_of!(P, roulette),
-                        offset_of!(P, seed),
-                        offset_of!(P, ray_offset),
-                        offset_of!(P, lod),
-                        offset_of!(P, flux_scale),
-                        offset_of!(P, light_count),
-                        offset_of!(P, flux_mix),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                        offset_of!(P, ranges),
-                    ]
-                },
-            ),
-            (
-                "vpl_gen.wgsl",
-                "Vpl",
-                size_of::<GpuVpl>(),
-                vec![
-                    offset_of!(GpuVpl, position),
-                    offset_of!(GpuVpl, normal),
-                    offset_of!(GpuVpl, id),
-                    offset_of!(GpuVpl, flux),
-                ],
-            ),
-            (
-                "methods/lightcuts/lc_build.wgsl",
-                "LcBuildParams",
-                size_of::<crate::methods::lightcuts::pass::GpuLcBuildParams>(),
-                {
-                    use crate::methods::lightcuts::pass::GpuLcBuildParams as P;
-                    vec![
-                        offset_of!(P, first),
-                        offset_of!(P, count),
-                        offset_of!(P, leaves),
-                        offset_of!(P, seed),
-                    ]
-                },
-            ),
-            (
-                "methods/lightcuts/lightcuts.wgsl",
-                "LcParams",
-                size_of::<crate::methods::lightcuts::pass::GpuLcParams>(),
-                {
-                    use crate::methods::lightcuts::pass::GpuLcParams as P;
-                    vec![
-                        offset_of!(P, width),
-                        offset_of!(P, height),
-                        offset_of!(P, leaves),
-                        offset_of!(P, max_cut),
-                        offset_of!(P, relative_error),
-                        offset_of!(P, epsilon),
-                        offset_of!(P, ray_offset),
-                        offset_of!(P, shadow_rays),
-                        offset_of!(P, accumulate),
-                        offset_of!(P, trace_pixel),
-                        offset_of!(P, first_pixel),
-                        offset_of!(P, slice),
-                        offset_of!(P, first),
-                        offset_of!(P, last),
-                        offset_of!(P, steps),
-                        offset_of!(P, radix),
-                        offset_of!(P, brdf),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                        offset_of!(P, _pad) + 8,
-                        offset_of!(P, eye),
-                    ]
-                },
-            ),
-            (
-                "methods/lightcuts/lc_views.wgsl",
-                "LcViewParams",
-                size_of::<crate::methods::lightcuts::pass::GpuLcViewParams>(),
-                {
-                    use crate::methods::lightcuts::pass::GpuLcViewParams as P;
-                    vec![
-                        offset_of!(P, mode),
-                        offset_of!(P, scale_top),
-                        offset_of!(P, relative_error),
-                        offset_of!(P, exposure),
-                        offset_of!(P, tonemap),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                        offset_of!(P, _pad) + 8,
-                    ]
-                },
-            ),
-            (
-                "methods/lightcut_interpolation/li_interp.wgsl",
-                "LiParams",
-                size_of::<crate::methods::lightcut_interpolation::pass::GpuLiParams>(),
-                {
-                    use crate::methods::lightcut_interpolation::pass::GpuLiParams as P;
-                    vec![
-                        offset_of!(P, width),
-                        offset_of!(P, height),
-                        offset_of!(P, tiles_x),
-                        offset_of!(P, tiles_y),
-                        offset_of!(P, leaves),
-                        offset_of!(P, levels),
-                        offset_of!(P, max_cut),
-                        offset_of!(P, capacity),
-                        offset_of!(P, r_min_px),
-                        offset_of!(P, r_max_px),
-                        offset_of!(P, one_minus_cos_max),
-                        offset_of!(P, epsilon),
-                        offset_of!(P, coverage),
-                        offset_of!(P, radius_rays),
-                        offset_of!(P, ray_offset),
-                        offset_of!(P, shadow_rays),
-                        offset_of!(P, interp_visibility),
-                        offset_of!(P, accumulate),
-                        offset_of!(P, trace_pixel),
-                        offset_of!(P, steps),
-                        offset_of!(P, first),
-                        offset_of!(P, last),
-                        offset_of!(P, distance_epsilon),
-                        offset_of!(P, _pad),
-                    ]
-                },
-            ),
-            (
-                "methods/lightcut_interpolation/li_views.wgsl",
-                "LiViewParams",
-                size_of::<crate::methods::lightcut_interpolation::pass::GpuLiViewParams>(),
-                {
-                    use crate::methods::lightcut_interpolation::pass::GpuLiViewParams as P;
-                    vec![
-                        offset_of!(P, mode),
-                        offset_of!(P, scale_top),
-                        offset_of!(P, r_min_px),
-                        offset_of!(P, r_max_px),
-                        offset_of!(P, exposure),
-                        offset_of!(P, tonemap),
-                        offset_of!(P, tiles_x),
-                        offset_of!(P, tiles_y),
-                        offset_of!(P, pinned),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                        offset_of!(P, _pad) + 8,
-                    ]
-                },
-            ),
-            (
-                "methods/light_culling/lcull_ranges.wgsl",
-                "LcullParams",
-                size_of::<crate::methods::light_culling::pass::GpuLcullParams>(),
-                {
-                    use crate::methods::light_culling::pass::GpuLcullParams as P;
-                    vec![
-                        offset_of!(P, width),
-                        offset_of!(P, height),
-                        offset_of!(P, tile),
-                        offset_of!(P, n),
-                        offset_of!(P, tiles_x),
-                        offset_of!(P, tiles_y),
-                        offset_of!(P, tiles),
-                        offset_of!(P, cap),
-                        offset_of!(P, count),
-                        offset_of!(P, offset),
-                        offset_of!(P, seed),
-                        offset_of!(P, mode),
-                        offset_of!(P, epsilon_max),
-                        offset_of!(P, exposure),
-                        offset_of!(P, eps),
-                        offset_of!(P, ray_offset),
-                        offset_of!(P, shadow_rays),
-                        offset_of!(P, stride),
-                        offset_of!(P, leaves),
-                        offset_of!(P, ism_flags),
-                        offset_of!(P, brdf),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                        offset_of!(P, _pad) + 8,
-                        offset_of!(P, eye),
-                    ]
-                },
-            ),
-            (
-                "ism.wgsl",
-                "IsmParams",
-                size_of::<crate::renderer::passes::ism::GpuIsmParams>(),
-                {
-                    use crate::renderer::passes::ism::GpuIsmParams as P;
-                    vec![
-                        offset_of!(P, atlas),
-                        offset_of!(P, tile),
-                        offset_of!(P, per_row),
-                        offset_of!(P, lights),
-                        offset_of!(P, points),
-                        offset_of!(P, level),
-                        offset_of!(P, bias),
-                        offset_of!(P, level_base),
-                        offset_of!(P, per_light),
-                        offset_of!(P, threads),
-                        offset_of!(P, front_cull),
-                        offset_of!(P, point_radius),
-                    ]
-                },
-            ),
-            (
-                "val_cluster.wgsl",
-                "ValParams",
-                size_of::<crate::renderer::passes::val_cluster::GpuValParams>(),
-                {
-                    use crate::renderer::passes::val_cluster::GpuValParams as P;
-                    vec![
-                        offset_of!(P, view_proj),
-                        offset_of!(P, light_dir),
-                        offset_of!(P, texel_area),
-                        offset_of!(P, res),
-                        offset_of!(P, clusters),
-                        offset_of!(P, splat),
-                        offset_of!(P, layer),
-                        offset_of!(P, w_p),
-                        offset_of!(P, w_n),
-                        offset_of!(P, w_f),
-                        offset_of!(P, extent),
-                        offset_of!(P, area_mode),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                        offset_of!(P, _pad) + 8,
-                    ]
-                },
-            ),
-            (
-                "methods/val/val_shade.wgsl",
-                "ValShadeParams",
-                size_of::<crate::methods::val::pass::GpuValShadeParams>(),
-                {
-                    use crate::methods::val::pass::GpuValShadeParams as P;
-                    vec![
-                        offset_of!(P, width),
-                        offset_of!(P, height),
-                        offset_of!(P, n),
-                        offset_of!(P, offset),
-                        offset_of!(P, clusters),
-                        offset_of!(P, as_point),
-                        offset_of!(P, visibility),
-                        offset_of!(P, count),
-                        offset_of!(P, eps),
-                        offset_of!(P, ray_offset),
-                        offset_of!(P, blocker_samples),
-                        offset_of!(P, pcf_samples),
-                        offset_of!(P, max_radius),
-                        offset_of!(P, res),
-                        offset_of!(P, layer),
-                        offset_of!(P, inspect),
-                        offset_of!(P, factor),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                        offset_of!(P, _pad) + 8,
-                    ]
-                },
-            ),
-            (
-                "methods/val/val_shade.wgsl",
-                "Val",
-                size_of::<crate::renderer::passes::val_cluster::GpuVal>(),
-                {
-                    use crate::renderer::passes::val_cluster::GpuVal as P;
-                    vec![
-                        offset_of!(P, position),
-                        offset_of!(P, area),
-                        offset_of!(P, normal),
-                        offset_of!(P, pixels),
-                        offset_of!(P, flux),
-                        offset_of!(P, texel),
-                    ]
-                },
-            ),
-            (
-                "methods/val/val_views.wgsl",
-                "ValViewParams",
-                size_of::<crate::methods::val::pass::GpuValViewParams>(),
-                {
-                    use crate::methods::val::pass::GpuValViewParams as P;
-                    vec![
-                        offset_of!(P, mode),
-                        offset_of!(P, clusters),
-                        offset_of!(P, exposure),
-                        offset_of!(P, tonemap),
-                        offset_of!(P, lo),
-                        offset_of!(P, hi),
-                        offset_of!(P, inspect),
-                        offset_of!(P, gap),
-                        offset_of!(P, ray_offset),
-                        offset_of!(P, res),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                    ]
-                },
-            ),
-            (
-                "methods/val/val_downsample.wgsl",
-                "DownParams",
-                size_of::<crate::methods::val::pass::GpuDownParams>(),
-                {
-                    use crate::methods::val::pass::GpuDownParams as P;
-                    vec![
-                        offset_of!(P, res),
-                        offset_of!(P, factor),
-                        offset_of!(P, layer),
-                        offset_of!(P, _pad),
-                        offset_of!(P, light_dir),
-                        offset_of!(P, texel_area),
-                    ]
-                },
-            ),
-            (
-                "val_cluster.wgsl",
-                "Val",
-                size_of::<crate::renderer::passes::val_cluster::GpuVal>(),
-                {
-                    use crate::renderer::passes::val_cluster::GpuVal as P;
-                    vec![
-                        offset_of!(P, position),
-                        offset_of!(P, area),
-                        offset_of!(P, normal),
-                        offset_of!(P, pixels),
-                        offset_of!(P, flux),
-                        offset_of!(P, texel),
-                    ]
-                },
-            ),
-            (
-                "ism_view.wgsl",
-                "IsmViewParams",
-                size_of::<crate::renderer::passes::ism::GpuIsmViewParams>(),
-                {
-                    use crate::renderer::passes::ism::GpuIsmViewParams as P;
-                    vec![
-                        offset_of!(P, atlas),
-                        offset_of!(P, tile),
-                        offset_of!(P, per_row),
-                        offset_of!(P, maps),
-                        offset_of!(P, lo),
-                        offset_of!(P, hi),
-                        offset_of!(P, scale),
-                        offset_of!(P, cols),
-                    ]
-                },
-            ),
-            (
-                "interleave_filter.wgsl",
-                "FilterParams",
-                size_of::<crate::renderer::passes::interleave_filter::GpuFilterParams>(),
-                {
-                    use crate::renderer::passes::interleave_filter::GpuFilterParams as P;
-                    vec![
-                        offset_of!(P, width),
-                        offset_of!(P, height),
-                        offset_of!(P, radius),
-                        offset_of!(P, accumulate),
-                        offset_of!(P, normal_cos),
-                        offset_of!(P, plane_tolerance),
-                        offset_of!(P, scale),
-                        offset_of!(P, modulate),
-                        offset_of!(P, period),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                        offset_of!(P, _pad) + 8,
-                    ]
-                },
-            ),
-            (
-                "methods/light_culling/lcull_views.wgsl",
-                "LcullViewParams",
-                size_of::<crate::methods::light_culling::pass::GpuLcullViewParams>(),
-                {
-                    use crate::methods::light_culling::pass::GpuLcullViewParams as P;
-                    vec![
-                        offset_of!(P, mode),
-                        offset_of!(P, scale_top),
-                        offset_of!(P, exposure),
-                        offset_of!(P, tonemap),
-                        offset_of!(P, n),
-                        offset_of!(P, cap),
-                        offset_of!(P, own_scale),
-                        offset_of!(P, companion_scale),
-                        offset_of!(P, own_is_clamped),
-                        offset_of!(P, range),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                    ]
-                },
-            ),
-            (
-                "methods/ground_truth/ground_truth.wgsl",
-                "GtParams",
-                size_of::<GpuGtParams>(),
-                vec![
-                    offset_of!(GpuGtParams, begin),
-                    offset_of!(GpuGtParams, end),
-                    offset_of!(GpuGtParams, width),
-                    offset_of!(GpuGtParams, height),
-                    offset_of!(GpuGtParams, epsilon),
-                    offset_of!(GpuGtParams, ray_offset),
-                    offset_of!(GpuGtParams, shadow_rays),
-                    offset_of!(GpuGtParams, brdf),
-                    offset_of!(GpuGtParams, eye),
-                    offset_of!(GpuGtParams, order),
-                ],
-            ),
-            (
-                "methods/tree_samplers/slc_sample.wgsl",
-                "SlcParams",
-                size_of::<GpuSlcParams>(),
-                vec![
-                    offset_of!(GpuSlcParams, width),
-                    offset_of!(GpuSlcParams, height),
-                    offset_of!(GpuSlcParams, block),
-                    offset_of!(GpuSlcParams, grid_x),
-                    offset_of!(GpuSlcParams, grid_y),
-                    offset_of!(GpuSlcParams, cut_size),
-                    offset_of!(GpuSlcParams, leaves),
-                    offset_of!(GpuSlcParams, levels),
-                    offset_of!(GpuSlcParams, method),
-                    offset_of!(GpuSlcParams, blending),
-                    offset_of!(GpuSlcParams, fallback),
-                    offset_of!(GpuSlcParams, cull),
-                    offset_of!(GpuSlcParams, seed),
-                    offset_of!(GpuSlcParams, accumulate),
-                    offset_of!(GpuSlcParams, epsilon),
-                    offset_of!(GpuSlcParams, ray_offset),
-                    offset_of!(GpuSlcParams, n_min),
-                    offset_of!(GpuSlcParams, d_max),
-                    offset_of!(GpuSlcParams, demodulate),
-                    offset_of!(GpuSlcParams, trace_pixel),
-                    offset_of!(GpuSlcParams, near_field),
-                    offset_of!(GpuSlcParams, shadow_rays),
-                    offset_of!(GpuSlcParams, substitute_offset),
-                    offset_of!(GpuSlcParams, child_probability),
-                    offset_of!(GpuSlcParams, interleave),
-                    offset_of!(GpuSlcParams, interleave_offset),
-                    offset_of!(GpuSlcParams, radix),
-                    offset_of!(GpuSlcParams, brdf),
-                    offset_of!(GpuSlcParams, glossy_material),
-                    offset_of!(GpuSlcParams, _pad),
-                    offset_of!(GpuSlcParams, _pad) + 4,
-                    offset_of!(GpuSlcParams, _pad) + 8,
-                    offset_of!(GpuSlcParams, eye),
-                ],
-            ),
-            (
-                "sst_overlay.wgsl",
-                "OverlayParams",
-                size_of::<crate::renderer::passes::sst_overlay::GpuOverlayParams>(),
-                {
-                    use crate::renderer::passes::sst_overlay::GpuOverlayParams as P;
-                    vec![
-                        offset_of!(P, level),
-                        offset_of!(P, color_mode),
-                        offset_of!(P, min_radius),
-                        offset_of!(P, radix),
-                        offset_of!(P, leaves),
-                        offset_of!(P, _pad),
-                        offset_of!(P, _pad) + 4,
-                        offset_of!(P, _pad) + 8,
-                    ]
-                },
-            ),
-            (
-                "sst_build.wgsl",
-                "SstNode",
-                size_of::<GpuSstNode>(),
-                vec![
-                    offset_of!(GpuSstNode, position),
-                    offset_of!(GpuSstNode, v),
-                    offset_of!(GpuSstNode, intensity),
-                    offset_of!(GpuSstNode, normal),
-                    offset_of!(GpuSstNode, bbox_min),
-                    offset_of!(GpuSstNode, var_z),
-                    offset_of!(GpuSstNode, bbox_max),
-                    offset_of!(GpuSstNode, var_xy),
-                ],
-            ),
-            (
-                "bvh_rays.wgsl",
-                "RayIn",
-                size_of::<GpuRay>(),
-                vec![offset_of!(GpuRay, origin), offset_of!(GpuRay, dir)],
-            ),
-            (
-                "bvh_rays.wgsl",
-                "HitOut",
-                size_of::<GpuHit>(),
-                vec![
-                    offset_of!(GpuHit, t),
-                    offset_of!(GpuHit, triangle),
-                    offset_of!(GpuHit, u),
-                    offset_of!(GpuHit, v),
-                ],
-            ),
-        ];
-        for (file, name, size, offsets) in cases {
-            let (wsize, woffsets) = wgsl_layout(file, name);
-            assert_eq!(wsize as usize, size, "size of {name} ({file})");
-            let woffsets: Vec<usize> = woffsets.into_iter().map(|o| o as usize).collect();
-            assert_eq!(woffsets, offsets, "member offsets of {name} ({file})");
+        for t in TWINS {
+            if let Err(e) = check_twin(t) {
+                panic!("{e}");
+            }
         }
     }
 

@@ -11,6 +11,8 @@ pub static MODULE: Module = Module {
     create,
     shaders: &[],
     entry_shaders: &[],
+    wgsl_twins: &[],
+    own_workgroups: &[],
 };
 
 pub static INFO: MethodInfo = MethodInfo {

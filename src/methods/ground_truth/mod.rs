@@ -9,9 +9,8 @@ mod ui;
 use super::{FrameCx, Kind, Method, MethodId, MethodInfo, Module, Resource};
 use crate::base::field::Field;
 use crate::renderer::settings::GiSettings;
-use crate::renderer::{
-    GiProgress, gpu_data::GpuGtParams, gpu_data::GpuVpl, settings::RenderSettings, shaders::ShaderError,
-};
+use crate::renderer::{GiProgress, gpu_data::GpuVpl, settings::RenderSettings, shaders::ShaderError};
+use pass::GpuGtParams;
 use pass::GroundTruthPass;
 
 pub const ID: MethodId = MethodId::new("ground-truth");
@@ -24,6 +23,8 @@ pub static MODULE: Module = Module {
         include_str!("../../../shaders/methods/ground_truth/ground_truth.wgsl"),
     )],
     entry_shaders: &["methods/ground_truth/ground_truth.wgsl"],
+    wgsl_twins: pass::WGSL_TWINS,
+    own_workgroups: &[],
 };
 
 pub static INFO: MethodInfo = MethodInfo {

@@ -4,12 +4,12 @@
 
 use crate::renderer::{
     frame::GbufferTargets,
-    gpu_data::GpuGtParams,
     kernel::{Kernel, KernelOptions, buf, tex},
     scene_gpu::SceneGpu,
     shaders,
     timing::GpuTimer,
 };
+use bytemuck::{Pod, Zeroable};
 
 use crate::renderer::passes::groups_2d;
 
@@ -113,3 +113,45 @@ impl GroundTruthPass {
         b
     }
 }
+
+/// Twin: `GtParams` in `shaders/methods/ground_truth/ground_truth.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuGtParams {
+    pub begin: u32,
+    pub end: u32,
+    pub width: u32,
+    pub height: u32,
+    pub epsilon: f32,
+    pub ray_offset: f32,
+    /// 1: shadow rays, 0: every VPL visible (`GiSettings::shadow_rays`).
+    pub shadow_rays: u32,
+    /// The BRDF model (`Brdf::gpu`).
+    pub brdf: u32,
+    /// xyz the camera's position (the view direction of glossy shading).
+    pub eye: [f32; 4],
+    /// The order the VPLs are summed in: step i evaluates VPL (i x order[0]) mod order[1]
+    /// (a stride coprime with the count, [`crate::methods::ground_truth::visit_stride`]), so
+    /// that every partial sum is spread over the whole set.
+    pub order: [u32; 4],
+}
+
+/// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
+/// checks them against naga's layout).
+pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[crate::wgsl_twin!(
+    GpuGtParams,
+    "methods/ground_truth/ground_truth.wgsl",
+    "GtParams",
+    [
+        begin,
+        end,
+        width,
+        height,
+        epsilon,
+        ray_offset,
+        shadow_rays,
+        brdf,
+        eye,
+        order
+    ]
+)];

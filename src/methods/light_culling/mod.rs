@@ -73,6 +73,13 @@ pub static MODULE: Module = Module {
         "methods/light_culling/lcull_tree.wgsl",
         "methods/light_culling/lcull_views.wgsl",
     ],
+    wgsl_twins: pass::WGSL_TWINS,
+    own_workgroups: &[crate::renderer::passes::OwnWorkgroup {
+        // One workgroup per tile.
+        file: "methods/light_culling/lcull_tiles.wgsl",
+        entries: &[],
+        size: [pass::TILE_WG, 1, 1],
+    }],
 };
 
 /// The pixel's tile list length (log heat map).

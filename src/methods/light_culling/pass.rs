@@ -690,3 +690,59 @@ impl LcullPass {
         );
     }
 }
+
+/// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
+/// checks them against naga's layout).
+pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[
+    crate::wgsl_twin!(
+        crate::methods::light_culling::pass::GpuLcullParams,
+        "methods/light_culling/lcull_ranges.wgsl",
+        "LcullParams",
+        [
+            width,
+            height,
+            tile,
+            n,
+            tiles_x,
+            tiles_y,
+            tiles,
+            cap,
+            count,
+            offset,
+            seed,
+            mode,
+            epsilon_max,
+            exposure,
+            eps,
+            ray_offset,
+            shadow_rays,
+            stride,
+            leaves,
+            ism_flags,
+            brdf,
+            _pad,
+            _pad + 4,
+            _pad + 8,
+            eye
+        ]
+    ),
+    crate::wgsl_twin!(
+        crate::methods::light_culling::pass::GpuLcullViewParams,
+        "methods/light_culling/lcull_views.wgsl",
+        "LcullViewParams",
+        [
+            mode,
+            scale_top,
+            exposure,
+            tonemap,
+            n,
+            cap,
+            own_scale,
+            companion_scale,
+            own_is_clamped,
+            range,
+            _pad,
+            _pad + 4
+        ]
+    ),
+];

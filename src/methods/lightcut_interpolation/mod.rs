@@ -59,6 +59,13 @@ pub static MODULE: Module = Module {
         "methods/lightcut_interpolation/li_interp.wgsl",
         "methods/lightcut_interpolation/li_views.wgsl",
     ],
+    wgsl_twins: pass::WGSL_TWINS,
+    own_workgroups: &[crate::renderer::passes::OwnWorkgroup {
+        // One workgroup per 16 x 16 tile.
+        file: "methods/lightcut_interpolation/li_records.wgsl",
+        entries: pass::TILE_WG_ENTRIES,
+        size: [pass::TILE_WG, 1, 1],
+    }],
 };
 
 /// The cache records over the grey final image (reach from red to green, paper Fig. 4 top).

@@ -655,3 +655,58 @@ impl LiPass {
         );
     }
 }
+
+/// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
+/// checks them against naga's layout).
+pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[
+    crate::wgsl_twin!(
+        crate::methods::lightcut_interpolation::pass::GpuLiParams,
+        "methods/lightcut_interpolation/li_interp.wgsl",
+        "LiParams",
+        [
+            width,
+            height,
+            tiles_x,
+            tiles_y,
+            leaves,
+            levels,
+            max_cut,
+            capacity,
+            r_min_px,
+            r_max_px,
+            one_minus_cos_max,
+            epsilon,
+            coverage,
+            radius_rays,
+            ray_offset,
+            shadow_rays,
+            interp_visibility,
+            accumulate,
+            trace_pixel,
+            steps,
+            first,
+            last,
+            distance_epsilon,
+            _pad
+        ]
+    ),
+    crate::wgsl_twin!(
+        crate::methods::lightcut_interpolation::pass::GpuLiViewParams,
+        "methods/lightcut_interpolation/li_views.wgsl",
+        "LiViewParams",
+        [
+            mode,
+            scale_top,
+            r_min_px,
+            r_max_px,
+            exposure,
+            tonemap,
+            tiles_x,
+            tiles_y,
+            pinned,
+            _pad,
+            _pad + 4,
+            _pad + 8
+        ]
+    ),
+];

@@ -54,6 +54,8 @@ pub static MODULE: Module = Module {
         "methods/lightcuts/lightcuts.wgsl",
         "methods/lightcuts/lc_views.wgsl",
     ],
+    wgsl_twins: pass::WGSL_TWINS,
+    own_workgroups: &[],
 };
 
 /// Nodes in each pixel's cut (log heat map).

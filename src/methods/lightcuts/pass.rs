@@ -651,3 +651,57 @@ pub fn read_build(ctx: &GpuContext, out: &LcBuffers) -> Result<LcTree, GpuError>
         reps: reps.into_iter().take(n).collect(),
     })
 }
+
+/// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
+/// checks them against naga's layout).
+pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[
+    crate::wgsl_twin!(
+        crate::methods::lightcuts::pass::GpuLcBuildParams,
+        "methods/lightcuts/lc_build.wgsl",
+        "LcBuildParams",
+        [first, count, leaves, seed]
+    ),
+    crate::wgsl_twin!(
+        crate::methods::lightcuts::pass::GpuLcParams,
+        "methods/lightcuts/lightcuts.wgsl",
+        "LcParams",
+        [
+            width,
+            height,
+            leaves,
+            max_cut,
+            relative_error,
+            epsilon,
+            ray_offset,
+            shadow_rays,
+            accumulate,
+            trace_pixel,
+            first_pixel,
+            slice,
+            first,
+            last,
+            steps,
+            radix,
+            brdf,
+            _pad,
+            _pad + 4,
+            _pad + 8,
+            eye
+        ]
+    ),
+    crate::wgsl_twin!(
+        crate::methods::lightcuts::pass::GpuLcViewParams,
+        "methods/lightcuts/lc_views.wgsl",
+        "LcViewParams",
+        [
+            mode,
+            scale_top,
+            relative_error,
+            exposure,
+            tonemap,
+            _pad,
+            _pad + 4,
+            _pad + 8
+        ]
+    ),
+];

@@ -11,11 +11,12 @@ mod ui;
 
 use super::{FrameCx, Kind, Method, MethodId, MethodInfo, Module, Resource};
 use crate::base::field::Field;
+use crate::methods::ground_truth::pass::GpuGtParams;
 use crate::methods::ground_truth::pass::{GroundTruthPass, MAX_BATCHES};
 use crate::renderer::settings::GiSettings;
 use crate::renderer::{
     GiProgress,
-    gpu_data::{GpuGtParams, GpuVpl},
+    gpu_data::GpuVpl,
     passes::light_paths::{LightPathPass, PathJob},
     settings::RenderSettings,
     shaders::ShaderError,
@@ -32,6 +33,8 @@ pub static MODULE: Module = Module {
         include_str!("../../../shaders/methods/reference/reference.wgsl"),
     )],
     entry_shaders: &["methods/reference/reference.wgsl"],
+    wgsl_twins: &[],
+    own_workgroups: &[],
 };
 
 pub static INFO: MethodInfo = MethodInfo {

@@ -23,13 +23,13 @@ use crate::base::sst_node::TreeKind;
 use crate::reference::interleave::Interleave;
 use crate::renderer::{
     context::{GpuContext, GpuError},
-    gpu_data::GpuSlcParams,
     passes::interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
     readback::{self, ImageF32},
     settings::RenderSettings,
     shaders::ShaderError,
 };
 use half::{HalfPass, HalfTargets};
+use pass::GpuSlcParams;
 use pass::{GpuSlcViewParams, PixelTrace, SamplingStats, SlcBuffers, SlcPass};
 use settings::{ChildProbability, CutBlending, CutFallback, SamplerVisibility};
 
@@ -63,6 +63,8 @@ pub static MODULE: Module = Module {
         "methods/tree_samplers/slc_half.wgsl",
         "methods/tree_samplers/slc_upsample.wgsl",
     ],
+    wgsl_twins: pass::WGSL_TWINS,
+    own_workgroups: &[],
 };
 
 /// Traversal steps per traversal, per pixel (heat map, thesis fig. 7.2).

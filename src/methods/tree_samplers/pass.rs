@@ -9,13 +9,13 @@
 
 use crate::renderer::{
     frame::GbufferTargets,
-    gpu_data::GpuSlcParams,
     kernel::{Kernel, KernelOptions, buf, tex},
     readback::CounterReadback,
     scene_gpu::SceneGpu,
     shaders,
     timing::GpuTimer,
 };
+use bytemuck::{Pod, Zeroable};
 
 use crate::renderer::passes::{
     WG_1D, groups_image,
@@ -592,6 +592,105 @@ impl SlcPass {
         );
     }
 }
+
+/// Twin: `SlcParams` in `shaders/common/slc_params.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuSlcParams {
+    pub width: u32,
+    pub height: u32,
+    pub block: u32,
+    pub grid_x: u32,
+    pub grid_y: u32,
+    pub cut_size: u32,
+    pub leaves: u32,
+    pub levels: u32,
+    /// 0 SLC, 1 SST, 2 RTSLC.
+    pub method: u32,
+    /// 0 stochastic, 1 off.
+    pub blending: u32,
+    /// 0 mock cut, 1 average, 2 root, 3 recompute.
+    pub fallback: u32,
+    pub cull: u32,
+    pub seed: u32,
+    pub accumulate: u32,
+    pub epsilon: f32,
+    pub ray_offset: f32,
+    pub n_min: f32,
+    pub d_max: f32,
+    /// 1: the estimate without the albedo (half-resolution GI, upsampled at full resolution;
+    /// interleaving, whose filter applies it).
+    pub demodulate: u32,
+    /// x | y << 16 of the pixel whose samples are recorded (`methods::tree_samplers::pass::PixelTrace`);
+    /// `u32::MAX` = none.
+    pub trace_pixel: u32,
+    /// Near-field refinement factor (`SamplingSettings::near_field`; 0 = off).
+    pub near_field: f32,
+    /// 1: shadow rays, 0: every sample visible (`GiSettings::shadow_rays`).
+    pub shadow_rays: u32,
+    /// Metres by which substitute samples' shadow rays stop short of the drawn point
+    /// (`SamplingSettings::substitute_offset`).
+    pub substitute_offset: f32,
+    /// 0 mean position (eq. 5.5), 1 min-max box distance, 2 defensive (`ChildProbability`).
+    pub child_probability: u32,
+    /// Interleaving pattern edge n (1 = off) and the frame's subset offset
+    /// (`reference::interleave::Interleave::offset_of`).
+    pub interleave: u32,
+    pub interleave_offset: u32,
+    /// 1: the radix tree (children from its links; `TreeKind::Lbvh`), 0: the perfect tree.
+    pub radix: u32,
+    /// The BRDF model (`Brdf::gpu`).
+    pub brdf: u32,
+    /// How glossy walks weigh the children: 0 geometric, 1 the SST paper's material term,
+    /// 2 defensive (`GlossyWeights::gpu`).
+    pub glossy_material: u32,
+    pub _pad: [u32; 3],
+    /// xyz the camera's position.
+    pub eye: [f32; 4],
+}
+
+/// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
+/// checks them against naga's layout).
+pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[crate::wgsl_twin!(
+    GpuSlcParams,
+    "methods/tree_samplers/slc_sample.wgsl",
+    "SlcParams",
+    [
+        width,
+        height,
+        block,
+        grid_x,
+        grid_y,
+        cut_size,
+        leaves,
+        levels,
+        method,
+        blending,
+        fallback,
+        cull,
+        seed,
+        accumulate,
+        epsilon,
+        ray_offset,
+        n_min,
+        d_max,
+        demodulate,
+        trace_pixel,
+        near_field,
+        shadow_rays,
+        substitute_offset,
+        child_probability,
+        interleave,
+        interleave_offset,
+        radix,
+        brdf,
+        glossy_material,
+        _pad,
+        _pad + 4,
+        _pad + 8,
+        eye
+    ]
+)];
 
 #[cfg(test)]
 mod tests {

@@ -69,6 +69,13 @@ pub static MODULE: Module = Module {
         "methods/val/val_views.wgsl",
         "methods/val/val_downsample.wgsl",
     ],
+    wgsl_twins: pass::WGSL_TWINS,
+    own_workgroups: &[crate::renderer::passes::OwnWorkgroup {
+        // The seeds' compaction: one workgroup.
+        file: "methods/val/val_shade.wgsl",
+        entries: &[pass::SEED_WG_ENTRY],
+        size: [pass::SEED_WG, 1, 1],
+    }],
 };
 
 /// The clusters over light 0's RSM.

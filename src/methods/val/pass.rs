@@ -501,3 +501,66 @@ impl ValPass {
         );
     }
 }
+
+/// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
+/// checks them against naga's layout).
+pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[
+    crate::wgsl_twin!(
+        crate::methods::val::pass::GpuValShadeParams,
+        "methods/val/val_shade.wgsl",
+        "ValShadeParams",
+        [
+            width,
+            height,
+            n,
+            offset,
+            clusters,
+            as_point,
+            visibility,
+            count,
+            eps,
+            ray_offset,
+            blocker_samples,
+            pcf_samples,
+            max_radius,
+            res,
+            layer,
+            inspect,
+            factor,
+            _pad,
+            _pad + 4,
+            _pad + 8
+        ]
+    ),
+    crate::wgsl_twin!(
+        crate::renderer::passes::val_cluster::GpuVal,
+        "methods/val/val_shade.wgsl",
+        "Val",
+        [position, area, normal, pixels, flux, texel]
+    ),
+    crate::wgsl_twin!(
+        crate::methods::val::pass::GpuValViewParams,
+        "methods/val/val_views.wgsl",
+        "ValViewParams",
+        [
+            mode,
+            clusters,
+            exposure,
+            tonemap,
+            lo,
+            hi,
+            inspect,
+            gap,
+            ray_offset,
+            res,
+            _pad,
+            _pad + 4
+        ]
+    ),
+    crate::wgsl_twin!(
+        crate::methods::val::pass::GpuDownParams,
+        "methods/val/val_downsample.wgsl",
+        "DownParams",
+        [res, factor, layer, _pad, light_dir, texel_area]
+    ),
+];

@@ -200,40 +200,58 @@ pub(crate) fn run_compute(
     encoder.pop_debug_group();
 }
 
+/// A kernel dispatched with a workgroup size of its own (not `WG_2D` x `WG_2D` or `WG_1D`):
+/// declared beside the pass that dispatches it, checked against its WGSL by
+/// [`check_workgroup_sizes`].
+pub struct OwnWorkgroup {
+    /// The WGSL file (under `shaders/`).
+    pub file: &'static str,
+    /// Its entry points of that size (empty: every entry point of the file).
+    pub entries: &'static [&'static str],
+    pub size: [u32; 3],
+}
+
+/// Every compute entry point of `files` has the standard sizes or one `own` declares; the
+/// message names the first that has neither.
+pub fn check_workgroup_sizes(files: &[&str], own: &[OwnWorkgroup]) -> Result<(), String> {
+    use crate::renderer::shaders::{Embedded, preprocess, validate};
+    for file in files {
+        let text = preprocess(&Embedded, file).map_err(|e| e.to_string())?;
+        let module = validate(file, &text).map_err(|e| e.to_string())?;
+        for ep in &module.entry_points {
+            if ep.stage != naga::ShaderStage::Compute {
+                continue;
+            }
+            let ws = ep.workgroup_size;
+            let declared = own.iter().any(|o| {
+                o.file == *file
+                    && (o.entries.is_empty() || o.entries.contains(&ep.name.as_str()))
+                    && o.size == ws
+            });
+            if !(declared || ws == [WG_2D, WG_2D, 1] || ws == [WG_1D, 1, 1]) {
+                return Err(format!("{file}::{} has workgroup size {ws:?}", ep.name));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The shared passes' own workgroup sizes: the parallel sort's kernels (the pass dispatches
+/// with it).
+pub static OWN_WORKGROUPS: &[OwnWorkgroup] = &[OwnWorkgroup {
+    file: "sst_sort.wgsl",
+    entries: &sst_sort::SORT_WG_ENTRIES,
+    size: [sst_sort::SORT_WG, 1, 1],
+}];
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::renderer::shaders::{Embedded, entry_shaders, preprocess, validate};
 
     #[test]
     fn workgroup_sizes_match_wgsl() {
-        for file in entry_shaders() {
-            let text = preprocess(&Embedded, file).unwrap();
-            let module = validate(file, &text).unwrap();
-            for ep in &module.entry_points {
-                if ep.stage != naga::ShaderStage::Compute {
-                    continue;
-                }
-                let ws = ep.workgroup_size;
-                // The parallel sort's kernels use their own size (the pass dispatches with it).
-                let own = file == "sst_sort.wgsl"
-                    && super::sst_sort::SORT_WG_ENTRIES.contains(&ep.name.as_str())
-                    && ws == [super::sst_sort::SORT_WG, 1, 1];
-                // Lightcut Interpolation's tile kernels: one workgroup per 16 x 16 tile.
-                let tile = file == "methods/lightcut_interpolation/li_records.wgsl"
-                    && crate::methods::lightcut_interpolation::pass::TILE_WG_ENTRIES
-                        .contains(&ep.name.as_str())
-                    && ws == [crate::methods::lightcut_interpolation::pass::TILE_WG, 1, 1];
-                // Light culling's tile kernel: one workgroup per tile.
-                let culling = file == "methods/light_culling/lcull_tiles.wgsl"
-                    && ws == [crate::methods::light_culling::pass::TILE_WG, 1, 1];
-                // The VAL seeds' compaction: one workgroup.
-                let seeds = file == "methods/val/val_shade.wgsl"
-                    && ep.name == crate::methods::val::pass::SEED_WG_ENTRY
-                    && ws == [crate::methods::val::pass::SEED_WG, 1, 1];
-                let ok = own || tile || culling || seeds || ws == [WG_2D, WG_2D, 1] || ws == [WG_1D, 1, 1];
-                assert!(ok, "{file}::{} has workgroup size {ws:?}", ep.name);
-            }
+        if let Err(e) = check_workgroup_sizes(crate::renderer::shaders::ENTRY_SHADERS, OWN_WORKGROUPS) {
+            panic!("{e}");
         }
     }
 }
