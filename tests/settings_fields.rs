@@ -48,11 +48,15 @@ fn every_declared_setting_is_accepted_at_its_ends_and_refused_beyond_them_by_nam
                         assert!(!range_refusal(&e), "{}: {path} = {v} is in range but: {e}", m.id);
                     }
                 }
-                let mut outside = vec![if spec.scale == Scale::Pow2 {
-                    2.0 * spec.max
-                } else {
-                    spec.max + step
-                }];
+                let mut outside = Vec::new();
+                // An integer declared up to its type's largest value has no value above it.
+                if !(spec.integer && spec.max >= u32::MAX as f64) {
+                    outside.push(if spec.scale == Scale::Pow2 {
+                        2.0 * spec.max
+                    } else {
+                        spec.max + step
+                    });
+                }
                 if spec.max_open {
                     outside.push(spec.max);
                 }

@@ -55,7 +55,8 @@ pub fn slider_within<T>(ui: &mut egui::Ui, f: &Field<T>, value: &mut T, min: f64
             if s.scale == Scale::Log {
                 slider = slider.logarithmic(true);
                 if lo <= 0.0 {
-                    slider = slider.smallest_positive(open_start(0.0, max));
+                    let smallest = if s.integer { 1.0 } else { open_start(0.0, max) };
+                    slider = slider.smallest_positive(smallest);
                 }
             }
             let r = ui.add(slider).on_hover_text(help);
@@ -68,7 +69,7 @@ pub fn slider_within<T>(ui: &mut egui::Ui, f: &Field<T>, value: &mut T, min: f64
 }
 
 /// The first slider value of a range open at `min` (or the smallest positive value of a
-/// logarithmic one from 0): six decades below its maximum.
+/// logarithmic one from 0): five decades below its maximum.
 fn open_start(min: f64, max: f64) -> f64 {
-    min + (max - min) * 1e-6
+    min + (max - min) * 1e-5
 }

@@ -1,6 +1,8 @@
-//! `#[repr(C)]` parameter structs shared with WGSL. Each has a twin of the same name in
-//! `shaders/`; `tests::layouts_match_wgsl` checks sizes and member offsets against naga's
-//! layout of the WGSL struct, so the two cannot drift apart silently.
+//! The shared passes' `#[repr(C)]` parameter structs shared with WGSL. Each has a twin in
+//! `shaders/`, listed in [`TWINS`] (a method's structs are in its folder, listed in its
+//! `Module::wgsl_twins`); [`check_twin`] compares sizes and member offsets with naga's
+//! layout of the WGSL struct (`tests::layouts_match_wgsl` here, the registry test for the
+//! methods'), so the two cannot drift apart silently.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -309,7 +311,13 @@ pub fn check_twin(t: &WgslTwin) -> Result<(), String> {
         if ty.name.as_deref() == Some(t.name)
             && let naga::TypeInner::Struct { members, span } = &ty.inner
         {
-            let size = layouter[handle].size.max(*span) as usize;
+            if layouter[handle].size != *span {
+                return Err(format!(
+                    "{} ({}): naga's layout size {} differs from the struct's span {span}",
+                    t.name, t.file, layouter[handle].size
+                ));
+            }
+            let size = *span as usize;
             let offsets: Vec<usize> = members.iter().map(|m| m.offset as usize).collect();
             if size != t.size {
                 return Err(format!(

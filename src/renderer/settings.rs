@@ -508,7 +508,6 @@ impl<D: PatternDefault> InterleaveSettings<D> {
     pub fn filters(&self) -> bool {
         self.n > 1 || self.filter_radius > 0
     }
-    /// Every field in range (n at most `max_n`), or a message naming it under `table`.
     /// The numeric settings, declared once (validation, the GUI's sliders, `--set`); the
     /// pattern's largest edge is the method's.
     pub fn fields(max_n: u32) -> Vec<Field<Self>> {
@@ -680,7 +679,6 @@ impl<D: IsmDefault> IsmSettings<D> {
     pub fn levels(&self) -> u32 {
         self.pull_push_levels.min(self.tile.max(1).ilog2())
     }
-    /// Every field in range, or a message naming it under `table`.
     /// The numeric settings, declared once (validation, the GUI's sliders, `--set`).
     pub fn fields() -> Vec<Field<Self>> {
         vec![

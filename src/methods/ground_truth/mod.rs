@@ -68,7 +68,7 @@ pub static FIELDS: &[Field<GiSettings>] = &[crate::field!(
     "shadow rays / frame",
     "",
     1,
-    1u32 << 30,
+    u32::MAX,
     Log,
     "the progressive truth's budget: more finishes sooner, but each frame takes longer"
 )];

@@ -80,7 +80,7 @@ pub static FIELDS: &[Field<GiSettings>] = &[
         "samples per pixel",
         "",
         1,
-        1 << 24,
+        u32::MAX,
         Log,
         "the target: the reference stops when every pixel has this many samples"
     ),
