@@ -16,7 +16,7 @@
 //! entry points use a filtering `sampler`; uniforms named in [`KernelOptions::dynamic`] take a
 //! dynamic offset and the struct's WGSL size as their minimum binding size. On CPU adapters the
 //! layouts read uniforms as read-only storage ([`super::passes::bind_group_layout`]), as the
-//! module's text does ([`super::shaders::create_module`]).
+//! module's text does ([`super::shaders::module_from_text`]).
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -283,8 +283,39 @@ impl Kernel {
     ) -> Result<Self, ShaderError> {
         let text = shaders::preprocessed(file)?;
         let (naga_module, info) = shaders::parse_validated(file, &text)?;
+        let module = shaders::module_from_text(device, file, text);
+        Self::from_parsed(device, file, module, &naga_module, &info, entries, &options)
+    }
+
+    /// One kernel per entry point of `file`, sharing one parse and one shader module: for a
+    /// file whose entry points bind different variables at the same slots, or different
+    /// parts of one group (each kernel's layouts are its entry point's alone).
+    pub fn per_entry(
+        device: &wgpu::Device,
+        file: &str,
+        entries: &[&str],
+        options: KernelOptions<'_>,
+    ) -> Result<Vec<Self>, ShaderError> {
+        let text = shaders::preprocessed(file)?;
+        let (naga_module, info) = shaders::parse_validated(file, &text)?;
+        let module = shaders::module_from_text(device, file, text);
+        entries
+            .iter()
+            .map(|e| Self::from_parsed(device, file, module.clone(), &naga_module, &info, &[e], &options))
+            .collect()
+    }
+
+    fn from_parsed(
+        device: &wgpu::Device,
+        file: &str,
+        module: wgpu::ShaderModule,
+        naga_module: &naga::Module,
+        info: &naga::valid::ModuleInfo,
+        entries: &[&str],
+        options: &KernelOptions<'_>,
+    ) -> Result<Self, ShaderError> {
         let reflected =
-            reflect(file, &naga_module, &info, entries, &options).map_err(|message| ShaderError::Parse {
+            reflect(file, naga_module, info, entries, options).map_err(|message| ShaderError::Parse {
                 file: file.to_string(),
                 message,
             })?;
@@ -321,7 +352,7 @@ impl Kernel {
         Ok(Self {
             file: file.to_string(),
             stem: stem.to_string(),
-            module: shaders::module_from_text(device, file, text),
+            module,
             groups,
             used_groups,
         })
@@ -422,10 +453,27 @@ impl Kernel {
 }
 
 impl Kernel {
-    /// A bind group of `group` whose slots take their resources from `table` by name: for a
-    /// pass whose kernels each read a part of one table (the temporal stage's entry points).
-    /// Names of the table that the group lacks are skipped; `None` when a slot's name is not in
-    /// the table.
+    /// A bind group of `group` whose slots take their resources from `table` by name: for
+    /// kernels that each read a part of one table (Lightcuts' two tree builds, the temporal
+    /// stage's entry points). Names of the table that the group lacks are skipped; a slot
+    /// missing from the table panics as in [`Kernel::bind`].
+    pub fn bind_table(
+        &self,
+        device: &wgpu::Device,
+        group: u32,
+        table: &[(&str, wgpu::BindingResource<'_>)],
+    ) -> wgpu::BindGroup {
+        let layout = self.group(group);
+        let picked: Vec<(&str, wgpu::BindingResource<'_>)> = table
+            .iter()
+            .filter(|(n, _)| layout.slots.iter().any(|s| s.name == *n))
+            .map(|(n, r)| (*n, r.clone()))
+            .collect();
+        self.bind(device, group, &picked)
+    }
+
+    /// [`Kernel::bind_table`], or `None` when a slot's name is not in the table (a pass whose
+    /// optional inputs decide whether it runs).
     pub fn bind_from(
         &self,
         device: &wgpu::Device,
@@ -433,12 +481,11 @@ impl Kernel {
         table: &[(&str, wgpu::BindingResource<'_>)],
     ) -> Option<wgpu::BindGroup> {
         let layout = self.group(group);
-        let mut picked = Vec::with_capacity(layout.slots.len());
-        for s in &layout.slots {
-            let (n, r) = table.iter().find(|(n, _)| *n == s.name)?;
-            picked.push((*n, r.clone()));
-        }
-        Some(self.bind(device, group, &picked))
+        let complete = layout
+            .slots
+            .iter()
+            .all(|s| table.iter().any(|(n, _)| *n == s.name));
+        complete.then(|| self.bind_table(device, group, table))
     }
 }
 

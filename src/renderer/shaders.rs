@@ -338,13 +338,6 @@ pub fn uniforms_to_storage(text: &str) -> String {
     text.replace("var<uniform>", "var<storage, read>")
 }
 
-/// Creates a wgpu shader module from a (preprocessed) shader.
-pub fn create_module(device: &wgpu::Device, name: &str) -> Result<wgpu::ShaderModule, ShaderError> {
-    let text = preprocessed(name)?;
-    validate(name, &text)?;
-    Ok(module_from_text(device, name, text))
-}
-
 /// The wgpu shader module of a preprocessed, validated shader's text.
 pub fn module_from_text(device: &wgpu::Device, name: &str, text: String) -> wgpu::ShaderModule {
     // Parameter blocks as read-only storage where the layouts make them so (lavapipe; see

@@ -450,7 +450,15 @@ impl BuildKernel {
                 .collect()
         };
         self.params.write(device, queue, &dispatches);
-        let bind = if radix {
+        // Both builds read one table; the radix tree's also its links and arrival counters.
+        let mut table = vec![
+            ("bp", self.params.binding()),
+            ("nodes", buf(&tree.nodes)),
+            ("sorted_vpls", buf(&tree.sorted_vpls)),
+            ("cones", buf(cones)),
+            ("reps", buf(reps)),
+        ];
+        if radix {
             let need = 4 * tree.leaves.max(4) as u64;
             if self.counters.as_ref().is_none_or(|c| c.size() < need) {
                 self.counters = Some(crate::renderer::passes::storage_buffer(
@@ -461,33 +469,14 @@ impl BuildKernel {
             }
             let Some(counters) = &self.counters else { return };
             encoder.clear_buffer(counters, 0, None);
-            self.radix_kernel.bind(
-                device,
-                0,
-                &[
-                    ("bp", self.params.binding()),
-                    ("nodes", buf(&tree.nodes)),
-                    ("sorted_vpls", buf(&tree.sorted_vpls)),
-                    ("cones", buf(cones)),
-                    ("reps", buf(reps)),
-                    ("links", buf(&tree.links)),
-                    ("parents", buf(&tree.parents)),
-                    ("counters", buf(counters)),
-                ],
-            )
-        } else {
-            self.kernel.bind(
-                device,
-                0,
-                &[
-                    ("bp", self.params.binding()),
-                    ("nodes", buf(&tree.nodes)),
-                    ("sorted_vpls", buf(&tree.sorted_vpls)),
-                    ("cones", buf(cones)),
-                    ("reps", buf(reps)),
-                ],
-            )
-        };
+            table.extend([
+                ("links", buf(&tree.links)),
+                ("parents", buf(&tree.parents)),
+                ("counters", buf(counters)),
+            ]);
+        }
+        let kernel = if radix { &self.radix_kernel } else { &self.kernel };
+        let bind = kernel.bind_table(device, 0, &table);
         let pipeline = if radix { &self.radix } else { &self.build };
         encoder.push_debug_group(name);
         {

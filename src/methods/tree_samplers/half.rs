@@ -126,19 +126,9 @@ impl HalfPass {
         d_max: f32,
     ) {
         self.write_params(queue, full_size, half, n_min, d_max);
-        let bind = self.down_kernel.bind(
-            device,
-            0,
-            &[
-                ("hp", buf(&self.params)),
-                ("full_position", tex(&full.position_view)),
-                ("full_normal", tex(&full.normal_view)),
-                ("full_albedo", tex(&full.albedo_view)),
-                ("half_position", tex(&half.gbuffer.position_view)),
-                ("half_normal", tex(&half.gbuffer.normal_view)),
-                ("half_albedo", tex(&half.gbuffer.albedo_view)),
-            ],
-        );
+        let bind = self
+            .down_kernel
+            .bind_table(device, 0, &Self::table(&self.params, full, half, None));
         run_compute(
             encoder,
             timer,
@@ -147,6 +137,30 @@ impl HalfPass {
             &bind,
             groups_image(half.size.0, half.size.1),
         );
+    }
+
+    /// What the down- and upsampling kernels read (each binds its part): the parameters, the
+    /// full- and half-resolution G-buffers, the half-resolution GI and the full accumulation.
+    fn table<'a>(
+        params: &'a wgpu::Buffer,
+        full: &'a GbufferTargets,
+        half: &'a HalfTargets,
+        accum: Option<&'a wgpu::Buffer>,
+    ) -> Vec<(&'static str, wgpu::BindingResource<'a>)> {
+        let mut t = vec![
+            ("hp", buf(params)),
+            ("full_position", tex(&full.position_view)),
+            ("full_normal", tex(&full.normal_view)),
+            ("full_albedo", tex(&full.albedo_view)),
+            ("half_position", tex(&half.gbuffer.position_view)),
+            ("half_normal", tex(&half.gbuffer.normal_view)),
+            ("half_albedo", tex(&half.gbuffer.albedo_view)),
+            ("half_accum", buf(&half.accum)),
+        ];
+        if let Some(a) = accum {
+            t.push(("accum", buf(a)));
+        }
+        t
     }
 
     /// The full-resolution accumulation from the half-resolution one (joint bilateral).
@@ -161,20 +175,9 @@ impl HalfPass {
         half: &HalfTargets,
         accum: &wgpu::Buffer,
     ) {
-        let bind = self.up_kernel.bind(
-            device,
-            0,
-            &[
-                ("hp", buf(&self.params)),
-                ("full_position", tex(&full.position_view)),
-                ("full_normal", tex(&full.normal_view)),
-                ("full_albedo", tex(&full.albedo_view)),
-                ("half_position", tex(&half.gbuffer.position_view)),
-                ("half_normal", tex(&half.gbuffer.normal_view)),
-                ("half_accum", buf(&half.accum)),
-                ("accum", buf(accum)),
-            ],
-        );
+        let bind = self
+            .up_kernel
+            .bind_table(device, 0, &Self::table(&self.params, full, half, Some(accum)));
         run_compute(
             encoder,
             timer,

@@ -86,8 +86,16 @@ pub struct LbvhPass {
 impl LbvhPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
         // The two entry points read different parts of group 0: a kernel each.
-        let kernel = Kernel::new(device, "lbvh.wgsl", &["build"], KernelOptions::default())?;
-        let node_kernel = Kernel::new(device, "lbvh.wgsl", &["node_data"], KernelOptions::default())?;
+        let mut kernels = Kernel::per_entry(
+            device,
+            "lbvh.wgsl",
+            &["build", "node_data"],
+            KernelOptions::default(),
+        )?
+        .into_iter();
+        let (Some(kernel), Some(node_kernel)) = (kernels.next(), kernels.next()) else {
+            unreachable!("one kernel per entry point")
+        };
         Ok(Self {
             pipeline: kernel.compute(device, "lbvh::build", "build"),
             node_pipeline: node_kernel.compute(device, "lbvh::node_data", "node_data"),

@@ -55,7 +55,7 @@ pub fn uniforms_as_storage(device: &wgpu::Device) -> bool {
 
 /// Creates a bind group layout: every layout of the renderer and the methods goes through
 /// here, so that uniform bindings become read-only storage where [`uniforms_as_storage`]
-/// says so (the shaders are rewritten to match in `shaders::create_module`).
+/// says so (the shaders are rewritten to match in `shaders::module_from_text`).
 pub fn bind_group_layout(
     device: &wgpu::Device,
     desc: &wgpu::BindGroupLayoutDescriptor<'_>,

@@ -254,29 +254,42 @@ pub struct TemporalPass {
 
 impl TemporalPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        // One kernel per entry point: each binds the slots it reads of one table
-        // (`TemporalPass::bind`).
-        let pipe = |entry_point: &str| -> Result<Pipe, shaders::ShaderError> {
-            let kernel = Kernel::new(
-                device,
-                "temporal.wgsl",
-                &[entry_point],
-                KernelOptions { dynamic: &["p"] },
-            )?;
-            let pipeline = kernel.compute(device, entry_point, entry_point);
-            Ok(Pipe { kernel, pipeline })
-        };
+        // One kernel per entry point (one parse, one module): each binds the slots it reads
+        // of one table (`TemporalPass::bind`).
+        let entries = [
+            "reproject",
+            "accumulate",
+            "variance",
+            "atrous",
+            "atrous_prep",
+            "atrous_weight",
+            "atrous_conserving",
+            "modulate",
+            "view_radiance",
+            "view_heat",
+        ];
+        let kernels = Kernel::per_entry(
+            device,
+            "temporal.wgsl",
+            &entries,
+            KernelOptions { dynamic: &["p"] },
+        )?;
+        let mut pipes = entries.iter().zip(kernels).map(|(entry, kernel)| {
+            let pipeline = kernel.compute(device, entry, entry);
+            Pipe { kernel, pipeline }
+        });
+        let mut pipe = || pipes.next().expect("one kernel per entry point");
         Ok(Self {
-            reproject: pipe("reproject")?,
-            accumulate: pipe("accumulate")?,
-            variance: pipe("variance")?,
-            atrous: pipe("atrous")?,
-            atrous_prep: pipe("atrous_prep")?,
-            atrous_weight: pipe("atrous_weight")?,
-            atrous_conserving: pipe("atrous_conserving")?,
-            modulate: pipe("modulate")?,
-            view_radiance: pipe("view_radiance")?,
-            view_heat: pipe("view_heat")?,
+            reproject: pipe(),
+            accumulate: pipe(),
+            variance: pipe(),
+            atrous: pipe(),
+            atrous_prep: pipe(),
+            atrous_weight: pipe(),
+            atrous_conserving: pipe(),
+            modulate: pipe(),
+            view_radiance: pipe(),
+            view_heat: pipe(),
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("temporal::params"),
                 size: SLOTS as u64 * SLOT_STRIDE,

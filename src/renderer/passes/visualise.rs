@@ -54,18 +54,22 @@ pub struct VisualisePass {
 
 impl VisualisePass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
-        let kernel =
-            |entry: &str, label: &str| -> Result<(Kernel, wgpu::ComputePipeline), shaders::ShaderError> {
-                let k = Kernel::new(device, "visualise.wgsl", &[entry], KernelOptions::default())?;
-                let p = k.compute(device, label, entry);
-                Ok((k, p))
-            };
+        // One kernel per entry point (one parse, one module): each binds its source kind at
+        // the same slots.
+        let entries = ["vis_float", "vis_depth", "vis_uint", "vis_array", "vis_scalar"];
+        let kernels = Kernel::per_entry(device, "visualise.wgsl", &entries, KernelOptions::default())?;
+        let mut pipes = entries.iter().zip(kernels).map(|(entry, k)| {
+            let label = format!("visualise::{}_pipeline", entry.trim_start_matches("vis_"));
+            let p = k.compute(device, &label, entry);
+            (k, p)
+        });
+        let mut kernel = || pipes.next().expect("one kernel per entry point");
         Ok(Self {
-            float: kernel("vis_float", "visualise::float_pipeline")?,
-            depth: kernel("vis_depth", "visualise::depth_pipeline")?,
-            uint: kernel("vis_uint", "visualise::uint_pipeline")?,
-            array: kernel("vis_array", "visualise::array_pipeline")?,
-            scalar: kernel("vis_scalar", "visualise::scalar_pipeline")?,
+            float: kernel(),
+            depth: kernel(),
+            uint: kernel(),
+            array: kernel(),
+            scalar: kernel(),
             params: super::uniform_buffer::<VisParams>(device, "visualise::params"),
         })
     }
