@@ -857,3 +857,80 @@ fn the_builtin_scene_buttons_open_their_scenes() {
         assert_ne!(shown_pixels(&h), before, "{button}: the view did not change");
     }
 }
+
+/// A lost GPU device (issue 42): the window's app goes to the handover with its state, and a
+/// new window on a new device resumes it; rendering goes on with the same settings, scene,
+/// camera, sun and views (as `run_gui` does between eframe windows).
+#[test]
+fn a_lost_device_is_recreated_and_the_app_resumes_in_a_new_window() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let handover = lightcut::app::Handover::default();
+    let mut s = lightcut::renderer::settings::RenderSettings::default();
+    s.gi.method = lightcut::methods::direct_only::ID;
+    s.display.exposure_ev = 1.5;
+    let options = AppOptions {
+        scene: "default".into(),
+        settings: Some(s.clone()),
+        views: vec![ViewBuffer::Final, ViewBuffer::Normal],
+        lose_device_at_frame: Some(10),
+        ..Default::default()
+    };
+    let h_in = handover.clone();
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(900.0, 600.0))
+        .wgpu_setup(setup())
+        .build_eframe(move |cc| WorkbenchApp::new(cc, options).with_handover(h_in));
+    // (The harness runs a few frames when it is built.)
+    assert!(h.state().frames() < 10 && !h.state().handed_over());
+    let before = shown_pixels(&h);
+    let old_errors = h.state().renderer().expect("renderer").ctx.errors.clone();
+    for _ in 0..20 {
+        if h.state().handed_over() {
+            break;
+        }
+        h.step();
+    }
+    assert!(
+        h.state().handed_over(),
+        "the app left the window of the lost device"
+    );
+    assert!(h.state().renderer().is_none());
+    let app = handover.borrow_mut().take().expect("the app is in the handover");
+    let frames = app.frames();
+    let camera = app.open().expect("open scene").camera.position;
+    assert!(frames >= 2);
+    drop(h);
+
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(900.0, 600.0))
+        .wgpu_setup(setup())
+        .build_eframe(move |cc| app.resume(cc));
+    h.run_steps(3);
+    let app = h.state();
+    assert_eq!(app.recoveries(), 1);
+    let r = app.renderer().expect("a renderer on the new device");
+    assert!(old_errors.device_lost(), "the old device is lost");
+    assert!(!r.ctx.errors.device_lost(), "the new one is not");
+    assert_eq!(r.settings(), &s, "the settings went on");
+    assert_eq!(app.open().expect("open scene").camera.position, camera);
+    assert_eq!(
+        app.layout()
+            .panes()
+            .iter()
+            .map(|p| p.spec.buffer)
+            .collect::<Vec<_>>(),
+        vec![ViewBuffer::Final, ViewBuffer::Normal]
+    );
+    assert!(app.frames() > frames, "frames go on");
+    assert!(
+        app.errors()
+            .iter()
+            .any(|e| e.contains("GPU device lost (Destroyed)"))
+            && app.errors().iter().any(|e| e.contains("was recreated")),
+        "{:?}",
+        app.errors()
+    );
+    assert_eq!(shown_pixels(&h), before, "the same image as before the loss");
+}

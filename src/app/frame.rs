@@ -14,8 +14,9 @@ impl WorkbenchApp {
         let Some(renderer) = self.renderer.as_mut() else {
             return;
         };
-        // A lost device: everything made on it is gone, eframe's painter included (egui-wgpu
-        // 0.37 does not recreate its device), so rendering stops and says why.
+        // A lost device the app could not leave for a new window (`recovery.rs`: the window
+        // of a test harness, or after MAX_DEVICE_RECOVERIES losses): rendering stops and
+        // says why.
         if renderer.ctx.errors.device_lost() {
             for e in renderer.ctx.errors.take() {
                 if !self.errors.contains(&e) {
@@ -25,8 +26,15 @@ impl WorkbenchApp {
             ui.centered_and_justified(|ui| {
                 ui.colored_label(
                     ui.visuals().error_fg_color,
-                    "The GPU device was lost (see the status line). Rendering has stopped; \
-                     restart the workbench (its settings are saved on exit).",
+                    format!(
+                        "The GPU device was lost (see the status line){}. Rendering has \
+                         stopped; restart the workbench (its layout is saved on exit).",
+                        if self.recoveries > 0 {
+                            format!(" after {} recoveries", self.recoveries)
+                        } else {
+                            String::new()
+                        }
+                    ),
                 )
             });
             return;

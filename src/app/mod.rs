@@ -12,6 +12,7 @@ pub mod viewport_texture;
 
 mod exports;
 mod frame;
+mod recovery;
 mod side_panel;
 mod tool_dock;
 
@@ -82,6 +83,9 @@ pub struct AppOptions {
     pub reset_layout: bool,
     /// Pin this frame pixel and open the pixel story window.
     pub pin: Option<(u32, u32)>,
+    /// Destroy the GPU device after this many frames, once (tests the recovery from a lost
+    /// device: [`WorkbenchApp::resume`]).
+    pub lose_device_at_frame: Option<u64>,
 }
 
 /// The workbench's first screen: the final image, the method's GI, the ground truth of the
@@ -215,7 +219,21 @@ pub struct WorkbenchApp {
     bookmark_note: String,
     /// The GI method to return to when a progressive one (ground truth, reference) is stopped.
     last_fast_method: MethodId,
+    /// Where the app goes when its GPU device is lost: [`run_gui`] opens a new window with a
+    /// new device and resumes it there ([`WorkbenchApp::resume`]). None: rendering stops.
+    handover: Option<Handover>,
+    /// Lost devices recovered from so far (at most [`MAX_DEVICE_RECOVERIES`]).
+    recoveries: u32,
+    /// This is the empty app left in a window whose state went to the handover.
+    handed_over: bool,
 }
+
+/// The slot a window whose GPU device was lost leaves its app in for the next window.
+pub type Handover = std::rc::Rc<std::cell::RefCell<Option<WorkbenchApp>>>;
+
+/// How many lost devices the GUI recreates before it stops rendering (a device that keeps
+/// being lost would otherwise loop).
+pub const MAX_DEVICE_RECOVERIES: u32 = 3;
 
 /// The dynamic scene: the sun's azimuth sweep and the camera's orbit path, per rendered frame;
 /// pause and single steps.
@@ -258,9 +276,7 @@ struct CutInspect {
 
 impl WorkbenchApp {
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
-        let tree_stats = options.tree_stats;
         let start_compare = options.compare_gt;
-        let start_timings = options.timings;
         let settings: RenderSettings = options.settings.clone().unwrap_or_default();
         let mut layout = None;
         if !options.reset_layout
@@ -282,57 +298,8 @@ impl WorkbenchApp {
         });
         // Views of the ground truth show nothing without the comparison: start it.
         let start_compare = start_compare || layout.panes().iter().any(|p| p.spec.buffer.is_compare_view());
-        let mut app = Self {
-            tools: tool_dock::ToolDock::default(),
-            render_state: cc.wgpu_render_state.clone(),
-            renderer: None,
-            open: None,
-            settings,
-            layout,
-            events: ViewEvents::default(),
-            pending_export: None,
-            export_dir: "screenshots".to_string(),
-            last_export: String::new(),
-            sun: None,
-            render_scale: 1.0,
-            timings: None,
-            errors: Vec::new(),
-            scene_path_input: if options.scene == "default" {
-                String::new()
-            } else {
-                options.scene.clone()
-            },
-            options,
-            frames: 0,
-            screenshot_done: Arc::new(AtomicBool::new(false)),
-            screenshot_requested: false,
-            last_frame_time: None,
-            frame_ms_smoothed: 0.0,
-            adapter: String::new(),
-            tree_panel: TreePanel::new(tree_stats),
-            sampling_stats: None,
-            method_status: None,
-            cut_inspect: None,
-            compare_gt: start_compare,
-            compare_metrics: None,
-            last_metrics_time: 0.0,
-            timings_panel: TimingsPanel::new(start_timings),
-            hover_view: None,
-            pixel: PixelInspect::default(),
-            story: story_panel::StoryPanel::new(),
-            anim: Animation::default(),
-            sheet_job: None,
-            sheet_status: None,
-            cancel_sheet: false,
-            sheet_methods: crate::methods::sheet_columns()
-                .iter()
-                .map(|m| m.per_frame())
-                .collect(),
-            sheet_frames: 8,
-            bookmark_name: "bookmark 1".into(),
-            bookmark_note: String::new(),
-            last_fast_method: MethodId::default(),
-        };
+        let mut app = Self::unbound(options, settings, layout, start_compare);
+        app.render_state = cc.wgpu_render_state.clone();
         let Some(rs) = app.render_state.clone() else {
             app.errors.push(format!(
                 "The workbench needs the wgpu renderer and got none: {}",
@@ -362,6 +329,65 @@ impl WorkbenchApp {
         app
     }
 
+    /// The app's state without a GPU (no render state, renderer or scene yet).
+    fn unbound(options: AppOptions, settings: RenderSettings, layout: Layout, compare_gt: bool) -> Self {
+        let (tree_stats, start_timings) = (options.tree_stats, options.timings);
+        Self {
+            tools: tool_dock::ToolDock::default(),
+            render_state: None,
+            renderer: None,
+            open: None,
+            settings,
+            layout,
+            events: ViewEvents::default(),
+            pending_export: None,
+            export_dir: "screenshots".to_string(),
+            last_export: String::new(),
+            sun: None,
+            render_scale: 1.0,
+            timings: None,
+            errors: Vec::new(),
+            scene_path_input: if options.scene == "default" {
+                String::new()
+            } else {
+                options.scene.clone()
+            },
+            options,
+            frames: 0,
+            screenshot_done: Arc::new(AtomicBool::new(false)),
+            screenshot_requested: false,
+            last_frame_time: None,
+            frame_ms_smoothed: 0.0,
+            adapter: String::new(),
+            tree_panel: TreePanel::new(tree_stats),
+            sampling_stats: None,
+            method_status: None,
+            cut_inspect: None,
+            compare_gt,
+            compare_metrics: None,
+            last_metrics_time: 0.0,
+            timings_panel: TimingsPanel::new(start_timings),
+            hover_view: None,
+            pixel: PixelInspect::default(),
+            story: story_panel::StoryPanel::new(),
+            anim: Animation::default(),
+            sheet_job: None,
+            sheet_status: None,
+            cancel_sheet: false,
+            sheet_methods: crate::methods::sheet_columns()
+                .iter()
+                .map(|m| m.per_frame())
+                .collect(),
+            sheet_frames: 8,
+            bookmark_name: "bookmark 1".into(),
+            bookmark_note: String::new(),
+            last_fast_method: MethodId::default(),
+            handover: None,
+            recoveries: 0,
+            handed_over: false,
+        }
+    }
+
     /// Opens a scene; on failure the previous scene stays and the message is returned.
     pub fn open_scene(&mut self, source: &str, camera: Option<&str>) -> Result<(), String> {
         let Some(rs) = self.render_state.clone() else {
@@ -381,19 +407,21 @@ impl WorkbenchApp {
                 r.load_scene(&open.scene);
                 let _ = r.set_settings(self.settings.clone());
             }
-            None => {
-                let ctx = GpuContext::from_parts(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info());
-                let mut r = Renderer::new(ctx, &open.scene, (64, 64), self.settings.clone())
-                    .map_err(|e| e.to_string())?;
-                // Every 4th frame records the diagnostics (statistics, method views, the
-                // pixel story) untimed; the GPU timings come from the other frames.
-                r.set_frame_mode(crate::renderer::FrameMode::Interleaved(GUI_DIAGNOSTICS_EVERY));
-                self.renderer = Some(r);
-            }
+            None => self.renderer = Some(self.make_renderer(&rs, &open.scene)?),
         }
         self.sun = open.scene.lights.first().map(SunControls::from_light);
         self.open = Some(open);
         Ok(())
+    }
+
+    /// A renderer of `scene` on the window's device, with the app's settings.
+    fn make_renderer(&self, rs: &egui_wgpu::RenderState, scene: &Scene) -> Result<Renderer, String> {
+        let ctx = GpuContext::from_parts(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info());
+        let mut r = Renderer::new(ctx, scene, (64, 64), self.settings.clone()).map_err(|e| e.to_string())?;
+        // Every 4th frame records the diagnostics (statistics, method views, the pixel story)
+        // untimed; the GPU timings come from the other frames.
+        r.set_frame_mode(crate::renderer::FrameMode::Interleaved(GUI_DIAGNOSTICS_EVERY));
+        Ok(r)
     }
 
     /// The buffer of the main view (the lowest-numbered one).
@@ -534,11 +562,19 @@ const LAYOUT_KEY: &str = "lightcut_view_layout";
 
 impl eframe::App for WorkbenchApp {
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        eframe::set_value(storage, LAYOUT_KEY, &self.layout);
+        // The empty app of a window whose device was lost: the layout went on with the app.
+        if !self.handed_over {
+            eframe::set_value(storage, LAYOUT_KEY, &self.layout);
+        }
     }
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
+        // Nothing is drawn in a window whose device is lost: egui-wgpu 0.37 panics when it
+        // cannot upload a frame's vertices to a lost device, and an empty frame has none.
+        if self.hand_over_if_lost(&ctx) {
+            return;
+        }
         let now = ctx.input(|i| i.time);
         if let Some(prev) = self.last_frame_time {
             let ms = (now - prev) * 1e3;
@@ -605,17 +641,31 @@ pub fn run_gui(options: AppOptions) -> anyhow::Result<()> {
         },
         ..Default::default()
     };
-    eframe::run_native(
-        "lightcut-workbench",
-        native,
-        Box::new(move |cc| Ok(Box::new(WorkbenchApp::new(cc, options)))),
-    )
-    .map_err(|e| {
-        let msg = e.to_string();
-        if msg.to_lowercase().contains("adapter") {
-            anyhow::anyhow!("{}", crate::renderer::context::NO_ADAPTER_HELP)
-        } else {
-            anyhow::anyhow!("could not start the window: {msg}")
+    // Windows one after the other: a window whose device is lost leaves its app in the
+    // handover, and the next window (a new instance, adapter and device) resumes it.
+    let handover = Handover::default();
+    let mut first = Some(options);
+    let mut resumed: Option<WorkbenchApp> = None;
+    loop {
+        let h = handover.clone();
+        let create: eframe::AppCreator<'_> = match (first.take(), resumed.take()) {
+            (Some(options), _) => {
+                Box::new(move |cc| Ok(Box::new(WorkbenchApp::new(cc, options).with_handover(h))))
+            }
+            (None, Some(app)) => Box::new(move |cc| Ok(Box::new(app.resume(cc)))),
+            (None, None) => return Ok(()),
+        };
+        eframe::run_native("lightcut-workbench", native.clone(), create).map_err(|e| {
+            let msg = e.to_string();
+            if msg.to_lowercase().contains("adapter") {
+                anyhow::anyhow!("{}", crate::renderer::context::NO_ADAPTER_HELP)
+            } else {
+                anyhow::anyhow!("could not start the window: {msg}")
+            }
+        })?;
+        resumed = handover.borrow_mut().take();
+        if resumed.is_none() {
+            return Ok(());
         }
-    })
+    }
 }

@@ -61,6 +61,10 @@ pub struct Cli {
     /// Pin a frame pixel "X,Y" and open its pixel story (tree samplers).
     #[arg(long, value_parser = parse_pixel)]
     pub pin: Option<(u32, u32)>,
+    /// Testing the recovery from a lost GPU device: destroy the device after this many frames
+    /// (once); the workbench recreates it and goes on (`.ci/run`'s second GUI run).
+    #[arg(long, hide = true)]
+    pub lose_device_at_frame: Option<u64>,
 }
 
 /// The GUI's start-up options from the command line (no subcommand): the settings file, the
@@ -107,6 +111,7 @@ pub fn gui_options(cli: &Cli) -> anyhow::Result<crate::app::AppOptions> {
         default_views: crate::app::FIRST_SCREEN.to_vec(),
         reset_layout: cli.reset_layout,
         pin: cli.pin,
+        lose_device_at_frame: cli.lose_device_at_frame,
     })
 }
 
