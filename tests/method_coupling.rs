@@ -23,7 +23,9 @@ const LIMITS: &[(&str, usize)] = &[
     ("ground_truth", 2),
     ("light_culling", 3),
     ("lightcut_interpolation", 2),
-    ("lightcuts", 7),
+    // 9, not 7, since Lightcut Interpolation's two files (which build on Lightcuts' tree and
+    // cut kernels) were split into four to keep files under 700 lines: the same code.
+    ("lightcuts", 9),
     ("reference", 0),
     ("tree_samplers", 16),
     ("val", 2),
@@ -335,4 +337,186 @@ fn the_scan_finds_paths_groups_types_and_ids() {
         "{g:?}"
     );
     assert!(has_word("a TreeSamplers b", "TreeSamplers") && !has_word("TreeSamplersX", "TreeSamplers"));
+}
+
+/// The shape issue 38 asks of the code outside tests, held as a ratchet (each count may fall,
+/// never grow; lower `SHAPE_LIMITS` when a change improves one). Its goal: every count 0.
+const SHAPE_LIMITS: &[(&str, usize)] = &[
+    ("files over 700 lines", 0),
+    ("functions over 150 lines", 29),
+    ("too_many_arguments allows", 55),
+    ("files in src/renderer that name methods", 5),
+    ("files below the app that name egui", 13),
+];
+
+/// The code with string and char literals' contents blanked (after [`strip_comments`]), so
+/// that braces inside them count for nothing.
+fn blank_literals(code: &str) -> String {
+    let b = code.as_bytes();
+    let mut out = String::with_capacity(code.len());
+    let mut i = 0;
+    while i < b.len() {
+        let c = b[i];
+        let raw_hashes = (c == b'r' && (i == 0 || !is_ident(b[i - 1] as char)))
+            .then(|| b[i + 1..].iter().take_while(|&&h| h == b'#').count())
+            .filter(|&n| b.get(i + 1 + n) == Some(&b'"'));
+        if let Some(n) = raw_hashes {
+            let close = format!("\"{}", "#".repeat(n));
+            let start = i + 1 + n + 1;
+            let end = code[start..]
+                .find(&close)
+                .map_or(b.len(), |k| start + k + close.len());
+            out.push_str("r\"\"");
+            out.extend(code[i..end].chars().filter(|&ch| ch == '\n'));
+            i = end;
+        } else if c == b'"' {
+            let mut j = i + 1;
+            while j < b.len() && b[j] != b'"' {
+                j += if b[j] == b'\\' { 2 } else { 1 };
+            }
+            out.push_str("\"\"");
+            out.extend(code[i..j.min(b.len())].chars().filter(|&ch| ch == '\n'));
+            i = (j + 1).min(b.len());
+        } else if c == b'\'' && i + 2 < b.len() && (b[i + 2] == b'\'' || b[i + 1] == b'\\') {
+            let from = if b[i + 1] == b'\\' { i + 3 } else { i + 2 };
+            let end = code[from..].find('\'').map_or(b.len(), |k| from + k + 1);
+            out.push_str("' '");
+            i = end;
+        } else {
+            let ch = code[i..].chars().next().unwrap_or(' ');
+            out.push(ch);
+            i += ch.len_utf8();
+        }
+    }
+    out
+}
+
+/// (name, first line, lines) of every `fn` with a body in `code` (literals blanked).
+fn functions(code: &str) -> Vec<(String, usize, usize)> {
+    let lines: Vec<&str> = code.lines().collect();
+    let mut out = Vec::new();
+    for (i, l) in lines.iter().enumerate() {
+        let Some(k) = l.find("fn ") else { continue };
+        if k > 0 && is_ident(l[..k].chars().next_back().unwrap_or(' ')) {
+            continue;
+        }
+        let name: String = l[k + 3..].chars().take_while(|&c| is_ident(c)).collect();
+        if name.is_empty() {
+            continue;
+        }
+        // The body: from the first `{` after the signature to its match (a `;` first: none).
+        let mut depth = 0usize;
+        let mut opened = false;
+        'scan: for (j, line) in lines.iter().enumerate().skip(i) {
+            let from = if j == i { k } else { 0 };
+            for ch in line[from..].chars() {
+                match ch {
+                    ';' if !opened => break 'scan,
+                    '{' => {
+                        depth += 1;
+                        opened = true;
+                    }
+                    '}' if opened => {
+                        depth -= 1;
+                        if depth == 0 {
+                            out.push((name.clone(), i + 1, j - i + 1));
+                            break 'scan;
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The measures of [`SHAPE_LIMITS`] over `src/` (files named `*tests.rs` and everything from a
+/// file's `#[cfg(test)]` on are tests), each with what it counted.
+fn shape(root: &Path) -> BTreeMap<&'static str, Vec<String>> {
+    let mut files = Vec::new();
+    rust_files(&root.join("src"), &mut files);
+    let mut m: BTreeMap<&'static str, Vec<String>> =
+        SHAPE_LIMITS.iter().map(|(k, _)| (*k, Vec::new())).collect();
+    for p in files {
+        let rel = p
+            .strip_prefix(root)
+            .unwrap_or(&p)
+            .to_string_lossy()
+            .replace('\\', "/");
+        if rel.ends_with("tests.rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&p).unwrap_or_default();
+        let end = text.find("\n#[cfg(test)]").map_or(text.len(), |k| k + 1);
+        let text = &text[..end];
+        let n_lines = text.lines().count();
+        let code = blank_literals(&strip_comments(text));
+        let mut push = |k: &'static str, v: String| m.entry(k).or_default().push(v);
+        if n_lines > 700 {
+            push("files over 700 lines", format!("{rel} ({n_lines})"));
+        }
+        for (name, line, n) in functions(&code) {
+            if n > 150 {
+                push("functions over 150 lines", format!("{rel}:{line} {name} ({n})"));
+            }
+        }
+        for (i, l) in code.lines().enumerate() {
+            if l.contains("too_many_arguments") {
+                push("too_many_arguments allows", format!("{rel}:{}", i + 1));
+            }
+        }
+        if rel.starts_with("src/renderer/")
+            && code
+                .lines()
+                .any(|l| l.contains("methods::") || l.contains("crate::methods"))
+        {
+            push("files in src/renderer that name methods", rel.clone());
+        }
+        let in_app = rel.starts_with("src/app/") || rel == "src/main.rs";
+        let gui = [
+            "egui",
+            "egui_wgpu",
+            "egui_plot",
+            "egui_tiles",
+            "eframe",
+            "epaint",
+            "ecolor",
+        ];
+        if !in_app && code.lines().any(|l| gui.iter().any(|w| has_word(l, w))) {
+            push("files below the app that name egui", rel.clone());
+        }
+    }
+    m
+}
+
+#[test]
+fn the_code_keeps_its_shape_no_worse_than_before() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let m = shape(root);
+    let mut over = Vec::new();
+    for (k, limit) in SHAPE_LIMITS {
+        let found = &m[k];
+        println!("{k}: {} (limit {limit})", found.len());
+        for f in found {
+            println!("    {f}");
+        }
+        if found.len() > *limit {
+            over.push(format!("{k}: {} > {limit}", found.len()));
+        }
+    }
+    assert!(over.is_empty(), "the code's shape got worse: {over:?}");
+}
+
+#[test]
+fn the_shape_scan_measures_bodies_not_literals() {
+    let code = blank_literals(&strip_comments(
+        "fn a() {\n    let s = \"{ not a brace\";\n    let c = '{';\n    let r = r#\"}\"#;\n}\nfn b();\npub fn c(x: u32) -> u32 {\n    x\n}\n",
+    ));
+    let f = functions(&code);
+    assert_eq!(
+        f,
+        vec![("a".to_string(), 1, 5), ("c".to_string(), 7, 3)],
+        "{code}"
+    );
 }

@@ -52,3 +52,14 @@ pub fn to_unorm8(c: [f32; 3]) -> [u8; 4] {
     let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
     [q(c[0]), q(c[1]), q(c[2]), 255]
 }
+
+/// A heat-map view's colour scale, as the GUI draws its legend.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Legend {
+    pub title: String,
+    /// The scale's ends: values, or with `log` their log10 (-4 and 0 for 1e-4 .. 1).
+    pub lo: f32,
+    pub hi: f32,
+    /// log10 scale (else linear).
+    pub log: bool,
+}

@@ -11,5 +11,6 @@ pub mod display;
 pub mod field;
 pub mod gpu_layout;
 pub mod image;
+pub mod progress;
 pub mod sampling;
 pub mod sst_node;

@@ -237,7 +237,7 @@ impl Renderer {
 
     /// The colour scale of a method's view (None: no legend).
     /// The colour scale of a temporal-stage view (None for its radiance views).
-    pub fn temporal_legend(&self, view: TemporalView) -> Option<methods::Legend> {
+    pub fn temporal_legend(&self, view: TemporalView) -> Option<crate::base::colormap::Legend> {
         self.temporal.legend(view)
     }
 
@@ -263,7 +263,7 @@ impl Renderer {
         }
     }
 
-    pub fn method_legend(&self, view: MethodView) -> Option<methods::Legend> {
+    pub fn method_legend(&self, view: MethodView) -> Option<crate::base::colormap::Legend> {
         let (_, owner) = view.find()?;
         self.method_instance(owner)?.legend(view, self.tree.levels())
     }

@@ -101,7 +101,7 @@ pub enum Buffer {
     GroundTruthIndirect,
 }
 
-pub use crate::methods::GiProgress;
+pub use crate::base::progress::GiProgress;
 
 /// Which frames record diagnostics and which are timed. A frame is one or the other, so the
 /// GPU timestamps of a timed frame never include diagnostics work: the samplers' counters,

@@ -8,8 +8,9 @@ mod ui;
 
 use super::{FrameCx, Kind, Method, MethodId, MethodInfo, Module, Resource};
 use crate::base::field::Field;
+use crate::base::progress::GiProgress;
 use crate::renderer::settings::GiSettings;
-use crate::renderer::{GiProgress, gpu_data::GpuVpl, settings::RenderSettings, shaders::ShaderError};
+use crate::renderer::{gpu_data::GpuVpl, settings::RenderSettings, shaders::ShaderError};
 use pass::GpuGtParams;
 use pass::GroundTruthPass;
 

@@ -613,9 +613,9 @@ impl TemporalPass {
     }
 
     /// The colour scale of a diagnostic view (None for the radiance views).
-    pub fn legend(&self, view: TemporalView) -> Option<crate::methods::Legend> {
+    pub fn legend(&self, view: TemporalView) -> Option<crate::base::colormap::Legend> {
         let l = |title: &str, lo: f32, hi: f32, log: bool| {
-            Some(crate::methods::Legend {
+            Some(crate::base::colormap::Legend {
                 title: title.into(),
                 lo,
                 hi,

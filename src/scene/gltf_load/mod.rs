@@ -23,6 +23,12 @@ use gltf::json::validation::Checked;
 use gltf::mesh::Mode;
 
 mod data;
+mod materials;
+mod prepare;
+mod walk;
+use materials::*;
+use prepare::*;
+use walk::*;
 
 use super::{Aabb, Camera, DirectionalLight, Material, Scene, TextureImage};
 use data::*;
@@ -163,10 +169,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let invalid = |message: String| SceneError::InvalidGltf {
-        path: path.to_path_buf(),
-        message,
-    };
+    let invalid = |message: String| invalid(path, message);
 
     // Container: GLB or plain JSON.
     let (json_bytes, blob): (Vec<u8>, Option<Vec<u8>>) = if bytes.starts_with(b"glTF") {
@@ -180,137 +183,10 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
     drop(json_bytes);
 
     let mut warnings = Warnings::default();
-
-    // Extension policy. Required extensions are removed from the list before validation
-    // (the gltf crate rejects required extensions it does not know, even harmless ones).
-    let required = std::mem::take(&mut root.extensions_required);
-    for name in &required {
-        match ext_policy(name) {
-            ExtPolicy::Supported => {}
-            ExtPolicy::Ignored(why) => {
-                warnings.push(format!("glTF extension {name} (required) is ignored: {why}"))
-            }
-            ExtPolicy::Partial(why) => warnings.push(format!("glTF extension {name} (required): {why}")),
-            ExtPolicy::Geometry(why) => {
-                return Err(SceneError::UnsupportedExtension {
-                    path: path.to_path_buf(),
-                    name: name.clone(),
-                    reason: why.to_string(),
-                });
-            }
-            ExtPolicy::Unknown => {
-                return Err(SceneError::UnsupportedExtension {
-                    path: path.to_path_buf(),
-                    name: name.clone(),
-                    reason: "unknown extension; it could change the geometry".into(),
-                });
-            }
-        }
-    }
-    for name in root.extensions_used.iter().filter(|n| !required.contains(n)) {
-        match ext_policy(name) {
-            ExtPolicy::Supported => {}
-            ExtPolicy::Ignored(why) => warnings.push(format!("glTF extension {name} is ignored: {why}")),
-            ExtPolicy::Partial(why) => warnings.push(format!("glTF extension {name}: {why}")),
-            ExtPolicy::Geometry(why) => warnings.push(format!(
-                "glTF extension {name} is used but not required and is ignored ({why}); \
-                 the uncompressed fallback data is loaded"
-            )),
-            ExtPolicy::Unknown => warnings.push(format!("unknown glTF extension {name} is ignored")),
-        }
-    }
-
-    // Textures whose only image is given through an extension (e.g. MSFT_texture_dds without
-    // a plain `source`) are pointed at a placeholder image so validation passes, and are
-    // treated as "no texture" below.
-    let mut sourceless: HashSet<usize> = HashSet::new();
-    // Their DDS image's URI (MSFT_texture_dds), where the file gives one.
-    let mut dds_uris: HashMap<usize, String> = HashMap::new();
-    for (i, t) in root.textures.iter().enumerate() {
-        if t.source.value() != u32::MAX as usize {
-            continue;
-        }
-        let uri = t
-            .extensions
-            .as_ref()
-            .and_then(|e| e.others.get("MSFT_texture_dds"))
-            .and_then(|v| v.get("source"))
-            .and_then(|v| v.as_u64())
-            .and_then(|k| root.images.get(k as usize))
-            .and_then(|img| img.uri.clone());
-        if let Some(uri) = uri {
-            dds_uris.insert(i, uri);
-        }
-    }
-    if root
-        .textures
-        .iter()
-        .any(|t| t.source.value() == u32::MAX as usize)
-    {
-        let placeholder: gltf::json::Image =
-            gltf::json::deserialize::from_str(r#"{"uri":"data:,","name":"placeholder"}"#)
-                .map_err(|e| invalid(e.to_string()))?;
-        let idx = root.images.len() as u32;
-        root.images.push(placeholder);
-        for (i, t) in root.textures.iter_mut().enumerate() {
-            if t.source.value() == u32::MAX as usize {
-                t.source = gltf::json::Index::new(idx);
-                sourceless.insert(i);
-            }
-        }
-    }
-
-    // KHR_draco_mesh_compression: the primitive's accessors have no buffer view (their data
-    // is in the Draco stream, `data::read_draco_primitive`), which the gltf crate's validation
-    // rejects; they are pointed at the Draco buffer view, and never read through it.
-    for mesh in &root.meshes {
-        for prim in &mesh.primitives {
-            let Some(view) = prim
-                .extensions
-                .as_ref()
-                .and_then(|e| e.others.get("KHR_draco_mesh_compression"))
-                .and_then(|d| d.get("bufferView"))
-                .and_then(|v| v.as_u64())
-            else {
-                continue;
-            };
-            let accessors = prim
-                .attributes
-                .values()
-                .map(|a| a.value())
-                .chain(prim.indices.map(|i| i.value()));
-            for a in accessors {
-                if let Some(acc) = root.accessors.get_mut(a)
-                    && acc.buffer_view.is_none()
-                    && acc.sparse.is_none()
-                {
-                    acc.buffer_view = Some(gltf::json::Index::new(view as u32));
-                    acc.byte_offset = None;
-                }
-            }
-        }
-    }
-
-    // POSITION min/max are required by the spec but unused here: do not reject files that
-    // lack them or get them wrong.
-    let position_accessors: Vec<usize> = root
-        .meshes
-        .iter()
-        .flat_map(|m| m.primitives.iter())
-        .flat_map(|p| p.attributes.iter())
-        .filter(|(sem, _)| matches!(sem, Checked::Valid(gltf::Semantic::Positions)))
-        .map(|(_, a)| a.value())
-        .collect();
-    for a in position_accessors {
-        // (the gltf crate's validation indexes POSITION accessors without a bounds check)
-        let acc = root
-            .accessors
-            .get_mut(a)
-            .ok_or_else(|| invalid(format!("a POSITION attribute names missing accessor {a}")))?;
-        let zero = gltf::json::Value::from(vec![0.0f32; 3]);
-        acc.min = Some(zero.clone());
-        acc.max = Some(zero);
-    }
+    apply_extension_policy(&mut root, path, &mut warnings)?;
+    let sources = point_sourceless_textures(&mut root).map_err(invalid)?;
+    point_draco_accessors(&mut root);
+    relax_position_bounds(&mut root).map_err(invalid)?;
 
     // Last line of defence: a panic inside the parser's validation becomes an error.
     let doc = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| gltf::Document::from_json(root)))
@@ -329,210 +205,10 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
     }
     let buffers = Buffers { data, decoded };
 
-    // Materials and their textures: base colour, and metallic-roughness (glTF's
-    // `metallicRoughnessTexture`, or AMD_split_roughnessMetallic's separate roughness and
-    // metallic textures; roughness is read from G and metallic from B either way, which also
-    // reads a grey image right).
-    let mut requests: Vec<MaterialTextures> = Vec::new();
-    let mut users: BTreeMap<(TexSource, TexKind), Vec<String>> = BTreeMap::new();
-    for (i, m) in doc.materials().enumerate() {
-        let name = m
-            .name()
-            .map(str::to_string)
-            .unwrap_or_else(|| format!("material{i}"));
-        let pbr = m.pbr_metallic_roughness();
-        let mut req = MaterialTextures::default();
-        // A texture's source: its image, or for a DDS-only data texture the image beside it.
-        let source = |tex: usize, kind: TexKind, what: &str, warnings: &mut Warnings| -> Option<TexSource> {
-            if !sourceless.contains(&tex) {
-                return doc
-                    .textures()
-                    .nth(tex)
-                    .map(|t| TexSource::Image(t.source().index()));
-            }
-            let sibling = (kind == TexKind::Data)
-                .then(|| dds_uris.get(&tex).and_then(|u| dds_sibling(&base_dir, u)))
-                .flatten();
-            if sibling.is_none() {
-                let fallback = match kind {
-                    TexKind::Color => "the colour factor only",
-                    TexKind::Data => "the factor only",
-                };
-                let beside = if kind == TexKind::Data {
-                    " (nor one beside its DDS)"
-                } else {
-                    ""
-                };
-                warnings.push(format!(
-                    "material '{name}': {what} texture {tex} has no PNG/JPG source{beside}; using {fallback}"
-                ));
-            }
-            sibling.map(TexSource::File)
-        };
-        if let Some(info) = pbr.base_color_texture() {
-            req.base = source(
-                info.texture().index(),
-                TexKind::Color,
-                "base colour",
-                &mut warnings,
-            )
-            .map(|src| (src, tex_coord(&info)));
-        }
-        if let Some(info) = pbr.metallic_roughness_texture() {
-            let src = source(
-                info.texture().index(),
-                TexKind::Data,
-                "metallic-roughness",
-                &mut warnings,
-            );
-            req.roughness = src.clone().map(|s| (s, tex_coord(&info)));
-            req.metallic = src.map(|s| (s, tex_coord(&info)));
-        }
-        if let Some(split) = m.extension_value("AMD_split_roughnessMetallic") {
-            for (key, what) in [("roughnessTexture", "roughness"), ("metallicTexture", "metallic")] {
-                let Some(tex) = split
-                    .get(key)
-                    .and_then(|t| t.get("index"))
-                    .and_then(|v| v.as_u64())
-                else {
-                    continue;
-                };
-                let set = split
-                    .get(key)
-                    .and_then(|t| t.get("texCoord"))
-                    .and_then(|v| v.as_u64())
-                    .unwrap_or(0) as u32;
-                let slot = if key == "roughnessTexture" {
-                    &mut req.roughness
-                } else {
-                    &mut req.metallic
-                };
-                // glTF's own metallicRoughnessTexture takes precedence.
-                if slot.is_some() {
-                    continue;
-                }
-                let found = if (tex as usize) < doc.textures().len() {
-                    source(tex as usize, TexKind::Data, what, &mut warnings)
-                } else {
-                    warnings.push(format!(
-                        "material '{name}': AMD_split_roughnessMetallic names missing texture {tex}; using the factor only"
-                    ));
-                    None
-                };
-                *slot = found.map(|s| (s, set));
-            }
-        }
-        for (src, kind) in [
-            (&req.base, TexKind::Color),
-            (&req.roughness, TexKind::Data),
-            (&req.metallic, TexKind::Data),
-        ] {
-            if let Some((src, _)) = src {
-                let u = users.entry((src.clone(), kind)).or_default();
-                if !u.contains(&name) {
-                    u.push(name.clone());
-                }
-            }
-        }
-        requests.push(req);
-    }
+    let (requests, users) = texture_requests(&doc, &sources, &base_dir, &mut warnings);
     let (textures, texture_of) = load_textures(&doc, &buffers, &base_dir, &users, &mut warnings);
-    let mut materials: Vec<Material> = Vec::new();
-    let mut material_uv_set: Vec<u32> = Vec::new();
-    let mut material_uv_transform: Vec<Option<Mat3>> = Vec::new();
-    let mut used_transform = false;
-    for ((i, m), req) in doc.materials().enumerate().zip(requests) {
-        let pbr = m.pbr_metallic_roughness();
-        let factor = pbr.base_color_factor();
-        let factor = if factor.iter().all(|c| c.is_finite()) {
-            factor
-        } else {
-            warnings.push(format!(
-                "material {i} has a non-finite baseColorFactor; using white"
-            ));
-            [1.0; 4]
-        };
-        let name = m
-            .name()
-            .map(str::to_string)
-            .unwrap_or_else(|| format!("material{i}"));
-        let texture = |t: &Option<(TexSource, u32)>, kind: TexKind| {
-            t.as_ref()
-                .and_then(|(src, _)| texture_of.get(&(src.clone(), kind)).copied().flatten())
-        };
-        let (base, roughness_tex, metallic_tex) = (
-            texture(&req.base, TexKind::Color),
-            texture(&req.roughness, TexKind::Data),
-            texture(&req.metallic, TexKind::Data),
-        );
-        // One UV set per material (the vertices carry one): the base colour's, else the
-        // metallic-roughness texture's.
-        let sets: Vec<u32> = [
-            (base, &req.base),
-            (roughness_tex, &req.roughness),
-            (metallic_tex, &req.metallic),
-        ]
-        .iter()
-        .filter(|(t, _)| t.is_some())
-        .filter_map(|(_, r)| r.as_ref().map(|(_, set)| *set))
-        .collect();
-        let set = sets
-            .first()
-            .copied()
-            .unwrap_or_else(|| pbr.base_color_texture().map(|t| tex_coord(&t)).unwrap_or(0));
-        if sets.iter().any(|&s| s != set) {
-            warnings.push(format!(
-                "material '{name}': its textures use different TEXCOORD sets; all read set {set}"
-            ));
-        }
-        // KHR_texture_transform: the base colour's (else the metallic-roughness texture's)
-        // goes into the vertex UVs; the metallic-roughness texture reads through its own
-        // transform relative to that one (`Material::metal_rough_uv`).
-        let base_t = pbr.base_color_texture().and_then(|t| texture_transform(&t));
-        let mr_t = pbr
-            .metallic_roughness_texture()
-            .and_then(|t| texture_transform(&t));
-        let transform = if pbr.base_color_texture().is_some() {
-            base_t
-        } else {
-            mr_t
-        };
-        let relative = mr_t.unwrap_or(Mat3::IDENTITY) * transform.unwrap_or(Mat3::IDENTITY).inverse();
-        let metal_rough_uv = if pbr.metallic_roughness_texture().is_some()
-            && relative.is_finite()
-            && !relative.abs_diff_eq(Mat3::IDENTITY, 1e-7)
-        {
-            used_transform = true;
-            [
-                [relative.x_axis.x, relative.y_axis.x, relative.z_axis.x],
-                [relative.x_axis.y, relative.y_axis.y, relative.z_axis.y],
-            ]
-        } else {
-            crate::scene::UV_IDENTITY
-        };
-        if let Some(t) = transform.filter(|t| *t != Mat3::IDENTITY) {
-            material_uv_transform.push(Some(t));
-            used_transform = true;
-        } else {
-            material_uv_transform.push(None);
-        }
-        materials.push(Material {
-            name,
-            base_color_factor: factor,
-            base_color_texture: base,
-            // glTF's defaults are 1 and 1; out-of-range or non-finite factors are clamped to
-            // the nearest valid value (NaN: the default).
-            metallic: clamp_factor(pbr.metallic_factor()),
-            roughness: clamp_factor(pbr.roughness_factor()),
-            roughness_texture: roughness_tex,
-            metallic_texture: metallic_tex,
-            metal_rough_uv,
-        });
-        material_uv_set.push(set);
-    }
-    let mut default_material: Option<u32> = None;
-
-    let mut scene = Scene {
+    let materials = build_materials(&doc, requests, &texture_of, &mut warnings);
+    let scene = Scene {
         name: path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -540,254 +216,27 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
         textures,
         ..Default::default()
     };
-
-    // Walk the node hierarchy.
-    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
-        Some(s) => s.nodes().collect(),
-        None => {
-            let mut is_child = vec![false; doc.nodes().len()];
-            for n in doc.nodes() {
-                for c in n.children() {
-                    is_child[c.index()] = true;
-                }
-            }
-            doc.nodes().filter(|n| !is_child[n.index()]).collect()
-        }
+    let mut walk = Walk {
+        doc: &doc,
+        buffers: &buffers,
+        path,
+        materials,
+        default_material: None,
+        scene,
+        stats: GeomStats::default(),
+        cameras: Vec::new(),
+        warnings,
     };
-
-    let mut stats = GeomStats::default();
-    let mut pending_cameras: Vec<(Camera, Option<f32>)> = Vec::new();
-    let mut visited = vec![false; doc.nodes().len()];
-    let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY)).collect();
-    let json = doc.as_json();
-    while let Some((node, parent)) = stack.pop() {
-        if std::mem::replace(&mut visited[node.index()], true) {
-            warnings.push(format!(
-                "node {} is reached twice (cycle or shared child); the repeat is skipped",
-                node.index()
-            ));
-            continue;
-        }
-        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
-        let world = parent * local;
-        for c in node.children().collect::<Vec<_>>().into_iter().rev() {
-            stack.push((c, world));
-        }
-
-        if let Some(mesh) = node.mesh() {
-            // EXT_mesh_gpu_instancing: the mesh once per instance (each instance's TRS after
-            // the node's transform), else once.
-            let instances = match node.extension_value("EXT_mesh_gpu_instancing") {
-                Some(ext) => match instance_transforms(&doc, ext, &buffers) {
-                    Ok(v) => {
-                        stats.instanced_nodes += 1;
-                        stats.instances += v.len();
-                        v
-                    }
-                    Err(e) => {
-                        warnings.push(format!(
-                            "node {}: EXT_mesh_gpu_instancing: {e}; its mesh is loaded once",
-                            node.index()
-                        ));
-                        vec![Mat4::IDENTITY]
-                    }
-                },
-                None => vec![Mat4::IDENTITY],
-            };
-            for (pi, prim) in mesh.primitives().enumerate() {
-                if prim.mode() != Mode::Triangles {
-                    *stats
-                        .skipped_modes
-                        .entry(format!("{:?}", prim.mode()))
-                        .or_insert(0) += 1;
-                    continue;
-                }
-                let mat = match prim.material().index() {
-                    Some(m) => m as u32,
-                    None => *default_material.get_or_insert_with(|| {
-                        materials.push(Material::default());
-                        material_uv_set.push(0);
-                        material_uv_transform.push(None);
-                        (materials.len() - 1) as u32
-                    }),
-                };
-                let uv_set = material_uv_set.get(mat as usize).copied().unwrap_or(0);
-                let label = format!(
-                    "mesh {} ('{}') primitive {pi}",
-                    mesh.index(),
-                    mesh.name().unwrap_or("")
-                );
-                let draco = prim.extension_value("KHR_draco_mesh_compression");
-                let read = match draco {
-                    Some(ext) => {
-                        let r = read_draco_primitive(&doc, &prim, ext, &buffers, uv_set);
-                        stats.draco += r.is_ok() as usize;
-                        r
-                    }
-                    None => read_primitive(&prim, &buffers, uv_set),
-                };
-                match read {
-                    Ok((mut data, uv_missing)) => {
-                        if uv_missing {
-                            stats.uv_missing.insert(label.clone());
-                        }
-                        if let (Some(t), Some(uvs)) = (
-                            material_uv_transform.get(mat as usize).copied().flatten(),
-                            data.uvs.as_mut(),
-                        ) {
-                            for uv in uvs.iter_mut() {
-                                *uv = t.transform_point2(*uv);
-                            }
-                        }
-                        // Instancing multiplies the geometry: a budget keeps a small file from
-                        // asking for more vertices than the u32 indices address.
-                        let adds = data.positions.len().saturating_mul(instances.len());
-                        if scene.positions.len().saturating_add(adds) > MAX_VERTICES {
-                            return Err(invalid(format!(
-                                "{label} with {} instance(s) would make the scene more than {MAX_VERTICES} vertices",
-                                instances.len()
-                            )));
-                        }
-                        for inst in &instances {
-                            append_primitive(&mut scene, &data, &(world * *inst), mat, &mut stats);
-                        }
-                    }
-                    Err(e) => warnings.push(format!("{label} skipped: {e}")),
-                }
-            }
-        }
-
-        let node_json = json.nodes.get(node.index());
-        if let Some(ci) = node_json.and_then(|n| n.camera).map(|c| c.value()) {
-            match json.cameras.get(ci) {
-                Some(cam) => match (cam.type_, cam.perspective.as_ref()) {
-                    (Checked::Valid(CameraType::Perspective), Some(p)) => {
-                        let name = cam
-                            .name
-                            .clone()
-                            .or_else(|| node.name().map(str::to_string))
-                            .unwrap_or_else(|| format!("camera{ci}"));
-                        let c = make_camera(&name, &world, p.yfov, p.znear, &mut warnings);
-                        pending_cameras.push((c, p.zfar));
-                    }
-                    _ => warnings.push(format!(
-                        "camera {ci} ('{}') is not a perspective camera; skipped",
-                        cam.name.as_deref().unwrap_or("")
-                    )),
-                },
-                None => warnings.push(format!("node {} references missing camera {ci}", node.index())),
-            }
-        }
-
-        let light_index = node_json
-            .and_then(|n| n.extensions.as_ref())
-            .and_then(|e| e.khr_lights_punctual.as_ref())
-            .map(|l| l.light.value());
-        if let Some(li) = light_index {
-            let light = json
-                .extensions
-                .as_ref()
-                .and_then(|e| e.khr_lights_punctual.as_ref())
-                .and_then(|l| l.lights.get(li));
-            match light {
-                Some(l) => match l.type_ {
-                    Checked::Valid(LightType::Directional) => {
-                        let dir = Mat3::from_mat4(world) * Vec3::NEG_Z;
-                        let name = l
-                            .name
-                            .clone()
-                            .or_else(|| node.name().map(str::to_string))
-                            .unwrap_or_else(|| format!("light{li}"));
-                        // KHR_lights_punctual: intensity (here irradiance, W/m^2) and colour
-                        // are non-negative; a negative or non-finite one is refused, not
-                        // clamped into a black or NaN image.
-                        let color = Vec3::from_array(l.color);
-                        if !(l.intensity.is_finite()
-                            && l.intensity >= 0.0
-                            && color.is_finite()
-                            && color.min_element() >= 0.0)
-                        {
-                            return Err(invalid(format!(
-                                "directional light '{name}' has intensity {} W/m^2 and colour {:?}: both must be finite and >= 0",
-                                l.intensity, l.color
-                            )));
-                        }
-                        if dir.is_finite() && dir.length_squared() > 0.0 {
-                            scene.lights.push(DirectionalLight {
-                                name,
-                                direction: dir.normalize(),
-                                irradiance: l.intensity * color,
-                            });
-                        } else {
-                            warnings.push(format!(
-                                "directional light '{name}' has a degenerate direction (a zero-scale node?); skipped"
-                            ));
-                        }
-                    }
-                    Checked::Valid(t) => {
-                        *stats.skipped_lights.entry(format!("{t:?}")).or_insert(0) += 1;
-                    }
-                    Checked::Invalid => warnings.push(format!("light {li} has an invalid type; skipped")),
-                },
-                None => warnings.push(format!("node {} references missing light {li}", node.index())),
-            }
-        }
-    }
-
-    // What was decoded (the load summary's extension lines).
-    if stats.draco > 0 {
-        info.push(format!(
-            "KHR_draco_mesh_compression: {} primitive(s) decoded (draco-core)",
-            stats.draco
-        ));
-    }
-    if stats.instanced_nodes > 0 {
-        info.push(format!(
-            "EXT_mesh_gpu_instancing: {} instance(s) of {} node(s) expanded",
-            stats.instances, stats.instanced_nodes
-        ));
-    }
-    if doc.extensions_used().any(|e| e == "KHR_mesh_quantization") {
-        info.push("KHR_mesh_quantization: quantised attributes dequantised".into());
-    }
-    if used_transform {
-        info.push("KHR_texture_transform: applied to the UVs of the transformed textures' sets".into());
-    }
-
-    // Summaries of skipped/dropped things, one warning each.
-    for (mode, n) in &stats.skipped_modes {
-        warnings.push(format!(
-            "{n} primitive(s) with mode {mode} skipped: only triangle lists are supported"
-        ));
-    }
-    for (kind, n) in &stats.skipped_lights {
-        warnings.push(format!(
-            "{n} {kind} light(s) skipped: only directional lights are supported"
-        ));
-    }
-    if stats.non_finite > 0 {
-        warnings.push(format!(
-            "{} triangle(s) with non-finite (NaN/inf) vertex positions dropped",
-            stats.non_finite
-        ));
-    }
-    if stats.degenerate > 0 {
-        warnings.push(format!("{} zero-area triangle(s) dropped", stats.degenerate));
-    }
-    if stats.bad_index > 0 {
-        warnings.push(format!(
-            "{} triangle(s) with out-of-range vertex indices dropped",
-            stats.bad_index
-        ));
-    }
-    if !stats.uv_missing.is_empty() {
-        let list: Vec<&str> = stats.uv_missing.iter().map(String::as_str).take(5).collect();
-        warnings.push(format!(
-            "{} textured primitive(s) lack the TEXCOORD set their material uses; zero UVs used (e.g. {})",
-            stats.uv_missing.len(),
-            list.join(", ")
-        ));
-    }
+    walk.nodes()?;
+    let Walk {
+        materials,
+        mut scene,
+        stats,
+        cameras: pending_cameras,
+        mut warnings,
+        ..
+    } = walk;
+    stats.summarise(&doc, materials.used_transform, &mut info, &mut warnings);
 
     if scene.indices.is_empty() {
         let mut details = String::new();
@@ -816,7 +265,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
         return Err(invalid("more than 2^32 vertices".into()));
     }
 
-    scene.materials = materials;
+    scene.materials = materials.materials;
     scene.recompute_bounds();
     let bounds = scene.bounds;
     for (mut cam, zfar) in pending_cameras {
@@ -846,6 +295,14 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
     }
     scene.load_notes = info;
     Ok(scene)
+}
+
+/// A file the loader refuses, with the message.
+fn invalid(path: &Path, message: String) -> SceneError {
+    SceneError::InvalidGltf {
+        path: path.to_path_buf(),
+        message,
+    }
 }
 
 /// The TEXCOORD set a texture reads: KHR_texture_transform's `texCoord` override, else the
