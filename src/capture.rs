@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::renderer::settings::RenderSettings;
 use crate::scene::Camera;
+use crate::settings::RenderSettings;
 
 /// The commit this binary was built from (`build.rs`; `-dirty` when the work tree differed).
 pub const COMMIT: &str = env!("LIGHTCUT_COMMIT");
@@ -146,7 +146,7 @@ impl Capture {
             what: what.into(),
             commit: COMMIT.into(),
             version: env!("CARGO_PKG_VERSION").into(),
-            adapter: crate::renderer::context::describe_adapter(adapter),
+            adapter: crate::gpu::context::describe_adapter(adapter),
             driver: format!("{} {}", adapter.driver, adapter.driver_info)
                 .trim()
                 .to_string(),

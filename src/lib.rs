@@ -6,6 +6,7 @@ pub mod base;
 pub mod capture;
 pub mod cli;
 pub mod export;
+pub mod gpu;
 pub mod harness;
 #[doc(hidden)]
 pub mod methods;
@@ -13,4 +14,5 @@ pub mod metrics;
 pub mod reference;
 pub mod renderer;
 pub mod scene;
+pub mod settings;
 pub mod sheet;

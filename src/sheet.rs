@@ -434,7 +434,7 @@ pub fn compose(sheet: &Sheet) -> Result<Canvas, String> {
     let top = margin + header;
     fn shown<'a>(
         img: &'a ImageF32,
-        d: &'a crate::renderer::settings::DisplaySettings,
+        d: &'a crate::settings::DisplaySettings,
     ) -> impl Fn(u32, u32) -> [u8; 3] + 'a {
         move |x: u32, y: u32| {
             let e = display::encode(img.get(x, y), d.exposure_ev, d.tonemap);

@@ -41,7 +41,7 @@ pub fn write_sheet(sheet: &crate::sheet::Sheet, dir: &std::path::Path) -> Result
 pub fn export_view_files(
     r: &Renderer,
     slot: usize,
-    spec: &crate::renderer::views::ViewSpec,
+    spec: &crate::gpu::views::ViewSpec,
     kind: ExportKind,
     dir: &std::path::Path,
 ) -> Result<Vec<PathBuf>, String> {
@@ -84,7 +84,7 @@ pub(super) fn capture_of(
     open: &OpenScene,
     lights: &[DirectionalLight],
     what: &str,
-) -> (crate::capture::Capture, crate::renderer::settings::RenderSettings) {
+) -> (crate::capture::Capture, crate::settings::RenderSettings) {
     let mut c = crate::capture::Capture::new(what, &r.ctx.adapter_info, &open.source, open.file.as_deref());
     c.camera = (&open.camera).into();
     c.lights = lights.iter().map(Into::into).collect();
@@ -98,7 +98,7 @@ pub(super) fn capture_of(
 /// Writes the capture record beside each of `files` (`name.capture.toml`; one per stem).
 pub(super) fn write_capture_records(
     mut c: crate::capture::Capture,
-    settings: &crate::renderer::settings::RenderSettings,
+    settings: &crate::settings::RenderSettings,
     files: &[PathBuf],
 ) -> Result<(), String> {
     c.files = files
@@ -120,7 +120,7 @@ impl WorkbenchApp {
     pub fn capture_record(
         &self,
         what: &str,
-    ) -> Option<(crate::capture::Capture, crate::renderer::settings::RenderSettings)> {
+    ) -> Option<(crate::capture::Capture, crate::settings::RenderSettings)> {
         let r = self.renderer.as_ref()?;
         let open = self.open.as_ref()?;
         let lights = super::frame::lights_with_sun(&open.scene, self.sun.as_ref());

@@ -167,7 +167,7 @@ impl WorkbenchApp {
             && renderer.compare_progress().is_some_and(|p| p.finished())
         {
             self.last_metrics_time = now;
-            let look = crate::renderer::views::ViewLook::from_display(&self.settings.display);
+            let look = crate::gpu::views::ViewLook::from_display(&self.settings.display);
             match ab_metrics(
                 renderer,
                 AbSource::Indirect,
@@ -417,7 +417,7 @@ impl WorkbenchApp {
     pub fn export_view(
         &mut self,
         slot: usize,
-        spec: &crate::renderer::views::ViewSpec,
+        spec: &crate::gpu::views::ViewSpec,
         kind: ExportKind,
     ) -> Vec<PathBuf> {
         let Some(r) = &self.renderer else {
@@ -484,9 +484,9 @@ pub(super) fn ab_metrics(
     r: &Renderer,
     a: AbSource,
     b: AbSource,
-    look: &crate::renderer::views::ViewLook,
+    look: &crate::gpu::views::ViewLook,
     rect: Option<[u32; 4]>,
-) -> Result<Option<AbMetrics>, crate::renderer::context::GpuError> {
+) -> Result<Option<AbMetrics>, crate::gpu::context::GpuError> {
     let (Some(a), Some(b)) = (r.read_ab_source(a)?, r.read_ab_source(b)?) else {
         return Ok(None);
     };

@@ -33,7 +33,7 @@ use std::{
 use glam::Vec3;
 
 use crate::base::sst_node::{SstNode, luminance};
-use crate::renderer::views::AbSource;
+use crate::gpu::views::AbSource;
 use crate::{
     renderer::{
         FrameInput, Renderer,
@@ -174,7 +174,7 @@ pub struct WorkbenchApp {
     /// What the user did in the views last frame (applied at the next frame).
     events: ViewEvents,
     /// A view export asked for this frame: (slot, spec, kind).
-    pending_export: Option<(usize, crate::renderer::views::ViewSpec, ExportKind)>,
+    pending_export: Option<(usize, crate::gpu::views::ViewSpec, ExportKind)>,
     /// Folder of exports and comparison sheets.
     export_dir: String,
     /// The files the last export wrote (shown in the side panel).
@@ -226,10 +226,14 @@ pub struct WorkbenchApp {
     recoveries: u32,
     /// This is the empty app left in a window whose state went to the handover.
     handed_over: bool,
+    /// `frames` when this window opened (`--lose-device-at-frame` counts from it).
+    window_start_frame: u64,
 }
 
-/// The slot a window whose GPU device was lost leaves its app in for the next window.
-pub type Handover = std::rc::Rc<std::cell::RefCell<Option<WorkbenchApp>>>;
+/// The slot a window whose GPU device was lost leaves its app in for the next window
+/// (`Ok`), or why no next window opens (`Err`: the device was lost once more than
+/// [`MAX_DEVICE_RECOVERIES`] allows).
+pub type Handover = std::rc::Rc<std::cell::RefCell<Option<Result<WorkbenchApp, String>>>>;
 
 /// How many lost devices the GUI recreates before it stops rendering (a device that keeps
 /// being lost would otherwise loop).
@@ -303,7 +307,7 @@ impl WorkbenchApp {
         let Some(rs) = app.render_state.clone() else {
             app.errors.push(format!(
                 "The workbench needs the wgpu renderer and got none: {}",
-                crate::renderer::context::NO_ADAPTER_HELP
+                crate::gpu::context::NO_ADAPTER_HELP
             ));
             return app;
         };
@@ -385,6 +389,7 @@ impl WorkbenchApp {
             handover: None,
             recoveries: 0,
             handed_over: false,
+            window_start_frame: 0,
         }
     }
 
@@ -563,13 +568,14 @@ const LAYOUT_KEY: &str = "lightcut_view_layout";
 impl eframe::App for WorkbenchApp {
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         // The empty app of a window whose device was lost: the layout went on with the app.
-        if !self.handed_over {
+        if !(self.handed_over && self.renderer.is_none()) {
             eframe::set_value(storage, LAYOUT_KEY, &self.layout);
         }
     }
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
+        self.lose_device_if_asked();
         // Nothing is drawn in a window whose device is lost: egui-wgpu 0.37 panics when it
         // cannot upload a frame's vertices to a lost device, and an empty frame has none.
         if self.hand_over_if_lost(&ctx) {
@@ -609,6 +615,8 @@ impl eframe::App for WorkbenchApp {
         self.error_window(&ctx);
         self.handle_exit(&ctx);
         ctx.request_repaint();
+        // A loss met during this frame's work: its shapes are dropped before they are painted.
+        self.hand_over_if_lost(&ctx);
     }
 }
 
@@ -619,9 +627,9 @@ pub fn run_gui(options: AppOptions) -> anyhow::Result<()> {
     log::info!("GPU adapter: {}", describe_adapter(&info));
     let mut wgpu_setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
     wgpu_setup.instance_descriptor.backends =
-        wgpu::Backends::from_env().unwrap_or(crate::renderer::context::BACKENDS);
+        wgpu::Backends::from_env().unwrap_or(crate::gpu::context::BACKENDS);
     wgpu_setup.device_descriptor = Arc::new(|adapter| {
-        let mut d = crate::renderer::context::device_descriptor(adapter);
+        let mut d = crate::gpu::context::device_descriptor(adapter);
         // The window surface may need large textures.
         d.required_limits.max_texture_dimension_2d = d
             .required_limits
@@ -658,14 +666,15 @@ pub fn run_gui(options: AppOptions) -> anyhow::Result<()> {
         eframe::run_native("lightcut-workbench", native.clone(), create).map_err(|e| {
             let msg = e.to_string();
             if msg.to_lowercase().contains("adapter") {
-                anyhow::anyhow!("{}", crate::renderer::context::NO_ADAPTER_HELP)
+                anyhow::anyhow!("{}", crate::gpu::context::NO_ADAPTER_HELP)
             } else {
                 anyhow::anyhow!("could not start the window: {msg}")
             }
         })?;
-        resumed = handover.borrow_mut().take();
-        if resumed.is_none() {
-            return Ok(());
+        match handover.borrow_mut().take() {
+            None => return Ok(()),
+            Some(Ok(app)) => resumed = Some(app),
+            Some(Err(stop)) => anyhow::bail!("{stop}"),
         }
     }
 }

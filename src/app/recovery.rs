@@ -30,9 +30,30 @@ impl WorkbenchApp {
         self.handed_over
     }
 
-    /// At the start of a UI frame: destroys the device when `--lose-device-at-frame` says so,
-    /// and hands the app over when the device is lost. True: this window's app is gone (the
-    /// window shows a line and closes).
+    /// `--lose-device-at-frame N`: destroys the device once this window has rendered N frames
+    /// (in every window, so that repeated losses reach [`MAX_DEVICE_RECOVERIES`]).
+    pub(super) fn lose_device_if_asked(&mut self) {
+        let (Some(n), Some(renderer)) = (self.options.lose_device_at_frame, self.renderer.as_ref()) else {
+            return;
+        };
+        if self.frames.saturating_sub(self.window_start_frame) < n || renderer.ctx.errors.device_lost() {
+            return;
+        }
+        log::warn!(
+            "destroying the GPU device at frame {} (--lose-device-at-frame)",
+            self.frames
+        );
+        renderer.ctx.device.destroy();
+        // wgpu reports the loss once the device's queue is empty.
+        let _ = renderer.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+    }
+
+    /// When the device is lost (checked at the start and at the end of a UI frame): drops the
+    /// frame's shapes (egui-wgpu 0.37 panics uploading them to a lost device), hands the app
+    /// over for [`super::run_gui`] to resume in a new window, or past [`MAX_DEVICE_RECOVERIES`]
+    /// leaves the reason there, and closes the window. True: this window's app is gone (it
+    /// draws nothing more). Without a handover (a test harness) it returns false and the
+    /// viewport says that rendering stopped.
     pub(super) fn hand_over_if_lost(&mut self, ctx: &egui::Context) -> bool {
         if self.handed_over {
             return true;
@@ -40,19 +61,6 @@ impl WorkbenchApp {
         let Some(renderer) = self.renderer.as_ref() else {
             return false;
         };
-        if self
-            .options
-            .lose_device_at_frame
-            .is_some_and(|n| self.frames >= n)
-        {
-            self.options.lose_device_at_frame = None;
-            log::warn!(
-                "destroying the GPU device at frame {} (--lose-device-at-frame)",
-                self.frames
-            );
-            renderer.ctx.device.destroy();
-            let _ = renderer.ctx.device.poll(wgpu::PollType::Poll);
-        }
         if !renderer.ctx.errors.device_lost() {
             return false;
         }
@@ -64,8 +72,23 @@ impl WorkbenchApp {
         let Some(handover) = self.handover.clone() else {
             return false;
         };
+        ctx.graphics_mut(|g| *g = Default::default());
+        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         if self.recoveries >= MAX_DEVICE_RECOVERIES {
-            return false;
+            let cause = self
+                .errors
+                .iter()
+                .rev()
+                .find(|e| e.starts_with("GPU device lost"))
+                .cloned()
+                .unwrap_or_else(|| "GPU device lost".into());
+            log::error!("the GPU device was lost again after {MAX_DEVICE_RECOVERIES} recoveries; stopping");
+            *handover.borrow_mut() = Some(Err(format!(
+                "{cause}; it was lost again after {MAX_DEVICE_RECOVERIES} recoveries, so the \
+                 workbench stops (restart it; its view layout was saved)"
+            )));
+            self.handed_over = true;
+            return true;
         }
         log::warn!(
             "the GPU device was lost; opening a new window on a new device (recovery {} of {})",
@@ -76,8 +99,7 @@ impl WorkbenchApp {
         let mut empty = Self::unbound(self.options.clone(), self.settings.clone(), layout, false);
         empty.handed_over = true;
         let app = std::mem::replace(self, empty);
-        *handover.borrow_mut() = Some(app);
-        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        *handover.borrow_mut() = Some(Ok(app));
         true
     }
 
@@ -85,10 +107,25 @@ impl WorkbenchApp {
     /// device from the open scene (camera, sun, settings and views as they were).
     pub fn resume(mut self, cc: &eframe::CreationContext<'_>) -> Self {
         self.recoveries += 1;
-        // Registered with the old window's egui renderer, which is gone: forget, not free.
+        self.window_start_frame = self.frames;
+        // The views' textures were registered with the old window's egui renderer, which is
+        // gone (forgotten, not freed), and their metrics were timed by the old window's clock.
         for p in self.layout.panes_mut() {
-            p.rt.texture = viewport_texture::ViewportTexture::new();
+            p.rt = image_views::PaneRuntime::default();
         }
+        // The new window's clock starts again at 0: every "last done at" goes.
+        self.last_frame_time = None;
+        self.frame_ms_smoothed = 0.0;
+        self.last_metrics_time = 0.0;
+        self.pixel.read = None;
+        self.pixel.rows.clear();
+        self.story.forget_read_time();
+        self.tree_panel.forget_refresh_time();
+        // A screenshot asked of the old window never comes: ask the new one.
+        if !self.screenshot_done.load(Ordering::Acquire) {
+            self.screenshot_requested = false;
+        }
+        self.cancel_sheet = false;
         self.renderer = None;
         self.timings = None;
         self.sampling_stats = None;
@@ -103,7 +140,7 @@ impl WorkbenchApp {
         let Some(rs) = self.render_state.clone() else {
             self.errors.push(format!(
                 "The GPU device was lost and no new one could be made: {}",
-                crate::renderer::context::NO_ADAPTER_HELP
+                crate::gpu::context::NO_ADAPTER_HELP
             ));
             return self;
         };
@@ -117,7 +154,8 @@ impl WorkbenchApp {
                 self.renderer = r;
                 self.errors.push(format!(
                     "The GPU device was lost and was recreated ({}, recovery {} of {}); \
-                     rendering goes on with the same settings and scene.",
+                     rendering goes on with the same settings, scene and views (the A/B \
+                     snapshots were on the lost device and are gone).",
                     self.adapter, self.recoveries, MAX_DEVICE_RECOVERIES
                 ));
             }

@@ -153,7 +153,7 @@ impl WorkbenchApp {
                     .on_hover_text("another image view (drag its :: handle to dock it elsewhere)")
                     .clicked()
                 {
-                    let spec = crate::renderer::views::ViewSpec::new(ViewBuffer::Indirect, &self.settings.display);
+                    let spec = crate::gpu::views::ViewSpec::new(ViewBuffer::Indirect, &self.settings.display);
                     self.layout.add_view(spec);
                 }
                 if ui
@@ -162,7 +162,7 @@ impl WorkbenchApp {
                     .clicked()
                 {
                     let spec =
-                        crate::renderer::views::ViewSpec::new(ViewBuffer::AbCompare, &self.settings.display);
+                        crate::gpu::views::ViewSpec::new(ViewBuffer::AbCompare, &self.settings.display);
                     self.layout.add_view(spec);
                 }
                 if ui
@@ -195,11 +195,11 @@ impl WorkbenchApp {
                     egui::ComboBox::from_label("VPL colour")
                         .selected_text(d.vpl_color.name())
                         .show_ui(ui, |ui| {
-                            for c in crate::renderer::settings::VplColor::ALL {
+                            for c in crate::settings::VplColor::ALL {
                                 ui.selectable_value(&mut d.vpl_color, c, c.name());
                             }
                         });
-                    if d.vpl_color == crate::renderer::settings::VplColor::Bounce {
+                    if d.vpl_color == crate::settings::VplColor::Bounce {
                         // The legend: one swatch per bounce of the frame.
                         for b in 1..=self.settings.vpl.bounces {
                             let [r, g, bl] = crate::base::colormap::bounce_color(b);
@@ -236,7 +236,7 @@ impl WorkbenchApp {
             );
             ui.checkbox(&mut self.timings_panel.show, "GPU timings window")
                 .on_hover_text("per-pass GPU times: last frame and history; hover a pass to see its output");
-            let hint = if crate::renderer::shaders::ShaderSourceDisk::reload_from_disk() {
+            let hint = if crate::gpu::shaders::ShaderSourceDisk::reload_from_disk() {
                 "rebuild the pipelines from shaders/ on disk (the last good ones stay on error)"
             } else {
                 "release build: rebuilds the pipelines from the embedded shaders"
@@ -379,7 +379,7 @@ impl WorkbenchApp {
             egui::ComboBox::from_label("BRDF")
                 .selected_text(g.brdf.name())
                 .show_ui(ui, |ui| {
-                    for b in crate::renderer::settings::Brdf::ALL {
+                    for b in crate::settings::Brdf::ALL {
                         ui.selectable_value(&mut g.brdf, b, b.name());
                     }
                 })
@@ -428,7 +428,7 @@ impl WorkbenchApp {
                 ui.checkbox(&mut v.animate, "new VPLs every frame");
             });
             // Multi-bounce VPLs (instant radiosity): light paths from the RSM through the BVH.
-            let max_bounces = crate::renderer::passes::light_paths::MAX_BOUNCES;
+            let max_bounces = crate::gpu::passes::light_paths::MAX_BOUNCES;
             ui.add(egui::Slider::new(&mut v.bounces, 1..=max_bounces).text("bounces"))
                 .on_hover_text(
                     "1: the RSM's VPLs (one bounce, the thesis). N: light paths traced through the \
@@ -436,7 +436,7 @@ impl WorkbenchApp {
                 );
             if v.bounces > 1 {
                 let (first, paths) =
-                    crate::renderer::passes::light_paths::split_bounces(v.count, v.bounces);
+                    crate::gpu::passes::light_paths::split_bounces(v.count, v.bounces);
                 ui.label(
                     egui::RichText::new(format!(
                         "bounce 1: {first} RSM VPLs · bounces 2..{}: {paths} light paths",
@@ -461,8 +461,8 @@ impl WorkbenchApp {
             let levels = self.renderer.as_ref().map(|r| {
                 let t = r.tree_buffers().1;
                 match t.kind {
-                    crate::renderer::settings::TreeKind::Perfect => t.levels(),
-                    crate::renderer::settings::TreeKind::Lbvh => t.depth_bound().min(48),
+                    crate::settings::TreeKind::Perfect => t.levels(),
+                    crate::settings::TreeKind::Lbvh => t.depth_bound().min(48),
                 }
             });
             self.tree_panel.controls(ui, &mut self.settings, levels);

@@ -57,6 +57,12 @@ impl StoryPanel {
         }
     }
 
+    /// Forgets when the story was last read (a new window's clock starts again at 0).
+    pub fn forget_read_time(&mut self) {
+        self.read_at = f64::NEG_INFINITY;
+        self.trace = None;
+    }
+
     /// Traces `pixel` (None: stop) and reads the last frame's story at most twice a second.
     pub fn refresh(&mut self, r: &mut Renderer, pixel: Option<(u32, u32)>, now: f64) -> Result<(), String> {
         let pixel = pixel.filter(|_| self.show);

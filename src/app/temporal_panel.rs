@@ -2,10 +2,10 @@
 //! SVGF and their parameters) and the camera path through the bookmarks (the animation
 //! section's player).
 
-use crate::renderer::settings::{MAX_ATROUS_ITERATIONS, TemporalMode, TemporalSettings};
-use crate::renderer::temporal_settings::AtrousFilter;
 use crate::scene::camera_path::CameraPath;
 use crate::scene::{Camera, Scene};
+use crate::settings::temporal::AtrousFilter;
+use crate::settings::{MAX_ATROUS_ITERATIONS, TemporalMode, TemporalSettings};
 
 /// The stage's switch and sliders. `per_frame`: whether the current method is one the stage
 /// applies to.

@@ -6,7 +6,8 @@ use std::collections::VecDeque;
 
 use egui_plot::{Legend, Line, Plot, PlotPoints};
 
-use crate::renderer::{settings::ViewBuffer, timing::PassTimings};
+use crate::gpu::timing::PassTimings;
+use crate::settings::ViewBuffer;
 
 /// Frames of history kept.
 pub const HISTORY: usize = 240;

@@ -6,7 +6,7 @@
 use egui_tiles::{Behavior, TileId, UiResponse};
 
 use super::WorkbenchApp;
-use crate::renderer::settings::ViewBuffer;
+use crate::settings::ViewBuffer;
 
 /// A tool pane.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

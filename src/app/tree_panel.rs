@@ -45,6 +45,11 @@ pub struct TreePanel {
 }
 
 impl TreePanel {
+    /// Forgets when the statistics were last read (a new window's clock starts again at 0).
+    pub fn forget_refresh_time(&mut self) {
+        self.last_refresh = f64::NEG_INFINITY;
+        self.refresh_requested = true;
+    }
     pub fn new(show_stats: bool) -> Self {
         Self {
             show_stats,
@@ -60,7 +65,7 @@ impl TreePanel {
         egui::ComboBox::from_label("tree")
             .selected_text(t.kind.name())
             .show_ui(ui, |ui| {
-                for k in crate::renderer::settings::TreeKind::ALL {
+                for k in crate::settings::TreeKind::ALL {
                     ui.selectable_value(&mut t.kind, k, k.label());
                 }
             })

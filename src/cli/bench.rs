@@ -218,7 +218,7 @@ fn time_back_to_back(
     timer: &mut GpuTimer,
     repeat: u32,
     mut record: impl FnMut(&mut wgpu::CommandEncoder, &mut GpuTimer),
-) -> anyhow::Result<Vec<crate::renderer::timing::PassTimings>> {
+) -> anyhow::Result<Vec<crate::gpu::timing::PassTimings>> {
     let mut out = Vec::new();
     for rep in 0..=repeat {
         let mut enc = ctx.device.create_command_encoder(&Default::default());
@@ -267,12 +267,12 @@ fn run_gbuffer(args: &BenchArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::new_headless()?;
     println!("adapter: {}", ctx.describe());
     let device = &ctx.device;
-    let tex = crate::renderer::settings::RenderSettings::default().textures;
+    let tex = crate::settings::RenderSettings::default().textures;
     let gpu_scene = SceneGpu::new(device, &ctx.queue, scene, tex.max_size, tex.anisotropy);
     let camera_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("bench::camera"),
         contents: bytemuck::bytes_of(&GpuCamera::new(&camera, size.0, size.1)),
-        usage: crate::renderer::passes::PARAMS_USAGE,
+        usage: crate::gpu::passes::PARAMS_USAGE,
     });
     println!(
         "scene: {} ({} triangles, one draw in file order), camera '{}', {}x{}",
@@ -445,7 +445,7 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
             sort.variant = *variant;
             // The first repetition includes pipeline warm-up: dropped. Repetitions run back
             // to back (no CPU work between them but the timestamp readback).
-            let d = crate::renderer::settings::TreeSettings::default();
+            let d = crate::settings::TreeSettings::default();
             let timed = time_back_to_back(&ctx, &mut timer, args.repeat, |enc, timer| {
                 sort.record(device, &ctx.queue, enc, timer, &buf, &sb);
                 build.record(
@@ -500,7 +500,7 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
         };
         let (ms, nodes_ms) = (med("lbvh_build"), med("lbvh_nodes"));
         let keys: Vec<[u32; 4]> =
-            bytemuck::pod_collect_to_vec(&crate::renderer::readback::read_storage_buffer(&ctx, &sb.keys)?);
+            bytemuck::pod_collect_to_vec(&crate::gpu::readback::read_storage_buffer(&ctx, &sb.keys)?);
         let keys: Vec<u64> = keys[..n as usize]
             .iter()
             .map(|k| (k[0] as u64) << 32 | k[1] as u64)

@@ -384,7 +384,7 @@ fn write_outputs(args: &BenchArgs, samples: &[Sample]) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::renderer::soak::HostMemory;
+    use crate::gpu::soak::HostMemory;
 
     fn slot(cycle: usize, method: MethodId, bind_groups: isize, rss_mib: u64) -> SlotEnd {
         let mut snap = Snapshot::default();

@@ -33,8 +33,8 @@ pub fn run() -> anyhow::Result<()> {
             println!("{:<14} BRDF: {brdf}; VPL bounces: {bounces}", "");
         }
         if m.kind == Kind::PerFrame {
-            let defaults = crate::renderer::settings::RenderSettings {
-                gi: crate::renderer::settings::GiSettings {
+            let defaults = crate::settings::RenderSettings {
+                gi: crate::settings::GiSettings {
                     method: m.id,
                     ..Default::default()
                 },

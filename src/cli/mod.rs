@@ -71,7 +71,7 @@ pub struct Cli {
 /// views by name, the first screen ([`crate::app::FIRST_SCREEN`]) when no view is named and
 /// no layout is saved.
 pub fn gui_options(cli: &Cli) -> anyhow::Result<crate::app::AppOptions> {
-    use crate::renderer::settings::ViewBuffer;
+    use crate::settings::ViewBuffer;
     let settings = cli
         .settings
         .as_ref()
@@ -183,7 +183,7 @@ pub struct SettingsArgs {
 }
 
 impl SettingsArgs {
-    pub fn resolve(&self, preset_exposure: f32) -> anyhow::Result<crate::renderer::settings::RenderSettings> {
+    pub fn resolve(&self, preset_exposure: f32) -> anyhow::Result<crate::settings::RenderSettings> {
         let mut s = match &self.settings {
             Some(p) => {
                 let text = std::fs::read_to_string(p)
@@ -197,7 +197,7 @@ impl SettingsArgs {
                 })?
             }
             None => {
-                let mut s = crate::renderer::settings::RenderSettings::default();
+                let mut s = crate::settings::RenderSettings::default();
                 s.display.exposure_ev = preset_exposure;
                 s
             }

@@ -449,8 +449,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             }
         }
         // The temporal stage's views (motion, disocclusion, history, variance, ...).
-        if r.settings().temporal.mode != crate::renderer::settings::TemporalMode::Off && method.per_frame() {
-            for v in crate::renderer::settings::TemporalView::ALL {
+        if r.settings().temporal.mode != crate::settings::TemporalMode::Off && method.per_frame() {
+            for v in crate::settings::TemporalView::ALL {
                 redraw(&mut r, ViewBuffer::Temporal(v));
                 let (w, h, bytes) = r.read_view_rgba8()?;
                 write_png(&out.join(format!("{}.png", v.file())), w, h, &bytes)?;

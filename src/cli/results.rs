@@ -275,7 +275,7 @@ impl ResultsArgs {
             }
             // Each value must be a valid setting of the method.
             for &x in &v {
-                let mut s = crate::renderer::settings::RenderSettings::default();
+                let mut s = crate::settings::RenderSettings::default();
                 (m.info().sweep.map(|sw| sw.apply).unwrap_or(|_, _| ()))(&mut s, x);
                 (m.info().validate)(&s).map_err(|e| anyhow::anyhow!("--sweep {arg}: {e}"))?;
             }
@@ -292,7 +292,7 @@ impl ResultsArgs {
         {
             bail!("--temporal-timing-width/--temporal-timing-height must be 16..=8192");
         }
-        let max_b = crate::renderer::passes::light_paths::MAX_BOUNCES;
+        let max_b = crate::gpu::passes::light_paths::MAX_BOUNCES;
         if self.bounce_counts.iter().any(|n| !(1..=max_b).contains(n)) {
             bail!("--bounce-counts must be 1..={max_b}");
         }

@@ -7,15 +7,19 @@
 use anyhow::{anyhow, bail};
 
 use crate::base::display::{Tonemap, luminance};
+use crate::gpu::readback::ImageF32;
+use crate::gpu::timing::PassTimings;
 use crate::metrics;
-use crate::renderer::{
-    Buffer, FrameInput, FrameMode, Renderer, readback::ImageF32, settings::RenderSettings,
-    settings::ViewBuffer, timing::PassTimings,
-};
+use crate::renderer::Buffer;
+use crate::renderer::FrameInput;
+use crate::renderer::FrameMode;
+use crate::renderer::Renderer;
 use crate::scene::{
     Camera, DirectionalLight, Scene,
     camera_path::{CameraPath, sun_sweep},
 };
+use crate::settings::RenderSettings;
+use crate::settings::ViewBuffer;
 
 /// A camera and lights per frame.
 #[derive(Clone, Debug)]

@@ -86,17 +86,17 @@ impl MethodId {
     }
     /// The BRDF a frame of this method shades with: `wanted`, or Lambert where it refuses
     /// it (the GUI says so; the direct light and the comparison's truth follow).
-    pub fn brdf(self, wanted: crate::renderer::settings::Brdf) -> crate::renderer::settings::Brdf {
+    pub fn brdf(self, wanted: crate::settings::Brdf) -> crate::settings::Brdf {
         if self.refuses_brdf(wanted).is_some() {
-            crate::renderer::settings::Brdf::Lambert
+            crate::settings::Brdf::Lambert
         } else {
             wanted
         }
     }
     /// The refusal of `gi.brdf = ggx` for a method that shades with Lambert only (the tree
     /// samplers' own limits, half resolution and interleaving, are in their `validate`).
-    pub fn refuses_brdf(self, brdf: crate::renderer::settings::Brdf) -> Option<String> {
-        (brdf != crate::renderer::settings::Brdf::Lambert && !self.info().glossy).then(|| {
+    pub fn refuses_brdf(self, brdf: crate::settings::Brdf) -> Option<String> {
+        (brdf != crate::settings::Brdf::Lambert && !self.info().glossy).then(|| {
             let glossy: Vec<&str> = REGISTRY
                 .iter()
                 .filter(|m| m.glossy && m.kind != Kind::DirectOnly)

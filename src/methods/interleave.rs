@@ -2,7 +2,7 @@
 //! culling over its VPLs, the tree samplers over their cut slots). The pattern itself lives
 //! in each method's kernel; the filter that undoes it is `renderer::passes::interleave_filter`.
 
-use crate::renderer::settings::{InterleaveSettings, PatternDefault};
+use crate::settings::{InterleaveSettings, PatternDefault};
 
 /// The pattern and filter sliders (`InterleaveSettings::fields`: the ranges validation
 /// uses). `lights` names what a pattern pixel takes a share of; `paper` the values the

@@ -1,7 +1,7 @@
 //! The imperfect shadow maps' settings in the GUI (shared by the methods that build them:
 //! light culling's adaptive maps, the VALs' maps).
 
-use crate::renderer::settings::{IsmDefault, IsmSettings};
+use crate::settings::{IsmDefault, IsmSettings};
 
 /// `m`'s sliders (`IsmSettings::fields`: the ranges validation uses); `light` names what a
 /// map belongs to ("VPL", "VAL"), `paper_tile` and `paper_points` the method's paper values.

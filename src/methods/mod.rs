@@ -35,20 +35,18 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 pub use crate::base::{colormap::Legend, progress::GiProgress};
 
-use crate::renderer::{
-    context::{ErrorSink, GpuContext, GpuError},
-    frame::FrameTargets,
-    passes::{
-        sst_build::TreeBuffers,
-        vpl_gen::{VplBuffers, VplFrame},
-    },
-    readback::ImageF32,
-    scene_gpu::SceneGpu,
-    settings::RenderSettings,
-    shaders::ShaderError,
-    timing::GpuTimer,
-    views::ViewLook,
+use crate::gpu::context::{ErrorSink, GpuContext, GpuError};
+use crate::gpu::frame::FrameTargets;
+use crate::gpu::passes::{
+    sst_build::TreeBuffers,
+    vpl_gen::{VplBuffers, VplFrame},
 };
+use crate::gpu::readback::ImageF32;
+use crate::gpu::scene_gpu::SceneGpu;
+use crate::gpu::shaders::ShaderError;
+use crate::gpu::timing::GpuTimer;
+use crate::gpu::views::ViewLook;
+use crate::settings::RenderSettings;
 
 /// Every GI method, in the order the GUI lists them. Adding a method: its folder and one
 /// line here.
@@ -132,10 +130,10 @@ pub struct Module {
     pub entry_shaders: &'static [&'static str],
     /// Its `#[repr(C)]` structs shared with WGSL (`wgsl_twin!`, beside the structs): one
     /// registry test checks them all against naga's layout.
-    pub wgsl_twins: &'static [crate::renderer::gpu_data::WgslTwin],
+    pub wgsl_twins: &'static [crate::gpu::gpu_data::WgslTwin],
     /// Its kernels dispatched with a workgroup size of their own (the registry test checks
     /// every other compute entry point has the standard sizes).
-    pub own_workgroups: &'static [crate::renderer::passes::OwnWorkgroup],
+    pub own_workgroups: &'static [crate::gpu::passes::OwnWorkgroup],
 }
 
 /// A per-frame method's quality knob: what `results` sweeps for its RMSE-vs-GPU-time curve
@@ -319,7 +317,7 @@ pub struct FrameCx<'a> {
     /// The frame's lights (one RSM layer each).
     pub lights: &'a [crate::scene::DirectionalLight],
     /// The BRDF of this frame (`gi.brdf`, Lambert where the frame's method refuses GGX).
-    pub brdf: crate::renderer::settings::Brdf,
+    pub brdf: crate::settings::Brdf,
     /// The camera's position (glossy shading's view direction).
     pub eye: glam::Vec3,
     /// The VPL generation's parameter buffer (the reference reads the RSM pyramids with it).
@@ -345,7 +343,7 @@ pub struct FrameCx<'a> {
     pub views: &'a [MethodView],
     /// Light 0's reflective shadow map raster (None without lights): the VAL clustering
     /// reads layer 0 of `targets.shadow` through it.
-    pub rsm: Option<crate::renderer::gpu_data::RsmRaster>,
+    pub rsm: Option<crate::gpu::gpu_data::RsmRaster>,
 }
 
 /// What a method's view drawing may use.
@@ -456,7 +454,7 @@ mod tests {
                     m.name,
                     t.file
                 );
-                if let Err(e) = crate::renderer::gpu_data::check_twin(t) {
+                if let Err(e) = crate::gpu::gpu_data::check_twin(t) {
                     panic!("{}: {e}", m.name);
                 }
                 n += 1;
@@ -469,8 +467,7 @@ mod tests {
     #[test]
     fn every_methods_workgroup_sizes_match_their_wgsl() {
         for m in super::modules() {
-            if let Err(e) = crate::renderer::passes::check_workgroup_sizes(m.entry_shaders, m.own_workgroups)
-            {
+            if let Err(e) = crate::gpu::passes::check_workgroup_sizes(m.entry_shaders, m.own_workgroups) {
                 panic!("{}: {e}", m.name);
             }
         }

@@ -99,12 +99,9 @@ impl Renderer {
             .unwrap_or(1.0);
         self.lights_texel = gpu_lights.lights[0].shadow[0];
         self.rsm_raster = lights.first().map(|l| {
-            let (view_proj, texel, _) = crate::renderer::gpu_data::light_frustum(
-                l.direction,
-                &self.scene.bounds,
-                s.shadow.resolution,
-            );
-            crate::renderer::gpu_data::RsmRaster {
+            let (view_proj, texel, _) =
+                crate::gpu::gpu_data::light_frustum(l.direction, &self.scene.bounds, s.shadow.resolution);
+            crate::gpu::gpu_data::RsmRaster {
                 view_proj,
                 direction: l.direction.normalize_or(glam::Vec3::NEG_Y),
                 texel,
@@ -147,7 +144,7 @@ impl Renderer {
             &queue,
             &mut enc,
             &mut self.timer,
-            &crate::renderer::passes::direct::DirectInputs {
+            &crate::gpu::passes::direct::DirectInputs {
                 brdf: self.frame_brdf.gpu(),
                 camera: &self.camera_buf,
                 lights: &self.lights_buf,

@@ -1,26 +1,23 @@
-//! The GPU pipeline. Knows nothing of egui: the app shows [`Renderer::view_texture`] through
-//! the one bridge module `app::viewport_texture`.
+//! The frame's orchestration: [`Renderer`] runs the shared passes of [`crate::gpu`] and the
+//! registered methods of [`crate::methods`] in the frame's order, and holds the frame graph,
+//! the inspection readbacks and the view recording; it sits above both. Knows nothing of egui:
+//! the app shows [`Renderer::view_texture`] through the one bridge module
+//! `app::viewport_texture`.
 //!
 //! Frame order (see ARCHITECTURE.md): shadow_map -> gbuffer -> direct -> display | visualise.
 
-pub mod brdf_probe;
-pub mod bvh_trace;
-pub mod context;
-pub mod frame;
-pub mod gpu_data;
-pub mod kernel;
-pub mod passes;
-pub mod readback;
-pub mod scene_gpu;
-pub mod settings;
-pub mod shaders;
-pub mod soak;
-pub mod temporal_settings;
-pub mod timing;
-pub mod views;
+// The GPU layer and the settings, below the methods, as they were reached before they moved
+// out of this module (the orchestration here sits above both and the methods).
+pub use crate::gpu::{
+    brdf_probe, bvh_trace, context, frame, gpu_data, kernel, passes, readback, scene_gpu, shaders, soak,
+    timing, views,
+};
+pub use crate::settings;
+pub use crate::settings::temporal as temporal_settings;
 
 mod frame_graph;
 mod inspect;
+mod view_data;
 mod view_record;
 
 use frame_graph::create_methods;

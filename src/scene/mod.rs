@@ -238,7 +238,7 @@ impl Scene {
         if self.bounds.is_empty() {
             return out;
         }
-        let defaults = crate::renderer::settings::GiSettings::default();
+        let defaults = crate::settings::GiSettings::default();
         let extent = self.bounds.min.abs().max(self.bounds.max.abs()).max_element();
         let step = extent * f32::EPSILON;
         if 16.0 * step > defaults.ray_offset {

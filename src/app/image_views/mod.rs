@@ -13,12 +13,10 @@ use serde::{Deserialize, Serialize};
 use toolbar::{draw_legend, view_toolbar};
 
 use super::viewport_texture::ViewportTexture;
+use crate::gpu::views::{AbMode, AbSource, Channel, ViewSpec};
 use crate::methods::tree_samplers::pass::SamplingStats;
-use crate::renderer::{
-    Renderer,
-    settings::{DisplaySettings, Tonemap, ViewBuffer},
-    views::{AbMode, AbSource, Channel, ViewSpec},
-};
+use crate::renderer::Renderer;
+use crate::settings::{DisplaySettings, Tonemap, ViewBuffer};
 
 /// One image view.
 #[derive(Serialize, Deserialize)]
@@ -349,7 +347,7 @@ fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
     // The tree overlay's two trees side by side: the divider and which half is which.
     let d = cx.display;
     if d.tree_compare
-        && d.tree_overlay != crate::renderer::settings::TreeOverlay::Off
+        && d.tree_overlay != crate::settings::TreeOverlay::Off
         && !pane.spec.buffer.is_rsm_space()
         && pane.spec.effective_ab().is_none()
     {

@@ -193,12 +193,12 @@ pub(super) fn draw_legend(cx: &PaneContext<'_>, painter: &egui::Painter, rect: e
         );
     } else if shown.is_log_heat() {
         legend_with(painter, rect, "importance / mean (log)", -3.0, 2.0, Scale::Log10);
-    } else if cx.display.vpl_overlay && cx.display.vpl_color == crate::renderer::settings::VplColor::Bounce {
+    } else if cx.display.vpl_overlay && cx.display.vpl_color == crate::settings::VplColor::Bounce {
         crate::app::bounce_legend(painter, rect, cx.renderer.vpl_frame().bounces);
     } else if cx.display.vpl_overlay {
         legend_with(painter, rect, "VPL flux / mean (log)", -2.0, 2.0, Scale::Log10);
-    } else if cx.display.tree_overlay != crate::renderer::settings::TreeOverlay::Off
-        && cx.display.tree_color == crate::renderer::settings::TreeColor::Intensity
+    } else if cx.display.tree_overlay != crate::settings::TreeOverlay::Off
+        && cx.display.tree_color == crate::settings::TreeColor::Intensity
         && !shown.is_rsm_space()
         && ab.is_none()
     {

@@ -98,7 +98,7 @@ pub(super) fn run_rays(args: &BenchArgs) -> anyhow::Result<()> {
     }
     drop(ctx);
     let mut per_layout = Vec::new();
-    let frames = crate::renderer::scene_gpu::frame_bvh_layout();
+    let frames = crate::gpu::scene_gpu::frame_bvh_layout();
     for layout in [BvhLayout::Binary, BvhLayout::Wide] {
         set_frame_bvh_layout(layout);
         let r = in_frame_rays(args, &opened, layout);

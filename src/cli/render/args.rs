@@ -217,7 +217,7 @@ impl SamplingArgs {
         if self.tree == Some(TreeArg::Lbvh)
             && let Some(msg) = methods
                 .iter()
-                .find_map(|m| m.refuses_tree(crate::renderer::settings::TreeKind::Lbvh))
+                .find_map(|m| m.refuses_tree(crate::settings::TreeKind::Lbvh))
         {
             return Err(anyhow!("--{msg}"));
         }
@@ -248,8 +248,8 @@ impl SamplingArgs {
         Ok(())
     }
 
-    pub fn apply(&self, s: &mut crate::renderer::settings::RenderSettings) {
-        use crate::renderer::settings::{ChildProbability, CutBlending, CutFallback};
+    pub fn apply(&self, s: &mut crate::settings::RenderSettings) {
+        use crate::settings::{ChildProbability, CutBlending, CutFallback};
         if let Some(v) = self.block {
             s.sampling.block_size = v;
         }
@@ -311,7 +311,7 @@ impl SamplingArgs {
             s.sampling.half_resolution = true;
         }
         if let Some(t) = self.temporal {
-            use crate::renderer::settings::TemporalMode;
+            use crate::settings::TemporalMode;
             s.temporal.mode = match t {
                 TemporalArg::Off => TemporalMode::Off,
                 TemporalArg::Reproject => TemporalMode::Reproject,
@@ -334,12 +334,12 @@ impl SamplingArgs {
         }
         if let Some(b) = self.brdf {
             s.gi.brdf = match b {
-                BrdfArg::Lambert => crate::renderer::settings::Brdf::Lambert,
-                BrdfArg::Ggx => crate::renderer::settings::Brdf::Ggx,
+                BrdfArg::Lambert => crate::settings::Brdf::Lambert,
+                BrdfArg::Ggx => crate::settings::Brdf::Ggx,
             };
         }
         if let Some(t) = self.tree {
-            use crate::renderer::settings::TreeKind;
+            use crate::settings::TreeKind;
             s.tree.kind = match t {
                 TreeArg::Perfect => TreeKind::Perfect,
                 TreeArg::Lbvh => TreeKind::Lbvh,

@@ -13,7 +13,7 @@ use crate::harness::LIGHT_PATH_PASSES;
 /// The path-start mixes at depths above 1: faithful first.
 const MIXES: [f32; 2] = [1.0, 0.1];
 
-fn image_mean(img: &crate::renderer::readback::ImageF32) -> f64 {
+fn image_mean(img: &crate::gpu::readback::ImageF32) -> f64 {
     let n = img.pixels.len().max(1) as f64;
     img.pixels
         .iter()
@@ -79,7 +79,7 @@ pub fn bounces(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 let first = b.r.vpl_frame().first_bounce as usize;
                 vpls[first.min(vpls.len())..]
                     .iter()
-                    .filter(|v| v.id != crate::renderer::gpu_data::VPL_NONE)
+                    .filter(|v| v.id != crate::gpu::gpu_data::VPL_NONE)
                     .count()
             } else {
                 0

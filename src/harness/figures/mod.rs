@@ -32,7 +32,7 @@ use crate::methods::{
     self as gi_methods, MethodId,
     tree_samplers::{RTSLC, SLC, SST},
 };
-use crate::renderer::settings::{CutBlending, CutFallback, RenderSettings};
+use crate::settings::{CutBlending, CutFallback, RenderSettings};
 
 /// What every figure needs besides the bench.
 #[derive(Clone, Debug)]

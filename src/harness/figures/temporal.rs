@@ -14,7 +14,7 @@ use crate::harness::{
     median,
     sequence::{self, Motion, SeqFrame},
 };
-use crate::renderer::settings::TemporalMode;
+use crate::settings::TemporalMode;
 
 /// The stage's passes (timer names), in order.
 const PASSES: [&str; 5] = [

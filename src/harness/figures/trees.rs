@@ -8,7 +8,7 @@
 //! and `bench lightcuts` measures the trees' far-paired clusters.
 
 use super::*;
-use crate::renderer::settings::TreeKind;
+use crate::settings::TreeKind;
 
 /// One tree's sweep: (total ms, RMSE) and (total ms, image-mean ratio) points, and at the
 /// base spp the steps per traversal, the build's ms and the total ms.

@@ -10,13 +10,13 @@
 //! visibility.
 
 use super::*;
+use crate::gpu::readback::ImageF32;
 use crate::harness::median;
 use crate::methods::val::{
     self as val_method,
     settings::{ValSettings, ValVisibility},
 };
 use crate::metrics;
-use crate::renderer::readback::ImageF32;
 
 /// The paper's Table 1 (Radeon HD 6850, 1280 x 720, Cornell box), ms: (row, our passes, 64
 /// PCSS VALs, 512 simple VALs). Its "complete" is the whole frame.

@@ -2,7 +2,8 @@
 //! so that "GI off" is a choice in every list, not a special case.
 
 use super::{FrameCx, Kind, Method, MethodId, MethodInfo, Module};
-use crate::renderer::{settings::RenderSettings, shaders::ShaderError};
+use crate::gpu::shaders::ShaderError;
+use crate::settings::RenderSettings;
 
 pub const ID: MethodId = MethodId::new("off");
 

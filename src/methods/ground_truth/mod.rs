@@ -9,8 +9,10 @@ mod ui;
 use super::{FrameCx, Kind, Method, MethodId, MethodInfo, Module, Resource};
 use crate::base::field::Field;
 use crate::base::progress::GiProgress;
-use crate::renderer::settings::GiSettings;
-use crate::renderer::{gpu_data::GpuVpl, settings::RenderSettings, shaders::ShaderError};
+use crate::gpu::gpu_data::GpuVpl;
+use crate::gpu::shaders::ShaderError;
+use crate::settings::GiSettings;
+use crate::settings::RenderSettings;
 use pass::GpuGtParams;
 use pass::GroundTruthPass;
 

@@ -2,16 +2,14 @@
 //! VPL batches so no dispatch is long; the caller accumulates batches over frames.
 //! Reads: BVH, a VPL array, G-buffer. Writes: an accumulation buffer (rgb sum per pixel).
 
-use crate::renderer::{
-    frame::GbufferTargets,
-    kernel::{Kernel, KernelOptions, buf, tex},
-    scene_gpu::SceneGpu,
-    shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::frame::GbufferTargets;
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::scene_gpu::SceneGpu;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 use bytemuck::{Pod, Zeroable};
 
-use crate::renderer::passes::groups_2d;
+use crate::gpu::passes::groups_2d;
 
 /// Dynamic-offset stride of the per-batch uniforms; most batches per recorded call.
 const STRIDE: u64 = 256;
@@ -35,7 +33,7 @@ impl GroundTruthPass {
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("ground_truth::params"),
             size: STRIDE * MAX_BATCHES as u64,
-            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
+            usage: crate::gpu::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         Ok(Self {
@@ -138,7 +136,7 @@ pub struct GpuGtParams {
 
 /// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
 /// checks them against naga's layout).
-pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[crate::wgsl_twin!(
+pub static WGSL_TWINS: &[crate::gpu::gpu_data::WgslTwin] = &[crate::wgsl_twin!(
     GpuGtParams,
     "methods/ground_truth/ground_truth.wgsl",
     "GtParams",

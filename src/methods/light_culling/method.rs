@@ -79,7 +79,7 @@ impl Method for LightCulling {
         };
         // The filter: raw (before albedo / pi) x albedo / pi into the accumulation; with GGX
         // raw is radiance already (and validation keeps the filter's window to the pixel).
-        let glossy = cx.brdf != crate::renderer::settings::Brdf::Lambert;
+        let glossy = cx.brdf != crate::settings::Brdf::Lambert;
         let fp = GpuFilterParams {
             accumulate: (frames > 1) as u32,
             scale: if glossy { 1.0 } else { std::f32::consts::FRAC_1_PI },

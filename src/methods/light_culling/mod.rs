@@ -24,15 +24,13 @@ use super::overlay::{MethodOverlay, Prim};
 use super::{
     FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
 };
+use crate::gpu::context::{GpuContext, GpuError};
+use crate::gpu::passes::interleave_filter::GpuFilterParams;
+use crate::gpu::passes::ism::{IsmPoints, IsmTargets};
+use crate::gpu::readback::{self, ImageF32};
+use crate::gpu::shaders::ShaderError;
 use crate::reference::light_culling::{Interleave, TileGrid};
-use crate::renderer::passes::interleave_filter::GpuFilterParams;
-use crate::renderer::passes::ism::{IsmPoints, IsmTargets};
-use crate::renderer::{
-    context::{GpuContext, GpuError},
-    readback::{self, ImageF32},
-    settings::RenderSettings,
-    shaders::ShaderError,
-};
+use crate::settings::RenderSettings;
 use pass::{
     FrameInputs, GpuLcullParams, GpuLcullViewParams, IsmFrame, LcullBuffers, LcullPass, LcullStats,
     TreeCullBuffers, TreeInputs, VISIBILITY_ISM,
@@ -76,7 +74,7 @@ pub static MODULE: Module = Module {
         "methods/light_culling/lcull_views.wgsl",
     ],
     wgsl_twins: pass::WGSL_TWINS,
-    own_workgroups: &[crate::renderer::passes::OwnWorkgroup {
+    own_workgroups: &[crate::gpu::passes::OwnWorkgroup {
         // One workgroup per tile.
         file: "methods/light_culling/lcull_tiles.wgsl",
         entries: &[],
@@ -413,7 +411,7 @@ fn validate(s: &RenderSettings) -> Result<(), String> {
     // multiplies the pixel's albedo / pi back; a glossy BRDF's radiance cannot be averaged so.
     // Interleaving alone (each pixel its subset x n^2) stays unbiased.
     let culling = [ID, CLAMPED, TREE].contains(&s.gi.method);
-    if culling && s.gi.brdf == crate::renderer::settings::Brdf::Ggx {
+    if culling && s.gi.brdf == crate::settings::Brdf::Ggx {
         let (name, r) = if s.gi.method == TREE {
             ("tree_filter_radius", lc.tree_filter_radius)
         } else {

@@ -12,21 +12,19 @@ mod record;
 use bytemuck::{Pod, Zeroable};
 
 use super::settings::{IsmAdaptive, IsmSettings};
-use crate::methods::lightcut_interpolation::pass::groups_1d_as_2d;
-use crate::renderer::{
-    frame::GbufferTargets,
-    kernel::{Kernel, KernelOptions, buf, tex},
-    passes::{
-        WG_1D, groups_image,
-        interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
-        ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
-        run_compute, storage_buffer, uniform_buffer,
-    },
-    readback::CounterReadback,
-    scene_gpu::SceneGpu,
-    shaders,
-    timing::GpuTimer,
+use crate::gpu::frame::GbufferTargets;
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::passes::{
+    WG_1D, groups_image,
+    interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
+    ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
+    run_compute, storage_buffer, uniform_buffer,
 };
+use crate::gpu::readback::CounterReadback;
+use crate::gpu::scene_gpu::SceneGpu;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
+use crate::methods::lightcut_interpolation::pass::groups_1d_as_2d;
 
 /// Workgroup size of `lcull_tiles.wgsl` (one tile per workgroup).
 pub const TILE_WG: u32 = 256;
@@ -337,7 +335,7 @@ pub struct LcullPass {
 
 /// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
 /// checks them against naga's layout).
-pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[
+pub static WGSL_TWINS: &[crate::gpu::gpu_data::WgslTwin] = &[
     crate::wgsl_twin!(
         crate::methods::light_culling::pass::GpuLcullParams,
         "methods/light_culling/lcull_ranges.wgsl",

@@ -6,9 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::base::field::{self, Field};
 
-pub use crate::renderer::settings::{
-    Interleave8, InterleaveSettings, IsmAdaptive, IsmSettings, MAX_FILTER_RADIUS,
-};
+pub use crate::settings::{Interleave8, InterleaveSettings, IsmAdaptive, IsmSettings, MAX_FILTER_RADIUS};
 
 /// Largest interleaving pattern edge (n x n subsets).
 pub const MAX_INTERLEAVE: u32 = 16;

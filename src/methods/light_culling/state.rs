@@ -64,7 +64,7 @@ impl LightCulling {
     /// The point cloud and the atlas for `s` on the frame's scene (rebuilt when either
     /// changed).
     pub(super) fn ensure_ism(&mut self, cx: &FrameCx<'_>, s: &IsmSettings<IsmAdaptive>) {
-        crate::renderer::passes::ism::ensure_maps(
+        crate::gpu::passes::ism::ensure_maps(
             cx.device,
             cx.queue,
             cx.scene,

@@ -2,7 +2,7 @@
 
 use super::settings::{CullingVisibility, LightCullingSettings, MAX_INTERLEAVE};
 use crate::methods::MethodId;
-use crate::renderer::settings::RenderSettings;
+use crate::settings::RenderSettings;
 
 pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) {
     let id = super::ID;

@@ -16,17 +16,15 @@ use super::{
     CutStory, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, StoryCut,
     ViewCx, ViewInfo,
 };
+use crate::gpu::context::{GpuContext, GpuError};
+use crate::gpu::readback::{self, ImageF32};
+use crate::gpu::shaders::ShaderError;
 use crate::methods::lightcuts::{
     Lightcuts,
     pass::{GpuLcParams, SCRATCH_BUDGET, steps_per_dispatch},
 };
 use crate::reference::lightcuts::{Cone, LcTree, MAX_CUT};
-use crate::renderer::{
-    context::{GpuContext, GpuError},
-    readback::{self, ImageF32},
-    settings::RenderSettings,
-    shaders::ShaderError,
-};
+use crate::settings::RenderSettings;
 use pass::{
     FrameInputs, GpuLiParams, GpuLiViewParams, LiBuffers, LiPass, LiStats, TracedInterpolation,
     walk_steps_per_dispatch,
@@ -61,7 +59,7 @@ pub static MODULE: Module = Module {
         "methods/lightcut_interpolation/li_views.wgsl",
     ],
     wgsl_twins: pass::WGSL_TWINS,
-    own_workgroups: &[crate::renderer::passes::OwnWorkgroup {
+    own_workgroups: &[crate::gpu::passes::OwnWorkgroup {
         // One workgroup per 16 x 16 tile.
         file: "methods/lightcut_interpolation/li_records.wgsl",
         entries: pass::TILE_WG_ENTRIES,

@@ -10,18 +10,16 @@ mod record;
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::gpu::frame::GbufferTargets;
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::passes::sst_build::TreeBuffers;
+use crate::gpu::passes::{StridedUniforms, WG_1D, groups_image, run_compute, storage_buffer, uniform_buffer};
+use crate::gpu::readback::CounterReadback;
+use crate::gpu::scene_gpu::SceneGpu;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 use crate::methods::lightcuts::pass::{BuildKernel, CutBindings, CutKernel, GpuLcParams, slice_pixels};
 use crate::reference::lightcut_interpolation::{TILE, TILE_CAP};
-use crate::renderer::{
-    frame::GbufferTargets,
-    kernel::{Kernel, KernelOptions, buf, tex},
-    passes::sst_build::TreeBuffers,
-    passes::{StridedUniforms, WG_1D, groups_image, run_compute, storage_buffer, uniform_buffer},
-    readback::CounterReadback,
-    scene_gpu::SceneGpu,
-    shaders,
-    timing::GpuTimer,
-};
 
 /// Workgroup size of `li_records.wgsl`'s tile kernels (`TILE_WG_ENTRIES`): a 16 x 16 tile
 /// per workgroup (`place_main`; `compact_main` runs one such group).
@@ -345,7 +343,7 @@ pub fn groups_1d_as_2d(n: u32) -> (u32, u32) {
 
 /// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
 /// checks them against naga's layout).
-pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[
+pub static WGSL_TWINS: &[crate::gpu::gpu_data::WgslTwin] = &[
     crate::wgsl_twin!(
         crate::methods::lightcut_interpolation::pass::GpuLiParams,
         "methods/lightcut_interpolation/li_interp.wgsl",

@@ -2,7 +2,7 @@
 
 use super::settings::{LiVisibility, LightcutInterpolationSettings};
 use crate::methods::MethodId;
-use crate::renderer::settings::RenderSettings;
+use crate::settings::RenderSettings;
 
 pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) {
     let mut li: LightcutInterpolationSettings = match s.method(method) {

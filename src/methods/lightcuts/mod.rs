@@ -16,12 +16,10 @@ use super::{
     CutStory, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, StoryCut,
     ViewCx, ViewInfo,
 };
-use crate::renderer::{
-    context::{GpuContext, GpuError},
-    readback::{self, ImageF32},
-    settings::RenderSettings,
-    shaders::ShaderError,
-};
+use crate::gpu::context::{GpuContext, GpuError};
+use crate::gpu::readback::{self, ImageF32};
+use crate::gpu::shaders::ShaderError;
+use crate::settings::RenderSettings;
 use pass::{GpuLcParams, GpuLcViewParams, LcBuffers, LcStats, LightcutsPass, TracedCut};
 use settings::LightcutsSettings;
 
@@ -293,7 +291,7 @@ impl Method for Lightcuts {
             first: 1,
             last: 1,
             steps: self.steps,
-            radix: (cx.tree.kind == crate::renderer::settings::TreeKind::Lbvh) as u32,
+            radix: (cx.tree.kind == crate::settings::TreeKind::Lbvh) as u32,
             brdf: cx.brdf.gpu(),
             _pad: [0; 3],
             eye: cx.eye.extend(0.0).to_array(),

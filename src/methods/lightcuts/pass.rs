@@ -5,18 +5,16 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::gpu::context::{GpuContext, GpuError};
+use crate::gpu::frame::GbufferTargets;
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::passes::sst_build::TreeBuffers;
+use crate::gpu::passes::{StridedUniforms, WG_1D, groups_image, run_compute, storage_buffer, uniform_buffer};
+use crate::gpu::readback::{self, CounterReadback};
+use crate::gpu::scene_gpu::SceneGpu;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 use crate::reference::lightcuts::{Cone, LcTree, MAX_CUT};
-use crate::renderer::{
-    context::{GpuContext, GpuError},
-    frame::GbufferTargets,
-    kernel::{Kernel, KernelOptions, buf, tex},
-    passes::sst_build::TreeBuffers,
-    passes::{StridedUniforms, WG_1D, groups_image, run_compute, storage_buffer, uniform_buffer},
-    readback::{self, CounterReadback},
-    scene_gpu::SceneGpu,
-    shaders,
-    timing::GpuTimer,
-};
 
 /// Twin: `LcBuildParams` in `lc_build.wgsl`.
 #[repr(C)]
@@ -429,7 +427,7 @@ impl BuildKernel {
         cones: &wgpu::Buffer,
         reps: &wgpu::Buffer,
     ) {
-        let radix = tree.kind == crate::renderer::settings::TreeKind::Lbvh;
+        let radix = tree.kind == crate::settings::TreeKind::Lbvh;
         // Per dispatch: its uniforms (the radix build reads only leaves and seed).
         let dispatches: Vec<GpuLcBuildParams> = if radix {
             vec![GpuLcBuildParams {
@@ -461,7 +459,7 @@ impl BuildKernel {
         if radix {
             let need = 4 * tree.leaves.max(4) as u64;
             if self.counters.as_ref().is_none_or(|c| c.size() < need) {
-                self.counters = Some(crate::renderer::passes::storage_buffer(
+                self.counters = Some(crate::gpu::passes::storage_buffer(
                     device,
                     "lightcuts_build_radix::counters",
                     need,
@@ -643,7 +641,7 @@ pub fn read_build(ctx: &GpuContext, out: &LcBuffers) -> Result<LcTree, GpuError>
 
 /// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
 /// checks them against naga's layout).
-pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[
+pub static WGSL_TWINS: &[crate::gpu::gpu_data::WgslTwin] = &[
     crate::wgsl_twin!(
         crate::methods::lightcuts::pass::GpuLcBuildParams,
         "methods/lightcuts/lc_build.wgsl",

@@ -2,7 +2,7 @@
 
 use super::settings::LightcutsSettings;
 use crate::methods::MethodId;
-use crate::renderer::settings::RenderSettings;
+use crate::settings::RenderSettings;
 
 pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) {
     let mut lc: LightcutsSettings = match s.method(method) {

@@ -11,16 +11,14 @@ mod ui;
 
 use super::{FrameCx, Kind, Method, MethodId, MethodInfo, Module, Resource};
 use crate::base::field::Field;
+use crate::base::progress::GiProgress;
+use crate::gpu::gpu_data::GpuVpl;
+use crate::gpu::passes::light_paths::{LightPathPass, PathJob};
+use crate::gpu::shaders::ShaderError;
 use crate::methods::ground_truth::pass::GpuGtParams;
 use crate::methods::ground_truth::pass::{GroundTruthPass, MAX_BATCHES};
-use crate::renderer::settings::GiSettings;
-use crate::renderer::{
-    GiProgress,
-    gpu_data::GpuVpl,
-    passes::light_paths::{LightPathPass, PathJob},
-    settings::RenderSettings,
-    shaders::ShaderError,
-};
+use crate::settings::GiSettings;
+use crate::settings::RenderSettings;
 use pass::{GpuRefParams, ReferencePass};
 
 pub const ID: MethodId = MethodId::new("reference");

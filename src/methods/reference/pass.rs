@@ -4,15 +4,13 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::renderer::{
-    frame::{GbufferTargets, ShadowTargets},
-    kernel::{Kernel, KernelOptions, buf, tex},
-    scene_gpu::SceneGpu,
-    shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::frame::{GbufferTargets, ShadowTargets};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::scene_gpu::SceneGpu;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 
-use crate::renderer::passes::{groups_image, run_compute, uniform_buffer, vpl_gen::VplBuffers};
+use crate::gpu::passes::{groups_image, run_compute, uniform_buffer, vpl_gen::VplBuffers};
 
 /// Twin: `RefParams` in `shaders/methods/reference/reference.wgsl`.
 #[repr(C)]

@@ -1,7 +1,7 @@
 //! The converged reference's settings in the GUI.
 
 use crate::methods::MethodId;
-use crate::renderer::settings::RenderSettings;
+use crate::settings::RenderSettings;
 
 pub fn settings_ui(ui: &mut egui::Ui, _: MethodId, s: &mut RenderSettings) {
     let bounces = s.vpl.bounces;

@@ -8,14 +8,12 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::renderer::{
-    frame::GbufferTargets,
-    kernel::{Kernel, KernelOptions, buf, tex},
-    shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::frame::GbufferTargets;
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 
-use crate::renderer::passes::{groups_image, run_compute, uniform_buffer};
+use crate::gpu::passes::{groups_image, run_compute, uniform_buffer};
 
 /// Twin: `HalfParams` in `shaders/methods/tree_samplers/slc_half.wgsl` and `slc_upsample.wgsl`.
 #[repr(C)]

@@ -82,7 +82,7 @@ impl Method for TreeSamplers {
         } else if self.raw.as_ref().is_none_or(|(_, sz)| *sz != gi_size) {
             let bytes = 16 * gi_size.0 as u64 * gi_size.1 as u64;
             self.raw = Some((
-                crate::renderer::passes::storage_buffer(device, "slc::interleaved_raw", bytes),
+                crate::gpu::passes::storage_buffer(device, "slc::interleaved_raw", bytes),
                 gi_size,
             ));
         }

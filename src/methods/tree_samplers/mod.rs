@@ -21,14 +21,12 @@ use super::{
     Bias, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
 };
 use crate::base::sst_node::TreeKind;
+use crate::gpu::context::{GpuContext, GpuError};
+use crate::gpu::passes::interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter};
+use crate::gpu::readback::{self, ImageF32};
+use crate::gpu::shaders::ShaderError;
 use crate::reference::interleave::Interleave;
-use crate::renderer::{
-    context::{GpuContext, GpuError},
-    passes::interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
-    readback::{self, ImageF32},
-    settings::RenderSettings,
-    shaders::ShaderError,
-};
+use crate::settings::RenderSettings;
 use half::{HalfPass, HalfTargets};
 use pass::GpuSlcParams;
 use pass::{GpuSlcViewParams, PixelTrace, SamplingStats, SlcBuffers, SlcPass};
@@ -321,7 +319,7 @@ fn validate(s: &RenderSettings) -> Result<(), String> {
     // Half-resolution GI and the interleaving's filter work on the GI without the albedo
     // (Lambert's rho / pi factored out), which a glossy BRDF does not allow.
     if s.gi.method.samples_tree()
-        && s.gi.brdf == crate::renderer::settings::Brdf::Ggx
+        && s.gi.brdf == crate::settings::Brdf::Ggx
         && (sm.half_resolution || sm.interleave.filters())
     {
         return Err(format!(
@@ -355,8 +353,8 @@ pub struct TreeSamplers {
     traced: bool,
     /// The leaves' maps (ISM visibility): the scene's point cloud (and the scene upload it
     /// was sampled from) and the atlas; maps built by the last frame (0: none).
-    ism_points: Option<(u64, crate::renderer::passes::ism::IsmPoints)>,
-    ism_targets: Option<crate::renderer::passes::ism::IsmTargets>,
+    ism_points: Option<(u64, crate::gpu::passes::ism::IsmPoints)>,
+    ism_targets: Option<crate::gpu::passes::ism::IsmTargets>,
     ism_maps: u32,
 }
 
@@ -384,7 +382,7 @@ fn create(device: &wgpu::Device) -> Result<Box<dyn Method>, ShaderError> {
 
 impl TreeSamplers {
     /// The leaves' maps of the last frame that built them, and how many (None: none).
-    pub fn ism(&self) -> Option<(&crate::renderer::passes::ism::IsmTargets, u32)> {
+    pub fn ism(&self) -> Option<(&crate::gpu::passes::ism::IsmTargets, u32)> {
         self.ism_targets
             .as_ref()
             .filter(|_| self.ism_maps > 0)
@@ -418,7 +416,7 @@ impl TreeSamplers {
             ));
             return None;
         }
-        crate::renderer::passes::ism::ensure_maps(
+        crate::gpu::passes::ism::ensure_maps(
             cx.device,
             cx.queue,
             cx.scene,
@@ -475,7 +473,7 @@ pub fn steps_scale(levels: u32) -> f32 {
 
 /// `MethodInfo::fields` (`[sampling]`, shared by the three samplers).
 fn fields() -> Vec<super::FieldSection> {
-    use crate::renderer::settings::{InterleaveOff, InterleaveSettings, IsmAdaptive, IsmSettings};
+    use crate::settings::{InterleaveOff, InterleaveSettings, IsmAdaptive, IsmSettings};
     vec![
         super::FieldSection::of("sampling", settings::FIELDS, true),
         super::FieldSection::of(

@@ -7,17 +7,15 @@
 //! and the pixel story ([`SlcBuffers`]). Timed frames run the sampling shader compiled with
 //! `DIAGNOSTICS = false` (same estimate, none of that work, no readback).
 
-use crate::renderer::{
-    frame::GbufferTargets,
-    kernel::{Kernel, KernelOptions, buf, tex},
-    readback::CounterReadback,
-    scene_gpu::SceneGpu,
-    shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::frame::GbufferTargets;
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::readback::CounterReadback;
+use crate::gpu::scene_gpu::SceneGpu;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 use bytemuck::{Pod, Zeroable};
 
-use crate::renderer::passes::{
+use crate::gpu::passes::{
     WG_1D, groups_image,
     ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
     run_compute,
@@ -407,18 +405,15 @@ impl SlcPass {
         Ok(Self {
             views: views_kernel.compute(device, "slc_views", "main"),
             views_kernel,
-            view_params: crate::renderer::passes::uniform_buffer::<GpuSlcViewParams>(
-                device,
-                "slc_views::params",
-            ),
+            view_params: crate::gpu::passes::uniform_buffer::<GpuSlcViewParams>(device, "slc_views::params"),
             cuts: cuts_kernel.compute(device, "slc_cuts", "build_cuts"),
             sample: sample_kernel.compute(device, "slc_sample", "main"),
             ism_leaves: sample_kernel.compute(device, "slc_ism_lights", "ism_leaves_main"),
             ism: IsmPass::new(device)?,
-            ism_params: crate::renderer::passes::uniform_buffer::<GpuIsmParams>(device, "slc::ism_params"),
+            ism_params: crate::gpu::passes::uniform_buffer::<GpuIsmParams>(device, "slc::ism_params"),
             ism_dummy: [
-                crate::renderer::passes::storage_buffer(device, "slc::ism_dummy_depth", 16),
-                crate::renderer::passes::storage_buffer(device, "slc::ism_dummy_lights", 32),
+                crate::gpu::passes::storage_buffer(device, "slc::ism_dummy_depth", 16),
+                crate::gpu::passes::storage_buffer(device, "slc::ism_dummy_lights", 32),
             ],
             sample_timed: sample_kernel.compute_with(
                 device,
@@ -426,7 +421,7 @@ impl SlcPass {
                 "main",
                 &[("DIAGNOSTICS", 0.0)],
             ),
-            params: crate::renderer::passes::uniform_buffer::<GpuSlcParams>(device, "slc::params"),
+            params: crate::gpu::passes::uniform_buffer::<GpuSlcParams>(device, "slc::params"),
             stats: CounterReadback::new(
                 device,
                 "slc::stats_readback",
@@ -651,7 +646,7 @@ pub struct GpuSlcParams {
 
 /// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
 /// checks them against naga's layout).
-pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[crate::wgsl_twin!(
+pub static WGSL_TWINS: &[crate::gpu::gpu_data::WgslTwin] = &[crate::wgsl_twin!(
     GpuSlcParams,
     "methods/tree_samplers/slc_sample.wgsl",
     "SlcParams",

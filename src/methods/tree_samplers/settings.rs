@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::base::field::Field;
 
-pub use crate::renderer::settings::{IsmAdaptive, IsmSettings};
+pub use crate::settings::{IsmAdaptive, IsmSettings};
 
 /// How the samplers' samples are shadowed while `gi.shadow_rays` is on.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -73,7 +73,7 @@ impl CutFallback {
 }
 
 pub use crate::base::sampling::{ChildProbability, GlossyWeights};
-pub use crate::renderer::settings::InterleaveSettings;
+pub use crate::settings::InterleaveSettings;
 
 /// Largest interleaving pattern of the tree samplers: 8 x 8 = 64 subsets of at most 64 cut
 /// slots.

@@ -4,7 +4,7 @@
 use super::settings::{ChildProbability, CutBlending, CutFallback, GlossyWeights, SamplerVisibility};
 use super::{RTSLC, SST};
 use crate::methods::MethodId;
-use crate::renderer::settings::RenderSettings;
+use crate::settings::RenderSettings;
 
 pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) {
     let sm = &mut s.sampling;
@@ -48,7 +48,7 @@ pub fn settings_ui(ui: &mut egui::Ui, method: MethodId, s: &mut RenderSettings) 
              of the closest-point one, which keeps VPLs next to the point from being \
              drawn rarely (fireflies)",
         );
-    if method != RTSLC && s.gi.brdf != crate::renderer::settings::Brdf::Lambert {
+    if method != RTSLC && s.gi.brdf != crate::settings::Brdf::Lambert {
         egui::ComboBox::from_label("glossy walk weights")
             .selected_text(sm.glossy_weights.name())
             .show_ui(ui, |ui| {

@@ -25,17 +25,15 @@ use std::collections::HashMap;
 use super::{
     FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
 };
+use crate::gpu::context::{GpuContext, GpuError};
+use crate::gpu::passes::interleave_filter::GpuFilterParams;
+use crate::gpu::passes::ism::{IsmPoints, IsmTargets};
+use crate::gpu::passes::val_cluster::{GpuVal, GpuValParams, ValTargets};
+use crate::gpu::readback::{self, CounterReadback, ImageF32};
+use crate::gpu::shaders::ShaderError;
 use crate::reference::val::MAX_CLUSTERS;
 use crate::reference::vpl::pcg_hash;
-use crate::renderer::passes::interleave_filter::GpuFilterParams;
-use crate::renderer::passes::ism::{IsmPoints, IsmTargets};
-use crate::renderer::passes::val_cluster::{GpuVal, GpuValParams, ValTargets};
-use crate::renderer::{
-    context::{GpuContext, GpuError},
-    readback::{self, CounterReadback, ImageF32},
-    settings::RenderSettings,
-    shaders::ShaderError,
-};
+use crate::settings::RenderSettings;
 use pass::{
     GpuDownParams, GpuValShadeParams, GpuValViewParams, VIS_DISK, VIS_ISM, VIS_NONE, VIS_PCSS, VIS_RAYS,
     ValBuffers, ValFrame, ValIsm, ValPass, ValRsm,
@@ -71,7 +69,7 @@ pub static MODULE: Module = Module {
         "methods/val/val_downsample.wgsl",
     ],
     wgsl_twins: pass::WGSL_TWINS,
-    own_workgroups: &[crate::renderer::passes::OwnWorkgroup {
+    own_workgroups: &[crate::gpu::passes::OwnWorkgroup {
         // The seeds' compaction: one workgroup.
         file: "methods/val/val_shade.wgsl",
         entries: &[pass::SEED_WG_ENTRY],
@@ -436,7 +434,7 @@ impl Vals {
                 s.capacity()
             ));
         }
-        crate::renderer::passes::ism::ensure_maps(
+        crate::gpu::passes::ism::ensure_maps(
             cx.device,
             cx.queue,
             cx.scene,
@@ -474,12 +472,12 @@ impl Vals {
 
 /// `MethodInfo::fields` (`val` and `val-vpl` share the table).
 fn fields() -> Vec<super::FieldSection> {
-    use crate::renderer::settings::{InterleaveSettings, IsmSettings, IsmVal};
+    use crate::settings::{InterleaveSettings, IsmSettings, IsmVal};
     vec![
         super::FieldSection::of("methods.val", settings::FIELDS, true),
         super::FieldSection::of(
             "methods.val.interleave",
-            &InterleaveSettings::<crate::renderer::settings::Interleave4>::fields(settings::MAX_INTERLEAVE),
+            &InterleaveSettings::<crate::settings::Interleave4>::fields(settings::MAX_INTERLEAVE),
             false,
         ),
         super::FieldSection::of("methods.val.ism", &IsmSettings::<IsmVal>::fields(), false),

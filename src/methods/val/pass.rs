@@ -12,20 +12,18 @@
 use bytemuck::{Pod, Zeroable};
 
 use super::settings::{IsmSettings, IsmVal};
-use crate::renderer::{
-    frame::GbufferTargets,
-    kernel::{Kernel, KernelOptions, buf, tex},
-    passes::{
-        WG_1D, groups_image,
-        interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
-        ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
-        run_compute, storage_buffer, uniform_buffer,
-        val_cluster::{GpuValParams, ValClusterPass, ValSeeds, ValTargets},
-    },
-    scene_gpu::SceneGpu,
-    shaders,
-    timing::GpuTimer,
+use crate::gpu::frame::GbufferTargets;
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::passes::{
+    WG_1D, groups_image,
+    interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
+    ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
+    run_compute, storage_buffer, uniform_buffer,
+    val_cluster::{GpuValParams, ValClusterPass, ValSeeds, ValTargets},
 };
+use crate::gpu::scene_gpu::SceneGpu;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 
 /// Twin: `ValShadeParams` in `val_common.wgsl`.
 #[repr(C)]
@@ -504,7 +502,7 @@ impl ValPass {
 
 /// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test
 /// checks them against naga's layout).
-pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[
+pub static WGSL_TWINS: &[crate::gpu::gpu_data::WgslTwin] = &[
     crate::wgsl_twin!(
         crate::methods::val::pass::GpuValShadeParams,
         "methods/val/val_shade.wgsl",
@@ -533,7 +531,7 @@ pub static WGSL_TWINS: &[crate::renderer::gpu_data::WgslTwin] = &[
         ]
     ),
     crate::wgsl_twin!(
-        crate::renderer::passes::val_cluster::GpuVal,
+        crate::gpu::passes::val_cluster::GpuVal,
         "methods/val/val_shade.wgsl",
         "Val",
         [position, area, normal, pixels, flux, texel]

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::base::field::{self, Field};
 
 use crate::reference::val::{ClusterParams, MAX_CLUSTERS, MetricWeights, POISSON, Pcss};
-pub use crate::renderer::settings::{Interleave4, InterleaveSettings, IsmSettings, IsmVal};
+pub use crate::settings::{Interleave4, InterleaveSettings, IsmSettings, IsmVal};
 
 pub const MAX_INTERLEAVE: u32 = 16;
 pub const MAX_ITERATIONS: u32 = 16;

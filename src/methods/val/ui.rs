@@ -2,7 +2,7 @@
 
 use super::settings::{MAX_INTERLEAVE, ValSettings, ValVisibility};
 use crate::methods::MethodId;
-use crate::renderer::settings::RenderSettings;
+use crate::settings::RenderSettings;
 
 pub fn settings_ui(ui: &mut egui::Ui, _method: MethodId, s: &mut RenderSettings) {
     let id = super::ID;

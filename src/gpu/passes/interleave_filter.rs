@@ -4,16 +4,14 @@
 //! G-buffer it was computed on, the camera. Writes: an accumulation buffer. Settings:
 //! `settings::InterleaveSettings`. Twin: `reference::interleave::filter_pixel`.
 
-use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 
 use super::{groups_image, run_compute, uniform_buffer};
-use crate::renderer::{
-    frame::GbufferTargets,
-    settings::{InterleaveSettings, PatternDefault},
-    shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::frame::GbufferTargets;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
+use crate::settings::{InterleaveSettings, PatternDefault};
 
 /// Twin: `FilterParams` in `shaders/interleave_filter.wgsl`.
 #[repr(C)]

@@ -5,14 +5,12 @@
 //! left, radix right). Reads: the tree(s), flags, parents, camera, G-buffer positions (to dim
 //! what is hidden). Writes: the view texture (alpha-blended raster).
 
-use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 
-use crate::renderer::{
-    settings::{TreeColor, TreeKind, TreeOverlay},
-    shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
+use crate::settings::{TreeColor, TreeKind, TreeOverlay};
 
 use super::{display::VIEW_FORMAT, sst_build::TreeBuffers};
 

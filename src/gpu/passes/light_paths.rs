@@ -8,7 +8,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::{
-    renderer::{
+    gpu::{
         context::{GpuContext, GpuError},
         frame::ShadowTargets,
         gpu_data::GpuVpl,

@@ -5,11 +5,9 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::renderer::{
-    kernel::{Kernel, KernelOptions, buf, tex},
-    shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 
 use super::{groups_image, run_compute, uniform_buffer};
 

@@ -7,18 +7,16 @@
 //! sampler_layout}`. `sst_build::BuildPass` runs it when `tree.kind` is `lbvh`; `bench tree`
 //! times both trees and checks the topology against the twin.
 
-use crate::renderer::kernel::{Kernel, KernelOptions, buf};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf};
 use bytemuck::{Pod, Zeroable};
 
 use super::{WG_1D, run_compute, uniform_buffer};
+use crate::gpu::context::{GpuContext, GpuError};
+use crate::gpu::passes::{sst_build::TreeBuffers, sst_sort::SortBuffers};
+use crate::gpu::readback::read_storage_buffer;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 use crate::reference::lbvh::{Child, Internal};
-use crate::renderer::{
-    context::{GpuContext, GpuError},
-    passes::{sst_build::TreeBuffers, sst_sort::SortBuffers},
-    readback::read_storage_buffer,
-    shaders,
-    timing::GpuTimer,
-};
 
 /// Twin: `LbvhParams` in `shaders/lbvh.wgsl`.
 #[repr(C)]

@@ -2,6 +2,7 @@
 //! are edited by the UI, saved with the app state, read from presets and set by CLI flags.
 
 mod shared_passes;
+pub mod temporal;
 mod view_buffer;
 
 pub use shared_passes::*;
@@ -217,8 +218,8 @@ impl Default for VplSettings {
     }
 }
 
-pub use super::temporal_settings::{MAX_ATROUS_ITERATIONS, TemporalMode, TemporalSettings, TemporalView};
 pub use crate::methods::{MethodId, MethodView};
+pub use temporal::{MAX_ATROUS_ITERATIONS, TemporalMode, TemporalSettings, TemporalView};
 
 pub use crate::base::brdf::Brdf;
 
@@ -534,7 +535,7 @@ impl RenderSettings {
         if !(0.0..=1.0).contains(&v.flux_mix) {
             return Err(format!("vpl.flux_mix {} is out of range (0..=1)", v.flux_mix));
         }
-        let max_bounces = crate::renderer::passes::light_paths::MAX_BOUNCES;
+        let max_bounces = crate::gpu::passes::light_paths::MAX_BOUNCES;
         if !(1..=max_bounces).contains(&v.bounces) {
             return Err(format!(
                 "vpl.bounces {} is out of range (1..={max_bounces})",

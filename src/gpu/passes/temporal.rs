@@ -9,18 +9,16 @@
 //! `atrous_conserving` per iteration), then `temporal_modulate`.
 //! Settings: `settings::TemporalSettings` (`[temporal]`). Twin: `reference::temporal`.
 
-use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 
 use super::{direct::RADIANCE_FORMAT, groups_image, storage_buffer};
-use crate::renderer::{
-    frame::GbufferTargets,
-    gpu_data::GpuCamera,
-    settings::{TemporalMode, TemporalSettings, TemporalView},
-    shaders,
-    temporal_settings::AtrousFilter,
-    timing::GpuTimer,
-};
+use crate::gpu::frame::GbufferTargets;
+use crate::gpu::gpu_data::GpuCamera;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
+use crate::settings::temporal::AtrousFilter;
+use crate::settings::{TemporalMode, TemporalSettings, TemporalView};
 
 /// Twin: `TemporalParams` in `shaders/temporal.wgsl`.
 #[repr(C)]
@@ -113,7 +111,7 @@ const SLOT_REPROJECT: u32 = 0;
 const SLOT_ACCUMULATE: u32 = 1;
 const SLOT_VARIANCE: u32 = 2;
 const SLOT_ATROUS: u32 = 3;
-const SLOT_MODULATE: u32 = SLOT_ATROUS + crate::renderer::settings::MAX_ATROUS_ITERATIONS;
+const SLOT_MODULATE: u32 = SLOT_ATROUS + crate::settings::MAX_ATROUS_ITERATIONS;
 const SLOT_VIEW: u32 = SLOT_MODULATE + 1;
 const SLOTS: u32 = SLOT_VIEW + 1;
 const SLOT_STRIDE: u64 = 256;

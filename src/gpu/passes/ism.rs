@@ -8,17 +8,15 @@
 //! `settings::IsmSettings`. Twin: `reference::ism`. `ism_view.wgsl` draws the atlas as a view
 //! ([`IsmPass::record_view`]).
 
-use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
 use super::{StridedUniforms, WG_1D, WG_2D, groups_image, run_compute, storage_buffer, uniform_buffer};
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 use crate::reference::ism::{IsmLayout, IsmLight, sample_oriented_points};
-use crate::renderer::{
-    settings::{IsmDefault, IsmSettings},
-    shaders,
-    timing::GpuTimer,
-};
+use crate::settings::{IsmDefault, IsmSettings};
 
 /// Twin: `IsmParams` in `shaders/common/ism.wgsl`.
 #[repr(C)]
@@ -149,7 +147,7 @@ impl IsmPoints {
 pub fn ensure_maps<D: IsmDefault>(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
-    scene: &crate::renderer::scene_gpu::SceneGpu,
+    scene: &crate::gpu::scene_gpu::SceneGpu,
     s: &IsmSettings<D>,
     seed: u32,
     points: &mut Option<(u64, IsmPoints)>,

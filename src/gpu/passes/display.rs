@@ -1,13 +1,11 @@
 //! Display: exposure (2^EV), tonemap and sRGB encoding of a linear-radiance buffer into the
 //! `Rgba8Unorm` view texture, with the view's look (channel, false colour, NaN highlight). Reads: one radiance buffer. Writes: the view texture.
 
-use crate::renderer::{
-    gpu_data::DisplayParams,
-    kernel::{Kernel, KernelOptions, buf, tex},
-    shaders,
-    timing::GpuTimer,
-    views::ViewLook,
-};
+use crate::gpu::gpu_data::DisplayParams;
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
+use crate::gpu::views::ViewLook;
 
 use super::{groups_image, run_compute, uniform_buffer};
 

@@ -6,13 +6,14 @@
 //! flux), the seeds. Writes: [`ValTargets`] (the clusters, each texel's key). Twin:
 //! `reference::val` (docs/val.md).
 
-use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, UVec2, Vec3};
 
 use super::{WG_1D, WG_2D, storage_buffer, uniform_buffer};
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 use crate::reference::val::{MAX_CLUSTERS, NONE, Val};
-use crate::renderer::{shaders, timing::GpuTimer};
 
 /// Twin: `ValParams` in `val_cluster.wgsl`.
 #[repr(C)]

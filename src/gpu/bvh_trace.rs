@@ -207,7 +207,7 @@ impl SurfaceProbe {
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("surface_rays::params"),
             contents: bytemuck::cast_slice(&[lod, 0, 0, 0]),
-            usage: crate::renderer::passes::PARAMS_USAGE,
+            usage: crate::gpu::passes::PARAMS_USAGE,
         });
         let bind = self.kernel.bind(
             device,

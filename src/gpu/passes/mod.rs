@@ -135,7 +135,7 @@ impl<T: bytemuck::Pod> StridedUniforms<T> {
         device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: count.max(1) as u64 * UNIFORM_STRIDE,
-            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
+            usage: crate::gpu::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         })
     }
@@ -172,7 +172,7 @@ pub(crate) fn uniform_buffer<T>(device: &wgpu::Device, label: &str) -> wgpu::Buf
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size: std::mem::size_of::<T>() as u64,
-        usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
+        usage: crate::gpu::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     })
 }
@@ -181,7 +181,7 @@ pub(crate) fn uniform_buffer<T>(device: &wgpu::Device, label: &str) -> wgpu::Buf
 /// dispatches `pipeline` once over `groups` with `bind` at group 0.
 pub(crate) fn run_compute(
     encoder: &mut wgpu::CommandEncoder,
-    timer: &mut crate::renderer::timing::GpuTimer,
+    timer: &mut crate::gpu::timing::GpuTimer,
     name: &str,
     pipeline: &wgpu::ComputePipeline,
     bind: &wgpu::BindGroup,
@@ -214,7 +214,7 @@ pub struct OwnWorkgroup {
 /// Every compute entry point of `files` has the standard sizes or one `own` declares; the
 /// message names the first that has neither.
 pub fn check_workgroup_sizes(files: &[&str], own: &[OwnWorkgroup]) -> Result<(), String> {
-    use crate::renderer::shaders::{Embedded, preprocess, validate};
+    use crate::gpu::shaders::{Embedded, preprocess, validate};
     for file in files {
         let text = preprocess(&Embedded, file).map_err(|e| e.to_string())?;
         let module = validate(file, &text).map_err(|e| e.to_string())?;
@@ -250,7 +250,7 @@ mod tests {
 
     #[test]
     fn workgroup_sizes_match_wgsl() {
-        if let Err(e) = check_workgroup_sizes(crate::renderer::shaders::ENTRY_SHADERS, OWN_WORKGROUPS) {
+        if let Err(e) = check_workgroup_sizes(crate::gpu::shaders::ENTRY_SHADERS, OWN_WORKGROUPS) {
             panic!("{e}");
         }
     }

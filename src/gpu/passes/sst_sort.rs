@@ -5,15 +5,14 @@
 //! tree`'s before / after.
 //! Reads: the VPL array. Writes: [`SortBuffers`].
 
-use crate::renderer::kernel::{Kernel, KernelOptions, buf};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
-use crate::renderer::{
-    context::{GpuContext, GpuError},
-    readback, shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::context::{GpuContext, GpuError};
+use crate::gpu::readback;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 
 use super::WG_1D;
 

@@ -4,14 +4,12 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::renderer::{
-    frame::{RSM_FLUX_FORMAT, RSM_NORMAL_FORMAT, RSM_POSITION_FORMAT, ShadowTargets},
-    gpu_data::{GpuLights, MAX_LIGHTS},
-    kernel::{Kernel, KernelOptions, buf, sampler, tex},
-    scene_gpu::SceneGpu,
-    shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::frame::{RSM_FLUX_FORMAT, RSM_NORMAL_FORMAT, RSM_POSITION_FORMAT, ShadowTargets};
+use crate::gpu::gpu_data::{GpuLights, MAX_LIGHTS};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, sampler, tex};
+use crate::gpu::scene_gpu::SceneGpu;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 
 use super::gbuffer::{DEPTH_FORMAT, vertex_layout};
 
@@ -84,7 +82,7 @@ impl RsmPass {
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("rsm::lights"),
             size: STRIDE * MAX_LIGHTS as u64,
-            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
+            usage: crate::gpu::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         Ok(Self {

@@ -1,12 +1,10 @@
 //! Visualise: maps any non-radiance buffer (normals, albedo, positions, depth, ids, shadow-map
 //! depth, integer buffers) to a viewable image in the `Rgba8Unorm` view texture.
 
-use crate::renderer::{
-    gpu_data::VisParams,
-    kernel::{Kernel, KernelOptions, buf, tex},
-    shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::gpu_data::VisParams;
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 
 use super::groups_2d;
 

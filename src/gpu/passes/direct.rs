@@ -1,12 +1,10 @@
 //! Direct light: rho/pi * E * max(0, n.l) * shadow-map visibility per directional light.
 //! Reads: camera, lights, shadow maps, G-buffer. Writes: the `direct` radiance buffer.
 
-use crate::renderer::{
-    frame::{GbufferTargets, ShadowTargets},
-    kernel::{Kernel, KernelOptions, buf, tex},
-    shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::frame::{GbufferTargets, ShadowTargets};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 
 use super::{groups_image, run_compute};
 

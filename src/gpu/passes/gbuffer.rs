@@ -10,14 +10,12 @@
 //! [`OverdrawCounter`] counts the fragments of
 //! each way (machine-independent: rasterisation rules and draw order), for `bench gbuffer`.
 
-use crate::renderer::{
-    frame::GbufferTargets,
-    gpu_data::GpuVertex,
-    kernel::{Kernel, KernelOptions, buf, sampler, tex},
-    scene_gpu::SceneGpu,
-    shaders,
-    timing::GpuTimer,
-};
+use crate::gpu::frame::GbufferTargets;
+use crate::gpu::gpu_data::GpuVertex;
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, sampler, tex};
+use crate::gpu::scene_gpu::SceneGpu;
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 
 pub const POSITION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -364,11 +362,11 @@ impl OverdrawCounter {
     /// `size`.
     pub fn count(
         &self,
-        ctx: &crate::renderer::context::GpuContext,
+        ctx: &crate::gpu::context::GpuContext,
         camera: &wgpu::Buffer,
         scene: &SceneGpu,
         size: (u32, u32),
-    ) -> Result<OverdrawCounts, crate::renderer::context::GpuError> {
+    ) -> Result<OverdrawCounts, crate::gpu::context::GpuError> {
         let device = &ctx.device;
         let texture = |label, format, usage| {
             device.create_texture(&wgpu::TextureDescriptor {
@@ -457,7 +455,7 @@ impl OverdrawCounter {
                 draw(&mut pass, pipeline);
             }
             ctx.queue.submit([enc.finish()]);
-            crate::renderer::readback::read_texture_f32(ctx, &counter, 0)
+            crate::gpu::readback::read_texture_f32(ctx, &counter, 0)
         };
         let sum = |img: &crate::base::image::ImageF32| -> (u64, u64) {
             img.pixels.iter().fold((0, 0), |(n, c), p| {

@@ -1,10 +1,11 @@
 //! VPL overlay: the frame's VPLs as discs over the view texture, coloured by flux (log scale
 //! around the mean VPL flux). Reads: VPLs, camera, G-buffer. Writes: the view texture.
 
-use crate::renderer::kernel::{Kernel, KernelOptions, buf, tex};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
 use bytemuck::{Pod, Zeroable};
 
-use crate::renderer::{shaders, timing::GpuTimer};
+use crate::gpu::shaders;
+use crate::gpu::timing::GpuTimer;
 
 use super::{WG_1D, run_compute, uniform_buffer};
 

@@ -3,12 +3,12 @@
 //! (separate pass, so a change of v_min / sigma_max costs one tiny dispatch, not a rebuild).
 //! Reads: the VPLs and the sorted (key, index) pairs. Writes: [`TreeBuffers`].
 
-use crate::renderer::kernel::{Kernel, KernelOptions, buf};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf};
 use bytemuck::{Pod, Zeroable};
 
 use crate::{
     base::sst_node::{TreeKind, leaf_count, level_count},
-    renderer::{
+    gpu::{
         context::{GpuContext, GpuError},
         gpu_data::{GpuSstNode, GpuVpl},
         readback, shaders,

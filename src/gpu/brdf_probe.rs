@@ -1,7 +1,7 @@
 //! Evaluates the shaders' BRDF (`shaders/common/brdf.wgsl`) for a batch of cases on the GPU
 //! (`shaders/brdf_eval.wgsl`): the test of the BRDF against its CPU twin `reference::brdf`.
 
-use crate::renderer::kernel::{Kernel, KernelOptions, buf};
+use crate::gpu::kernel::{Kernel, KernelOptions, buf};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 

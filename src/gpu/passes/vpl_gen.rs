@@ -6,15 +6,15 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use crate::{
-    renderer::{
+    gpu::{
         frame::{GbufferTargets, ShadowTargets},
         gpu_data::{GpuVpl, GpuVplParams, MAX_LIGHTS},
         kernel::{Kernel, KernelOptions, buf, tex},
-        settings::{GiSettings, VplMode, VplSettings},
         shaders,
         timing::GpuTimer,
     },
     scene::DirectionalLight,
+    settings::{GiSettings, VplMode, VplSettings},
 };
 
 use super::{WG_1D, groups_2d};
@@ -170,7 +170,7 @@ impl VplGenPass {
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("vpl_gen::params"),
             size: std::mem::size_of::<GpuVplParams>() as u64,
-            usage: crate::renderer::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
+            usage: crate::gpu::passes::PARAMS_USAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         // Level l's uniform is the constant l: written once, at creation.
@@ -181,7 +181,7 @@ impl VplGenPass {
         let level_params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("vpl_gen::level_params"),
             contents: &levels,
-            usage: crate::renderer::passes::PARAMS_USAGE,
+            usage: crate::gpu::passes::PARAMS_USAGE,
         });
         Ok(Self {
             importance: kernel.compute(device, "vpl_gen::importance", "importance"),

@@ -194,7 +194,11 @@ impl ErrorSink {
             // (Dropping a device does not call this; `destroy` does, with `Destroyed`.)
             sink.lost.store(true, std::sync::atomic::Ordering::SeqCst);
             let message: Vec<&str> = message.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
-            let msg = format!("GPU device lost ({reason:?}): {}", message.join(" "));
+            let msg = if message.is_empty() {
+                format!("GPU device lost ({reason:?})")
+            } else {
+                format!("GPU device lost ({reason:?}): {}", message.join(" "))
+            };
             log::error!("{msg}");
             set_first_error(&msg);
             sink.report(msg);

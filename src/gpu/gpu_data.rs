@@ -171,7 +171,7 @@ pub struct DisplayParams {
 }
 
 impl DisplayParams {
-    pub fn new(look: &crate::renderer::views::ViewLook) -> Self {
+    pub fn new(look: &crate::gpu::views::ViewLook) -> Self {
         Self {
             exposure: look.exposure_ev.exp2(),
             tonemap: look.tonemap.gpu_id(),
@@ -290,7 +290,7 @@ pub struct WgslTwin {
 #[macro_export]
 macro_rules! wgsl_twin {
     ($t:ty, $file:expr, $name:expr, [$($f:ident $(+ $k:literal)?),* $(,)?]) => {
-        $crate::renderer::gpu_data::WgslTwin {
+        $crate::gpu::gpu_data::WgslTwin {
             file: $file,
             name: $name,
             size: std::mem::size_of::<$t>(),
@@ -302,7 +302,7 @@ macro_rules! wgsl_twin {
 /// Whether `t`'s size and member offsets are naga's for its WGSL struct; the message names
 /// the struct and file.
 pub fn check_twin(t: &WgslTwin) -> Result<(), String> {
-    use crate::renderer::shaders::{Embedded, preprocess, validate};
+    use crate::gpu::shaders::{Embedded, preprocess, validate};
     let text = preprocess(&Embedded, t.file).map_err(|e| e.to_string())?;
     let module = validate(t.file, &text).map_err(|e| e.to_string())?;
     let mut layouter = naga::proc::Layouter::default();
@@ -341,7 +341,7 @@ pub fn check_twin(t: &WgslTwin) -> Result<(), String> {
 /// The shared passes' structs shared with WGSL.
 pub static TWINS: &[WgslTwin] = &[
     crate::wgsl_twin!(
-        crate::renderer::passes::compare::GpuCmpParams,
+        crate::gpu::passes::compare::GpuCmpParams,
         "compare_views.wgsl",
         "CmpParams",
         [
@@ -412,7 +412,7 @@ pub static TWINS: &[WgslTwin] = &[
         ]
     ),
     crate::wgsl_twin!(
-        crate::renderer::passes::light_paths::GpuPathParams,
+        crate::gpu::passes::light_paths::GpuPathParams,
         "light_paths.wgsl",
         "PathParams",
         [
@@ -433,7 +433,7 @@ pub static TWINS: &[WgslTwin] = &[
     ),
     crate::wgsl_twin!(GpuVpl, "vpl_gen.wgsl", "Vpl", [position, normal, id, flux]),
     crate::wgsl_twin!(
-        crate::renderer::passes::ism::GpuIsmParams,
+        crate::gpu::passes::ism::GpuIsmParams,
         "ism.wgsl",
         "IsmParams",
         [
@@ -452,7 +452,7 @@ pub static TWINS: &[WgslTwin] = &[
         ]
     ),
     crate::wgsl_twin!(
-        crate::renderer::passes::val_cluster::GpuValParams,
+        crate::gpu::passes::val_cluster::GpuValParams,
         "val_cluster.wgsl",
         "ValParams",
         [
@@ -474,19 +474,19 @@ pub static TWINS: &[WgslTwin] = &[
         ]
     ),
     crate::wgsl_twin!(
-        crate::renderer::passes::val_cluster::GpuVal,
+        crate::gpu::passes::val_cluster::GpuVal,
         "val_cluster.wgsl",
         "Val",
         [position, area, normal, pixels, flux, texel]
     ),
     crate::wgsl_twin!(
-        crate::renderer::passes::ism::GpuIsmViewParams,
+        crate::gpu::passes::ism::GpuIsmViewParams,
         "ism_view.wgsl",
         "IsmViewParams",
         [atlas, tile, per_row, maps, lo, hi, scale, cols]
     ),
     crate::wgsl_twin!(
-        crate::renderer::passes::interleave_filter::GpuFilterParams,
+        crate::gpu::passes::interleave_filter::GpuFilterParams,
         "interleave_filter.wgsl",
         "FilterParams",
         [
@@ -505,7 +505,7 @@ pub static TWINS: &[WgslTwin] = &[
         ]
     ),
     crate::wgsl_twin!(
-        crate::renderer::passes::sst_overlay::GpuOverlayParams,
+        crate::gpu::passes::sst_overlay::GpuOverlayParams,
         "sst_overlay.wgsl",
         "OverlayParams",
         [
