@@ -14,9 +14,8 @@ impl WorkbenchApp {
         let Some(renderer) = self.renderer.as_mut() else {
             return;
         };
-        // A lost device the app could not leave for a new window (`recovery.rs`: the window
-        // of a test harness, or after MAX_DEVICE_RECOVERIES losses): rendering stops and
-        // says why.
+        // A lost device the app has no next window for (`recovery.rs`: an app without a
+        // handover, as in a test harness): rendering stops and says why.
         if renderer.ctx.errors.device_lost() {
             for e in renderer.ctx.errors.take() {
                 if !self.errors.contains(&e) {

@@ -83,8 +83,8 @@ pub struct AppOptions {
     pub reset_layout: bool,
     /// Pin this frame pixel and open the pixel story window.
     pub pin: Option<(u32, u32)>,
-    /// Destroy the GPU device after this many frames, once (tests the recovery from a lost
-    /// device: [`WorkbenchApp::resume`]).
+    /// Destroy the GPU device after this many frames of each window (tests the recovery from
+    /// a lost device, [`WorkbenchApp::resume`], and its stop after [`MAX_DEVICE_RECOVERIES`]).
     pub lose_device_at_frame: Option<u64>,
 }
 
@@ -235,8 +235,8 @@ pub struct WorkbenchApp {
 /// [`MAX_DEVICE_RECOVERIES`] allows).
 pub type Handover = std::rc::Rc<std::cell::RefCell<Option<Result<WorkbenchApp, String>>>>;
 
-/// How many lost devices the GUI recreates before it stops rendering (a device that keeps
-/// being lost would otherwise loop).
+/// How many lost devices the GUI recreates; the next loss stops it with an error (a device
+/// that keeps being lost would otherwise loop).
 pub const MAX_DEVICE_RECOVERIES: u32 = 3;
 
 /// The dynamic scene: the sun's azimuth sweep and the camera's orbit path, per rendered frame;

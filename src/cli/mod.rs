@@ -62,7 +62,8 @@ pub struct Cli {
     #[arg(long, value_parser = parse_pixel)]
     pub pin: Option<(u32, u32)>,
     /// Testing the recovery from a lost GPU device: destroy the device after this many frames
-    /// (once); the workbench recreates it and goes on (`.ci/run`'s second GUI run).
+    /// of each window; the workbench recreates it and goes on, and stops after three
+    /// recoveries (`.ci/run`'s lost-device runs).
     #[arg(long, hide = true)]
     pub lose_device_at_frame: Option<u64>,
 }

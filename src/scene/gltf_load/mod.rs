@@ -169,7 +169,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let invalid = |message: String| invalid(path, message);
+    let invalid = |message: String| invalid_gltf(path, message);
 
     // Container: GLB or plain JSON.
     let (json_bytes, blob): (Vec<u8>, Option<Vec<u8>>) = if bytes.starts_with(b"glTF") {
@@ -298,7 +298,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
 }
 
 /// A file the loader refuses, with the message.
-fn invalid(path: &Path, message: String) -> SceneError {
+fn invalid_gltf(path: &Path, message: String) -> SceneError {
     SceneError::InvalidGltf {
         path: path.to_path_buf(),
         message,

@@ -144,7 +144,7 @@ impl Walk<'_> {
                     // asking for more vertices than the u32 indices address.
                     let adds = data.positions.len().saturating_mul(instances.len());
                     if self.scene.positions.len().saturating_add(adds) > MAX_VERTICES {
-                        return Err(invalid(
+                        return Err(invalid_gltf(
                             self.path,
                             format!(
                                 "{label} with {} instance(s) would make the scene more than {MAX_VERTICES} vertices",
@@ -228,7 +228,7 @@ impl Walk<'_> {
                             && color.is_finite()
                             && color.min_element() >= 0.0)
                         {
-                            return Err(invalid(
+                            return Err(invalid_gltf(
                                 self.path,
                                 format!(
                                     "directional light '{name}' has intensity {} W/m^2 and colour {:?}: both must be finite and >= 0",
