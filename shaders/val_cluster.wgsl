@@ -4,8 +4,11 @@
 //                  its centre texel); each lit texel keeps the least key (eq. 1's mu with the
 //                  low 10 mantissa bits replaced by the cluster index), stored inverted so that
 //                  atomicMax keeps it and a cleared 0 means none;
-//   fallback_main: per lit texel no splat reached, the least key over all clusters; the texel
-//                  joins the fallback list (averaged by its cluster below);
+//   list_main:     the lit texels no splat reached, in texel order, as the fallback list (one
+//                  workgroup: a chunk of texels per thread and a scan of the chunks' counts, so
+//                  the list, and the sums over it below, do not depend on thread scheduling;
+//                  an atomic append made the clusters differ in the last bits from run to run);
+//   fallback_main: per texel of the list, the least key over all clusters;
 //   average_main:  per cluster (one workgroup) the sums over its window's texels and the
 //                  fallback list's that hold its index: mean position, normalised mean normal,
 //                  summed flux and surface area, pixel count; its new centre is the texel its
@@ -135,19 +138,57 @@ fn map_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     atomicMax(&keys[t.y * vp.res + t.x], inverted_key(metric(x, c, cf), ci));
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn fallback_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if gid.x >= vp.res || gid.y >= vp.res {
+const LIST_WG: u32 = 256u;
+var<workgroup> s_counts: array<u32, LIST_WG>;
+
+// Dispatched as one workgroup, after map_main. Thread `li` takes the texels
+// [li * chunk, (li + 1) * chunk): it counts its unreached lit ones, the workgroup scans the
+// counts, and each thread writes its texels' indices from its offset, in texel order.
+@compute @workgroup_size(256, 1, 1)
+fn list_main(@builtin(local_invocation_index) li: u32) {
+    let n = vp.res * vp.res;
+    let chunk = (n + LIST_WG - 1u) / LIST_WG;
+    let lo = min(li * chunk, n);
+    let hi = min(lo + chunk, n);
+    var count = 0u;
+    for (var i = lo; i < hi; i++) {
+        if atomicLoad(&keys[i]) == 0u && load(vec2<u32>(i % vp.res, i / vp.res)).lit {
+            count += 1u;
+        }
+    }
+    s_counts[li] = count;
+    workgroupBarrier();
+    // Inclusive Hillis-Steele scan of the counts.
+    for (var d = 1u; d < LIST_WG; d <<= 1u) {
+        var add = 0u;
+        if li >= d {
+            add = s_counts[li - d];
+        }
+        workgroupBarrier();
+        s_counts[li] += add;
+        workgroupBarrier();
+    }
+    var slot = s_counts[li] - count;
+    for (var i = lo; i < hi; i++) {
+        if atomicLoad(&keys[i]) == 0u && load(vec2<u32>(i % vp.res, i / vp.res)).lit {
+            atomicStore(&fallback[1u + slot], i);
+            slot += 1u;
+        }
+    }
+    if li == LIST_WG - 1u {
+        atomicStore(&fallback[0], s_counts[li]);
+    }
+}
+
+// Per texel of the fallback list (after list_main): its key, the least over all clusters.
+@compute @workgroup_size(64, 1, 1)
+fn fallback_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
+    let k = gid.x + gid.y * nw.x * 64u;
+    if k >= atomicLoad(&fallback[0]) {
         return;
     }
-    let i = gid.y * vp.res + gid.x;
-    if atomicLoad(&keys[i]) != 0u {
-        return;
-    }
-    let x = load(gid.xy);
-    if !x.lit {
-        return;
-    }
+    let i = atomicLoad(&fallback[1u + k]);
+    let x = load(vec2<u32>(i % vp.res, i / vp.res));
     var best = 0u;
     for (var ci = 0u; ci < vp.clusters; ci++) {
         let c = vals_in[ci];
@@ -157,8 +198,6 @@ fn fallback_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         best = max(best, inverted_key(metric(x, c, load(unpack_texel(c.texel)).flux), ci));
     }
     atomicStore(&keys[i], best);
-    let slot = atomicAdd(&fallback[0], 1u);
-    atomicStore(&fallback[1u + slot], i);
 }
 
 // A cluster seeded at texel t (packed): its attributes, one pixel. Twin: reference::val::seed.

@@ -301,9 +301,9 @@ pub fn window(res: u32, splat: u32, t: UVec2) -> (UVec2, UVec2) {
 
 /// The mapping step: each lit texel's cluster (index into `vals`; `NONE` for texels without
 /// flux). Splats first: each cluster keys the texels of its window; texels no splat reached
-/// take the least key over all clusters. Returns (assignment, texels that needed the
-/// fallback).
-pub fn map(rsm: &Rsm, p: &ClusterParams, vals: &[Val]) -> (Vec<u32>, usize) {
+/// take the least key over all clusters. Returns (assignment, the texels that needed the
+/// fallback, in texel order: the GPU's fallback list).
+pub fn map(rsm: &Rsm, p: &ClusterParams, vals: &[Val]) -> (Vec<u32>, Vec<u32>) {
     let n = rsm.texels.len();
     let mut keys = vec![u32::MAX; n];
     let ext = extent(rsm, p);
@@ -324,12 +324,12 @@ pub fn map(rsm: &Rsm, p: &ClusterParams, vals: &[Val]) -> (Vec<u32>, usize) {
             }
         }
     }
-    let mut fallback = 0;
+    let mut fallback = Vec::new();
     for (i, k) in keys.iter_mut().enumerate() {
         if *k != u32::MAX || !rsm.lit(i) {
             continue;
         }
-        fallback += 1;
+        fallback.push(i as u32);
         for (ci, c) in vals.iter().enumerate() {
             if c.pixels > 0 {
                 *k = (*k).min(key(metric(p, ext, &rsm.texels[i], c, centre_flux[ci]), ci as u32));
@@ -889,8 +889,9 @@ mod tests {
             // Small splats leave gaps that the fallback closes (it is exercised here).
             let (_, fallback) = map(&rsm, &p, &vals);
             assert!(
-                splat != 8 || fallback > 0,
-                "{fallback} texels by fallback at splat {splat}"
+                splat != 8 || !fallback.is_empty(),
+                "{} texels by fallback at splat {splat}",
+                fallback.len()
             );
         }
     }

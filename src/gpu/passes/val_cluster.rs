@@ -109,7 +109,9 @@ pub struct ValTargets {
     vals: [wgpu::Buffer; 2],
     /// Per RSM texel the inverted least key of the last step ([`key_cluster`]).
     pub keys: wgpu::Buffer,
-    fallback: wgpu::Buffer,
+    /// The last step's fallback list: [0] its length, then the texels no splat reached, in
+    /// texel order (so a run's sums do not depend on thread scheduling).
+    pub fallback: wgpu::Buffer,
     /// Per cluster its seed texel (packed x | y << 16): written by [`ValClusterPass::record`]
     /// from CPU seeds, or by the caller's kernel ([`ValSeeds::Written`]).
     pub seeds: wgpu::Buffer,
@@ -173,6 +175,7 @@ pub struct ValClusterPass {
     clear: wgpu::ComputePipeline,
     seed: wgpu::ComputePipeline,
     map: wgpu::ComputePipeline,
+    list: wgpu::ComputePipeline,
     fallback: wgpu::ComputePipeline,
     average: wgpu::ComputePipeline,
     reseed: wgpu::ComputePipeline,
@@ -188,6 +191,7 @@ impl ValClusterPass {
                 "clear_main",
                 "seed_main",
                 "map_main",
+                "list_main",
                 "fallback_main",
                 "average_main",
                 "reseed_main",
@@ -199,6 +203,7 @@ impl ValClusterPass {
             clear: pipe("clear_main"),
             seed: pipe("seed_main"),
             map: pipe("map_main"),
+            list: pipe("list_main"),
             fallback: pipe("fallback_main"),
             average: pipe("average_main"),
             reseed: pipe("reseed_main"),
@@ -280,7 +285,6 @@ impl ValClusterPass {
                 let texel_groups = (p.res * p.res).div_ceil(WG_1D);
                 let (cx, cy) = (texel_groups.min(65535), texel_groups.div_ceil(65535));
                 let splat = p.splat.div_ceil(WG_2D);
-                let image = p.res.div_ceil(WG_2D);
                 // Carried over: the last run's clusters are the first step's input.
                 // Else seed into vals[0] (the bind group whose output is 0).
                 let carry = carry && t.primed;
@@ -303,8 +307,11 @@ impl ValClusterPass {
                     pass.dispatch_workgroups(cx, cy, 1);
                     pass.set_pipeline(&self.map);
                     pass.dispatch_workgroups(splat, splat, n);
+                    // The fallback list in texel order (one workgroup), then its keys.
+                    pass.set_pipeline(&self.list);
+                    pass.dispatch_workgroups(1, 1, 1);
                     pass.set_pipeline(&self.fallback);
-                    pass.dispatch_workgroups(image, image, 1);
+                    pass.dispatch_workgroups(cx, cy, 1);
                     pass.set_pipeline(&self.average);
                     pass.dispatch_workgroups(n, 1, 1);
                     cur = 1 - cur;
