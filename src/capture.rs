@@ -120,6 +120,12 @@ pub struct Capture {
     pub timing_frames: u32,
     /// The renderer's frame index at the capture (random numbers are keyed by it).
     pub frame_index: u64,
+    /// The frame index of the first frame the image averages (a per-frame method's image is
+    /// frames `first_frame .. first_frame + frames`): `render --settings` numbers its image
+    /// frames from it, so a view exported from the GUI after any number of frames renders
+    /// again bit for bit. None: a progressive method, or a record from before it was kept.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_frame: Option<u64>,
     /// The command line that made it.
     pub command: String,
     /// A sequence's `render --camera-path` (bookmark names; empty: all of them).

@@ -336,6 +336,60 @@ fn raising_v_min_changes_the_traversal_steps_image() {
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
 }
 
+/// A view exported from the window after some frames, rendered again headlessly from its
+/// capture record alone: the same bytes (issue 41). Accumulation on, so the image averages
+/// several frames that started after the window had rendered others.
+#[test]
+fn a_view_exported_from_the_gui_renders_again_bit_for_bit_from_its_record() {
+    use lightcut::app::image_views::ExportKind;
+    let mut settings = slc_settings();
+    settings.sampling.accumulate = true;
+    let options = AppOptions {
+        settings: Some(settings),
+        views: vec![ViewBuffer::Final],
+        reset_layout: true,
+        ..Default::default()
+    };
+    let Some(mut h) = harness_with(egui::vec2(900.0, 600.0), options) else {
+        return;
+    };
+    h.run_steps(6);
+    let dir = std::env::temp_dir().join(format!("lightcut_ui_again_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    h.state_mut().set_export_dir(dir.to_str().unwrap());
+    let spec = h.state().layout().panes()[0].spec;
+    let exr = h.state_mut().export_view(0, &spec, ExportKind::Exr);
+    assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());
+    assert_eq!(exr.len(), 1);
+    let rec = lightcut::capture::sidecar_path(&exr[0]);
+    let (c, _) = lightcut::capture::split(&std::fs::read_to_string(&rec).unwrap()).unwrap();
+    let c = c.expect("a [capture] table");
+    let first = c.first_frame.expect("a per-frame method's first image frame");
+    assert!(
+        c.frames >= 2 && first > 0 && first + c.frames as u64 == c.frame_index,
+        "{c:?}"
+    );
+    let again = dir.join("again");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_lightcut-workbench"))
+        .args(["render", "--settings"])
+        .arg(&rec)
+        .args(["--output", "final", "--out"])
+        .arg(&again)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "render --settings: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        std::fs::read(&exr[0]).unwrap() == std::fs::read(again.join("final.exr")).unwrap(),
+        "the exported view and its render from the record differ"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn several_views_render_their_buffers_and_export_files_that_decode() {
     use lightcut::app::image_views::ExportKind;

@@ -92,6 +92,13 @@ pub(super) fn capture_of(
     c.seed = r.settings().vpl.seed;
     c.frames = r.sampling_frames().max(1);
     c.frame_index = r.frame_index();
+    // The image is the last `frames` frames (one without accumulation).
+    c.first_frame = r
+        .settings()
+        .gi
+        .method
+        .per_frame()
+        .then(|| r.frame_index().saturating_sub(c.frames as u64));
     (c, r.settings().clone())
 }
 

@@ -202,6 +202,15 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         settings.gi.method = m;
     }
     let method = settings.gi.method;
+    if let Some(c) = &record
+        && c.what != "render"
+        && c.first_frame.is_some()
+        && settings.temporal.mode != crate::settings::TemporalMode::Off
+    {
+        println!(
+            "  note: the temporal stage's history from the window's earlier frames is not in the record: its image is the stage's over the frames rendered here"
+        );
+    }
     args.sampling.apply(&mut settings);
     args.sampling.check_visibility(&[method])?;
     // `tree.kind = lbvh` from a settings file or --set: the same refusal as --tree's.
@@ -319,6 +328,14 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         );
     }
     let mut frames_averaged = None;
+    // A record's first image frame (a GUI export's last frames): the image frames are
+    // numbered from it, so their random numbers are the captured ones.
+    if method.per_frame()
+        && let Some(first) = record.as_ref().and_then(|c| c.first_frame)
+    {
+        r.set_frame_index(first);
+    }
+    let first_frame = method.per_frame().then(|| r.frame_index());
     if method.per_frame() {
         r.set_frame_mode(FrameMode::Diagnostic);
         for _ in 0..args.sampling.frames {
@@ -547,6 +564,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     capture.frames = args.sampling.frames;
     capture.timing_frames = n_timing;
     capture.frame_index = r.frame_index();
+    capture.first_frame = first_frame;
     capture.files = written_files(out);
     crate::capture::write_record(&out.join("capture.toml"), &capture, &image_settings_for_record)
         .map_err(|e| anyhow!("{e}"))?;

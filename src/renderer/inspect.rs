@@ -207,6 +207,11 @@ impl Renderer {
         self.frames = 0;
     }
 
+    /// Numbers the next frame `index` (a capture's first image frame, to render it again).
+    pub fn set_frame_index(&mut self, index: u64) {
+        self.frames = index;
+    }
+
     /// The GPU instance of the method module whose type is `T` (tests and tools that read a
     /// method's own buffers, e.g. `methods::lightcuts::Lightcuts`).
     pub fn method_module<T: Method>(&self) -> Option<&T> {
