@@ -13,6 +13,7 @@ pub mod viewport_texture;
 mod exports;
 mod frame;
 mod recovery;
+mod settings_ui;
 mod side_panel;
 mod tool_dock;
 

@@ -7,7 +7,7 @@
 
 use glam::Vec3;
 
-use super::image_views::Prim;
+use super::image_views::{Prim, rgba8};
 use crate::base::sst_node::{SstNode, Topology, basis, flag, luminance};
 use crate::methods::tree_samplers::pass::{PixelTrace, SampleVisibility, StopReason};
 use crate::renderer::Renderer;
@@ -206,8 +206,8 @@ impl StoryPanel {
                 if faint {
                     c = c.gamma_multiply(0.25);
                 }
-                out.push(Prim::Line(x, p, c));
-                out.push(Prim::Point(p, c));
+                out.push(Prim::Line(x, p, rgba8(c)));
+                out.push(Prim::Point(p, rgba8(c)));
             }
             let show_nodes = self.selected.is_none_or(|k| k == i);
             if show_nodes && s.end != 0 && s.end < self.leaves() {
@@ -218,12 +218,12 @@ impl StoryPanel {
                 for n in std::iter::once(s.start).chain(s.path.iter().map(|p| p.0)) {
                     let node = self.node(n);
                     if !node.is_empty() && n < self.leaves() {
-                        out.push(Prim::Box(node.bbox_min, node.bbox_max, PATH));
+                        out.push(Prim::Box(node.bbox_min, node.bbox_max, rgba8(PATH)));
                     }
                 }
             }
         }
-        out.push(Prim::Point(self.position, egui::Color32::WHITE));
+        out.push(Prim::Point(self.position, rgba8(egui::Color32::WHITE)));
         out
     }
 
@@ -526,6 +526,6 @@ fn ellipse(node: &SstNode, color: egui::Color32) -> Prim {
     Prim::Ellipse {
         center: node.position,
         axes: [t * sx, b * sy],
-        color,
+        color: rgba8(color),
     }
 }

@@ -3,7 +3,7 @@
 //! A [`Field`] names a setting by its TOML key under its section (`relative_error`,
 //! `interleave.n`), gives its range, unit, label and help, and reads and writes it in its
 //! settings struct. The settings' validation ([`check`]), the GUI's slider
-//! (`methods::field_ui::slider`) and `--set` (the section's TOML path plus the key) all go
+//! (`base::settings_ui::slider`) and `--set` (the section's TOML path plus the key) all go
 //! through it, so a slider cannot offer a value that validation refuses nor stop short of one
 //! it accepts. [`Spec`] is the part without the struct's type, which the registry lists for
 //! the tests.

@@ -13,4 +13,5 @@ pub mod gpu_layout;
 pub mod image;
 pub mod progress;
 pub mod sampling;
+pub mod settings_ui;
 pub mod sst_node;

@@ -1,18 +1,19 @@
 //! The imperfect shadow maps' settings in the GUI (shared by the methods that build them:
 //! light culling's adaptive maps, the VALs' maps).
 
+use crate::base::settings_ui::{SettingsUi, slider_within};
 use crate::settings::{IsmDefault, IsmSettings};
 
 /// `m`'s sliders (`IsmSettings::fields`: the ranges validation uses); `light` names what a
 /// map belongs to ("VPL", "VAL"), `paper_tile` and `paper_points` the method's paper values.
 pub fn settings_ui<D: IsmDefault>(
-    ui: &mut egui::Ui,
+    ui: &mut dyn SettingsUi,
     m: &mut IsmSettings<D>,
     light: &str,
     paper_tile: &str,
     paper_points: &str,
 ) {
-    ui.label(format!(
+    ui.text(&format!(
         "a map per {light} (paper: {paper_tile} maps, {paper_points} points each)"
     ));
     for f in IsmSettings::<D>::fields() {
@@ -22,14 +23,17 @@ pub fn settings_ui<D: IsmDefault>(
         } else {
             (f.spec.min, f.spec.max)
         };
-        crate::methods::field_ui::slider_within(ui, &f, m, min, max);
+        slider_within(ui, &f, m, min, max);
         if f.spec.key == "tile" {
             m.atlas = m.atlas.clamp(m.tile, m.tile << 7);
         }
     }
-    ui.label(format!("{} maps", m.capacity()));
-    ui.checkbox(&mut m.front_face_culling, "cull front faces (Program 1)")
-        .on_hover_text(format!(
+    ui.text(&format!("{} maps", m.capacity()));
+    ui.toggle(
+        &mut m.front_face_culling,
+        "cull front faces (Program 1)",
+        &format!(
             "a map leaves out points whose surface faces its {light} (no self-shadowing of lit surfaces)"
-        ));
+        ),
+    );
 }

@@ -14,7 +14,6 @@
 //! through a new one.
 
 pub mod direct_only;
-pub mod field_ui;
 pub mod ground_truth;
 mod ids;
 pub mod interleave;
@@ -195,7 +194,7 @@ pub struct MethodInfo {
     /// checks that `validate` refuses it by name); None for a method without settings.
     pub invalid_example: Option<fn(&mut RenderSettings) -> &'static str>,
     /// Its settings in the GUI's Global illumination section.
-    pub ui: fn(&mut egui::Ui, MethodId, &mut RenderSettings),
+    pub ui: fn(&mut dyn crate::base::settings_ui::SettingsUi, MethodId, &mut RenderSettings),
     /// The tests (by name, `file::test`) that check it against a CPU reference or for
     /// convergence; the registry test checks that each exists.
     pub tests: &'static [&'static str],

@@ -250,7 +250,18 @@ pub struct ViewEvents {
     pub snapshot: Option<AbSource>,
 }
 
-pub use crate::methods::overlay::Prim;
+pub use crate::methods::overlay::{Prim, Rgba8};
+
+/// An overlay colour as egui draws it.
+pub fn color32(c: Rgba8) -> egui::Color32 {
+    let [r, g, b, a] = c.0;
+    egui::Color32::from_rgba_unmultiplied(r, g, b, a)
+}
+
+/// An egui colour as an overlay colour.
+pub fn rgba8(c: egui::Color32) -> Rgba8 {
+    Rgba8(c.to_srgba_unmultiplied())
+}
 
 /// Everything a pane needs to draw itself.
 pub struct PaneContext<'a> {
@@ -564,7 +575,7 @@ fn view_pane_ui(cx: &mut PaneContext<'_>, ui: &mut egui::Ui, pane: &mut ViewPane
             }
         };
         for prim in cx.overlay {
-            match *prim {
+            match (*prim).map_color(color32) {
                 Prim::Point(p, c) => {
                     if let Some(q) = project(p) {
                         painter.circle_filled(q, 3.0, c);

@@ -1,10 +1,11 @@
 //! The ground truth's settings in the GUI.
 
+use crate::base::settings_ui::{SettingsUi, slider};
 use crate::methods::MethodId;
 use crate::settings::RenderSettings;
 
-pub fn settings_ui(ui: &mut egui::Ui, _: MethodId, s: &mut RenderSettings) {
+pub fn settings_ui(ui: &mut dyn SettingsUi, _: MethodId, s: &mut RenderSettings) {
     for f in super::FIELDS {
-        crate::methods::field_ui::slider(ui, f, &mut s.gi);
+        slider(ui, f, &mut s.gi);
     }
 }

@@ -424,9 +424,9 @@ impl Method for LightCulling {
             let s = spheres[k];
             let c = glam::Vec3::new(s[0], s[1], s[2]);
             let color = if holds(&s) {
-                egui::Color32::from_rgb(90, 230, 110)
+                crate::methods::overlay::Rgba8::rgb(90, 230, 110)
             } else {
-                egui::Color32::from_rgba_unmultiplied(255, 160, 40, 140)
+                crate::methods::overlay::Rgba8::rgba(255, 160, 40, 140)
             };
             prims.push(Prim::Sphere {
                 center: c,
@@ -435,7 +435,7 @@ impl Method for LightCulling {
             });
             prims.push(Prim::Point(c, color));
         }
-        prims.push(Prim::Point(position, egui::Color32::WHITE));
+        prims.push(Prim::Point(position, crate::methods::overlay::Rgba8::WHITE));
         rows.push((
             "range spheres holding the pixel's point".into(),
             format!("{inside} of {} listed", spheres.len()),
