@@ -162,11 +162,21 @@ fn every_method_is_named_consistently_and_has_its_tests() {
             };
             assert!(at.is_some_and(is_test), "{}: test {t} not found", m.id);
         }
-        // Its entry shaders are embedded (`renderer::shaders` validates every one with naga).
+        // Its entry shaders are embedded, and the GPU layer finds them through the module's
+        // `ShaderTable` (`gpu::shaders` validates every entry shader with naga).
+        let found = lightcut::gpu::shaders::entry_shaders();
         for f in m.module.entry_shaders {
             assert!(
                 m.module.shaders.iter().any(|(n, _)| n == f),
                 "{}: entry shader {f} not embedded",
+                m.id
+            );
+            assert!(found.contains(f), "{}: entry shader {f} not submitted", m.id);
+        }
+        for (f, _) in m.module.shaders {
+            assert!(
+                lightcut::gpu::shaders::all_files().any(|(n, _)| n == *f),
+                "{}: {f} not submitted",
                 m.id
             );
         }

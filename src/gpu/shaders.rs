@@ -10,8 +10,8 @@ use std::collections::HashSet;
 use thiserror::Error;
 
 /// The WGSL files of the frame's shared passes and includes, by their path under `shaders/`.
-/// Each GI method declares its own files (`MethodInfo::shaders`, under
-/// `shaders/methods/<method>/`); [`all_files`] joins the two.
+/// Each GI method declares its own files (`Module::shaders`, under
+/// `shaders/methods/<method>/`, submitted as [`ShaderTable`]s); [`all_files`] joins the two.
 pub const SHADER_FILES: &[(&str, &str)] = &[
     ("common/bvh.wgsl", include_str!("../../shaders/common/bvh.wgsl")),
     (
@@ -178,21 +178,37 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "surface_rays.wgsl",
 ];
 
-/// Every WGSL file: the shared ones and those the registered GI methods declare.
+/// A GI method's WGSL files and entry points, submitted by its module
+/// (`inventory::submit!` beside its `Module`): the GPU layer finds every method's shaders
+/// without naming a method.
+pub struct ShaderTable {
+    /// (path under `shaders/`, text), embedded.
+    pub files: &'static [(&'static str, &'static str)],
+    /// Those of the files that are entry points.
+    pub entries: &'static [&'static str],
+}
+
+inventory::collect!(ShaderTable);
+
+/// Every WGSL file: the shared ones and those the GI methods submit.
 pub fn all_files() -> impl Iterator<Item = (&'static str, &'static str)> {
     SHADER_FILES.iter().copied().chain(
-        crate::methods::modules()
+        inventory::iter::<ShaderTable>
             .into_iter()
-            .flat_map(|m| m.shaders.iter().copied()),
+            .flat_map(|t| t.files.iter().copied()),
     )
 }
 
-/// Every entry-point shader: the shared ones and the methods' (each file once).
+/// Every entry-point shader: the shared ones, then the methods' (sorted; each file once).
 pub fn entry_shaders() -> Vec<&'static str> {
+    let mut methods: Vec<&'static str> = inventory::iter::<ShaderTable>
+        .into_iter()
+        .flat_map(|t| t.entries.iter().copied())
+        .collect();
+    methods.sort_unstable();
+    methods.dedup();
     let mut v: Vec<&'static str> = ENTRY_SHADERS.to_vec();
-    for m in crate::methods::modules() {
-        v.extend(m.entry_shaders.iter().copied());
-    }
+    v.extend(methods);
     v
 }
 

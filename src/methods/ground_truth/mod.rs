@@ -18,14 +18,28 @@ use pass::GroundTruthPass;
 
 pub const ID: MethodId = MethodId::new("ground-truth");
 
+/// Its WGSL files (paths under `shaders/`), embedded; the GPU layer finds them through
+/// `gpu::shaders::ShaderTable` without naming the method.
+const SHADERS: &[(&str, &str)] = &[(
+    "methods/ground_truth/ground_truth.wgsl",
+    include_str!("../../../shaders/methods/ground_truth/ground_truth.wgsl"),
+)];
+
+/// Those of its files that are entry points.
+const ENTRY_SHADERS: &[&str] = &["methods/ground_truth/ground_truth.wgsl"];
+
+inventory::submit! {
+    crate::gpu::shaders::ShaderTable {
+        files: SHADERS,
+        entries: ENTRY_SHADERS,
+    }
+}
+
 pub static MODULE: Module = Module {
     name: "ground_truth",
     create,
-    shaders: &[(
-        "methods/ground_truth/ground_truth.wgsl",
-        include_str!("../../../shaders/methods/ground_truth/ground_truth.wgsl"),
-    )],
-    entry_shaders: &["methods/ground_truth/ground_truth.wgsl"],
+    shaders: SHADERS,
+    entry_shaders: ENTRY_SHADERS,
     wgsl_twins: pass::WGSL_TWINS,
     own_workgroups: &[],
 };

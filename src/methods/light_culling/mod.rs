@@ -53,26 +53,40 @@ macro_rules! shader {
     };
 }
 
+/// Its WGSL files (paths under `shaders/`), embedded; the GPU layer finds them through
+/// `gpu::shaders::ShaderTable` without naming the method.
+const SHADERS: &[(&str, &str)] = &[
+    shader!("lcull_common.wgsl"),
+    shader!("lcull_light.wgsl"),
+    shader!("lcull_term.wgsl"),
+    shader!("lcull_ranges.wgsl"),
+    shader!("lcull_tree.wgsl"),
+    shader!("lcull_tiles.wgsl"),
+    shader!("lcull_shade.wgsl"),
+    shader!("lcull_views.wgsl"),
+];
+
+/// Those of its files that are entry points.
+const ENTRY_SHADERS: &[&str] = &[
+    "methods/light_culling/lcull_ranges.wgsl",
+    "methods/light_culling/lcull_tiles.wgsl",
+    "methods/light_culling/lcull_shade.wgsl",
+    "methods/light_culling/lcull_tree.wgsl",
+    "methods/light_culling/lcull_views.wgsl",
+];
+
+inventory::submit! {
+    crate::gpu::shaders::ShaderTable {
+        files: SHADERS,
+        entries: ENTRY_SHADERS,
+    }
+}
+
 pub static MODULE: Module = Module {
     name: "light_culling",
     create,
-    shaders: &[
-        shader!("lcull_common.wgsl"),
-        shader!("lcull_light.wgsl"),
-        shader!("lcull_term.wgsl"),
-        shader!("lcull_ranges.wgsl"),
-        shader!("lcull_tree.wgsl"),
-        shader!("lcull_tiles.wgsl"),
-        shader!("lcull_shade.wgsl"),
-        shader!("lcull_views.wgsl"),
-    ],
-    entry_shaders: &[
-        "methods/light_culling/lcull_ranges.wgsl",
-        "methods/light_culling/lcull_tiles.wgsl",
-        "methods/light_culling/lcull_shade.wgsl",
-        "methods/light_culling/lcull_tree.wgsl",
-        "methods/light_culling/lcull_views.wgsl",
-    ],
+    shaders: SHADERS,
+    entry_shaders: ENTRY_SHADERS,
     wgsl_twins: pass::WGSL_TWINS,
     own_workgroups: &[crate::gpu::passes::OwnWorkgroup {
         // One workgroup per tile.

@@ -42,22 +42,36 @@ macro_rules! shader {
     };
 }
 
+/// Its WGSL files (paths under `shaders/`), embedded; the GPU layer finds them through
+/// `gpu::shaders::ShaderTable` without naming the method.
+const SHADERS: &[(&str, &str)] = &[
+    shader!("li_common.wgsl"),
+    shader!("li_records.wgsl"),
+    shader!("li_select.wgsl"),
+    shader!("li_interp.wgsl"),
+    shader!("li_views.wgsl"),
+];
+
+/// Those of its files that are entry points.
+const ENTRY_SHADERS: &[&str] = &[
+    "methods/lightcut_interpolation/li_records.wgsl",
+    "methods/lightcut_interpolation/li_select.wgsl",
+    "methods/lightcut_interpolation/li_interp.wgsl",
+    "methods/lightcut_interpolation/li_views.wgsl",
+];
+
+inventory::submit! {
+    crate::gpu::shaders::ShaderTable {
+        files: SHADERS,
+        entries: ENTRY_SHADERS,
+    }
+}
+
 pub static MODULE: Module = Module {
     name: "lightcut_interpolation",
     create,
-    shaders: &[
-        shader!("li_common.wgsl"),
-        shader!("li_records.wgsl"),
-        shader!("li_select.wgsl"),
-        shader!("li_interp.wgsl"),
-        shader!("li_views.wgsl"),
-    ],
-    entry_shaders: &[
-        "methods/lightcut_interpolation/li_records.wgsl",
-        "methods/lightcut_interpolation/li_select.wgsl",
-        "methods/lightcut_interpolation/li_interp.wgsl",
-        "methods/lightcut_interpolation/li_views.wgsl",
-    ],
+    shaders: SHADERS,
+    entry_shaders: ENTRY_SHADERS,
     wgsl_twins: pass::WGSL_TWINS,
     own_workgroups: &[crate::gpu::passes::OwnWorkgroup {
         // One workgroup per 16 x 16 tile.

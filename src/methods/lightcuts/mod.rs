@@ -34,24 +34,38 @@ macro_rules! shader {
     };
 }
 
+/// Its WGSL files (paths under `shaders/`), embedded; the GPU layer finds them through
+/// `gpu::shaders::ShaderTable` without naming the method.
+const SHADERS: &[(&str, &str)] = &[
+    shader!("lc_common.wgsl"),
+    shader!("lc_brdf_bound.wgsl"),
+    shader!("lc_build.wgsl"),
+    shader!("lc_merge.wgsl"),
+    shader!("lc_build_radix.wgsl"),
+    shader!("lightcuts.wgsl"),
+    shader!("lc_views.wgsl"),
+];
+
+/// Those of its files that are entry points.
+const ENTRY_SHADERS: &[&str] = &[
+    "methods/lightcuts/lc_build.wgsl",
+    "methods/lightcuts/lc_build_radix.wgsl",
+    "methods/lightcuts/lightcuts.wgsl",
+    "methods/lightcuts/lc_views.wgsl",
+];
+
+inventory::submit! {
+    crate::gpu::shaders::ShaderTable {
+        files: SHADERS,
+        entries: ENTRY_SHADERS,
+    }
+}
+
 pub static MODULE: Module = Module {
     name: "lightcuts",
     create,
-    shaders: &[
-        shader!("lc_common.wgsl"),
-        shader!("lc_brdf_bound.wgsl"),
-        shader!("lc_build.wgsl"),
-        shader!("lc_merge.wgsl"),
-        shader!("lc_build_radix.wgsl"),
-        shader!("lightcuts.wgsl"),
-        shader!("lc_views.wgsl"),
-    ],
-    entry_shaders: &[
-        "methods/lightcuts/lc_build.wgsl",
-        "methods/lightcuts/lc_build_radix.wgsl",
-        "methods/lightcuts/lightcuts.wgsl",
-        "methods/lightcuts/lc_views.wgsl",
-    ],
+    shaders: SHADERS,
+    entry_shaders: ENTRY_SHADERS,
     wgsl_twins: pass::WGSL_TWINS,
     own_workgroups: &[],
 };

@@ -23,14 +23,28 @@ use pass::{GpuRefParams, ReferencePass};
 
 pub const ID: MethodId = MethodId::new("reference");
 
+/// Its WGSL files (paths under `shaders/`), embedded; the GPU layer finds them through
+/// `gpu::shaders::ShaderTable` without naming the method.
+const SHADERS: &[(&str, &str)] = &[(
+    "methods/reference/reference.wgsl",
+    include_str!("../../../shaders/methods/reference/reference.wgsl"),
+)];
+
+/// Those of its files that are entry points.
+const ENTRY_SHADERS: &[&str] = &["methods/reference/reference.wgsl"];
+
+inventory::submit! {
+    crate::gpu::shaders::ShaderTable {
+        files: SHADERS,
+        entries: ENTRY_SHADERS,
+    }
+}
+
 pub static MODULE: Module = Module {
     name: "reference",
     create,
-    shaders: &[(
-        "methods/reference/reference.wgsl",
-        include_str!("../../../shaders/methods/reference/reference.wgsl"),
-    )],
-    entry_shaders: &["methods/reference/reference.wgsl"],
+    shaders: SHADERS,
+    entry_shaders: ENTRY_SHADERS,
     wgsl_twins: &[],
     own_workgroups: &[],
 };

@@ -45,23 +45,37 @@ macro_rules! shader {
     };
 }
 
+/// Its WGSL files (paths under `shaders/`), embedded; the GPU layer finds them through
+/// `gpu::shaders::ShaderTable` without naming the method.
+const SHADERS: &[(&str, &str)] = &[
+    shader!("slc_cuts.wgsl"),
+    shader!("slc_sample.wgsl"),
+    shader!("slc_views.wgsl"),
+    shader!("slc_half.wgsl"),
+    shader!("slc_upsample.wgsl"),
+];
+
+/// Those of its files that are entry points.
+const ENTRY_SHADERS: &[&str] = &[
+    "methods/tree_samplers/slc_cuts.wgsl",
+    "methods/tree_samplers/slc_sample.wgsl",
+    "methods/tree_samplers/slc_views.wgsl",
+    "methods/tree_samplers/slc_half.wgsl",
+    "methods/tree_samplers/slc_upsample.wgsl",
+];
+
+inventory::submit! {
+    crate::gpu::shaders::ShaderTable {
+        files: SHADERS,
+        entries: ENTRY_SHADERS,
+    }
+}
+
 pub static MODULE: Module = Module {
     name: "tree_samplers",
     create,
-    shaders: &[
-        shader!("slc_cuts.wgsl"),
-        shader!("slc_sample.wgsl"),
-        shader!("slc_views.wgsl"),
-        shader!("slc_half.wgsl"),
-        shader!("slc_upsample.wgsl"),
-    ],
-    entry_shaders: &[
-        "methods/tree_samplers/slc_cuts.wgsl",
-        "methods/tree_samplers/slc_sample.wgsl",
-        "methods/tree_samplers/slc_views.wgsl",
-        "methods/tree_samplers/slc_half.wgsl",
-        "methods/tree_samplers/slc_upsample.wgsl",
-    ],
+    shaders: SHADERS,
+    entry_shaders: ENTRY_SHADERS,
     wgsl_twins: pass::WGSL_TWINS,
     own_workgroups: &[],
 };

@@ -54,20 +54,34 @@ macro_rules! shader {
     };
 }
 
+/// Its WGSL files (paths under `shaders/`), embedded; the GPU layer finds them through
+/// `gpu::shaders::ShaderTable` without naming the method.
+const SHADERS: &[(&str, &str)] = &[
+    shader!("val_common.wgsl"),
+    shader!("val_shade.wgsl"),
+    shader!("val_views.wgsl"),
+    shader!("val_downsample.wgsl"),
+];
+
+/// Those of its files that are entry points.
+const ENTRY_SHADERS: &[&str] = &[
+    "methods/val/val_shade.wgsl",
+    "methods/val/val_views.wgsl",
+    "methods/val/val_downsample.wgsl",
+];
+
+inventory::submit! {
+    crate::gpu::shaders::ShaderTable {
+        files: SHADERS,
+        entries: ENTRY_SHADERS,
+    }
+}
+
 pub static MODULE: Module = Module {
     name: "val",
     create,
-    shaders: &[
-        shader!("val_common.wgsl"),
-        shader!("val_shade.wgsl"),
-        shader!("val_views.wgsl"),
-        shader!("val_downsample.wgsl"),
-    ],
-    entry_shaders: &[
-        "methods/val/val_shade.wgsl",
-        "methods/val/val_views.wgsl",
-        "methods/val/val_downsample.wgsl",
-    ],
+    shaders: SHADERS,
+    entry_shaders: ENTRY_SHADERS,
     wgsl_twins: pass::WGSL_TWINS,
     own_workgroups: &[crate::gpu::passes::OwnWorkgroup {
         // The seeds' compaction: one workgroup.
