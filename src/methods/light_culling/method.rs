@@ -17,24 +17,8 @@ impl Method for LightCulling {
             (grid.count(), lc.max_lights_per_tile)
         };
         let vpl_capacity = cx.vpl_buffers.capacity;
-        if !self.buffers.matches(vpl_capacity, cx.size, tiles, cap) {
-            let need = LcullBuffers::list_bytes(tiles, cap);
-            let limit = cx.device.limits().max_storage_buffer_binding_size;
-            if need > limit {
-                cx.errors.report(format!(
-                    "light culling: {tiles} tiles x {cap} list entries need a {} MiB buffer; this \
-                     device binds at most {} MiB (lower methods.light-culling.max_lights_per_tile \
-                     or raise tile_size)",
-                    need >> 20,
-                    limit >> 20
-                ));
-                enc.clear_buffer(cx.gi_accum, 0, None);
-                self.state = None;
-                self.companion = None;
-                return 1.0;
-            }
-            self.buffers = LcullBuffers::new(cx.device, vpl_capacity, cx.size, tiles, cap);
-            self.companion = None;
+        if !self.fit_buffers(cx, enc, tiles, cap) {
+            return 1.0;
         }
         let frames = match self.state {
             Some((k, m, n)) if s.sampling.accumulate && k == cx.key && m == cx.method => n + 1,
@@ -93,52 +77,11 @@ impl Method for LightCulling {
         // The difference view's companion: the other variant with the same settings, in
         // diagnostic frames while the view is drawn, recorded first (the own run then leaves
         // its lists and counters for the other views).
-        if cx.diagnostics && cx.views.contains(&DIFFERENCE) {
-            self.buffers.ensure_companion(cx.device);
-            let other = if cx.method == CLAMPED { ID } else { CLAMPED };
-            let n = match self.companion {
-                Some((k, m, n)) if s.sampling.accumulate && k == cx.key && m == other => n + 1,
-                _ => 1,
-            };
-            self.companion = Some((cx.key, other, n));
-            let cp = GpuLcullParams {
-                mode: (other == CLAMPED) as u32,
-                ..p
-            };
-            let cfp = GpuFilterParams {
-                accumulate: (n > 1) as u32,
-                ..fp
-            };
-            let Some(companion) = self.buffers.companion.as_ref() else {
-                return 0.0;
-            };
-            let inputs = FrameInputs {
-                scene: cx.scene,
-                gbuffer: &cx.targets.gbuffer,
-                camera: cx.camera,
-                vpls: &cx.vpl_buffers.vpls,
-                accum: &companion.accum,
-            };
-            let ism = ism_frame(
-                &self.settings.ism,
-                &self.ism_points,
-                &self.ism_targets,
-                self.ism_maps,
-                ism_flags & 1 != 0,
-            );
-            self.pass.record(
-                true,
-                true,
-                cx.device,
-                cx.queue,
-                enc,
-                cx.timer,
-                cp,
-                cfp,
-                &inputs,
-                &self.buffers,
-                ism.as_ref(),
-            );
+        if cx.diagnostics
+            && cx.views.contains(&DIFFERENCE)
+            && !self.record_companion(cx, enc, p, fp, ism_flags)
+        {
+            return 0.0;
         }
         let inputs = FrameInputs {
             scene: cx.scene,
@@ -320,154 +263,12 @@ impl Method for LightCulling {
         if self.state.is_none() || x >= b.size.0 || y >= b.size.1 {
             return Ok(None);
         }
-        let read_spheres =
-            |lights: &wgpu::Buffer, capacity: u32, list: &[u32]| -> Result<Vec<[f32; 4]>, GpuError> {
-                let ranges: Vec<(u64, u64)> = list
-                    .iter()
-                    .filter(|&&i| i < capacity)
-                    .map(|&i| (32 * i as u64, 16))
-                    .collect();
-                Ok(readback::read_buffer_ranges(ctx, lights, &ranges)?
-                    .iter()
-                    .map(|v| bytemuck::pod_read_unaligned::<[f32; 4]>(&v[..16]))
-                    .collect())
-            };
-        let (title, mut rows, spheres) = if self.is_tree() {
-            let Some(t) = self.tree.as_ref().filter(|t| t.size == b.size) else {
-                return Ok(None);
-            };
-            let k = (y * b.size.0 + x) as u64;
-            let mv = readback::read_buffer_range(ctx, &t.m, 8 * k, 8)?;
-            let [m, visited]: [u32; 2] = bytemuck::pod_read_unaligned(&mv[..8]);
-            let listed = m.min(t.k);
-            let list: Vec<u32> = if listed > 0 {
-                bytemuck::pod_collect_to_vec(&readback::read_buffer_range(
-                    ctx,
-                    &t.list,
-                    4 * k * t.k as u64,
-                    4 * listed as u64,
-                )?)
-            } else {
-                Vec::new()
-            };
-            let spheres = read_spheres(&t.lights, t.leaves, &list)?;
-            let rows = vec![
-                (
-                    "VPLs in range (m) / listed (k)".to_string(),
-                    format!(
-                        "{m} / {listed} (k = {}; each kept with probability min(k / m, 1))",
-                        t.k
-                    ),
-                ),
-                ("tree nodes visited".into(), visited.to_string()),
-            ];
-            (
-                "the range spheres of its reservoir list (bounding-sphere tree, section 5)".to_string(),
-                rows,
-                spheres,
-            )
+        let list = if self.is_tree() {
+            self.read_tree_list(ctx, pixel)?
         } else {
-            let grid = Self::grid(&self.settings, b.size);
-            let t = grid.tile_of(x, y);
-            if t >= b.tiles {
-                return Ok(None);
-            }
-            let count_bytes = readback::read_buffer_range(ctx, &b.tile_count, 4 * t as u64, 4)?;
-            let count = bytemuck::pod_read_unaligned::<u32>(&count_bytes[..4]);
-            let listed = count.min(b.cap);
-            let list: Vec<u32> = if listed > 0 {
-                bytemuck::pod_collect_to_vec(&readback::read_buffer_range(
-                    ctx,
-                    &b.tile_lists,
-                    4 * t as u64 * b.cap as u64,
-                    4 * listed as u64,
-                )?)
-            } else {
-                Vec::new()
-            };
-            let spheres = read_spheres(&b.lights, b.vpl_capacity, &list)?;
-            let subset = x % grid.n + grid.n * (y % grid.n);
-            let rows = vec![
-                (
-                    "tile (interleaving subset)".to_string(),
-                    format!("{t} (subset {subset} of {})", grid.n * grid.n),
-                ),
-                (
-                    "VPLs in the tile's list".into(),
-                    if count > b.cap {
-                        format!(
-                            "{count}: over the cap of {}, the pixel tests its whole subset",
-                            b.cap
-                        )
-                    } else {
-                        count.to_string()
-                    },
-                ),
-            ];
-            let variant = if self.state.is_some_and(|(_, m, _)| m == CLAMPED) {
-                "clamped ranges"
-            } else {
-                "stochastic ranges of the frame's xi"
-            };
-            (
-                format!("the range spheres of its tile's light list ({variant})"),
-                rows,
-                spheres,
-            )
+            self.read_tile_list(ctx, pixel)?
         };
-        let holds = |s: &[f32; 4]| glam::Vec3::new(s[0], s[1], s[2]).distance(position) < s[3];
-        let mut order: Vec<usize> = (0..spheres.len()).collect();
-        order.sort_by_key(|&k| !holds(&spheres[k]));
-        let inside = spheres.iter().filter(|s| holds(s)).count();
-        let mut prims = Vec::new();
-        for &k in order.iter().take(OVERLAY_SPHERES) {
-            let s = spheres[k];
-            let c = glam::Vec3::new(s[0], s[1], s[2]);
-            let color = if holds(&s) {
-                crate::methods::overlay::Rgba8::rgb(90, 230, 110)
-            } else {
-                crate::methods::overlay::Rgba8::rgba(255, 160, 40, 140)
-            };
-            prims.push(Prim::Sphere {
-                center: c,
-                radius: s[3].min(1e6),
-                color,
-            });
-            prims.push(Prim::Point(c, color));
-        }
-        prims.push(Prim::Point(position, crate::methods::overlay::Rgba8::WHITE));
-        rows.push((
-            "range spheres holding the pixel's point".into(),
-            format!("{inside} of {} listed", spheres.len()),
-        ));
-        let (rmin, rmax) = spheres
-            .iter()
-            .fold((f32::INFINITY, 0.0f32), |(a, b), s| (a.min(s[3]), b.max(s[3])));
-        if !spheres.is_empty() {
-            rows.push((
-                "range radii of the list (scene units)".into(),
-                format!("{rmin:.3} .. {rmax:.3}"),
-            ));
-        }
-        rows.push((
-            "spheres drawn".into(),
-            format!("{} of {}", spheres.len().min(OVERLAY_SPHERES), spheres.len()),
-        ));
-        Ok(Some(MethodOverlay {
-            title,
-            rows,
-            key: if self.is_tree() {
-                "green: the listed VPLs (each range sphere holds the pixel's point; one of them \
-                 is shaded, resampled by eq. 8); white: the pixel"
-                    .into()
-            } else {
-                "green: listed VPLs whose range sphere holds the pixel's point (the ones that \
-                 light it); orange: listed for the tile but out of the pixel's range; white: \
-                 the pixel"
-                    .into()
-            },
-            prims,
-        }))
+        Ok(list.map(|(title, rows, spheres)| self.overlay_of(title, rows, spheres, position)))
     }
 
     fn legend(&self, view: MethodView, _tree_levels: u32) -> Option<Legend> {
@@ -639,4 +440,184 @@ impl Method for LightCulling {
             st.rays_per_pixel()
         ))
     }
+}
+
+impl LightCulling {
+    /// The pinned pixel's reservoir list (the tree variant): the overlay's title, rows and
+    /// the listed VPLs' range spheres.
+    fn read_tree_list(&self, ctx: &GpuContext, (x, y): (u32, u32)) -> Result<Option<OverlayList>, GpuError> {
+        let b = &self.buffers;
+        let Some(t) = self.tree.as_ref().filter(|t| t.size == b.size) else {
+            return Ok(None);
+        };
+        let k = (y * b.size.0 + x) as u64;
+        let mv = readback::read_buffer_range(ctx, &t.m, 8 * k, 8)?;
+        let [m, visited]: [u32; 2] = bytemuck::pod_read_unaligned(&mv[..8]);
+        let listed = m.min(t.k);
+        let list: Vec<u32> = if listed > 0 {
+            bytemuck::pod_collect_to_vec(&readback::read_buffer_range(
+                ctx,
+                &t.list,
+                4 * k * t.k as u64,
+                4 * listed as u64,
+            )?)
+        } else {
+            Vec::new()
+        };
+        let spheres = read_spheres(ctx, &t.lights, t.leaves, &list)?;
+        let rows = vec![
+            (
+                "VPLs in range (m) / listed (k)".to_string(),
+                format!(
+                    "{m} / {listed} (k = {}; each kept with probability min(k / m, 1))",
+                    t.k
+                ),
+            ),
+            ("tree nodes visited".into(), visited.to_string()),
+        ];
+        Ok(Some((
+            "the range spheres of its reservoir list (bounding-sphere tree, section 5)".to_string(),
+            rows,
+            spheres,
+        )))
+    }
+
+    /// The pinned pixel's tile list (the tiled variants): the overlay's title, rows and the
+    /// listed VPLs' range spheres.
+    fn read_tile_list(&self, ctx: &GpuContext, (x, y): (u32, u32)) -> Result<Option<OverlayList>, GpuError> {
+        let b = &self.buffers;
+        let grid = Self::grid(&self.settings, b.size);
+        let t = grid.tile_of(x, y);
+        if t >= b.tiles {
+            return Ok(None);
+        }
+        let count_bytes = readback::read_buffer_range(ctx, &b.tile_count, 4 * t as u64, 4)?;
+        let count = bytemuck::pod_read_unaligned::<u32>(&count_bytes[..4]);
+        let listed = count.min(b.cap);
+        let list: Vec<u32> = if listed > 0 {
+            bytemuck::pod_collect_to_vec(&readback::read_buffer_range(
+                ctx,
+                &b.tile_lists,
+                4 * t as u64 * b.cap as u64,
+                4 * listed as u64,
+            )?)
+        } else {
+            Vec::new()
+        };
+        let spheres = read_spheres(ctx, &b.lights, b.vpl_capacity, &list)?;
+        let subset = x % grid.n + grid.n * (y % grid.n);
+        let rows = vec![
+            (
+                "tile (interleaving subset)".to_string(),
+                format!("{t} (subset {subset} of {})", grid.n * grid.n),
+            ),
+            (
+                "VPLs in the tile's list".into(),
+                if count > b.cap {
+                    format!(
+                        "{count}: over the cap of {}, the pixel tests its whole subset",
+                        b.cap
+                    )
+                } else {
+                    count.to_string()
+                },
+            ),
+        ];
+        let variant = if self.state.is_some_and(|(_, m, _)| m == CLAMPED) {
+            "clamped ranges"
+        } else {
+            "stochastic ranges of the frame's xi"
+        };
+        Ok(Some((
+            format!("the range spheres of its tile's light list ({variant})"),
+            rows,
+            spheres,
+        )))
+    }
+
+    /// The overlay of a pinned pixel at `position` from its list's `title`, `rows` and range
+    /// spheres: the spheres holding the point first, at most [`OVERLAY_SPHERES`].
+    fn overlay_of(
+        &self,
+        title: String,
+        mut rows: Vec<(String, String)>,
+        spheres: Vec<[f32; 4]>,
+        position: glam::Vec3,
+    ) -> MethodOverlay {
+        let holds = |s: &[f32; 4]| glam::Vec3::new(s[0], s[1], s[2]).distance(position) < s[3];
+        let mut order: Vec<usize> = (0..spheres.len()).collect();
+        order.sort_by_key(|&k| !holds(&spheres[k]));
+        let inside = spheres.iter().filter(|s| holds(s)).count();
+        let mut prims = Vec::new();
+        for &k in order.iter().take(OVERLAY_SPHERES) {
+            let s = spheres[k];
+            let c = glam::Vec3::new(s[0], s[1], s[2]);
+            let color = if holds(&s) {
+                crate::methods::overlay::Rgba8::rgb(90, 230, 110)
+            } else {
+                crate::methods::overlay::Rgba8::rgba(255, 160, 40, 140)
+            };
+            prims.push(Prim::Sphere {
+                center: c,
+                radius: s[3].min(1e6),
+                color,
+            });
+            prims.push(Prim::Point(c, color));
+        }
+        prims.push(Prim::Point(position, crate::methods::overlay::Rgba8::WHITE));
+        rows.push((
+            "range spheres holding the pixel's point".into(),
+            format!("{inside} of {} listed", spheres.len()),
+        ));
+        let (rmin, rmax) = spheres
+            .iter()
+            .fold((f32::INFINITY, 0.0f32), |(a, b), s| (a.min(s[3]), b.max(s[3])));
+        if !spheres.is_empty() {
+            rows.push((
+                "range radii of the list (scene units)".into(),
+                format!("{rmin:.3} .. {rmax:.3}"),
+            ));
+        }
+        rows.push((
+            "spheres drawn".into(),
+            format!("{} of {}", spheres.len().min(OVERLAY_SPHERES), spheres.len()),
+        ));
+        MethodOverlay {
+            title,
+            rows,
+            key: if self.is_tree() {
+                "green: the listed VPLs (each range sphere holds the pixel's point; one of them \
+             is shaded, resampled by eq. 8); white: the pixel"
+                    .into()
+            } else {
+                "green: listed VPLs whose range sphere holds the pixel's point (the ones that \
+             light it); orange: listed for the tile but out of the pixel's range; white: \
+             the pixel"
+                    .into()
+            },
+            prims,
+        }
+    }
+}
+
+/// An overlay's title, (what, value) rows and the listed VPLs' range spheres.
+type OverlayList = (String, Vec<(String, String)>, Vec<[f32; 4]>);
+
+/// The range spheres (centre, radius) of the VPLs `list` names in `lights` (those below
+/// `capacity`).
+fn read_spheres(
+    ctx: &GpuContext,
+    lights: &wgpu::Buffer,
+    capacity: u32,
+    list: &[u32],
+) -> Result<Vec<[f32; 4]>, GpuError> {
+    let ranges: Vec<(u64, u64)> = list
+        .iter()
+        .filter(|&&i| i < capacity)
+        .map(|&i| (32 * i as u64, 16))
+        .collect();
+    Ok(readback::read_buffer_ranges(ctx, lights, &ranges)?
+        .iter()
+        .map(|v| bytemuck::pod_read_unaligned::<[f32; 4]>(&v[..16]))
+        .collect())
 }

@@ -219,3 +219,98 @@ impl LightCulling {
         1.0 / frames as f32
     }
 }
+
+impl LightCulling {
+    /// Sizes the tiled variant's buffers for `tiles` lists of `cap` entries. False (with the
+    /// error reported, the accumulation cleared and the history dropped) when the lists would
+    /// exceed the device's binding limit.
+    pub(super) fn fit_buffers(
+        &mut self,
+        cx: &mut FrameCx<'_>,
+        enc: &mut wgpu::CommandEncoder,
+        tiles: u32,
+        cap: u32,
+    ) -> bool {
+        let vpl_capacity = cx.vpl_buffers.capacity;
+        if self.buffers.matches(vpl_capacity, cx.size, tiles, cap) {
+            return true;
+        }
+        let need = LcullBuffers::list_bytes(tiles, cap);
+        let limit = cx.device.limits().max_storage_buffer_binding_size;
+        if need > limit {
+            cx.errors.report(format!(
+                "light culling: {tiles} tiles x {cap} list entries need a {} MiB buffer; this \
+                 device binds at most {} MiB (lower methods.light-culling.max_lights_per_tile \
+                 or raise tile_size)",
+                need >> 20,
+                limit >> 20
+            ));
+            enc.clear_buffer(cx.gi_accum, 0, None);
+            self.state = None;
+            self.companion = None;
+            return false;
+        }
+        self.buffers = LcullBuffers::new(cx.device, vpl_capacity, cx.size, tiles, cap);
+        self.companion = None;
+        true
+    }
+
+    /// The difference view's companion: the other tiled variant with the same parameters
+    /// `p` / `fp`, into the companion's own accumulation. False when the companion buffers
+    /// are missing.
+    pub(super) fn record_companion(
+        &mut self,
+        cx: &mut FrameCx<'_>,
+        enc: &mut wgpu::CommandEncoder,
+        p: GpuLcullParams,
+        fp: GpuFilterParams,
+        ism_flags: u32,
+    ) -> bool {
+        self.buffers.ensure_companion(cx.device);
+        let other = if cx.method == CLAMPED { ID } else { CLAMPED };
+        let n = match self.companion {
+            Some((k, m, n)) if cx.settings.sampling.accumulate && k == cx.key && m == other => n + 1,
+            _ => 1,
+        };
+        self.companion = Some((cx.key, other, n));
+        let cp = GpuLcullParams {
+            mode: (other == CLAMPED) as u32,
+            ..p
+        };
+        let cfp = GpuFilterParams {
+            accumulate: (n > 1) as u32,
+            ..fp
+        };
+        let Some(companion) = self.buffers.companion.as_ref() else {
+            return false;
+        };
+        let inputs = FrameInputs {
+            scene: cx.scene,
+            gbuffer: &cx.targets.gbuffer,
+            camera: cx.camera,
+            vpls: &cx.vpl_buffers.vpls,
+            accum: &companion.accum,
+        };
+        let ism = ism_frame(
+            &self.settings.ism,
+            &self.ism_points,
+            &self.ism_targets,
+            self.ism_maps,
+            ism_flags & 1 != 0,
+        );
+        self.pass.record(
+            true,
+            true,
+            cx.device,
+            cx.queue,
+            enc,
+            cx.timer,
+            cp,
+            cfp,
+            &inputs,
+            &self.buffers,
+            ism.as_ref(),
+        );
+        true
+    }
+}
