@@ -94,77 +94,16 @@ impl LiPass {
             })
             .collect();
         self.params.write(device, queue, &all);
-        let g = f.gbuffer;
 
         self.build.record(
             device, queue, encoder, timer, "li_build", seed, f.tree, &b.cones, &b.reps,
         );
 
-        let rbind = self.records_kernel.bind(
-            device,
-            0,
-            &[
-                ("lp", self.params.binding()),
-                ("gb_position", tex(&g.position_view)),
-                ("gb_normal", tex(&g.normal_view)),
-                ("camera", buf(f.camera)),
-                ("bvh_nodes", buf(&f.scene.bvh_nodes)),
-                ("bvh_triangles", buf(&f.scene.bvh_triangles)),
-                ("radius", buf(&b.radius)),
-                ("tile_count", buf(&b.tile_count)),
-                ("tile_recs", buf(&b.tile_recs)),
-                ("tile_offset", buf(&b.tile_offset)),
-                ("records", buf(&b.records)),
-                ("rec_meta", buf(&b.rec_meta)),
-            ],
-        );
-        let tiles = b.tiles.0 * b.tiles.1;
-        for (name, pipe, groups) in [
-            ("li_radius", &self.radius, groups_image(p.width, p.height)),
-            ("li_place", &self.place, {
-                let (gx, gy) = groups_1d_as_2d(tiles);
-                (gx, gy, 1)
-            }),
-            ("li_compact", &self.compact, (1, 1, 1)),
-        ] {
-            encoder.push_debug_group(name);
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(name),
-                    timestamp_writes: timer.compute_pass(name),
-                });
-                pass.set_pipeline(pipe);
-                pass.set_bind_group(0, &rbind, &[0]);
-                pass.dispatch_workgroups(groups.0, groups.1, groups.2);
-            }
-            encoder.pop_debug_group();
-        }
+        self.record_records(device, encoder, timer, &p, f, b);
 
         if diagnostics {
             encoder.clear_buffer(&b.stats, 0, None);
             encoder.clear_buffer(&b.trace, 0, None);
-        }
-        fn cut_bindings<'a>(
-            f: &FrameInputs<'a>,
-            b: &'a LiBuffers,
-            lanes: &'a wgpu::Buffer,
-        ) -> CutBindings<'a> {
-            CutBindings {
-                tree: f.tree,
-                scene: f.scene,
-                gbuffer: f.gbuffer,
-                cones: &b.cones,
-                reps: &b.reps,
-                accum: f.accum,
-                diag: &b.diag,
-                stats: &b.stats,
-                trace: &b.trace,
-                scratch: &b.scratch,
-                state: &b.lc_state,
-                lanes,
-                record_cuts: &b.record_cuts,
-                rec_meta: &b.rec_meta,
-            }
         }
         let rb = cut_bindings(f, b, &b.records);
         self.record_cuts.record(
@@ -184,57 +123,10 @@ impl LiPass {
             &rb,
         );
 
-        let sbind = self.select_kernel.bind(
-            device,
-            0,
-            &[
-                ("lp", self.params.binding()),
-                ("gb_position", tex(&g.position_view)),
-                ("gb_normal", tex(&g.normal_view)),
-                ("radius", buf(&b.radius)),
-                ("tile_count", buf(&b.tile_count)),
-                ("tile_offset", buf(&b.tile_offset)),
-                ("records", buf(&b.records)),
-                ("rec_meta", buf(&b.rec_meta)),
-                ("sel", buf(&b.sel)),
-            ],
-        );
-        encoder.push_debug_group("li_select");
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("li_select"),
-                timestamp_writes: timer.compute_pass("li_select"),
-            });
-            pass.set_pipeline(&self.select);
-            pass.set_bind_group(0, &sbind, &[0]);
-            let (x, y, z) = groups_image(p.width, p.height);
-            pass.dispatch_workgroups(x, y, z);
-        }
-        encoder.pop_debug_group();
+        self.record_select(device, encoder, timer, &p, f, b);
 
-        let ibind = self.interp_kernel.bind(
-            device,
-            0,
-            &[
-                ("lp", self.params.binding()),
-                ("gb_position", tex(&g.position_view)),
-                ("gb_normal", tex(&g.normal_view)),
-                ("gb_albedo", tex(&g.albedo_view)),
-                ("rec_meta", buf(&b.rec_meta)),
-                ("record_cuts", buf(&b.record_cuts)),
-                ("sel", buf(&b.sel)),
-                ("tree", buf(&f.tree.nodes)),
-                ("sorted_vpls", buf(&f.tree.sorted_vpls)),
-                ("reps", buf(&b.reps)),
-                ("bvh_nodes", buf(&f.scene.bvh_nodes)),
-                ("bvh_triangles", buf(&f.scene.bvh_triangles)),
-                ("accum", buf(f.accum)),
-                ("diag", buf(&b.diag)),
-                ("stats", buf(&b.stats)),
-                ("trace", buf(&b.trace)),
-                ("state", buf(&b.walk_state)),
-            ],
-        );
+        // The interpolation from the selected records, one dispatch per walk uniform.
+        let ibind = self.interp_bind(device, f, b);
         encoder.push_debug_group("li_interp");
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -315,5 +207,147 @@ impl LiPass {
             &bind,
             groups_image(b.size.0, b.size.1),
         );
+    }
+}
+
+impl LiPass {
+    /// The records: each pixel's record radius, the records placed per tile, then compacted.
+    fn record_records(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: &GpuLiParams,
+        f: &FrameInputs<'_>,
+        b: &LiBuffers,
+    ) {
+        let g = f.gbuffer;
+        let rbind = self.records_kernel.bind(
+            device,
+            0,
+            &[
+                ("lp", self.params.binding()),
+                ("gb_position", tex(&g.position_view)),
+                ("gb_normal", tex(&g.normal_view)),
+                ("camera", buf(f.camera)),
+                ("bvh_nodes", buf(&f.scene.bvh_nodes)),
+                ("bvh_triangles", buf(&f.scene.bvh_triangles)),
+                ("radius", buf(&b.radius)),
+                ("tile_count", buf(&b.tile_count)),
+                ("tile_recs", buf(&b.tile_recs)),
+                ("tile_offset", buf(&b.tile_offset)),
+                ("records", buf(&b.records)),
+                ("rec_meta", buf(&b.rec_meta)),
+            ],
+        );
+        let tiles = b.tiles.0 * b.tiles.1;
+        for (name, pipe, groups) in [
+            ("li_radius", &self.radius, groups_image(p.width, p.height)),
+            ("li_place", &self.place, {
+                let (gx, gy) = groups_1d_as_2d(tiles);
+                (gx, gy, 1)
+            }),
+            ("li_compact", &self.compact, (1, 1, 1)),
+        ] {
+            encoder.push_debug_group(name);
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(name),
+                    timestamp_writes: timer.compute_pass(name),
+                });
+                pass.set_pipeline(pipe);
+                pass.set_bind_group(0, &rbind, &[0]);
+                pass.dispatch_workgroups(groups.0, groups.1, groups.2);
+            }
+            encoder.pop_debug_group();
+        }
+    }
+
+    /// The selection: each pixel's records to interpolate from.
+    fn record_select(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        p: &GpuLiParams,
+        f: &FrameInputs<'_>,
+        b: &LiBuffers,
+    ) {
+        let g = f.gbuffer;
+        let sbind = self.select_kernel.bind(
+            device,
+            0,
+            &[
+                ("lp", self.params.binding()),
+                ("gb_position", tex(&g.position_view)),
+                ("gb_normal", tex(&g.normal_view)),
+                ("radius", buf(&b.radius)),
+                ("tile_count", buf(&b.tile_count)),
+                ("tile_offset", buf(&b.tile_offset)),
+                ("records", buf(&b.records)),
+                ("rec_meta", buf(&b.rec_meta)),
+                ("sel", buf(&b.sel)),
+            ],
+        );
+        encoder.push_debug_group("li_select");
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("li_select"),
+                timestamp_writes: timer.compute_pass("li_select"),
+            });
+            pass.set_pipeline(&self.select);
+            pass.set_bind_group(0, &sbind, &[0]);
+            let (x, y, z) = groups_image(p.width, p.height);
+            pass.dispatch_workgroups(x, y, z);
+        }
+        encoder.pop_debug_group();
+    }
+
+    /// The interpolation's bind group.
+    fn interp_bind(&self, device: &wgpu::Device, f: &FrameInputs<'_>, b: &LiBuffers) -> wgpu::BindGroup {
+        let g = f.gbuffer;
+        self.interp_kernel.bind(
+            device,
+            0,
+            &[
+                ("lp", self.params.binding()),
+                ("gb_position", tex(&g.position_view)),
+                ("gb_normal", tex(&g.normal_view)),
+                ("gb_albedo", tex(&g.albedo_view)),
+                ("rec_meta", buf(&b.rec_meta)),
+                ("record_cuts", buf(&b.record_cuts)),
+                ("sel", buf(&b.sel)),
+                ("tree", buf(&f.tree.nodes)),
+                ("sorted_vpls", buf(&f.tree.sorted_vpls)),
+                ("reps", buf(&b.reps)),
+                ("bvh_nodes", buf(&f.scene.bvh_nodes)),
+                ("bvh_triangles", buf(&f.scene.bvh_triangles)),
+                ("accum", buf(f.accum)),
+                ("diag", buf(&b.diag)),
+                ("stats", buf(&b.stats)),
+                ("trace", buf(&b.trace)),
+                ("state", buf(&b.walk_state)),
+            ],
+        )
+    }
+}
+
+/// The lightcut kernel's bindings of a frame, `lanes` its per-lane work list.
+fn cut_bindings<'a>(f: &FrameInputs<'a>, b: &'a LiBuffers, lanes: &'a wgpu::Buffer) -> CutBindings<'a> {
+    CutBindings {
+        tree: f.tree,
+        scene: f.scene,
+        gbuffer: f.gbuffer,
+        cones: &b.cones,
+        reps: &b.reps,
+        accum: f.accum,
+        diag: &b.diag,
+        stats: &b.stats,
+        trace: &b.trace,
+        scratch: &b.scratch,
+        state: &b.lc_state,
+        lanes,
+        record_cuts: &b.record_cuts,
+        rec_meta: &b.rec_meta,
     }
 }
