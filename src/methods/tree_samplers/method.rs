@@ -15,50 +15,11 @@ impl Method for TreeSamplers {
         // and is upsampled into the full-resolution accumulation afterwards.
         let half = sm.half_resolution;
         let gi_size = if half { HalfTargets::half_size(size) } else { size };
-        if !self.buffers.matches(gi_size, sm.block_size, sm.cut_size) {
-            let need = SlcBuffers::largest_binding(gi_size, sm.block_size, sm.cut_size);
-            let limit = device.limits().max_storage_buffer_binding_size;
-            if need > limit {
-                // Refuse (once per change) rather than fail validation; GI stays black.
-                cx.errors.report(format!(
-                    "sampling: {}x{} pixels with {}x{} blocks and cuts of {} need a {} MiB buffer; \
-                     this device binds at most {} MiB (raise sampling.block_size or lower cut_size)",
-                    gi_size.0,
-                    gi_size.1,
-                    sm.block_size,
-                    sm.block_size,
-                    sm.cut_size,
-                    need >> 20,
-                    limit >> 20
-                ));
-                enc.clear_buffer(cx.gi_accum, 0, None);
-                self.state = None;
-                return 1.0;
-            }
-            self.buffers = SlcBuffers::new(device, gi_size, sm.block_size, sm.cut_size);
+        if !self.fit_buffers(cx, enc, gi_size) {
+            return 1.0;
         }
         let d_max = s.vpl.d_max * cx.scene_radius;
-        let half_targets = if half {
-            let h = match self.half.take() {
-                Some(h) if h.size == gi_size => h,
-                _ => HalfTargets::new(device, size),
-            };
-            self.half_pass.record_downsample(
-                device,
-                cx.queue,
-                enc,
-                cx.timer,
-                &cx.targets.gbuffer,
-                size,
-                &h,
-                s.vpl.n_min,
-                d_max,
-            );
-            Some(h)
-        } else {
-            self.half = None;
-            None
-        };
+        let half_targets = self.record_downsample(cx, enc, gi_size, d_max);
         // Accumulate while nothing changes (the key also covers the method and its settings);
         // a frozen tree keeps its VPLs, otherwise new VPLs average in too.
         let key = cx.key;
@@ -77,15 +38,7 @@ impl Method for TreeSamplers {
         // `raw`, the filter then averages the pattern into the accumulation.
         let il = &sm.interleave;
         let filtered = il.filters();
-        if !filtered {
-            self.raw = None;
-        } else if self.raw.as_ref().is_none_or(|(_, sz)| *sz != gi_size) {
-            let bytes = 16 * gi_size.0 as u64 * gi_size.1 as u64;
-            self.raw = Some((
-                crate::gpu::passes::storage_buffer(device, "slc::interleaved_raw", bytes),
-                gi_size,
-            ));
-        }
+        self.fit_raw(device, filtered, gi_size);
         let seed = if sm.fixed_seed {
             s.vpl.seed
         } else {
@@ -186,29 +139,7 @@ impl Method for TreeSamplers {
             ism.as_ref(),
         );
         if let Some(raw) = raw {
-            // The demodulated estimate's mean over the pattern, x albedo (at half resolution
-            // it stays demodulated: the upsampler applies the full-resolution albedo).
-            let fp = GpuFilterParams {
-                accumulate: (frames > 1) as u32,
-                modulate: (!half) as u32,
-                ..GpuFilterParams::new(gi_size, il)
-            };
-            let inputs = FilterInputs {
-                gbuffer,
-                camera: cx.camera,
-                raw,
-                accum,
-            };
-            self.filter.record(
-                device,
-                cx.queue,
-                enc,
-                cx.timer,
-                "slc_filter",
-                &self.filter_params,
-                fp,
-                &inputs,
-            );
+            self.record_filter(cx, enc, half_targets.as_ref(), gi_size, frames, raw);
         }
         if let Some(h) = half_targets {
             self.half_pass
@@ -345,5 +276,131 @@ impl Method for TreeSamplers {
             100.0 * st.fallback_fraction(),
             st.dead
         ))
+    }
+}
+
+impl TreeSamplers {
+    /// Sizes the sampler's buffers for the GI resolution `gi_size`. False (reported, the
+    /// accumulation cleared, the history dropped) when they exceed the device's binding size.
+    fn fit_buffers(
+        &mut self,
+        cx: &mut FrameCx<'_>,
+        enc: &mut wgpu::CommandEncoder,
+        gi_size: (u32, u32),
+    ) -> bool {
+        let sm = &cx.settings.sampling;
+        let device = cx.device;
+        if self.buffers.matches(gi_size, sm.block_size, sm.cut_size) {
+            return true;
+        }
+        let need = SlcBuffers::largest_binding(gi_size, sm.block_size, sm.cut_size);
+        let limit = device.limits().max_storage_buffer_binding_size;
+        if need > limit {
+            // Refuse (once per change) rather than fail validation; GI stays black.
+            cx.errors.report(format!(
+                "sampling: {}x{} pixels with {}x{} blocks and cuts of {} need a {} MiB buffer; \
+                 this device binds at most {} MiB (raise sampling.block_size or lower cut_size)",
+                gi_size.0,
+                gi_size.1,
+                sm.block_size,
+                sm.block_size,
+                sm.cut_size,
+                need >> 20,
+                limit >> 20
+            ));
+            enc.clear_buffer(cx.gi_accum, 0, None);
+            self.state = None;
+            return false;
+        }
+        self.buffers = SlcBuffers::new(device, gi_size, sm.block_size, sm.cut_size);
+        true
+    }
+
+    /// Half-resolution GI: the half-resolution targets of the frame (kept from the last frame
+    /// at the same size), with the G-buffer downsampled into them; None at full resolution.
+    fn record_downsample(
+        &mut self,
+        cx: &mut FrameCx<'_>,
+        enc: &mut wgpu::CommandEncoder,
+        gi_size: (u32, u32),
+        d_max: f32,
+    ) -> Option<HalfTargets> {
+        let s = cx.settings;
+        let device = cx.device;
+        let size = cx.size;
+        if s.sampling.half_resolution {
+            let h = match self.half.take() {
+                Some(h) if h.size == gi_size => h,
+                _ => HalfTargets::new(device, size),
+            };
+            self.half_pass.record_downsample(
+                device,
+                cx.queue,
+                enc,
+                cx.timer,
+                &cx.targets.gbuffer,
+                size,
+                &h,
+                s.vpl.n_min,
+                d_max,
+            );
+            Some(h)
+        } else {
+            self.half = None;
+            None
+        }
+    }
+
+    /// The interleaved sampler's per-frame estimate (`raw`) at the GI resolution while the
+    /// interleave pattern is filtered.
+    fn fit_raw(&mut self, device: &wgpu::Device, filtered: bool, gi_size: (u32, u32)) {
+        if !filtered {
+            self.raw = None;
+        } else if self.raw.as_ref().is_none_or(|(_, sz)| *sz != gi_size) {
+            let bytes = 16 * gi_size.0 as u64 * gi_size.1 as u64;
+            self.raw = Some((
+                crate::gpu::passes::storage_buffer(device, "slc::interleaved_raw", bytes),
+                gi_size,
+            ));
+        }
+    }
+
+    /// The interleave filter: the demodulated estimate `raw`'s mean over the pattern, x albedo
+    /// (at half resolution it stays demodulated: the upsampler applies the full-resolution
+    /// albedo), into the accumulation (`half`'s at half resolution).
+    fn record_filter(
+        &self,
+        cx: &mut FrameCx<'_>,
+        enc: &mut wgpu::CommandEncoder,
+        half: Option<&HalfTargets>,
+        gi_size: (u32, u32),
+        frames: u32,
+        raw: &wgpu::Buffer,
+    ) {
+        let (gbuffer, accum) = match half {
+            Some(h) => (&h.gbuffer, &h.accum),
+            None => (&cx.targets.gbuffer, cx.gi_accum),
+        };
+        let fp = GpuFilterParams {
+            accumulate: (frames > 1) as u32,
+            modulate: half.is_none() as u32,
+            ..GpuFilterParams::new(gi_size, &cx.settings.sampling.interleave)
+        };
+        let inputs = FilterInputs {
+            gbuffer,
+            camera: cx.camera,
+            raw,
+            accum,
+        };
+        self.filter.record(
+            cx.device,
+            cx.queue,
+            enc,
+            cx.timer,
+            "slc_filter",
+            &self.filter_params,
+            fp,
+            &inputs,
+        );
     }
 }
