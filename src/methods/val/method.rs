@@ -13,56 +13,15 @@ impl Method for Vals {
         let Some(rsm) = cx.rsm else {
             return self.fail(cx, enc, None);
         };
-        if self.buffers.size != cx.size {
-            self.buffers = ValBuffers::new(cx.device, cx.size);
-        }
         // The clustering RSM: light 0's summed down by `factor`.
         let res = vs.resolution.min(rsm.res).max(1);
         let factor = (rsm.res / res).max(1);
-        if self.coarse.as_ref().is_none_or(|c| c.res != res) {
-            self.coarse = Some(ValRsm::new(cx.device, res));
-        }
-        let capacity = cx.vpl_buffers.capacity;
-        if self.seed_list.as_ref().is_none_or(|(c, _)| *c != capacity) {
-            let b = cx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("val::seed_list"),
-                size: pass::seed_list_bytes(capacity),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            self.seed_list = Some((capacity, b));
-        }
-        if !self.targets.as_ref().is_some_and(|t| t.matches(vs.clusters, res)) {
-            let t = ValTargets::new(cx.device, vs.clusters, res);
-            self.stats = Some(CounterReadback::new(
-                cx.device,
-                "val::stats_readback",
-                (t.clusters as usize * std::mem::size_of::<GpuVal>()) as u64,
-                ValStats::from_words,
-            ));
-            self.targets = Some(t);
-        }
-        // Clusters carried over belong to one scene.
-        if self.scene_generation != cx.scene.generation {
-            self.scene_generation = cx.scene.generation;
-            if let Some(t) = self.targets.as_mut() {
-                t.unprime();
-            }
-        }
+        self.fit_targets(cx, &vs, res);
         let frames = match self.state {
             Some((k, m, n)) if s.sampling.accumulate && k == cx.key && m == cx.method => n + 1,
             _ => 1,
         };
-        let visibility = if !s.gi.shadow_rays {
-            VIS_NONE
-        } else {
-            match vs.visibility {
-                ValVisibility::Rays => VIS_RAYS,
-                ValVisibility::Ism => VIS_ISM,
-                ValVisibility::Pcss => VIS_PCSS,
-                ValVisibility::Disk => VIS_DISK,
-            }
-        };
+        let visibility = visibility_of(s, &vs);
         let maps_shown = cx.diagnostics && (cx.views.contains(&ISM_ATLAS) || cx.views.contains(&ISM_TRUE));
         let build = visibility == VIS_ISM || visibility == VIS_PCSS || maps_shown;
         self.ism_maps = 0;
@@ -380,5 +339,60 @@ impl Method for Vals {
             ("ism_maps", self.ism_maps as f64),
             ("visibility", self.visibility as f64),
         ]
+    }
+}
+
+impl Vals {
+    /// Sizes the frame's buffers, the clustering RSM (`res` texels a side), the seed list and
+    /// the cluster targets for `cx` and `vs`; clusters carried over from another scene are
+    /// dropped.
+    fn fit_targets(&mut self, cx: &FrameCx<'_>, vs: &ValSettings, res: u32) {
+        if self.buffers.size != cx.size {
+            self.buffers = ValBuffers::new(cx.device, cx.size);
+        }
+        if self.coarse.as_ref().is_none_or(|c| c.res != res) {
+            self.coarse = Some(ValRsm::new(cx.device, res));
+        }
+        let capacity = cx.vpl_buffers.capacity;
+        if self.seed_list.as_ref().is_none_or(|(c, _)| *c != capacity) {
+            let b = cx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("val::seed_list"),
+                size: pass::seed_list_bytes(capacity),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            self.seed_list = Some((capacity, b));
+        }
+        if !self.targets.as_ref().is_some_and(|t| t.matches(vs.clusters, res)) {
+            let t = ValTargets::new(cx.device, vs.clusters, res);
+            self.stats = Some(CounterReadback::new(
+                cx.device,
+                "val::stats_readback",
+                (t.clusters as usize * std::mem::size_of::<GpuVal>()) as u64,
+                ValStats::from_words,
+            ));
+            self.targets = Some(t);
+        }
+        // Clusters carried over belong to one scene.
+        if self.scene_generation != cx.scene.generation {
+            self.scene_generation = cx.scene.generation;
+            if let Some(t) = self.targets.as_mut() {
+                t.unprime();
+            }
+        }
+    }
+}
+
+/// The frame's visibility (`VIS_*`): none without shadow rays, else `vs.visibility`'s.
+fn visibility_of(s: &RenderSettings, vs: &ValSettings) -> u32 {
+    if !s.gi.shadow_rays {
+        VIS_NONE
+    } else {
+        match vs.visibility {
+            ValVisibility::Rays => VIS_RAYS,
+            ValVisibility::Ism => VIS_ISM,
+            ValVisibility::Pcss => VIS_PCSS,
+            ValVisibility::Disk => VIS_DISK,
+        }
     }
 }

@@ -342,45 +342,10 @@ impl ValPass {
             )
         };
         let per_cluster = (p.clusters.div_ceil(WG_1D), 1, 1);
-        // The clustering RSM.
-        queue.write_buffer(&self.down_params, 0, bytemuck::bytes_of(&f.down));
-        let down = self.down_kernel.bind(
-            device,
-            0,
-            &[
-                ("dp", buf(&self.down_params)),
-                ("rsm_position", tex(f.rsm[0])),
-                ("rsm_normal", tex(f.rsm[1])),
-                ("rsm_flux", tex(f.rsm[2])),
-                ("out_position", tex(&f.coarse.storage[0])),
-                ("out_normal", tex(&f.coarse.storage[1])),
-                ("out_flux", tex(&f.coarse.storage[2])),
-            ],
-        );
-        run_compute(
-            encoder,
-            timer,
-            "val_downsample",
-            &self.down,
-            &down,
-            groups_image(f.coarse.res, f.coarse.res),
-        );
-        // The seeds: claims, the unique VPLs, a seed per cluster (the VALs bound are not read).
+        self.record_downsample(device, queue, encoder, timer, f);
+        // The seeds (the VALs bound are not read).
         let before = bind(t.vals(), &t.seeds);
-        encoder.clear_buffer(&f.coarse.claim, 0, None);
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("val_seeds"),
-                timestamp_writes: timer.compute_pass("val_seeds"),
-            });
-            pass.set_bind_group(0, &before, &[]);
-            pass.set_pipeline(&self.claim);
-            pass.dispatch_workgroups(p.count.div_ceil(WG_1D).clamp(1, 65535), 1, 1);
-            pass.set_pipeline(&self.unique);
-            pass.dispatch_workgroups(1, 1, 1);
-            pass.set_pipeline(&self.seeds);
-            pass.dispatch_workgroups(per_cluster.0, 1, 1);
-        }
+        self.record_seeds(encoder, timer, f, &before, &p);
         self.cluster.record(
             device,
             queue,
@@ -562,3 +527,64 @@ pub static WGSL_TWINS: &[crate::gpu::gpu_data::WgslTwin] = &[
         [res, factor, layer, _pad, light_dir, texel_area]
     ),
 ];
+
+impl ValPass {
+    /// The clustering RSM: light 0's RSM summed down by `f.down.factor` into `f.coarse`.
+    fn record_downsample(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        f: &ValFrame<'_>,
+    ) {
+        queue.write_buffer(&self.down_params, 0, bytemuck::bytes_of(&f.down));
+        let down = self.down_kernel.bind(
+            device,
+            0,
+            &[
+                ("dp", buf(&self.down_params)),
+                ("rsm_position", tex(f.rsm[0])),
+                ("rsm_normal", tex(f.rsm[1])),
+                ("rsm_flux", tex(f.rsm[2])),
+                ("out_position", tex(&f.coarse.storage[0])),
+                ("out_normal", tex(&f.coarse.storage[1])),
+                ("out_flux", tex(&f.coarse.storage[2])),
+            ],
+        );
+        run_compute(
+            encoder,
+            timer,
+            "val_downsample",
+            &self.down,
+            &down,
+            groups_image(f.coarse.res, f.coarse.res),
+        );
+    }
+
+    /// The seeds: claims, the unique VPLs and a seed per cluster, with the shading kernel's
+    /// group `before` (its VALs unread).
+    fn record_seeds(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+        f: &ValFrame<'_>,
+        before: &wgpu::BindGroup,
+        p: &GpuValShadeParams,
+    ) {
+        encoder.clear_buffer(&f.coarse.claim, 0, None);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("val_seeds"),
+                timestamp_writes: timer.compute_pass("val_seeds"),
+            });
+            pass.set_bind_group(0, before, &[]);
+            pass.set_pipeline(&self.claim);
+            pass.dispatch_workgroups(p.count.div_ceil(WG_1D).clamp(1, 65535), 1, 1);
+            pass.set_pipeline(&self.unique);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&self.seeds);
+            pass.dispatch_workgroups(p.clusters.div_ceil(WG_1D), 1, 1);
+        }
+    }
+}
