@@ -191,18 +191,7 @@ impl Method for GroundTruth {
             eye: cx.eye.extend(0.0).to_array(),
             order: [visit_stride(total), total, 0, 0],
         };
-        gt.progress.done = self.pass.record(
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            base,
-            batch,
-            cx.scene,
-            &gt.snapshot,
-            &cx.targets.gbuffer,
-            cx.gi_accum,
-        );
+        gt.progress.done = self.pass.record(cx, enc, base, batch, &gt.snapshot);
         partial_scale(gt.progress)
     }
 

@@ -2,11 +2,9 @@
 //! VPL batches so no dispatch is long; the caller accumulates batches over frames.
 //! Reads: BVH, a VPL array, G-buffer. Writes: an accumulation buffer (rgb sum per pixel).
 
-use crate::gpu::frame::GbufferTargets;
 use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
-use crate::gpu::scene_gpu::SceneGpu;
 use crate::gpu::shaders;
-use crate::gpu::timing::GpuTimer;
+use crate::methods::FrameCx;
 use bytemuck::{Pod, Zeroable};
 
 use crate::gpu::passes::groups_2d;
@@ -43,21 +41,16 @@ impl GroundTruthPass {
         })
     }
 
-    /// Records dispatches for VPLs `[begin, end)` in batches of `batch` VPLs (at most
-    /// MAX_BATCHES batches; returns the end actually reached).
-    #[allow(clippy::too_many_arguments)]
+    /// Records dispatches for VPLs `[begin, end)` of `vpls` in batches of `batch` VPLs (at
+    /// most MAX_BATCHES batches; returns the end actually reached), shading the frame's
+    /// G-buffer against its scene into `cx.gi_accum`.
     pub fn record(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut FrameCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
         base: GpuGtParams,
         batch: u32,
-        scene: &SceneGpu,
         vpls: &wgpu::Buffer,
-        gbuffer: &GbufferTargets,
-        accum: &wgpu::Buffer,
     ) -> u32 {
         let batch = batch.max(1);
         let mut b = base.begin;
@@ -69,12 +62,13 @@ impl GroundTruthPass {
                 end: e,
                 ..base
             };
-            queue.write_buffer(&self.params, n * STRIDE, bytemuck::bytes_of(&p));
+            cx.queue
+                .write_buffer(&self.params, n * STRIDE, bytemuck::bytes_of(&p));
             b = e;
             n += 1;
         }
         let bind = self.kernel.bind(
-            device,
+            cx.device,
             0,
             &[
                 (
@@ -85,20 +79,20 @@ impl GroundTruthPass {
                         size: wgpu::BufferSize::new(std::mem::size_of::<GpuGtParams>() as u64),
                     }),
                 ),
-                ("bvh_nodes", buf(&scene.bvh_nodes)),
-                ("bvh_triangles", buf(&scene.bvh_triangles)),
+                ("bvh_nodes", buf(&cx.scene.bvh_nodes)),
+                ("bvh_triangles", buf(&cx.scene.bvh_triangles)),
                 ("vpls", buf(vpls)),
-                ("gb_position", tex(&gbuffer.position_view)),
-                ("gb_normal", tex(&gbuffer.normal_view)),
-                ("gb_albedo", tex(&gbuffer.albedo_view)),
-                ("accum", buf(accum)),
+                ("gb_position", tex(&cx.targets.gbuffer.position_view)),
+                ("gb_normal", tex(&cx.targets.gbuffer.normal_view)),
+                ("gb_albedo", tex(&cx.targets.gbuffer.albedo_view)),
+                ("accum", buf(cx.gi_accum)),
             ],
         );
         encoder.push_debug_group("ground_truth");
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("ground_truth::pass"),
-                timestamp_writes: timer.compute_pass("ground_truth"),
+                timestamp_writes: cx.timer.compute_pass("ground_truth"),
             });
             pass.set_pipeline(&self.pipeline);
             let (gx, gy) = groups_2d(base.width, base.height);

@@ -188,18 +188,9 @@ impl Method for LightCulling {
             range: DIFFERENCE_RANGE,
             _pad: [0; 2],
         };
-        self.pass.record_view(
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            p,
-            &cx.targets.lighting.final_view,
-            &cx.targets.gbuffer.position_view,
-            &cx.targets.lighting.gi_accum,
-            &self.buffers,
-            cx.dst,
-        );
+        let targets = cx.targets;
+        self.pass
+            .record_view(cx, enc, p, &targets.lighting.gi_accum, &self.buffers);
     }
 
     /// Per pixel: tile list length, VPLs in range, VPLs tested, shadow rays; the difference

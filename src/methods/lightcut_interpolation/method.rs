@@ -187,17 +187,7 @@ impl Method for LightcutInterpolation {
             pinned: self.pinned.unwrap_or(u32::MAX),
             _pad: [0; 3],
         };
-        pass.record_view(
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            p,
-            &cx.targets.lighting.final_view,
-            &cx.targets.gbuffer.position_view,
-            b,
-            cx.dst,
-        );
+        pass.record_view(cx, enc, p, b);
     }
 
     /// The pinned pixel: its records (pixel, weight, cut), the interpolated cut, and where

@@ -239,7 +239,6 @@ pub struct LiBuffers {
 }
 
 impl LiBuffers {
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         device: &wgpu::Device,
         leaves: u32,

@@ -314,20 +314,8 @@ impl Method for Lightcuts {
             self.traced = cx.trace_pixel.is_some();
         }
         self.settings = lc;
-        self.pass.record(
-            cx.diagnostics,
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            p,
-            Self::seed(s, cx.frame_index),
-            cx.tree,
-            cx.scene,
-            &cx.targets.gbuffer,
-            cx.gi_accum,
-            &self.buffers,
-        );
+        let seed = Self::seed(s, cx.frame_index);
+        self.pass.record(cx, enc, p, seed, &self.buffers);
         1.0 / frames as f32
     }
 
@@ -364,17 +352,7 @@ impl Method for Lightcuts {
             tonemap: cx.look.tonemap.gpu_id(),
             _pad: [0; 3],
         };
-        self.pass.record_view(
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            p,
-            &cx.targets.lighting.final_view,
-            &cx.targets.gbuffer.position_view,
-            &self.buffers,
-            cx.dst,
-        );
+        self.pass.record_view(cx, enc, p, &self.buffers);
     }
 
     /// The pinned pixel's cut with its refinement counters.

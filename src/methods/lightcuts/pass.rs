@@ -3,6 +3,7 @@
 //! Reads: the light tree (nodes, VPLs in leaf order), BVH, G-buffer. Writes: the GI
 //! accumulation, per-pixel diagnostics, counters and the pinned pixel's cut.
 
+use crate::methods::{FrameCx, ViewCx};
 use bytemuck::{Pod, Zeroable};
 
 use crate::gpu::context::{GpuContext, GpuError};
@@ -525,28 +526,24 @@ impl LightcutsPass {
         })
     }
 
-    /// Records `lightcuts_build` (every level, one compute pass) and `lightcuts`.
-    #[allow(clippy::too_many_arguments)]
+    /// Records `lightcuts_build` (every level, one compute pass) and `lightcuts` over the
+    /// frame's tree, scene and G-buffer into `cx.gi_accum`.
     pub fn record(
         &mut self,
-        diagnostics: bool,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut FrameCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
         p: GpuLcParams,
         seed: u32,
-        tree: &TreeBuffers,
-        scene: &SceneGpu,
-        gbuffer: &GbufferTargets,
-        accum: &wgpu::Buffer,
         out: &LcBuffers,
     ) {
+        let diagnostics = cx.diagnostics;
+        let (device, queue, tree, scene, targets) = (cx.device, cx.queue, cx.tree, cx.scene, cx.targets);
+        let (gbuffer, accum) = (&targets.gbuffer, cx.gi_accum);
         self.build.record(
             device,
             queue,
             encoder,
-            timer,
+            cx.timer,
             "lightcuts_build",
             seed,
             tree,
@@ -579,7 +576,7 @@ impl LightcutsPass {
             device,
             queue,
             encoder,
-            timer,
+            cx.timer,
             "lightcuts",
             p,
             items,
@@ -592,22 +589,21 @@ impl LightcutsPass {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// Draws one of the diagnostic views (`p.mode`) into `cx.dst`.
     pub fn record_view(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut ViewCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
         p: GpuLcViewParams,
-        final_image: &wgpu::TextureView,
-        gb_position: &wgpu::TextureView,
         out: &LcBuffers,
-        dst: &wgpu::TextureView,
     ) {
-        queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
+        let final_image = &cx.targets.lighting.final_view;
+        let gb_position = &cx.targets.gbuffer.position_view;
+        let dst = cx.dst;
+        cx.queue
+            .write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
         let bind = self.views_kernel.bind(
-            device,
+            cx.device,
             0,
             &[
                 ("vp", buf(&self.view_params)),
@@ -619,7 +615,7 @@ impl LightcutsPass {
         );
         run_compute(
             encoder,
-            timer,
+            cx.timer,
             "lightcuts_views",
             &self.views,
             &bind,

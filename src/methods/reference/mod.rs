@@ -187,19 +187,7 @@ impl Method for Reference {
                 _pad: [0; 3],
                 eye: cx.eye.extend(0.0).to_array(),
             };
-            self.pass.record(
-                cx.device,
-                cx.queue,
-                enc,
-                cx.timer,
-                p,
-                cx.vpl_params,
-                cx.vpl_buffers,
-                &cx.targets.shadow,
-                &cx.targets.gbuffer,
-                cx.scene,
-                cx.gi_accum,
-            );
+            self.pass.record(cx, enc, p);
             let bounces = cx.settings.vpl.bounces;
             if bounces > 1 {
                 // This frame's n samples of bounce 1 come with n x paths_per_sample light
@@ -257,18 +245,8 @@ impl Method for Reference {
                         // In order: each chunk is summed whole within the frame.
                         order: [0; 4],
                     };
-                    self.shade.record(
-                        cx.device,
-                        cx.queue,
-                        enc,
-                        cx.timer,
-                        base,
-                        count.div_ceil(MAX_BATCHES).max(1),
-                        cx.scene,
-                        vpls,
-                        &cx.targets.gbuffer,
-                        cx.gi_accum,
-                    );
+                    self.shade
+                        .record(cx, enc, base, count.div_ceil(MAX_BATCHES).max(1), vpls);
                 }
             }
             progress.done += n;

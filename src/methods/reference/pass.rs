@@ -4,13 +4,11 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::gpu::frame::{GbufferTargets, ShadowTargets};
 use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
-use crate::gpu::scene_gpu::SceneGpu;
 use crate::gpu::shaders;
-use crate::gpu::timing::GpuTimer;
+use crate::methods::FrameCx;
 
-use crate::gpu::passes::{groups_image, run_compute, uniform_buffer, vpl_gen::VplBuffers};
+use crate::gpu::passes::{groups_image, run_compute, uniform_buffer};
 
 /// Twin: `RefParams` in `shaders/methods/reference/reference.wgsl`.
 #[repr(C)]
@@ -54,28 +52,16 @@ impl ReferencePass {
         })
     }
 
-    /// Records `p.samples` more samples per pixel into `accum`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-        p: GpuRefParams,
-        vpl_params: &wgpu::Buffer,
-        vpl: &VplBuffers,
-        rsm: &ShadowTargets,
-        gbuffer: &GbufferTargets,
-        scene: &SceneGpu,
-        accum: &wgpu::Buffer,
-    ) {
-        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+    /// Records `p.samples` more samples per pixel into `cx.gi_accum` (from the frame's VPL
+    /// pyramids, RSM, G-buffer and scene).
+    pub fn record(&self, cx: &mut FrameCx<'_>, encoder: &mut wgpu::CommandEncoder, p: GpuRefParams) {
+        let (vpl, rsm, gbuffer, scene) = (cx.vpl_buffers, &cx.targets.shadow, &cx.targets.gbuffer, cx.scene);
+        cx.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         let bind = self.kernel.bind(
-            device,
+            cx.device,
             0,
             &[
-                ("params", buf(vpl_params)),
+                ("params", buf(cx.vpl_params)),
                 ("rp", buf(&self.params)),
                 ("rsm_position", tex(&rsm.position_array)),
                 ("rsm_normal", tex(&rsm.normal_array)),
@@ -88,12 +74,12 @@ impl ReferencePass {
                 ("bounds_pyramid", buf(&vpl.bounds_pyramid)),
                 ("bvh_nodes", buf(&scene.bvh_nodes)),
                 ("bvh_triangles", buf(&scene.bvh_triangles)),
-                ("accum", buf(accum)),
+                ("accum", buf(cx.gi_accum)),
             ],
         );
         run_compute(
             encoder,
-            timer,
+            cx.timer,
             "reference",
             &self.pipeline,
             &bind,

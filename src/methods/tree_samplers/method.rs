@@ -190,18 +190,8 @@ impl Method for TreeSamplers {
             radix: (cx.tree.kind == TreeKind::Lbvh) as u32,
             leaves: cx.tree.leaves,
         };
-        self.pass.record_view(
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            p,
-            &cx.targets.lighting.final_view,
-            &cx.targets.gbuffer.position_view,
-            b,
-            &cx.tree.links,
-            cx.dst,
-        );
+        let tree = cx.tree;
+        self.pass.record_view(cx, enc, p, b, &tree.links);
     }
 
     /// The per-pixel diagnostics (steps per traversal, fell back, samples, 1 + block) at the

@@ -13,6 +13,7 @@ use crate::gpu::readback::CounterReadback;
 use crate::gpu::scene_gpu::SceneGpu;
 use crate::gpu::shaders;
 use crate::gpu::timing::GpuTimer;
+use crate::methods::ViewCx;
 use bytemuck::{Pod, Zeroable};
 
 use crate::gpu::passes::{
@@ -548,24 +549,22 @@ impl SlcPass {
         }
     }
 
-    /// Draws one of the diagnostic views into `dst` (the GI resolution).
-    #[allow(clippy::too_many_arguments)]
+    /// Draws one of the diagnostic views (`p.mode`) into `cx.dst` (the GI resolution).
     pub fn record_view(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut ViewCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
         p: GpuSlcViewParams,
-        final_image: &wgpu::TextureView,
-        gb_position: &wgpu::TextureView,
         out: &SlcBuffers,
         tree_links: &wgpu::Buffer,
-        dst: &wgpu::TextureView,
     ) {
-        queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
+        let final_image = &cx.targets.lighting.final_view;
+        let gb_position = &cx.targets.gbuffer.position_view;
+        let dst = cx.dst;
+        cx.queue
+            .write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
         let bind = self.views_kernel.bind(
-            device,
+            cx.device,
             0,
             &[
                 ("vp", buf(&self.view_params)),
@@ -579,7 +578,7 @@ impl SlcPass {
         );
         run_compute(
             encoder,
-            timer,
+            cx.timer,
             "slc_views",
             &self.views,
             &bind,

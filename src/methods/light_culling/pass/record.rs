@@ -2,6 +2,7 @@
 //! variant, the ISM companion, views).
 
 use super::*;
+use crate::methods::ViewCx;
 
 impl LcullPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
@@ -315,23 +316,22 @@ impl LcullPass {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// Draws one of the diagnostic views (`p.mode`) into `cx.dst`.
     pub fn record_view(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut ViewCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
         p: GpuLcullViewParams,
-        final_image: &wgpu::TextureView,
-        gb_position: &wgpu::TextureView,
         own_accum: &wgpu::Buffer,
         b: &LcullBuffers,
-        dst: &wgpu::TextureView,
     ) {
-        queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
+        let final_image = &cx.targets.lighting.final_view;
+        let gb_position = &cx.targets.gbuffer.position_view;
+        let dst = cx.dst;
+        cx.queue
+            .write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
         let bind = self.views_kernel.bind(
-            device,
+            cx.device,
             0,
             &[
                 ("vp", buf(&self.view_params)),
@@ -352,7 +352,7 @@ impl LcullPass {
         );
         run_compute(
             encoder,
-            timer,
+            cx.timer,
             "lcull_views",
             &self.views,
             &bind,

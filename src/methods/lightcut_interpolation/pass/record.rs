@@ -2,6 +2,7 @@
 //! refinement, views).
 
 use super::*;
+use crate::methods::ViewCx;
 
 impl LiPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
@@ -168,22 +169,21 @@ impl LiPass {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// Draws one of the diagnostic views (`p.mode`) into `cx.dst`.
     pub fn record_view(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut ViewCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
         p: GpuLiViewParams,
-        final_image: &wgpu::TextureView,
-        gb_position: &wgpu::TextureView,
         b: &LiBuffers,
-        dst: &wgpu::TextureView,
     ) {
-        queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
+        let final_image = &cx.targets.lighting.final_view;
+        let gb_position = &cx.targets.gbuffer.position_view;
+        let dst = cx.dst;
+        cx.queue
+            .write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
         let bind = self.views_kernel.bind(
-            device,
+            cx.device,
             0,
             &[
                 ("vp", buf(&self.view_params)),
@@ -201,7 +201,7 @@ impl LiPass {
         );
         run_compute(
             encoder,
-            timer,
+            cx.timer,
             "li_views",
             &self.views,
             &bind,
