@@ -127,25 +127,8 @@ impl Method for LightcutInterpolation {
             pass.stats.clear();
         }
         self.settings = li;
-        let f = FrameInputs {
-            tree: cx.tree,
-            scene: cx.scene,
-            gbuffer: &cx.targets.gbuffer,
-            camera: cx.camera,
-            accum: cx.gi_accum,
-        };
-        pass.record(
-            cx.diagnostics,
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            p,
-            lc,
-            Lightcuts::seed(s, cx.frame_index),
-            &f,
-            b,
-        );
+        let seed = Lightcuts::seed(s, cx.frame_index);
+        pass.record(cx, enc, p, lc, seed, b);
         1.0 / frames as f32
     }
 

@@ -26,8 +26,7 @@ use crate::methods::lightcuts::{
 use crate::reference::lightcuts::{Cone, LcTree, MAX_CUT};
 use crate::settings::RenderSettings;
 use pass::{
-    FrameInputs, GpuLiParams, GpuLiViewParams, LiBuffers, LiPass, LiStats, TracedInterpolation,
-    walk_steps_per_dispatch,
+    GpuLiParams, GpuLiViewParams, LiBuffers, LiPass, LiStats, TracedInterpolation, walk_steps_per_dispatch,
 };
 use settings::{LiVisibility, LightcutInterpolationSettings};
 

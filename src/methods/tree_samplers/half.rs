@@ -11,7 +11,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::gpu::frame::GbufferTargets;
 use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
 use crate::gpu::shaders;
-use crate::gpu::timing::GpuTimer;
+use crate::methods::FrameCx;
 
 use crate::gpu::passes::{groups_image, run_compute, uniform_buffer};
 
@@ -109,27 +109,24 @@ impl HalfPass {
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
     }
 
-    /// The half-resolution G-buffer from the full one.
-    #[allow(clippy::too_many_arguments)]
+    /// The half-resolution G-buffer from the frame's full one (`n_min`, `d_max` the VPL
+    /// clamping of the half-resolution parameters).
     pub fn record_downsample(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut FrameCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-        full: &GbufferTargets,
-        full_size: (u32, u32),
         half: &HalfTargets,
         n_min: f32,
         d_max: f32,
     ) {
-        self.write_params(queue, full_size, half, n_min, d_max);
+        let full = &cx.targets.gbuffer;
+        self.write_params(cx.queue, cx.size, half, n_min, d_max);
         let bind = self
             .down_kernel
-            .bind_table(device, 0, &Self::table(&self.params, full, half, None));
+            .bind_table(cx.device, 0, &Self::table(&self.params, full, half, None));
         run_compute(
             encoder,
-            timer,
+            cx.timer,
             "gi_downsample",
             &self.down,
             &bind,
@@ -161,28 +158,27 @@ impl HalfPass {
         t
     }
 
-    /// The full-resolution accumulation from the half-resolution one (joint bilateral).
-    #[allow(clippy::too_many_arguments)]
+    /// The frame's full-resolution accumulation (`cx.gi_accum`) from the half-resolution one
+    /// (joint bilateral).
     pub fn record_upsample(
         &self,
-        device: &wgpu::Device,
+        cx: &mut FrameCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-        full: &GbufferTargets,
-        full_size: (u32, u32),
         half: &HalfTargets,
-        accum: &wgpu::Buffer,
     ) {
-        let bind = self
-            .up_kernel
-            .bind_table(device, 0, &Self::table(&self.params, full, half, Some(accum)));
+        let full = &cx.targets.gbuffer;
+        let bind = self.up_kernel.bind_table(
+            cx.device,
+            0,
+            &Self::table(&self.params, full, half, Some(cx.gi_accum)),
+        );
         run_compute(
             encoder,
-            timer,
+            cx.timer,
             "gi_upsample",
             &self.up,
             &bind,
-            groups_image(full_size.0, full_size.1),
+            groups_image(cx.size.0, cx.size.1),
         );
     }
 }

@@ -142,8 +142,7 @@ impl Method for TreeSamplers {
             self.record_filter(cx, enc, half_targets.as_ref(), gi_size, frames, raw);
         }
         if let Some(h) = half_targets {
-            self.half_pass
-                .record_upsample(device, enc, cx.timer, &cx.targets.gbuffer, size, &h, cx.gi_accum);
+            self.half_pass.record_upsample(cx, enc, &h);
             self.half = Some(h);
         }
         1.0 / frames.max(1) as f32
@@ -323,17 +322,7 @@ impl TreeSamplers {
                 Some(h) if h.size == gi_size => h,
                 _ => HalfTargets::new(device, size),
             };
-            self.half_pass.record_downsample(
-                device,
-                cx.queue,
-                enc,
-                cx.timer,
-                &cx.targets.gbuffer,
-                size,
-                &h,
-                s.vpl.n_min,
-                d_max,
-            );
+            self.half_pass.record_downsample(cx, enc, &h, s.vpl.n_min, d_max);
             Some(h)
         } else {
             self.half = None;

@@ -2,7 +2,7 @@
 //! refinement, views).
 
 use super::*;
-use crate::methods::ViewCx;
+use crate::methods::{FrameCx, ViewCx};
 
 impl LiPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
@@ -62,22 +62,27 @@ impl LiPass {
         })
     }
 
-    /// Records every pass of a frame (module doc), `lc` the lightcut kernel's parameters for
-    /// the records and the fallback (its `steps` per dispatch).
-    #[allow(clippy::too_many_arguments)]
+    /// Records every pass of a frame (module doc) over the frame's tree, scene and G-buffer
+    /// into `cx.gi_accum`, `lc` the lightcut kernel's parameters for the records and the
+    /// fallback (its `steps` per dispatch).
     pub fn record(
         &mut self,
-        diagnostics: bool,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut FrameCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
         p: GpuLiParams,
         lc: GpuLcParams,
         seed: u32,
-        f: &FrameInputs<'_>,
         b: &LiBuffers,
     ) {
+        let (diagnostics, device, queue) = (cx.diagnostics, cx.device, cx.queue);
+        let targets = cx.targets;
+        let f = &FrameInputs {
+            tree: cx.tree,
+            scene: cx.scene,
+            gbuffer: &targets.gbuffer,
+            camera: cx.camera,
+            accum: cx.gi_accum,
+        };
         // Uniforms: 0 the records' and selection's; 1.. the walk's dispatches.
         let walks = walk_dispatches(p.max_cut, f.tree.levels(), p.steps);
         let n = 1 + walks;
@@ -97,10 +102,10 @@ impl LiPass {
         self.params.write(device, queue, &all);
 
         self.build.record(
-            device, queue, encoder, timer, "li_build", seed, f.tree, &b.cones, &b.reps,
+            device, queue, encoder, cx.timer, "li_build", seed, f.tree, &b.cones, &b.reps,
         );
 
-        self.record_records(device, encoder, timer, &p, f, b);
+        self.record_records(device, encoder, cx.timer, &p, f, b);
 
         if diagnostics {
             encoder.clear_buffer(&b.stats, 0, None);
@@ -112,7 +117,7 @@ impl LiPass {
             device,
             queue,
             encoder,
-            timer,
+            cx.timer,
             "li_record_cuts",
             GpuLcParams {
                 trace_pixel: u32::MAX,
@@ -124,7 +129,7 @@ impl LiPass {
             &rb,
         );
 
-        self.record_select(device, encoder, timer, &p, f, b);
+        self.record_select(device, encoder, cx.timer, &p, f, b);
 
         // The interpolation from the selected records, one dispatch per walk uniform.
         let ibind = self.interp_bind(device, f, b);
@@ -132,7 +137,7 @@ impl LiPass {
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("li_interp"),
-                timestamp_writes: timer.compute_pass("li_interp"),
+                timestamp_writes: cx.timer.compute_pass("li_interp"),
             });
             pass.set_pipeline(if diagnostics {
                 &self.interp
@@ -153,7 +158,7 @@ impl LiPass {
             device,
             queue,
             encoder,
-            timer,
+            cx.timer,
             "li_fallback",
             GpuLcParams {
                 trace_pixel: u32::MAX,
