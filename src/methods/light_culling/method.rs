@@ -83,13 +83,6 @@ impl Method for LightCulling {
         {
             return 0.0;
         }
-        let inputs = FrameInputs {
-            scene: cx.scene,
-            gbuffer: &cx.targets.gbuffer,
-            camera: cx.camera,
-            vpls: &cx.vpl_buffers.vpls,
-            accum: cx.gi_accum,
-        };
         let ism = ism_frame(
             &self.settings.ism,
             &self.ism_points,
@@ -97,19 +90,17 @@ impl Method for LightCulling {
             self.ism_maps,
             ism_flags & 1 != 0,
         );
-        self.pass.record(
-            false,
-            cx.diagnostics,
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            p,
-            fp,
-            &inputs,
-            &self.buffers,
-            ism.as_ref(),
-        );
+        let (targets, vpl_buffers) = (cx.targets, cx.vpl_buffers);
+        let inputs = FrameInputs {
+            scene: cx.scene,
+            gbuffer: &targets.gbuffer,
+            camera: cx.camera,
+            vpls: &vpl_buffers.vpls,
+            accum: cx.gi_accum,
+            ism: ism.as_ref(),
+        };
+        let frame = LcullFrameParams { cull: p, filter: fp };
+        self.pass.record(cx, enc, false, frame, &inputs, &self.buffers);
         1.0 / frames as f32
     }
 

@@ -32,8 +32,8 @@ use crate::gpu::shaders::ShaderError;
 use crate::reference::light_culling::{Interleave, TileGrid};
 use crate::settings::RenderSettings;
 use pass::{
-    FrameInputs, GpuLcullParams, GpuLcullViewParams, IsmFrame, LcullBuffers, LcullPass, LcullStats,
-    TreeCullBuffers, TreeInputs, VISIBILITY_ISM,
+    FrameInputs, GpuLcullParams, GpuLcullViewParams, IsmFrame, LcullBuffers, LcullFrameParams, LcullPass,
+    LcullStats, TreeCullBuffers, VISIBILITY_ISM,
 };
 use settings::{CullingVisibility, IsmAdaptive, IsmSettings, LightCullingSettings};
 

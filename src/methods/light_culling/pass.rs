@@ -23,7 +23,6 @@ use crate::gpu::passes::{
 use crate::gpu::readback::CounterReadback;
 use crate::gpu::scene_gpu::SceneGpu;
 use crate::gpu::shaders;
-use crate::gpu::timing::GpuTimer;
 use crate::methods::lightcut_interpolation::pass::groups_1d_as_2d;
 
 /// Workgroup size of `lcull_tiles.wgsl` (one tile per workgroup).
@@ -260,6 +259,15 @@ pub struct FrameInputs<'a> {
     pub camera: &'a wgpu::Buffer,
     pub vpls: &'a wgpu::Buffer,
     pub accum: &'a wgpu::Buffer,
+    /// The frame's imperfect shadow maps (None: no maps this frame).
+    pub ism: Option<&'a IsmFrame<'a>>,
+}
+
+/// A frame's GPU parameters: the culling's and the interleave filter's.
+#[derive(Clone, Copy)]
+pub struct LcullFrameParams {
+    pub cull: GpuLcullParams,
+    pub filter: GpuFilterParams,
 }
 
 impl FrameInputs<'_> {

@@ -184,17 +184,6 @@ impl LightCulling {
             radius: lc.tree_filter_radius,
             ..fp
         };
-        let inputs = FrameInputs {
-            scene: cx.scene,
-            gbuffer: &cx.targets.gbuffer,
-            camera: cx.camera,
-            vpls: &cx.vpl_buffers.vpls,
-            accum: cx.gi_accum,
-        };
-        let tree = TreeInputs {
-            nodes: &cx.tree.nodes,
-            sorted_vpls: &cx.tree.sorted_vpls,
-        };
         let ism = ism_frame(
             &self.settings.ism,
             &self.ism_points,
@@ -202,20 +191,17 @@ impl LightCulling {
             self.ism_maps,
             tp.ism_flags & 1 != 0,
         );
-        self.pass.record_tree(
-            cx.diagnostics,
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            tp,
-            fp,
-            &inputs,
-            &tree,
-            &self.buffers,
-            t,
-            ism.as_ref(),
-        );
+        let (targets, vpl_buffers) = (cx.targets, cx.vpl_buffers);
+        let inputs = FrameInputs {
+            scene: cx.scene,
+            gbuffer: &targets.gbuffer,
+            camera: cx.camera,
+            vpls: &vpl_buffers.vpls,
+            accum: cx.gi_accum,
+            ism: ism.as_ref(),
+        };
+        let frame = LcullFrameParams { cull: tp, filter: fp };
+        self.pass.record_tree(cx, enc, frame, &inputs, &self.buffers, t);
         1.0 / frames as f32
     }
 }
@@ -284,13 +270,6 @@ impl LightCulling {
         let Some(companion) = self.buffers.companion.as_ref() else {
             return false;
         };
-        let inputs = FrameInputs {
-            scene: cx.scene,
-            gbuffer: &cx.targets.gbuffer,
-            camera: cx.camera,
-            vpls: &cx.vpl_buffers.vpls,
-            accum: &companion.accum,
-        };
         let ism = ism_frame(
             &self.settings.ism,
             &self.ism_points,
@@ -298,19 +277,20 @@ impl LightCulling {
             self.ism_maps,
             ism_flags & 1 != 0,
         );
-        self.pass.record(
-            true,
-            true,
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            cp,
-            cfp,
-            &inputs,
-            &self.buffers,
-            ism.as_ref(),
-        );
+        let (targets, vpl_buffers) = (cx.targets, cx.vpl_buffers);
+        let inputs = FrameInputs {
+            scene: cx.scene,
+            gbuffer: &targets.gbuffer,
+            camera: cx.camera,
+            vpls: &vpl_buffers.vpls,
+            accum: &companion.accum,
+            ism: ism.as_ref(),
+        };
+        let frame = LcullFrameParams {
+            cull: cp,
+            filter: cfp,
+        };
+        self.pass.record(cx, enc, true, frame, &inputs, &self.buffers);
         true
     }
 }

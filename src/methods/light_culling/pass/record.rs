@@ -2,7 +2,7 @@
 //! variant, the ISM companion, views).
 
 use super::*;
-use crate::methods::ViewCx;
+use crate::methods::{FrameCx, ViewCx};
 
 impl LcullPass {
     pub fn new(device: &wgpu::Device) -> Result<Self, shaders::ShaderError> {
@@ -97,26 +97,23 @@ impl LcullPass {
         }
     }
 
-    /// Records the frame's passes (module doc); `fp` the filter's parameters. `companion`:
-    /// the other variant for the difference view, into `f.accum` (its own accumulation),
-    /// without diagnostics and with its own parameters and timer names; recorded before the
-    /// method's own run, which then leaves its lists and counters for the views.
-    #[allow(clippy::too_many_arguments)]
+    /// Records the frame's passes (module doc) with `frame`'s culling and filter parameters.
+    /// `companion`: the other variant for the difference view, into `f.accum` (its own
+    /// accumulation), without diagnostics and with its own parameters and timer names;
+    /// recorded before the method's own run, which then leaves its lists and counters for
+    /// the views.
     pub fn record(
         &mut self,
-        companion: bool,
-        diagnostics: bool,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut FrameCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-        p: GpuLcullParams,
-        fp: GpuFilterParams,
+        companion: bool,
+        frame: LcullFrameParams,
         f: &FrameInputs<'_>,
         b: &LcullBuffers,
-        ism: Option<&IsmFrame<'_>>,
     ) {
-        let diagnostics = diagnostics && !companion;
+        let (p, fp, ism) = (frame.cull, frame.filter, f.ism);
+        let (device, queue) = (cx.device, cx.queue);
+        let diagnostics = cx.diagnostics && !companion;
         let (params, filter_params, names) = if companion {
             (
                 &self.companion_params,
@@ -140,12 +137,12 @@ impl LcullPass {
             ],
         );
         let (gx, gy) = groups_1d_as_2d(p.count.div_ceil(WG_1D).max(1));
-        run_compute(encoder, timer, names[0], &self.ranges, &rbind, (gx, gy, 1));
+        run_compute(encoder, cx.timer, names[0], &self.ranges, &rbind, (gx, gy, 1));
         let sbind = self.shade_bind_group(device, params, f, b, ism_depth);
         if let Some(m) = ism {
             let (ms, mp, mt) = (m.settings, m.points, m.targets);
             self.ism
-                .record_maps(device, queue, encoder, timer, names[4], ms, mp, m.maps, mt);
+                .record_maps(device, queue, encoder, cx.timer, names[4], ms, mp, m.maps, mt);
         }
 
         if diagnostics {
@@ -170,7 +167,7 @@ impl LcullPass {
         } else {
             &self.tiles_timed
         };
-        run_compute(encoder, timer, names[1], tiles, &tbind, (tx, ty, 1));
+        run_compute(encoder, cx.timer, names[1], tiles, &tbind, (tx, ty, 1));
 
         let shade = if diagnostics {
             &self.shade
@@ -178,12 +175,12 @@ impl LcullPass {
             &self.shade_timed
         };
         let groups = groups_image(p.width, p.height);
-        run_compute(encoder, timer, names[2], shade, &sbind, groups);
+        run_compute(encoder, cx.timer, names[2], shade, &sbind, groups);
         self.filter.record(
             device,
             queue,
             encoder,
-            timer,
+            cx.timer,
             names[3],
             filter_params,
             fp,
@@ -229,24 +226,24 @@ impl LcullPass {
     }
 
     /// Records the tree variant's frame (section 5; `lcull_tree.wgsl`): leaves and node
-    /// bounds, the per-pixel traversal, the one-ray shading, then the shared filter (`fp`
-    /// with the tree's filter radius).
-    #[allow(clippy::too_many_arguments)]
+    /// bounds, the per-pixel traversal, the one-ray shading, then the shared filter
+    /// (`frame.filter` with the tree's filter radius) over the frame's light tree.
     pub fn record_tree(
         &mut self,
-        diagnostics: bool,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut FrameCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-        p: GpuLcullParams,
-        fp: GpuFilterParams,
+        frame: LcullFrameParams,
         f: &FrameInputs<'_>,
-        tree: &TreeInputs<'_>,
         b: &LcullBuffers,
         t: &TreeCullBuffers,
-        ism: Option<&IsmFrame<'_>>,
     ) {
+        let (p, fp, ism) = (frame.cull, frame.filter, f.ism);
+        let (diagnostics, device, queue) = (cx.diagnostics, cx.device, cx.queue);
+        let light_tree = cx.tree;
+        let tree = TreeInputs {
+            nodes: &light_tree.nodes,
+            sorted_vpls: &light_tree.sorted_vpls,
+        };
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         let (ism_depth, ism_lights) = self.ism_bindings(queue, ism);
         let g = f.gbuffer;
@@ -281,7 +278,7 @@ impl LcullPass {
         let (gx, gy) = groups_1d_as_2d(p.leaves.div_ceil(WG_1D).max(1));
         run_compute(
             encoder,
-            timer,
+            cx.timer,
             "lcull_tree_leaves",
             &self.tree_leaves,
             &bind,
@@ -290,7 +287,7 @@ impl LcullPass {
         if let Some(m) = ism {
             let (ms, mp, mt) = (m.settings, m.points, m.targets);
             self.ism
-                .record_maps(device, queue, encoder, timer, "lcull_ism", ms, mp, m.maps, mt);
+                .record_maps(device, queue, encoder, cx.timer, "lcull_ism", ms, mp, m.maps, mt);
         }
         let groups = groups_image(p.width, p.height);
         let (traverse, shade) = if diagnostics {
@@ -298,13 +295,13 @@ impl LcullPass {
         } else {
             (&self.tree_traverse_timed, &self.tree_shade_timed)
         };
-        run_compute(encoder, timer, "lcull_tree_traverse", traverse, &bind, groups);
-        run_compute(encoder, timer, "lcull_tree_shade", shade, &bind, groups);
+        run_compute(encoder, cx.timer, "lcull_tree_traverse", traverse, &bind, groups);
+        run_compute(encoder, cx.timer, "lcull_tree_shade", shade, &bind, groups);
         self.filter.record(
             device,
             queue,
             encoder,
-            timer,
+            cx.timer,
             "lcull_filter",
             &self.filter_params,
             fp,
