@@ -74,20 +74,10 @@ impl Method for Vals {
             period: if vs.paper_filter { n } else { 0 },
             ..GpuFilterParams::new(cx.size, &vs.interleave)
         };
-        let shadow = &cx.targets.shadow;
+        let (frame_targets, vpl_buffers) = (cx.targets, cx.vpl_buffers);
+        let shadow = &frame_targets.shadow;
         let (Some(coarse), Some((_, seed_list))) = (self.coarse.as_ref(), self.seed_list.as_ref()) else {
             return 0.0;
-        };
-        let f = ValFrame {
-            coarse,
-            seed_list,
-            down,
-            scene: cx.scene,
-            gbuffer: &cx.targets.gbuffer,
-            camera: cx.camera,
-            vpls: &cx.vpl_buffers.vpls,
-            accum: cx.gi_accum,
-            rsm: [&shadow.position_array, &shadow.normal_array, &shadow.flux_array],
         };
         let ism = match (build, self.ism_points.as_ref(), self.ism_targets.as_ref()) {
             (true, Some((_, points)), Some(targets)) => Some(ValIsm {
@@ -97,26 +87,30 @@ impl Method for Vals {
             }),
             _ => None,
         };
+        let f = ValFrame {
+            coarse,
+            seed_list,
+            down,
+            scene: cx.scene,
+            gbuffer: &frame_targets.gbuffer,
+            camera: cx.camera,
+            vpls: &vpl_buffers.vpls,
+            accum: cx.gi_accum,
+            rsm: [&shadow.position_array, &shadow.normal_array, &shadow.flux_array],
+            ism: ism.as_ref(),
+        };
         let Some(t) = self.targets.as_mut() else {
             return 0.0;
         };
         let built = ism.is_some();
-        let r = self.pass.record(
-            cx.diagnostics,
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            p,
-            cp,
-            vs.iterations,
-            vs.carry_over,
-            fp,
-            &f,
-            &self.buffers,
-            t,
-            ism.as_ref(),
-        );
+        let frame = ValRecordParams {
+            shade: p,
+            cluster: cp,
+            iterations: vs.iterations,
+            carry: vs.carry_over,
+            filter: fp,
+        };
+        let r = self.pass.record(cx, enc, frame, &f, &self.buffers, t);
         if let Err(e) = r {
             return self.fail(cx, enc, Some(e));
         }

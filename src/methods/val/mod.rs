@@ -36,7 +36,7 @@ use crate::reference::vpl::pcg_hash;
 use crate::settings::RenderSettings;
 use pass::{
     GpuDownParams, GpuValShadeParams, GpuValViewParams, VIS_DISK, VIS_ISM, VIS_NONE, VIS_PCSS, VIS_RAYS,
-    ValBuffers, ValFrame, ValIsm, ValPass, ValRsm,
+    ValBuffers, ValFrame, ValIsm, ValPass, ValRecordParams, ValRsm,
 };
 use settings::{ValSettings, ValVisibility};
 

@@ -24,6 +24,7 @@ use crate::gpu::passes::{
 use crate::gpu::scene_gpu::SceneGpu;
 use crate::gpu::shaders;
 use crate::gpu::timing::GpuTimer;
+use crate::methods::FrameCx;
 
 /// Twin: `ValShadeParams` in `val_common.wgsl`.
 #[repr(C)]
@@ -181,6 +182,8 @@ pub struct ValFrame<'a> {
     /// The unique seed VPLs: [count, indices] (`seed_list_bytes`).
     pub seed_list: &'a wgpu::Buffer,
     pub down: GpuDownParams,
+    /// The VALs' maps to build this frame (None: no maps).
+    pub ism: Option<&'a ValIsm<'a>>,
 }
 
 /// The VALs' maps to build this frame.
@@ -188,6 +191,17 @@ pub struct ValIsm<'a> {
     pub settings: &'a IsmSettings<IsmVal>,
     pub points: &'a IsmPoints,
     pub targets: &'a IsmTargets,
+}
+
+/// A frame's GPU parameters: the shading's, the clustering's (`iterations` steps, from the
+/// last frame's clusters with `carry`) and the interleave filter's.
+#[derive(Clone, Copy)]
+pub struct ValRecordParams {
+    pub shade: GpuValShadeParams,
+    pub cluster: GpuValParams,
+    pub iterations: u32,
+    pub carry: bool,
+    pub filter: GpuFilterParams,
 }
 
 /// Workgroup size of `unique_main` (one workgroup compacts the unique seed VPLs).
@@ -280,28 +294,27 @@ impl ValPass {
         })
     }
 
-    /// Records the frame (module doc): seeds, `iterations` clustering steps with `cp` (from the
-    /// last frame's clusters with `carry`), the maps
-    /// (`ism`), shading with `p` and the filter with `fp` into `f.accum`. Refused (nothing
-    /// recorded) when the clustering refuses its targets.
-    #[allow(clippy::too_many_arguments)]
+    /// Records the frame (module doc): seeds, `frame.iterations` clustering steps with
+    /// `frame.cluster` (from the last frame's clusters with `frame.carry`), the maps
+    /// (`f.ism`), shading with `frame.shade` and the filter with `frame.filter` into
+    /// `f.accum`. Refused (nothing recorded) when the clustering refuses its targets.
     pub fn record(
         &mut self,
-        diagnostics: bool,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut FrameCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-        p: GpuValShadeParams,
-        cp: GpuValParams,
-        iterations: u32,
-        carry: bool,
-        fp: GpuFilterParams,
+        frame: ValRecordParams,
         f: &ValFrame<'_>,
         b: &ValBuffers,
         t: &mut ValTargets,
-        ism: Option<&ValIsm<'_>>,
     ) -> Result<(), String> {
+        let ValRecordParams {
+            shade: p,
+            cluster: cp,
+            iterations,
+            carry,
+            filter: fp,
+        } = frame;
+        let (diagnostics, device, queue, ism) = (cx.diagnostics, cx.device, cx.queue, f.ism);
         if p.clusters == 0 || p.clusters > t.clusters {
             return Err(format!(
                 "VAL: {} clusters for targets of {}",
@@ -342,15 +355,15 @@ impl ValPass {
             )
         };
         let per_cluster = (p.clusters.div_ceil(WG_1D), 1, 1);
-        self.record_downsample(device, queue, encoder, timer, f);
+        self.record_downsample(device, queue, encoder, cx.timer, f);
         // The seeds (the VALs bound are not read).
         let before = bind(t.vals(), &t.seeds);
-        self.record_seeds(encoder, timer, f, &before, &p);
+        self.record_seeds(encoder, cx.timer, f, &before, &p);
         self.cluster.record(
             device,
             queue,
             encoder,
-            timer,
+            cx.timer,
             "val_cluster",
             [&f.coarse.arrays[0], &f.coarse.arrays[1], &f.coarse.arrays[2]],
             cp,
@@ -364,14 +377,14 @@ impl ValPass {
         if let Some(m) = ism {
             run_compute(
                 encoder,
-                timer,
+                cx.timer,
                 "val_ism_lights",
                 &self.lights,
                 &after,
                 per_cluster,
             );
             self.ism.record_maps(
-                device, queue, encoder, timer, "val_ism", m.settings, m.points, p.clusters, m.targets,
+                device, queue, encoder, cx.timer, "val_ism", m.settings, m.points, p.clusters, m.targets,
             );
         }
         let shade = if diagnostics {
@@ -381,7 +394,7 @@ impl ValPass {
         };
         run_compute(
             encoder,
-            timer,
+            cx.timer,
             "val_shade",
             shade,
             &after,
@@ -391,7 +404,7 @@ impl ValPass {
             device,
             queue,
             encoder,
-            timer,
+            cx.timer,
             "val_filter",
             &self.filter_params,
             fp,
