@@ -237,12 +237,19 @@ pub fn check_workgroup_sizes(files: &[&str], own: &[OwnWorkgroup]) -> Result<(),
 }
 
 /// The shared passes' own workgroup sizes: the parallel sort's kernels (the pass dispatches
-/// with it).
-pub static OWN_WORKGROUPS: &[OwnWorkgroup] = &[OwnWorkgroup {
-    file: "sst_sort.wgsl",
-    entries: &sst_sort::SORT_WG_ENTRIES,
-    size: [sst_sort::SORT_WG, 1, 1],
-}];
+/// with it) and the VAL clustering's fallback list (one workgroup of 256 scans it).
+pub static OWN_WORKGROUPS: &[OwnWorkgroup] = &[
+    OwnWorkgroup {
+        file: "sst_sort.wgsl",
+        entries: &sst_sort::SORT_WG_ENTRIES,
+        size: [sst_sort::SORT_WG, 1, 1],
+    },
+    OwnWorkgroup {
+        file: "val_cluster.wgsl",
+        entries: &["list_main"],
+        size: [256, 1, 1],
+    },
+];
 
 #[cfg(test)]
 mod tests {
