@@ -90,15 +90,7 @@ impl Method for LightCulling {
             self.ism_maps,
             ism_flags & 1 != 0,
         );
-        let (targets, vpl_buffers) = (cx.targets, cx.vpl_buffers);
-        let inputs = FrameInputs {
-            scene: cx.scene,
-            gbuffer: &targets.gbuffer,
-            camera: cx.camera,
-            vpls: &vpl_buffers.vpls,
-            accum: cx.gi_accum,
-            ism: ism.as_ref(),
-        };
+        let inputs = super::state::frame_inputs(cx, cx.gi_accum, ism);
         let frame = LcullFrameParams { cull: p, filter: fp };
         self.pass.record(cx, enc, false, frame, &inputs, &self.buffers);
         1.0 / frames as f32

@@ -260,7 +260,7 @@ pub struct FrameInputs<'a> {
     pub vpls: &'a wgpu::Buffer,
     pub accum: &'a wgpu::Buffer,
     /// The frame's imperfect shadow maps (None: no maps this frame).
-    pub ism: Option<&'a IsmFrame<'a>>,
+    pub ism: Option<IsmFrame<'a>>,
 }
 
 /// A frame's GPU parameters: the culling's and the interleave filter's.

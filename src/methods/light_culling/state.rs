@@ -137,6 +137,24 @@ impl LightCulling {
     }
 }
 
+/// What a frame's culling passes read: the frame's scene, G-buffer, camera and VPLs, the
+/// accumulation `accum`, and the frame's imperfect shadow maps (`ism_frame`).
+pub(super) fn frame_inputs<'s, 'f: 's>(
+    cx: &FrameCx<'f>,
+    accum: &'s wgpu::Buffer,
+    ism: Option<IsmFrame<'s>>,
+) -> FrameInputs<'s> {
+    let (scene, targets, camera, vpl_buffers) = (cx.scene, cx.targets, cx.camera, cx.vpl_buffers);
+    FrameInputs {
+        scene,
+        gbuffer: &targets.gbuffer,
+        camera,
+        vpls: &vpl_buffers.vpls,
+        accum,
+        ism,
+    }
+}
+
 impl LightCulling {
     /// The tree variant's frame (section 5): `p` is the tiled frame's parameters.
     pub(super) fn record_tree(
@@ -191,15 +209,7 @@ impl LightCulling {
             self.ism_maps,
             tp.ism_flags & 1 != 0,
         );
-        let (targets, vpl_buffers) = (cx.targets, cx.vpl_buffers);
-        let inputs = FrameInputs {
-            scene: cx.scene,
-            gbuffer: &targets.gbuffer,
-            camera: cx.camera,
-            vpls: &vpl_buffers.vpls,
-            accum: cx.gi_accum,
-            ism: ism.as_ref(),
-        };
+        let inputs = frame_inputs(cx, cx.gi_accum, ism);
         let frame = LcullFrameParams { cull: tp, filter: fp };
         self.pass.record_tree(cx, enc, frame, &inputs, &self.buffers, t);
         1.0 / frames as f32
@@ -277,15 +287,7 @@ impl LightCulling {
             self.ism_maps,
             ism_flags & 1 != 0,
         );
-        let (targets, vpl_buffers) = (cx.targets, cx.vpl_buffers);
-        let inputs = FrameInputs {
-            scene: cx.scene,
-            gbuffer: &targets.gbuffer,
-            camera: cx.camera,
-            vpls: &vpl_buffers.vpls,
-            accum: &companion.accum,
-            ism: ism.as_ref(),
-        };
+        let inputs = frame_inputs(cx, &companion.accum, ism);
         let frame = LcullFrameParams {
             cull: cp,
             filter: cfp,

@@ -111,7 +111,7 @@ impl LcullPass {
         f: &FrameInputs<'_>,
         b: &LcullBuffers,
     ) {
-        let (p, fp, ism) = (frame.cull, frame.filter, f.ism);
+        let (p, fp, ism) = (frame.cull, frame.filter, f.ism.as_ref());
         let (device, queue) = (cx.device, cx.queue);
         let diagnostics = cx.diagnostics && !companion;
         let (params, filter_params, names) = if companion {
@@ -237,7 +237,7 @@ impl LcullPass {
         b: &LcullBuffers,
         t: &TreeCullBuffers,
     ) {
-        let (p, fp, ism) = (frame.cull, frame.filter, f.ism);
+        let (p, fp, ism) = (frame.cull, frame.filter, f.ism.as_ref());
         let (diagnostics, device, queue) = (cx.diagnostics, cx.device, cx.queue);
         let light_tree = cx.tree;
         let tree = TreeInputs {
