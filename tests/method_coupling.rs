@@ -6,7 +6,7 @@
 //!
 //! What counts as naming a module `m` (comments stripped): a path through the registry's
 //! module (`methods::m`, `methods::{.., m, ..}`, or `super::m` from a sibling under
-//! `src/methods/`), one of the module's own type names (a `pub struct` / `enum` / `trait` /
+//! `src/methods/`), one of the module's own type names in code, not in a string literal (a `pub struct` / `enum` / `trait` /
 //! `type` defined only in its folder, re-exports included), or one of its methods' CLI ids as
 //! a string literal (but for ids that are common values, `SHARED_WORDS`). The registry file (`src/methods/mod.rs`) is reported apart: its lines are
 //! the registry.
@@ -21,14 +21,14 @@ use std::path::{Path, PathBuf};
 const LIMITS: &[(&str, usize)] = &[
     ("direct_only", 0),
     ("ground_truth", 2),
-    ("light_culling", 3),
-    ("lightcut_interpolation", 2),
+    ("light_culling", 2),
+    ("lightcut_interpolation", 1),
     // 9, not 7, since Lightcut Interpolation's two files (which build on Lightcuts' tree and
     // cut kernels) were split into four to keep files under 700 lines: the same code.
-    ("lightcuts", 9),
+    ("lightcuts", 8),
     ("reference", 0),
     ("tree_samplers", 16),
-    ("val", 2),
+    ("val", 1),
 ];
 
 /// Method ids that are also other settings' values ("off": the temporal stage's mode, a
@@ -242,7 +242,11 @@ fn coupling(root: &Path) -> (Table, Vec<Module>) {
     for f in &files {
         let rel = f.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/");
         let code = strip_comments(&std::fs::read_to_string(f).unwrap());
-        let groups = group_names(&code);
+        // Paths and type names count in code only, not in string literals (a figure's
+        // description naming "Lightcuts" is prose); ids count as string literals.
+        let blank = blank_literals(&code);
+        let blank_lines: Vec<&str> = blank.lines().collect();
+        let groups = group_names(&blank);
         let in_methods = rel.starts_with("src/methods/");
         for m in &mods {
             if rel.starts_with(&format!("src/methods/{}/", m.folder)) {
@@ -251,14 +255,15 @@ fn coupling(root: &Path) -> (Table, Vec<Module>) {
             let mut hits = Vec::new();
             for (n, line) in code.lines().enumerate() {
                 let mut what = Vec::new();
-                if line.contains(&format!("methods::{}", m.folder)) && has_word(line, &m.folder) {
+                let bare = blank_lines.get(n).copied().unwrap_or("");
+                if bare.contains(&format!("methods::{}", m.folder)) && has_word(bare, &m.folder) {
                     what.push(format!("methods::{}", m.folder));
                 }
-                if in_methods && line.contains(&format!("super::{}", m.folder)) && has_word(line, &m.folder) {
+                if in_methods && bare.contains(&format!("super::{}", m.folder)) && has_word(bare, &m.folder) {
                     what.push(format!("super::{}", m.folder));
                 }
                 for ty in &m.types {
-                    if has_word(line, ty) {
+                    if has_word(bare, ty) {
                         what.push(ty.clone());
                     }
                 }

@@ -143,9 +143,9 @@ pub enum Command {
     /// A comparison sheet: methods side by side on the same VPLs, their error maps against
     /// the ground truth, and captions (method, settings, RMSE, SSIM, FLIP, GPU time).
     Sheet(sheet::SheetArgs),
-    /// Thesis chapter 7's evaluation, one figure per name (timings, equal-time, steps,
-    /// blocks, blending, upsampling, scaling): CSV, PNG plots and images per scene, the
-    /// ratio checks in checks.csv.
+    /// Thesis chapter 7's evaluation and every method's own study, one figure per name
+    /// (`results --help` lists them): CSV, PNG plots and images per scene, the ratio checks in
+    /// checks.csv.
     Results(results::ResultsArgs),
     /// Download the reference scenes (Sponza, Breakfast Room) from AMD's CapsaicinTestMedia
     /// (CC BY 3.0), check every file's SHA-256 against the files the measurements used, and

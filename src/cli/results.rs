@@ -8,77 +8,75 @@ pub use merge::*;
 use std::path::PathBuf;
 
 use anyhow::{Context, anyhow, bail};
-use clap::{Args, ValueEnum};
+use clap::Args;
 
 use super::SettingsArgs;
 use crate::{
     harness::{
         Bench, Csv,
-        figures::{self, Check, Opts},
+        figures::{self, Check, FigureDef, Opts},
         num,
     },
     renderer::{Renderer, context::GpuContext},
     scene::preset::{SceneSource, open_scene},
 };
 
-/// A figure of thesis chapter 7.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Figure {
-    /// Every figure below.
+/// A `results` figure argument: `all`, or a registered figure by its CLI name
+/// (`crate::harness::figures::all`: the harness's and the methods' own figures).
+#[derive(Clone, Copy, Debug)]
+pub enum FigureArg {
     All,
-    /// Table 7.1: GPU time per pass (median, mean and spread over many timed frames).
-    Timings,
-    /// Fig. 7.1 / 7.3: RMSE and SSIM over GI GPU time for every per-frame method (SLC, RTSLC,
-    /// SST over spp; Lightcuts over its relative error); equal-time table.
-    EqualTime,
-    /// Fig. 7.2: traversal steps per pixel of the three samplers, heat maps.
-    Steps,
-    /// Fig. 7.5: block size sweep (cut build time, frame time, RMSE).
-    Blocks,
-    /// Fig. 7.4 / 7.6: no blending vs blending; mock cut vs averaging vs root vs recomputed cut.
-    Blending,
-    /// Table 7.2: full vs half GI resolution.
-    Upsampling,
-    /// VPL count sweep: tree build time, GI time, RMSE.
-    Scaling,
-    /// Lightcut Interpolation's headline comparison (its paper's Fig. 8 / 10): Lightcuts vs
-    /// interpolation with full and interpolated visibility, GPU time per pass and error.
-    Interpolation,
-    /// Stochastic Light Culling's study (its figs. 4-6, Table 1): stochastic vs clamped ranges
-    /// over the VPL count (--vpl-exponents) and eps_max (--sweep light-culling=..), with and
-    /// without visibility, GPU time and error.
-    Culling,
-    /// The VAL paper's Table 1: 64 PCSS VALs vs 512 simple VALs, GPU time of clustering,
-    /// indirect illumination and maps, error against the ground truth and against the same
-    /// VALs with exact visibility; the VPL-shading mode beside them.
-    Val,
-    /// Temporal reuse (reprojection, history, SVGF) after every per-frame method along a
-    /// camera path, a sun sweep and a still view: per-frame RMSE / SSIM of raw and filtered GI
-    /// against each frame's ground truth, flicker, and the stage's GPU time per pass.
-    Temporal,
-    /// Issue 23: the tree samplers and Lightcuts on the perfect binary tree and on the radix
-    /// tree (LBVH): RMSE over GPU time (method + tree build), steps, and RMSE at equal time.
-    Trees,
-    /// Issue 23: multi-bounce VPLs at 1..=4 bounces: the light the ground truth gathers, the
-    /// light paths' GPU time, every per-frame method's time and relative error.
-    Bounces,
+    One(&'static FigureDef),
 }
 
-const ORDER: [Figure; 13] = [
-    Figure::Timings,
-    Figure::Steps,
-    Figure::EqualTime,
-    Figure::Interpolation,
-    Figure::Culling,
-    Figure::Val,
-    Figure::Temporal,
-    Figure::Trees,
-    Figure::Bounces,
-    Figure::Blocks,
-    Figure::Blending,
-    Figure::Upsampling,
-    Figure::Scaling,
-];
+/// A figure's CLI name, or `all`.
+pub fn parse_figure(name: &str) -> Result<FigureArg, String> {
+    if name == "all" {
+        return Ok(FigureArg::All);
+    }
+    figures::find(name).map(FigureArg::One).ok_or_else(|| {
+        let names: Vec<&str> = figures::all().iter().map(|f| f.cli).collect();
+        format!("'{name}' is no figure; figures: all, {}", names.join(", "))
+    })
+}
+
+/// The figures' short help: their CLI names in a run's order.
+pub fn figure_help() -> String {
+    let names: Vec<&str> = figures::all().iter().map(|f| f.cli).collect();
+    format!("Figures to make (comma-separated): all, {}", names.join(", "))
+}
+
+/// The figures' long help: each with its description.
+pub fn figure_long_help() -> String {
+    let mut s = String::from(
+        "Figures to make (comma-separated), in the order a run makes them:\n- all: every figure below",
+    );
+    for f in figures::all() {
+        s.push_str(&format!("\n- {}: {}", f.cli, f.doc));
+    }
+    s
+}
+
+/// The figures `args` chose, in the order a run makes them.
+fn chosen(args: &[FigureArg]) -> Vec<&'static FigureDef> {
+    let all = args.iter().any(|a| matches!(a, FigureArg::All));
+    figures::all()
+        .into_iter()
+        .filter(|f| {
+            all || args
+                .iter()
+                .any(|a| matches!(a, FigureArg::One(g) if std::ptr::eq(*g, *f)))
+        })
+        .collect()
+}
+
+/// A figure label's place in a run's order (unknown labels last).
+fn figure_rank(label: &str) -> usize {
+    figures::all()
+        .iter()
+        .position(|f| f.label == label)
+        .unwrap_or(usize::MAX)
+}
 
 /// The K-th of N shards of a sweep (`--shard K/N`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -135,9 +133,14 @@ pub struct MergeArgs {
 pub struct ResultsArgs {
     #[command(subcommand)]
     pub command: Option<ResultsCommand>,
-    /// Figures to make (comma-separated).
-    #[arg(value_enum, value_delimiter = ',', default_value = "all")]
-    pub figures: Vec<Figure>,
+    #[arg(
+        value_parser = parse_figure,
+        value_delimiter = ',',
+        default_value = "all",
+        help = figure_help(),
+        long_help = figure_long_help()
+    )]
+    pub figures: Vec<FigureArg>,
     /// Scenes, comma-separated: presets (.toml), glTF files or `default`.
     #[arg(
         long,
@@ -334,15 +337,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         return merge(m);
     }
     let o = args.opts()?;
-    let figures: Vec<Figure> = if args.figures.contains(&Figure::All) {
-        ORDER.to_vec()
-    } else {
-        ORDER
-            .iter()
-            .copied()
-            .filter(|f| args.figures.contains(f))
-            .collect()
-    };
+    let figures = chosen(&args.figures);
     // Open every scene first, so that a broken one fails before hours of work.
     let mut opened = Vec::new();
     for s in &args.scenes {
@@ -361,7 +356,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
     for (arg, sc) in opened {
         let label = scene_label(&arg);
         let all_figures = &figures;
-        let figures: Vec<Figure> = all_figures
+        let figures: Vec<&FigureDef> = all_figures
             .iter()
             .copied()
             .filter(|_| {
@@ -373,7 +368,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         if figures.is_empty() {
             continue;
         }
-        units_done.extend(figures.iter().map(|f| format!("{label}/{f:?}")));
+        units_done.extend(figures.iter().map(|f| format!("{label}/{}", f.label)));
         let dir = args.out.join(&label);
         std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let mut settings = args.settings.resolve(sc.exposure_ev)?;
@@ -409,27 +404,12 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         for f in &figures {
             let t = std::time::Instant::now();
             let gpu0 = b.gpu_wall;
-            b.figure = format!("{f:?}");
+            b.figure = f.label.to_string();
             // Every figure starts at frame index 0 (the temporal figure's sequences set their
             // settings without `Bench::apply`): its numbers do not depend on the figures run
             // before it in this process (a shard runs other ones).
             b.r.restart_frame_index();
-            let rep = match f {
-                Figure::Timings => figures::timings(&mut b, &o, &dir)?,
-                Figure::EqualTime => figures::equal_time(&mut b, &o, &dir)?,
-                Figure::Culling => figures::culling(&mut b, &o, &dir)?,
-                Figure::Val => figures::val(&mut b, &o, &dir)?,
-                Figure::Temporal => figures::temporal(&mut b, &o, &dir)?,
-                Figure::Trees => figures::trees(&mut b, &o, &dir)?,
-                Figure::Bounces => figures::bounces(&mut b, &o, &dir)?,
-                Figure::Steps => figures::steps(&mut b, &o, &dir)?,
-                Figure::Blocks => figures::blocks(&mut b, &o, &dir)?,
-                Figure::Blending => figures::blending(&mut b, &o, &dir)?,
-                Figure::Upsampling => figures::upsampling(&mut b, &o, &dir)?,
-                Figure::Scaling => figures::scaling(&mut b, &o, &dir)?,
-                Figure::Interpolation => figures::interpolation(&mut b, &o, &dir)?,
-                Figure::All => unreachable!("expanded above"),
-            };
+            let rep = (f.make)(&mut b, &o, &dir)?;
             print!("{}", rep.table);
             for c in &rep.checks {
                 println!("  check: {}", c.line());
@@ -444,16 +424,17 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
                 0.0
             };
             println!(
-                "  ({f:?} took {wall:.1} s wall, {:.0}% of it outside rendering and GPU waits)",
+                "  ({} took {wall:.1} s wall, {:.0}% of it outside rendering and GPU waits)",
+                f.label,
                 100.0 * outside
             );
             figure_times.push(serde_json::json!({
-                "figure": format!("{f:?}"),
+                "figure": f.label,
                 "wall_s": wall,
                 "rendering_and_gpu_wait_s": gpu,
                 "share_outside_gpu": outside,
             }));
-            checks.extend(rep.checks.into_iter().map(|c| (format!("{f:?}"), c)));
+            checks.extend(rep.checks.into_iter().map(|c| (f.label.to_string(), c)));
         }
         checks.extend(
             timing_agreement(&b, o.size, &dir)?
@@ -506,7 +487,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         // What a merge compares between shards: every option but the shard and the output.
         "options": options_key(args),
         "scene_order": args.scenes.iter().map(|s| scene_label(s)).collect::<Vec<_>>(),
-        "figures": figures.iter().map(|f| format!("{f:?}")).collect::<Vec<_>>(),
+        "figures": figures.iter().map(|f| f.label).collect::<Vec<_>>(),
     });
     let p = args.out.join("run.json");
     std::fs::write(&p, serde_json::to_string_pretty(&info)?)

@@ -161,9 +161,8 @@ pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
         .collect();
     let scene_pos = |s: &str| scene_order.iter().position(|x| x == s).unwrap_or(usize::MAX);
     let figure_pos = |f: &str| {
-        ORDER
-            .iter()
-            .position(|x| format!("{x:?}") == f)
+        Some(figure_rank(f))
+            .filter(|&r| r != usize::MAX)
             .unwrap_or(if f == AGREEMENT_FIGURE {
                 usize::MAX - 1
             } else {
@@ -198,12 +197,7 @@ pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
                 Some(s) => {
                     let mut times = s["figure_times"].as_array().cloned().unwrap_or_default();
                     times.extend(sc["figure_times"].as_array().cloned().unwrap_or_default());
-                    let pos = |t: &serde_json::Value| {
-                        ORDER
-                            .iter()
-                            .position(|f| t["figure"].as_str() == Some(&format!("{f:?}")))
-                            .unwrap_or(usize::MAX)
-                    };
+                    let pos = |t: &serde_json::Value| figure_rank(t["figure"].as_str().unwrap_or_default());
                     times.sort_by_key(pos);
                     s["figure_times"] = serde_json::Value::Array(times);
                 }
@@ -241,12 +235,7 @@ pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
             header.get_or_insert(h);
         }
         if let Some(h) = header {
-            let pos = |t: &crate::harness::BaseTiming| {
-                ORDER
-                    .iter()
-                    .position(|f| format!("{f:?}") == t.figure)
-                    .unwrap_or(usize::MAX)
-            };
+            let pos = |t: &crate::harness::BaseTiming| figure_rank(&t.figure);
             rows.sort_by_key(pos);
             let mut text = h.join(",");
             text.push('\n');

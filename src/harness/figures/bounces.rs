@@ -22,6 +22,16 @@ fn image_mean(img: &crate::gpu::readback::ImageF32) -> f64 {
         / n
 }
 
+inventory::submit! {
+    FigureDef {
+        cli: "bounces",
+        label: "Bounces",
+        order: 90,
+        doc: "Issue 23: multi-bounce VPLs at 1..=4 bounces: the light the ground truth gathers, the light paths' GPU time, every per-frame method's time and relative error.",
+        make: bounces,
+    }
+}
+
 pub fn bounces(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let mut csv = Csv::new(&[
         "scene",

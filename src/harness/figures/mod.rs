@@ -2,23 +2,70 @@
 //! `<figure>.csv`, PNG plots and images into the scene's results folder, and returns a
 //! [`Report`]: a short text table and the ratio checks of issue 7 it covers.
 
+//!
+//! Figures are registered, not listed: each submits a [`FigureDef`] with `inventory::submit!`
+//! beside its function, so that a method's own figures live in its folder
+//! (`src/methods/<m>/figure.rs`) and `results` finds them ([`all`], [`find`]) without a line
+//! here. A figure's code imports [`prelude`].
+
 mod bounces;
-mod culling;
-mod interpolation;
 mod resolution;
 mod sampling;
 mod temporal;
 mod trees;
-mod val;
 
 pub use bounces::bounces;
-pub use culling::culling;
-pub use interpolation::interpolation;
 pub use resolution::{scaling, upsampling};
 pub use sampling::{blending, blocks, steps};
 pub use temporal::temporal;
 pub use trees::trees;
-pub use val::val;
+
+/// What a figure's code needs: the bench and its measurements, the options, the report and
+/// its checks, the CSV and plot writers.
+pub mod prelude {
+    pub use super::super::{
+        Bench, Csv, Frames, Measured, PASS_GROUPS, SAMPLE_PASSES, SORT_PASSES, TREE_BUILD_PASSES, gi_passes,
+        mean_std, median, num, plot,
+    };
+    pub use super::{
+        Check, FigureDef, Opts, Report, check, images, interp_loglog, methods, tree_methods, with,
+    };
+    pub use crate::methods::MethodId;
+    pub use crate::settings::RenderSettings;
+    pub use anyhow::Context;
+    pub use std::path::Path;
+}
+
+/// A figure of `results`: its CLI name, the label its rows carry in `checks.csv`,
+/// `run.json` and the printed table, its place in a run (figures run in ascending `order`),
+/// its one-paragraph description (`results --help`) and the function that makes it.
+pub struct FigureDef {
+    pub cli: &'static str,
+    pub label: &'static str,
+    pub order: u32,
+    pub doc: &'static str,
+    pub make: fn(&mut Bench, &Opts, &Path) -> anyhow::Result<Report>,
+}
+
+impl std::fmt::Debug for FigureDef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.label)
+    }
+}
+
+inventory::collect!(FigureDef);
+
+/// Every registered figure, in the order a run makes them.
+pub fn all() -> Vec<&'static FigureDef> {
+    let mut v: Vec<&'static FigureDef> = inventory::iter::<FigureDef>.into_iter().collect();
+    v.sort_by_key(|f| (f.order, f.cli));
+    v
+}
+
+/// The figure with CLI name `cli`.
+pub fn find(cli: &str) -> Option<&'static FigureDef> {
+    inventory::iter::<FigureDef>.into_iter().find(|f| f.cli == cli)
+}
 
 use std::path::Path;
 
@@ -160,19 +207,22 @@ pub fn tree_methods(o: &Opts) -> Vec<(MethodId, &'static str)> {
     methods(o).into_iter().filter(|(m, _)| m.samples_tree()).collect()
 }
 
-fn with(b: &Bench, f: impl FnOnce(&mut RenderSettings)) -> RenderSettings {
+/// The bench's base settings changed by `f`.
+pub fn with(b: &Bench, f: impl FnOnce(&mut RenderSettings)) -> RenderSettings {
     let mut s = b.base.clone();
     f(&mut s);
     s
 }
 
-fn images(dir: &Path) -> anyhow::Result<std::path::PathBuf> {
+/// `<dir>/images`, created.
+pub fn images(dir: &Path) -> anyhow::Result<std::path::PathBuf> {
     let d = dir.join("images");
     std::fs::create_dir_all(&d).with_context(|| format!("cannot create {}", d.display()))?;
     Ok(d)
 }
 
-fn check(b: &Bench, name: &str, value: f64, limit: f64, at_least: bool, detail: String) -> Check {
+/// A check on the bench's scene.
+pub fn check(b: &Bench, name: &str, value: f64, limit: f64, at_least: bool, detail: String) -> Check {
     Check {
         scene: b.scene.clone(),
         name: name.into(),
@@ -180,6 +230,16 @@ fn check(b: &Bench, name: &str, value: f64, limit: f64, at_least: bool, detail: 
         limit,
         at_least,
         detail,
+    }
+}
+
+inventory::submit! {
+    FigureDef {
+        cli: "timings",
+        label: "Timings",
+        order: 10,
+        doc: "Table 7.1: GPU time per pass (median, mean and spread over many timed frames).",
+        make: timings,
     }
 }
 
@@ -324,6 +384,16 @@ fn knob(v: f64, integer: bool) -> String {
         format!("{}", v.round() as i64)
     } else {
         format!("{v}")
+    }
+}
+
+inventory::submit! {
+    FigureDef {
+        cli: "equal-time",
+        label: "EqualTime",
+        order: 30,
+        doc: "Fig. 7.1 / 7.3: RMSE and SSIM over GI GPU time for every per-frame method (SLC, RTSLC, SST over spp; Lightcuts over its relative error); equal-time table.",
+        make: equal_time,
     }
 }
 
@@ -591,7 +661,7 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
 
 #[cfg(test)]
 mod tests {
-    use super::interp_loglog;
+    use super::*;
 
     #[test]
     fn loglog_interpolation() {
@@ -602,5 +672,49 @@ mod tests {
         let (y, ex) = interp_loglog(&p, 64.0);
         assert!((y - 64f64.powf(-0.5)).abs() < 1e-12 && ex);
         assert!(interp_loglog(&[], 1.0).0.is_nan());
+    }
+
+    /// Every figure once (CLI name, label and place unique), the thesis's own in its order
+    /// with the methods' studies between them where they were when the list was written by
+    /// hand.
+    #[test]
+    fn figures_are_registered_once_in_a_runs_order() {
+        let figs = all();
+        for key in [
+            |f: &FigureDef| f.cli.to_string(),
+            |f: &FigureDef| f.label.to_string(),
+            |f: &FigureDef| f.order.to_string(),
+        ] {
+            let mut k: Vec<String> = figs.iter().map(|f| key(f)).collect();
+            k.sort();
+            let n = k.len();
+            k.dedup();
+            assert_eq!(k.len(), n, "a figure registered twice: {figs:?}");
+        }
+        let before = [
+            "Timings",
+            "Steps",
+            "EqualTime",
+            "Interpolation",
+            "Culling",
+            "Val",
+            "Temporal",
+            "Trees",
+            "Bounces",
+            "Blocks",
+            "Blending",
+            "Upsampling",
+            "Scaling",
+        ];
+        let kept: Vec<&str> = figs
+            .iter()
+            .map(|f| f.label)
+            .filter(|l| before.contains(l))
+            .collect();
+        assert_eq!(kept, before);
+        for f in &figs {
+            assert_eq!(find(f.cli).map(|g| g.label), Some(f.label));
+            assert!(!f.doc.is_empty(), "{} has no description", f.cli);
+        }
     }
 }

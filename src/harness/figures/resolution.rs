@@ -2,6 +2,16 @@
 
 use super::*;
 
+inventory::submit! {
+    FigureDef {
+        cli: "upsampling",
+        label: "Upsampling",
+        order: 120,
+        doc: "Table 7.2: full vs half GI resolution.",
+        make: upsampling,
+    }
+}
+
 /// Thesis table 7.2: full vs half GI resolution at one or more frame sizes: RMSE, the
 /// image-mean ratio against the ground truth, SSIM, GI time (GPU timestamps of the GI
 /// passes: cuts, sampling, down- and upsampling) and the frame's wall clock (a separate
@@ -105,6 +115,16 @@ pub fn upsampling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
         false,
     )?;
     Ok(Report { table, checks })
+}
+
+inventory::submit! {
+    FigureDef {
+        cli: "scaling",
+        label: "Scaling",
+        order: 130,
+        doc: "VPL count sweep: tree build time, GI time, RMSE.",
+        make: scaling,
+    }
 }
 
 /// VPL count 2^10 .. 2^16: tree build GPU time (keys, sort, build, classify), GI GPU time,

@@ -3,6 +3,16 @@
 
 use super::*;
 
+inventory::submit! {
+    FigureDef {
+        cli: "steps",
+        label: "Steps",
+        order: 20,
+        doc: "Fig. 7.2: traversal steps per pixel of the three samplers, heat maps.",
+        make: steps,
+    }
+}
+
 /// Thesis fig. 7.2: traversal steps of the three samplers at the base settings: means,
 /// per-pixel heat maps on one scale, the distribution over pixels.
 pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
@@ -163,6 +173,16 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     })
 }
 
+inventory::submit! {
+    FigureDef {
+        cli: "blocks",
+        label: "Blocks",
+        order: 100,
+        doc: "Fig. 7.5: block size sweep (cut build time, frame time, RMSE).",
+        make: blocks,
+    }
+}
+
 /// Thesis fig. 7.5: SLC over block sizes k: cut-building and sampling GPU time (timed
 /// frames), frame wall clock (a separate column), RMSE and the image-mean ratio against the
 /// ground truth.
@@ -283,6 +303,16 @@ pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         ));
     }
     Ok(Report { table, checks })
+}
+
+inventory::submit! {
+    FigureDef {
+        cli: "blending",
+        label: "Blending",
+        order: 110,
+        doc: "Fig. 7.4 / 7.6: no blending vs blending; mock cut vs averaging vs root vs recomputed cut.",
+        make: blending,
+    }
 }
 
 /// Thesis fig. 7.4 and 7.6: no blending vs blending, and the fallbacks for pixels without a

@@ -54,6 +54,16 @@ fn mean_finite(v: impl Iterator<Item = f64>) -> f64 {
     if x.is_empty() { f64::NAN } else { mean_std(&x).0 }
 }
 
+inventory::submit! {
+    FigureDef {
+        cli: "temporal",
+        label: "Temporal",
+        order: 70,
+        doc: "Temporal reuse (reprojection, history, SVGF) after every per-frame method along a camera path, a sun sweep and a still view: per-frame RMSE / SSIM of raw and filtered GI against each frame's ground truth, flicker, and the stage's GPU time per pass.",
+        make: temporal,
+    }
+}
+
 pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let methods = methods(o);
     let motions = motions(b, o)?;

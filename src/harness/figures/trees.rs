@@ -20,6 +20,16 @@ struct TreeCurve {
     t_base: f64,
 }
 
+inventory::submit! {
+    FigureDef {
+        cli: "trees",
+        label: "Trees",
+        order: 80,
+        doc: "Issue 23: the tree samplers and Lightcuts on the perfect binary tree and on the radix tree (LBVH): RMSE over GPU time (method + tree build), steps, and RMSE at equal time.",
+        make: trees,
+    }
+}
+
 pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let base_spp = b.base.sampling.cut_size;
     let mut csv = Csv::new(&[

@@ -14,6 +14,7 @@
 //!
 //! Passes: `pass.rs`; CPU twins: `crate::reference::light_culling`; docs/light-culling.md.
 
+mod figure;
 mod method;
 pub mod pass;
 pub mod settings;

@@ -7,6 +7,7 @@
 //! Passes in `pass` (module doc there); CPU twins in
 //! `crate::reference::lightcut_interpolation`; docs/lightcut-interpolation.md.
 
+mod figure;
 mod method;
 pub mod pass;
 pub mod settings;

@@ -15,6 +15,7 @@
 //! Passes: `pass.rs`; CPU twins: `crate::reference::val`, `crate::reference::ism`;
 //! docs/val.md.
 
+mod figure;
 mod method;
 pub mod pass;
 pub mod settings;

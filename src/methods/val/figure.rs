@@ -9,8 +9,8 @@
 //! run of a count shades the same interleaving subsets, so two of them differ only in
 //! visibility.
 
-use super::*;
 use crate::gpu::readback::ImageF32;
+use crate::harness::figures::prelude::*;
 use crate::harness::median;
 use crate::methods::val::{
     self as val_method,
@@ -58,6 +58,16 @@ fn stat(m: &Measured, k: &str) -> f64 {
         .iter()
         .find(|(n, _)| *n == k)
         .map_or(f64::NAN, |(_, v)| *v)
+}
+
+inventory::submit! {
+    FigureDef {
+        cli: "val",
+        label: "Val",
+        order: 60,
+        doc: "The VAL paper's Table 1: 64 PCSS VALs vs 512 simple VALs, GPU time of clustering, indirect illumination and maps, error against the ground truth and against the same VALs with exact visibility; the VPL-shading mode beside them.",
+        make: val,
+    }
 }
 
 pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {

@@ -7,7 +7,7 @@
 //! are the checks. `interpolation.csv`'s `mean_ratio` is against the ground truth (mean over
 //! the diagnostic frames), `mean_ratio_vs_lightcuts` against Lightcuts' last frame.
 
-use super::*;
+use crate::harness::figures::prelude::*;
 use crate::methods::{
     lightcut_interpolation::{
         self as li,
@@ -21,6 +21,16 @@ use crate::metrics;
 /// full visibility 40.4-56.4%, interpolated visibility 4.50-8.32%.
 pub const PAPER_FULL_RATIO: (f64, f64) = (0.404, 0.564);
 pub const PAPER_INTERP_RATIO: (f64, f64) = (0.045, 0.0832);
+
+inventory::submit! {
+    FigureDef {
+        cli: "interpolation",
+        label: "Interpolation",
+        order: 40,
+        doc: "Lightcut Interpolation's headline comparison (its paper's Fig. 8 / 10): Lightcuts vs interpolation with full and interpolated visibility, GPU time per pass and error.",
+        make: interpolation,
+    }
+}
 
 pub fn interpolation(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let li_base: LightcutInterpolationSettings = b.base.method(li::ID).map_err(|e| anyhow::anyhow!(e))?;

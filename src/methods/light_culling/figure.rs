@@ -10,7 +10,7 @@
 //! imperfect shadow maps (sections 4.3-4.4, against the true ground truth), and with the
 //! maps' range culling off (figure 7: the maps' build time with and without it).
 
-use super::*;
+use crate::harness::figures::prelude::*;
 use crate::methods::light_culling::{
     self as lcull,
     settings::{CullingVisibility, LightCullingSettings},
@@ -88,6 +88,16 @@ fn stat(m: &Measured, k: &str) -> f64 {
         .iter()
         .find(|(n, _)| *n == k)
         .map_or(f64::NAN, |(_, v)| *v)
+}
+
+inventory::submit! {
+    FigureDef {
+        cli: "culling",
+        label: "Culling",
+        order: 50,
+        doc: "Stochastic Light Culling's study (its figs. 4-6, Table 1): stochastic vs clamped ranges over the VPL count (--vpl-exponents) and eps_max (--sweep light-culling=..), with and without visibility, GPU time and error.",
+        make: culling,
+    }
 }
 
 /// The study (module doc). Its VPL counts are `--vpl-exponents`, its error bounds the
