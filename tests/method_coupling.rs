@@ -348,7 +348,7 @@ fn the_scan_finds_paths_groups_types_and_ids() {
 /// never grow; lower `SHAPE_LIMITS` when a change improves one). Its goal: every count 0.
 const SHAPE_LIMITS: &[(&str, usize)] = &[
     ("files over 700 lines", 0),
-    ("functions over 150 lines", 23),
+    ("functions over 150 lines", 17),
     ("too_many_arguments allows", 41),
     ("files in src/gpu and src/settings that name methods", 1),
     (

@@ -485,41 +485,73 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
             both[0][1] / both[1][1],
             both[0].iter().sum::<f64>() / both[1].iter().sum::<f64>()
         );
-        // The radix tree over the same sorted keys (Karras 2012; issue 23): its topology,
-        // checked against its CPU twin, and its node data bottom-up, against the perfect
-        // tree's build (whose topology is implicit).
-        sort.variant = SortVariant::Parallel;
-        let lb = TreeBuffers::new(device, n, crate::base::sst_node::TreeKind::Lbvh);
-        let timed = time_back_to_back(&ctx, &mut timer, args.repeat, |enc, timer| {
-            sort.record(device, &ctx.queue, enc, timer, &buf, &sb);
-            lbvh.record(device, &ctx.queue, enc, timer, &sb, &lb);
-            lbvh.record_node_data(device, &ctx.queue, enc, timer, &sb, &buf, &lb);
-        })?;
-        let med = |name: &str| {
-            median(timed.iter().map(|t| t.get(name).unwrap_or(f64::NAN)).collect()).unwrap_or(f64::NAN)
-        };
-        let (ms, nodes_ms) = (med("lbvh_build"), med("lbvh_nodes"));
-        let keys: Vec<[u32; 4]> =
-            bytemuck::pod_collect_to_vec(&crate::gpu::readback::read_storage_buffer(&ctx, &sb.keys)?);
-        let keys: Vec<u64> = keys[..n as usize]
-            .iter()
-            .map(|k| (k[0] as u64) << 32 | k[1] as u64)
-            .collect();
-        let same = read_topology(&ctx, &lb)? == crate::reference::lbvh::build(&keys);
-        println!(
-            "{n:>9} {:>9} topology {ms:.3} ms + node data {nodes_ms:.3} ms = {:.3} ms (the perfect tree's build {:.3} ms); topology equals the CPU reference: {}",
-            "radix",
-            ms + nodes_ms,
+        radix_tree(
+            &ctx,
+            &mut timer,
+            (&mut sort, &lbvh),
+            (&buf, &sb),
+            (n, args.repeat),
             both[1][2],
-            if same { "yes" } else { "NO" }
-        );
-        if !same {
-            return Err(anyhow!(
-                "the radix tree of {n} keys differs from its CPU reference"
-            ));
-        }
+        )?;
         rows.push((n as f64, both));
     }
+    print_slopes(&rows, &variants);
+    if let Some(e) = ctx.errors.take().into_iter().next() {
+        return Err(anyhow!("GPU error: {e}"));
+    }
+    Ok(())
+}
+
+/// The radix tree over the same sorted keys (Karras 2012; issue 23): its topology, checked
+/// against its CPU twin, and its node data bottom-up, timed against the perfect tree's build
+/// (whose topology is implicit). `size`: the VPL count and the timed repetitions.
+fn radix_tree(
+    ctx: &GpuContext,
+    timer: &mut GpuTimer,
+    passes: (&mut SortPass, &LbvhPass),
+    inputs: (&wgpu::Buffer, &SortBuffers),
+    size: (u32, u32),
+    perfect_build_ms: f64,
+) -> anyhow::Result<()> {
+    let (sort, lbvh) = passes;
+    let (buf, sb) = inputs;
+    let (n, repeat) = size;
+    let device = &ctx.device;
+    sort.variant = SortVariant::Parallel;
+    let lb = TreeBuffers::new(device, n, crate::base::sst_node::TreeKind::Lbvh);
+    let timed = time_back_to_back(ctx, timer, repeat, |enc, timer| {
+        sort.record(device, &ctx.queue, enc, timer, buf, sb);
+        lbvh.record(device, &ctx.queue, enc, timer, sb, &lb);
+        lbvh.record_node_data(device, &ctx.queue, enc, timer, sb, buf, &lb);
+    })?;
+    let med = |name: &str| {
+        median(timed.iter().map(|t| t.get(name).unwrap_or(f64::NAN)).collect()).unwrap_or(f64::NAN)
+    };
+    let (ms, nodes_ms) = (med("lbvh_build"), med("lbvh_nodes"));
+    let keys: Vec<[u32; 4]> =
+        bytemuck::pod_collect_to_vec(&crate::gpu::readback::read_storage_buffer(ctx, &sb.keys)?);
+    let keys: Vec<u64> = keys[..n as usize]
+        .iter()
+        .map(|k| (k[0] as u64) << 32 | k[1] as u64)
+        .collect();
+    let same = read_topology(ctx, &lb)? == crate::reference::lbvh::build(&keys);
+    println!(
+        "{n:>9} {:>9} topology {ms:.3} ms + node data {nodes_ms:.3} ms = {:.3} ms (the perfect tree's build {:.3} ms); topology equals the CPU reference: {}",
+        "radix",
+        ms + nodes_ms,
+        perfect_build_ms,
+        if same { "yes" } else { "NO" }
+    );
+    if !same {
+        return Err(anyhow!(
+            "the radix tree of {n} keys differs from its CPU reference"
+        ));
+    }
+    Ok(())
+}
+
+/// Per variant, the log-log slope of each stage's time over N.
+fn print_slopes(rows: &[(f64, [[f64; 4]; 2])], variants: &[(SortVariant, &str); 2]) {
     for (vi, (_, name)) in variants.iter().enumerate() {
         let slope = |k: usize| {
             log_log_slope(&rows.iter().map(|(n, m)| (*n, m[vi][k])).collect::<Vec<_>>())
@@ -542,10 +574,6 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
             total
         );
     }
-    if let Some(e) = ctx.errors.take().into_iter().next() {
-        return Err(anyhow!("GPU error: {e}"));
-    }
-    Ok(())
 }
 
 #[cfg(test)]

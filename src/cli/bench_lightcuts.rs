@@ -129,6 +129,73 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         leaves,
         args.max_cut
     );
+    let far_share = print_tree_pairing(&nodes, leaves);
+    radix_tree_pairing(&r.read_vpls()?, leaves);
+    // The frame's G-buffer and sorted VPLs for the CPU reference.
+    let bvh = Bvh::build(&scene.positions, &scene.indices);
+    let pos = r.read(Buffer::Position)?;
+    let nrm = r.read(Buffer::Normal)?;
+    let (_, tree) = r.tree_buffers();
+    let sorted: Vec<crate::base::gpu_layout::GpuVpl> =
+        bytemuck::pod_collect_to_vec(&read_storage_buffer(&r.ctx, &tree.sorted_vpls)?);
+    let pixels: Vec<usize> = {
+        let all = (size.0 * size.1) as usize;
+        let step = (all / args.cpu_pixels.max(1) as usize).max(1);
+        (0..all)
+            .step_by(step)
+            .filter(|&k| pos.pixels[k][3] > 0.0)
+            .collect()
+    };
+    println!(
+        "per relative error: GPU time of lightcuts_build + lightcuts (median of {} timed frames), a diagnostic frame's counters, and the CPU reference's refinements on {} pixels",
+        args.repeat,
+        pixels.len()
+    );
+    println!("  rel. error  GPU ms  mean cut  rays/pixel  at max cut  refinements on far-paired nodes");
+    for &e in &args.errors {
+        let mut si = s.clone();
+        si.set_method(lightcuts::ID, &lc(e)).map_err(|e| anyhow!("{e}"))?;
+        r.set_settings(si.clone())?;
+        let gpu_ms = median_gpu_ms(&mut r, &input, args.repeat);
+        r.set_frame_mode(FrameMode::Diagnostic);
+        r.render(&input);
+        r.wait_idle();
+        let stats = r.method_stats_blocking();
+        let get = |k: &str| stats.iter().find(|(n, _)| *n == k).map_or(f64::NAN, |(_, v)| *v);
+        let build = r
+            .method_module::<Lightcuts>()
+            .ok_or_else(|| anyhow!("lightcuts is not registered"))?
+            .read_build(&r.ctx)?;
+        let p = CutParams {
+            relative_error: e,
+            max_cut: args.max_cut,
+            eps: si.gi.distance_epsilon,
+            shadow_rays: si.gi.shadow_rays.then_some(si.gi.ray_offset),
+            trace_every_node: false,
+        };
+        let cpu = CpuCuts::of(&pixels, (&pos, &nrm), (&nodes, &build, &sorted), &bvh, &p);
+        let (refined, refined_far, cpu_cut, cpu_max) = (cpu.refined, cpu.refined_far, cpu.cut, cpu.at_max);
+        let np = pixels.len().max(1) as f64;
+        println!(
+            "  {e:>10}  {gpu_ms:>6.2}  {:>8.1}  {:>10.1}  {:>9.2}%  {:>6.1}% (of {refined} refinements of clusters; of the tree's nodes over clusters: {:.1}%); CPU subset: mean cut {:.1}, {:.2}% at max cut",
+            get("mean_cut_size"),
+            get("shadow_rays_per_pixel"),
+            100.0 * get("max_cut_pixel_fraction"),
+            100.0 * refined_far as f64 / refined.max(1) as f64,
+            100.0 * far_share,
+            cpu_cut as f64 / np,
+            100.0 * cpu_max as f64 / np
+        );
+    }
+    if let Some(e) = r.ctx.errors.take().into_iter().next() {
+        return Err(anyhow!("GPU error: {e}"));
+    }
+    Ok(())
+}
+
+/// Prints the tree's pairing per level (inner nodes with two non-empty children: mean
+/// diagonal, disjoint children, far-paired ones); returns the far-paired share over clusters.
+fn print_tree_pairing(nodes: &[SstNode], leaves: usize) -> f64 {
     println!("the tree's pairing per level (inner nodes with two non-empty children):");
     println!(
         "  level  nodes  mean diagonal (m)  disjoint children  far-paired (gap > half the node's diagonal)"
@@ -173,74 +240,64 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         far_total.1,
         100.0 * far_share
     );
-    radix_tree_pairing(&r.read_vpls()?, leaves);
-    // The frame's G-buffer and sorted VPLs for the CPU reference.
-    let bvh = Bvh::build(&scene.positions, &scene.indices);
-    let pos = r.read(Buffer::Position)?;
-    let nrm = r.read(Buffer::Normal)?;
-    let (_, tree) = r.tree_buffers();
-    let sorted: Vec<crate::base::gpu_layout::GpuVpl> =
-        bytemuck::pod_collect_to_vec(&read_storage_buffer(&r.ctx, &tree.sorted_vpls)?);
-    let pixels: Vec<usize> = {
-        let all = (size.0 * size.1) as usize;
-        let step = (all / args.cpu_pixels.max(1) as usize).max(1);
-        (0..all)
-            .step_by(step)
-            .filter(|&k| pos.pixels[k][3] > 0.0)
-            .collect()
-    };
-    println!(
-        "per relative error: GPU time of lightcuts_build + lightcuts (median of {} timed frames), a diagnostic frame's counters, and the CPU reference's refinements on {} pixels",
-        args.repeat,
-        pixels.len()
-    );
-    println!("  rel. error  GPU ms  mean cut  rays/pixel  at max cut  refinements on far-paired nodes");
-    for &e in &args.errors {
-        let mut si = s.clone();
-        si.set_method(lightcuts::ID, &lc(e)).map_err(|e| anyhow!("{e}"))?;
-        r.set_settings(si.clone())?;
-        let gpu_ms = if r.timestamps_supported() {
-            r.set_frame_mode(FrameMode::Timed);
-            let mut v = Vec::new();
-            for i in 0..args.repeat + 2 {
-                r.render(&input);
-                if let Some(t) = r.wait_new_timings()
-                    && i >= 2
-                {
-                    v.push(t.get("lightcuts").unwrap_or(0.0) + t.get("lightcuts_build").unwrap_or(0.0));
-                }
+    far_share
+}
+
+/// The median GPU time of `lightcuts_build` + `lightcuts` over `repeat` timed frames after
+/// two warm-up ones (NaN without timestamps).
+fn median_gpu_ms(r: &mut Renderer, input: &FrameInput<'_>, repeat: u32) -> f64 {
+    if r.timestamps_supported() {
+        r.set_frame_mode(FrameMode::Timed);
+        let mut v = Vec::new();
+        for i in 0..repeat + 2 {
+            r.render(input);
+            if let Some(t) = r.wait_new_timings()
+                && i >= 2
+            {
+                v.push(t.get("lightcuts").unwrap_or(0.0) + t.get("lightcuts_build").unwrap_or(0.0));
             }
-            v.sort_by(|a, b| a.total_cmp(b));
-            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-        } else {
-            f64::NAN
-        };
-        r.set_frame_mode(FrameMode::Diagnostic);
-        r.render(&input);
-        r.wait_idle();
-        let stats = r.method_stats_blocking();
-        let get = |k: &str| stats.iter().find(|(n, _)| *n == k).map_or(f64::NAN, |(_, v)| *v);
-        let build = r
-            .method_module::<Lightcuts>()
-            .ok_or_else(|| anyhow!("lightcuts is not registered"))?
-            .read_build(&r.ctx)?;
-        let p = CutParams {
-            relative_error: e,
-            max_cut: args.max_cut,
-            eps: si.gi.distance_epsilon,
-            shadow_rays: si.gi.shadow_rays.then_some(si.gi.ray_offset),
-            trace_every_node: false,
-        };
+        }
+        v.sort_by(|a, b| a.total_cmp(b));
+        v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+    } else {
+        f64::NAN
+    }
+}
+
+/// The CPU reference's cuts on a subset of pixels: refinements of clusters (inner nodes
+/// above each pixel's cut, clusters of clusters) and those of far-paired nodes, the summed cut
+/// sizes and the pixels at the maximum cut.
+struct CpuCuts {
+    refined: u64,
+    refined_far: u64,
+    cut: u64,
+    at_max: u64,
+}
+
+impl CpuCuts {
+    fn of(
+        pixels: &[usize],
+        gbuffer: (&crate::base::image::ImageF32, &crate::base::image::ImageF32),
+        tree: (
+            &[SstNode],
+            &crate::reference::lightcuts::LcTree,
+            &[crate::base::gpu_layout::GpuVpl],
+        ),
+        bvh: &Bvh,
+        p: &CutParams,
+    ) -> Self {
+        let (pos, nrm) = gbuffer;
+        let (nodes, build, sorted) = tree;
         // Refined nodes = the inner nodes above each pixel's cut.
         let (mut refined, mut refined_far) = (0u64, 0u64);
         let (mut cpu_cut, mut cpu_max) = (0u64, 0u64);
-        for &k in &pixels {
+        for &k in pixels {
             let g = pos.pixels[k];
             let x = Vec3::new(g[0], g[1], g[2]);
             let n = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
-            let cut = lightcut(&nodes, &build, &sorted, &bvh, x, n, &p);
+            let cut = lightcut(nodes, build, sorted, bvh, x, n, p);
             cpu_cut += cut.cut.len() as u64;
-            cpu_max += cut.hit_max_cut(&p) as u64;
+            cpu_max += cut.hit_max_cut(p) as u64;
             let mut seen = std::collections::HashSet::new();
             for c in &cut.cut {
                 let mut a = c.node / 2;
@@ -248,26 +305,17 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
                     // Refinements of clusters of clusters (as the far-pairing counts).
                     if 4 * a < nodes.len() as u32 {
                         refined += 1;
-                        refined_far += far_paired(&nodes, a as usize) as u64;
+                        refined_far += far_paired(nodes, a as usize) as u64;
                     }
                     a /= 2;
                 }
             }
         }
-        let np = pixels.len().max(1) as f64;
-        println!(
-            "  {e:>10}  {gpu_ms:>6.2}  {:>8.1}  {:>10.1}  {:>9.2}%  {:>6.1}% (of {refined} refinements of clusters; of the tree's nodes over clusters: {:.1}%); CPU subset: mean cut {:.1}, {:.2}% at max cut",
-            get("mean_cut_size"),
-            get("shadow_rays_per_pixel"),
-            100.0 * get("max_cut_pixel_fraction"),
-            100.0 * refined_far as f64 / refined.max(1) as f64,
-            100.0 * far_share,
-            cpu_cut as f64 / np,
-            100.0 * cpu_max as f64 / np
-        );
+        Self {
+            refined,
+            refined_far,
+            cut: cpu_cut,
+            at_max: cpu_max,
+        }
     }
-    if let Some(e) = r.ctx.errors.take().into_iter().next() {
-        return Err(anyhow!("GPU error: {e}"));
-    }
-    Ok(())
 }

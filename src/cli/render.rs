@@ -183,72 +183,17 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let mut opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
     let record_camera = record.as_ref().map(|c| &c.camera).filter(|c| !c.name.is_empty());
     if let Some(c) = &record {
-        if !c.scene_sha256.is_empty()
-            && let Some(f) = &opened.file
-            && let Ok(bytes) = std::fs::read(f)
-            && crate::scene::scene_path::sha256_hex(&bytes) != c.scene_sha256
-        {
-            println!(
-                "  note: {} differs from the recorded scene file (SHA-256)",
-                f.display()
-            );
-        }
-        if !c.lights.is_empty() {
-            opened.scene.lights = c.lights.iter().map(|l| l.light()).collect();
-        }
+        apply_record(c, &mut opened);
     }
-    let mut settings = args.settings.resolve(opened.exposure_ev)?;
-    if let Some(m) = args.method {
-        settings.gi.method = m;
-    }
+    let settings = run_settings(args, record.as_ref(), &opened)?;
     let method = settings.gi.method;
-    if let Some(c) = &record
-        && c.what != "render"
-        && c.first_frame.is_some()
-        && settings.temporal.mode != crate::settings::TemporalMode::Off
-    {
-        println!(
-            "  note: the temporal stage's history from the window's earlier frames is not in the record: its image is the stage's over the frames rendered here"
-        );
-    }
-    args.sampling.apply(&mut settings);
-    args.sampling.check_visibility(&[method])?;
-    // `tree.kind = lbvh` from a settings file or --set: the same refusal as --tree's.
-    if let Some(msg) = method.refuses_tree(settings.tree.kind) {
-        return Err(anyhow!("{msg}"));
-    }
-    if let Some(msg) = method
-        .refuses_bounces(settings.vpl.bounces)
-        .or(method.refuses_brdf(settings.gi.brdf))
-    {
-        return Err(anyhow!("{msg}"));
-    }
-    if args.sampling.frames == 0 {
-        return Err(anyhow!("--frames must be at least 1"));
-    }
-    if let Some(v) = args.samples {
-        settings.gi.reference_samples = v;
-    }
-    settings.gi.reference_spp_per_frame = settings.gi.reference_samples.min(16);
-    if let Some(v) = args.vpls {
-        settings.vpl.count = v;
-    }
-    if let Some(v) = args.seed {
-        settings.vpl.seed = v;
-    }
-    if let Some(v) = args.epsilon {
-        settings.gi.distance_epsilon = v;
-    }
-    // Headless: large GI steps (each submit still splits into bounded dispatches).
-    settings.gi.rays_per_frame = 1 << 26;
-    settings.validate().map_err(|e| anyhow!("{e}"))?;
     let wants = |o: Output| args.output.contains(&Output::All) || args.output.contains(&o);
-    let cam_name = args.camera.clone().or(opened.camera_name.clone());
+    // The record's camera, else `--camera`, else the preset's.
     let camera = match record_camera {
         Some(c) => c.camera(),
         None => opened
             .scene
-            .camera_or_default(cam_name.as_deref())
+            .camera_or_default(args.camera.as_deref().or(opened.camera_name.as_deref()))
             .map_err(|e| anyhow!("{e}"))?,
     };
     if args.camera_path.is_some() || args.sun_sweep.is_some() {
@@ -293,23 +238,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let n_timing = args.timing_frames.max(1);
     // Live GPU objects and resident memory after 30 frames and at the end (issue 42).
     let mut watch = Watch::new(Watch::WARM_FRAMES);
-    let mut timed: Vec<PassTimings> = Vec::new();
-    let mut wall_ms: Vec<f64> = Vec::new();
-    // Progressive methods: the GPU time of every frame's passes adds up.
-    let mut gi_ms = 0.0;
-    for i in 0..n_timing {
-        let t0 = std::time::Instant::now();
-        frame(&mut r, ViewBuffer::Final);
-        r.ctx.wait_idle()?;
-        watch.frame(&r.ctx);
-        let ms = t0.elapsed().as_secs_f64() * 1e3;
-        let t = r.wait_new_timings();
-        gi_ms += t.as_ref().map_or(0.0, |t| method_ms(t, method));
-        if i > 0 || n_timing == 1 {
-            wall_ms.push(ms);
-            timed.extend(t);
-        }
-    }
+    let (timed, wall_ms, mut gi_ms) = timed_frames(&mut r, &frame, &mut watch, n_timing, method)?;
     let timings = mean_timings(&timed);
     // The image: a per-frame method averages exactly --frames new diagnostic frames
     // (untimed; the accumulation restarts with the settings change). A progressive method
@@ -337,52 +266,17 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     let first_frame = method.per_frame().then(|| r.frame_index());
     if method.per_frame() {
-        r.set_frame_mode(FrameMode::Diagnostic);
-        for _ in 0..args.sampling.frames {
-            if let Some(e) = r.ctx.errors.take().into_iter().next() {
-                return Err(anyhow!("GPU error: {e}"));
-            }
-            frame(&mut r, ViewBuffer::Final);
-            r.ctx.wait_idle()?;
-            watch.frame(&r.ctx);
-        }
-        frames_averaged = Some(r.sampling_frames());
-        if let Some(st) = r.sampling_stats_blocking().filter(|_| method.samples_tree()) {
-            println!(
-                "tree sampling: {} frame(s) averaged; {:.3} traversal steps per traversal, {:.2} per pixel; {:.3}% of pixels without a similar cut; {} dead branches and {} shadow rays in the last frame",
-                r.sampling_frames(),
-                st.steps_per_traversal(),
-                st.steps_per_pixel(),
-                100.0 * st.fallback_fraction(),
-                st.dead,
-                st.rays
-            );
-        }
+        frames_averaged = Some(image_frames(
+            &mut r,
+            &frame,
+            &mut watch,
+            args.sampling.frames,
+            method,
+        )?);
     }
-    // Progressive GI: keep rendering the same frame until it has seen every VPL / sample.
     let info = method.info();
-    while let Some(p) = r.gi_progress() {
-        if p.finished() {
-            break;
-        }
-        frame(&mut r, ViewBuffer::Final);
-        r.ctx.wait_idle()?;
-        watch.frame(&r.ctx);
-        if let Some(t) = r.wait_new_timings() {
-            gi_ms += method_ms(&t, method);
-        }
-        if let Some(p) = r.gi_progress() {
-            eprint!(
-                "\r{} ({}): {:5.1}% of {}",
-                info.label,
-                info.progress_unit,
-                100.0 * p.fraction(),
-                p.total
-            );
-        }
-    }
+    gi_ms += progressive_frames(&mut r, &frame, &mut watch, method)?;
     if let Some(p) = r.gi_progress() {
-        eprintln!();
         let what = format!("{}: {} {}", info.short, p.total, info.progress_unit);
         println!(
             "{what} x {}x{} pixels in {:.2} s wall (from the first frame), {:.1} ms GPU",
@@ -392,12 +286,109 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             gi_ms
         );
     }
-    if let Some(e) = r.ctx.errors.take().into_iter().next() {
-        return Err(anyhow!("GPU error: {e}"));
-    }
+    gpu_error(&r)?;
     let out = &args.out;
     write_resources(out, &watch.finish(&r.ctx))?;
 
+    let (direct, indirect) = write_exrs(&mut r, out, &wants, &camera)?;
+    if wants(Output::Png) {
+        write_pngs(&mut r, out, method, &redraw)?;
+    }
+    if method.per_frame() {
+        let timed = Timed {
+            timings: timings.as_ref(),
+            frames: timed.len(),
+            wall_ms: crate::harness::mean_std(&wall_ms).0,
+            frames_averaged: frames_averaged.unwrap_or(1),
+        };
+        write_metrics(&mut r, args, &indirect, &timed, &frame)?;
+    }
+    gpu_error(&r)?;
+    print_summary(
+        &opened,
+        &camera,
+        args,
+        &direct,
+        timings.as_ref(),
+        (timed.len(), n_timing),
+        &wall_ms,
+    );
+    write_capture(
+        &r,
+        args,
+        &opened,
+        (&camera, &lights),
+        (n_timing, first_frame),
+        &image_settings_for_record,
+    )?;
+    println!("wrote {}", out.display());
+    Ok(())
+}
+
+/// The first GPU error the device reported since the last look, as an error.
+fn gpu_error(r: &Renderer) -> anyhow::Result<()> {
+    match r.ctx.errors.take().into_iter().next() {
+        Some(e) => Err(anyhow!("GPU error: {e}")),
+        None => Ok(()),
+    }
+}
+
+/// A capture record's scene notes and lights: a note when the scene file differs from the
+/// recorded one (SHA-256), the recorded lights replacing the scene's.
+fn apply_record(c: &crate::capture::Capture, opened: &mut crate::scene::preset::OpenedScene) {
+    if !c.scene_sha256.is_empty()
+        && let Some(f) = &opened.file
+        && let Ok(bytes) = std::fs::read(f)
+        && crate::scene::scene_path::sha256_hex(&bytes) != c.scene_sha256
+    {
+        println!(
+            "  note: {} differs from the recorded scene file (SHA-256)",
+            f.display()
+        );
+    }
+    if !c.lights.is_empty() {
+        opened.scene.lights = c.lights.iter().map(|l| l.light()).collect();
+    }
+}
+
+/// A per-frame method's image: `frames` diagnostic frames averaged (untimed); prints the
+/// tree samplers' statistics. Returns the frames averaged.
+fn image_frames(
+    r: &mut Renderer,
+    frame: &dyn Fn(&mut Renderer, ViewBuffer),
+    watch: &mut Watch,
+    frames: u32,
+    method: MethodId,
+) -> anyhow::Result<u32> {
+    r.set_frame_mode(FrameMode::Diagnostic);
+    for _ in 0..frames {
+        gpu_error(r)?;
+        frame(r, ViewBuffer::Final);
+        r.ctx.wait_idle()?;
+        watch.frame(&r.ctx);
+    }
+    let averaged = r.sampling_frames();
+    if let Some(st) = r.sampling_stats_blocking().filter(|_| method.samples_tree()) {
+        println!(
+            "tree sampling: {} frame(s) averaged; {:.3} traversal steps per traversal, {:.2} per pixel; {:.3}% of pixels without a similar cut; {} dead branches and {} shadow rays in the last frame",
+            r.sampling_frames(),
+            st.steps_per_traversal(),
+            st.steps_per_pixel(),
+            100.0 * st.fallback_fraction(),
+            st.dead,
+            st.rays
+        );
+    }
+    Ok(averaged)
+}
+
+/// The EXRs `render` was asked for (`wants`); returns the direct and indirect images.
+fn write_exrs(
+    r: &mut Renderer,
+    out: &std::path::Path,
+    wants: &dyn Fn(Output) -> bool,
+    camera: &crate::scene::Camera,
+) -> anyhow::Result<(ImageF32, ImageF32)> {
     let direct = r.read(Buffer::Direct)?;
     let indirect = r.read(Buffer::Indirect)?;
     if wants(Output::Direct) {
@@ -419,100 +410,264 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             &linear_depth(&position, camera.position, camera.forward),
         )?;
     }
-    if wants(Output::Png) {
-        let pngs = [
-            (ViewBuffer::Final, "final.png"),
-            (ViewBuffer::Direct, "direct.png"),
-            (ViewBuffer::Indirect, "indirect.png"),
-            (ViewBuffer::Albedo, "albedo.png"),
-            (ViewBuffer::Normal, "normal.png"),
-            (ViewBuffer::Depth, "depth.png"),
-            (ViewBuffer::ShadowMap, "shadow_map.png"),
-            (ViewBuffer::RsmFlux, "rsm_flux.png"),
-            (ViewBuffer::ImportanceRaw, "brsm_importance_raw.png"),
-            (ViewBuffer::ImportanceFiltered, "brsm_importance_filtered.png"),
-        ];
-        // Views are drawn from the last frame's buffers (no new frame: the averaged GI and
-        // its frame count stay those of the EXRs).
-        for (view, name) in pngs {
-            redraw(&mut r, view);
-            let (w, h, bytes) = r.read_view_rgba8()?;
-            write_png(&out.join(name), w, h, &bytes)?;
-        }
-        // The VPLs over the RSM and in the camera view, and a coarse PDF-pyramid level.
-        let mut s2 = r.settings().clone();
-        s2.display.vpl_overlay = true;
-        s2.display.vpl_point_size = 1;
-        s2.display.pyramid_level = 4;
-        r.set_settings(s2)?;
-        for (view, name) in [
-            (ViewBuffer::RsmFlux, "vpls_over_rsm.png"),
-            (ViewBuffer::Final, "vpls_in_view.png"),
-            (ViewBuffer::PdfPyramid, "pdf_pyramid_level4.png"),
-        ] {
-            redraw(&mut r, view);
-            let (w, h, bytes) = r.read_view_rgba8()?;
-            write_png(&out.join(name), w, h, &bytes)?;
-        }
-        // The method's own views (the tree samplers': thesis figs. 7.2, 7.4, 7.6).
-        if !info.views.is_empty() {
-            let mut s3 = r.settings().clone();
-            s3.display.vpl_overlay = false;
-            r.set_settings(s3)?;
-            for v in info.views {
-                redraw(&mut r, ViewBuffer::Method(MethodView::new(v.name)));
-                let (w, h, bytes) = r.read_view_rgba8()?;
-                write_png(&out.join(format!("{}.png", v.file)), w, h, &bytes)?;
-            }
-        }
-        // The temporal stage's views (motion, disocclusion, history, variance, ...).
-        if r.settings().temporal.mode != crate::settings::TemporalMode::Off && method.per_frame() {
-            for v in crate::settings::TemporalView::ALL {
-                redraw(&mut r, ViewBuffer::Temporal(v));
-                let (w, h, bytes) = r.read_view_rgba8()?;
-                write_png(&out.join(format!("{}.png", v.file())), w, h, &bytes)?;
-            }
-        }
-        // The light tree over the albedo (which shows the geometry): distributions by flux
-        // and by usable flag, and bounding boxes of a coarse level.
-        for (overlay, color, level, name) in [
-            (
-                TreeOverlay::Distributions,
-                TreeColor::Intensity,
-                6,
-                "tree_distributions_level6.png",
-            ),
-            (
-                TreeOverlay::Distributions,
-                TreeColor::Usable,
-                8,
-                "tree_usable_level8.png",
-            ),
-            (TreeOverlay::Boxes, TreeColor::Node, 4, "tree_boxes_level4.png"),
-        ] {
-            let mut s3 = r.settings().clone();
-            s3.display.vpl_overlay = false;
-            s3.display.tree_overlay = overlay;
-            s3.display.tree_color = color;
-            s3.display.tree_level = level;
-            r.set_settings(s3)?;
-            redraw(&mut r, ViewBuffer::Albedo);
-            let (w, h, bytes) = r.read_view_rgba8()?;
-            write_png(&out.join(name), w, h, &bytes)?;
+    Ok((direct, indirect))
+}
+
+/// The capture record: what reproduces these files (`render --settings capture.toml`);
+/// `frames`: the timed frames and the first image frame.
+fn write_capture(
+    r: &Renderer,
+    args: &RenderArgs,
+    opened: &crate::scene::preset::OpenedScene,
+    view: (&crate::scene::Camera, &[crate::scene::DirectionalLight]),
+    frames: (u32, Option<u64>),
+    settings: &crate::settings::RenderSettings,
+) -> anyhow::Result<()> {
+    let (camera, lights) = view;
+    let (n_timing, first_frame) = frames;
+    let out = &args.out;
+    let mut capture =
+        crate::capture::Capture::new("render", &r.ctx.adapter_info, &args.scene, opened.file.as_deref());
+    capture.camera = camera.into();
+    capture.lights = lights.iter().map(Into::into).collect();
+    capture.width = args.width;
+    capture.height = args.height;
+    capture.seed = r.settings().vpl.seed;
+    capture.frames = args.sampling.frames;
+    capture.timing_frames = n_timing;
+    capture.frame_index = r.frame_index();
+    capture.first_frame = first_frame;
+    capture.files = written_files(out);
+    crate::capture::write_record(&out.join("capture.toml"), &capture, settings)
+        .map_err(|e| anyhow!("{e}"))?;
+    Ok(())
+}
+
+/// The settings of a `render` run: the settings file / `--set`, `--method` and the flags,
+/// checked (the method's refusals, ranges).
+fn run_settings(
+    args: &RenderArgs,
+    record: Option<&crate::capture::Capture>,
+    opened: &crate::scene::preset::OpenedScene,
+) -> anyhow::Result<crate::settings::RenderSettings> {
+    let mut settings = args.settings.resolve(opened.exposure_ev)?;
+    if let Some(m) = args.method {
+        settings.gi.method = m;
+    }
+    let method = settings.gi.method;
+    if let Some(c) = record
+        && c.what != "render"
+        && c.first_frame.is_some()
+        && settings.temporal.mode != crate::settings::TemporalMode::Off
+    {
+        println!(
+            "  note: the temporal stage's history from the window's earlier frames is not in the record: its image is the stage's over the frames rendered here"
+        );
+    }
+    args.sampling.apply(&mut settings);
+    args.sampling.check_visibility(&[method])?;
+    // `tree.kind = lbvh` from a settings file or --set: the same refusal as --tree's.
+    if let Some(msg) = method.refuses_tree(settings.tree.kind) {
+        return Err(anyhow!("{msg}"));
+    }
+    if let Some(msg) = method
+        .refuses_bounces(settings.vpl.bounces)
+        .or(method.refuses_brdf(settings.gi.brdf))
+    {
+        return Err(anyhow!("{msg}"));
+    }
+    if args.sampling.frames == 0 {
+        return Err(anyhow!("--frames must be at least 1"));
+    }
+    if let Some(v) = args.samples {
+        settings.gi.reference_samples = v;
+    }
+    settings.gi.reference_spp_per_frame = settings.gi.reference_samples.min(16);
+    if let Some(v) = args.vpls {
+        settings.vpl.count = v;
+    }
+    if let Some(v) = args.seed {
+        settings.vpl.seed = v;
+    }
+    if let Some(v) = args.epsilon {
+        settings.gi.distance_epsilon = v;
+    }
+    // Headless: large GI steps (each submit still splits into bounded dispatches).
+    settings.gi.rays_per_frame = 1 << 26;
+    settings.validate().map_err(|e| anyhow!("{e}"))?;
+    Ok(settings)
+}
+
+/// The timed frames (`FrameMode::Timed`): their timings and wall times (the first of two or
+/// more is a warm-up, not counted) and the GI's GPU time of all of them.
+fn timed_frames(
+    r: &mut Renderer,
+    frame: &dyn Fn(&mut Renderer, ViewBuffer),
+    watch: &mut Watch,
+    n_timing: u32,
+    method: MethodId,
+) -> anyhow::Result<(Vec<PassTimings>, Vec<f64>, f64)> {
+    let mut timed: Vec<PassTimings> = Vec::new();
+    let mut wall_ms: Vec<f64> = Vec::new();
+    // Progressive methods: the GPU time of every frame's passes adds up.
+    let mut gi_ms = 0.0;
+    for i in 0..n_timing {
+        let t0 = std::time::Instant::now();
+        frame(r, ViewBuffer::Final);
+        r.ctx.wait_idle()?;
+        watch.frame(&r.ctx);
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        let t = r.wait_new_timings();
+        gi_ms += t.as_ref().map_or(0.0, |t| method_ms(t, method));
+        if i > 0 || n_timing == 1 {
+            wall_ms.push(ms);
+            timed.extend(t);
         }
     }
-    if method.per_frame() {
-        let timed = Timed {
-            timings: timings.as_ref(),
-            frames: timed.len(),
-            wall_ms: crate::harness::mean_std(&wall_ms).0,
-            frames_averaged: frames_averaged.unwrap_or(1),
-        };
-        write_metrics(&mut r, args, &indirect, &timed, &frame)?;
+    Ok((timed, wall_ms, gi_ms))
+}
+
+/// A progressive method's frames until it has seen every VPL / sample (progress on stderr);
+/// returns their GI GPU time.
+fn progressive_frames(
+    r: &mut Renderer,
+    frame: &dyn Fn(&mut Renderer, ViewBuffer),
+    watch: &mut Watch,
+    method: MethodId,
+) -> anyhow::Result<f64> {
+    let info = method.info();
+    let mut gi_ms = 0.0;
+    // Progressive GI: keep rendering the same frame until it has seen every VPL / sample.
+    while let Some(p) = r.gi_progress() {
+        if p.finished() {
+            break;
+        }
+        frame(r, ViewBuffer::Final);
+        r.ctx.wait_idle()?;
+        watch.frame(&r.ctx);
+        if let Some(t) = r.wait_new_timings() {
+            gi_ms += method_ms(&t, method);
+        }
+        if let Some(p) = r.gi_progress() {
+            eprint!(
+                "\r{} ({}): {:5.1}% of {}",
+                info.label,
+                info.progress_unit,
+                100.0 * p.fraction(),
+                p.total
+            );
+        }
     }
-    if let Some(e) = r.ctx.errors.take().into_iter().next() {
-        return Err(anyhow!("GPU error: {e}"));
+    if r.gi_progress().is_some() {
+        eprintln!();
     }
+    Ok(gi_ms)
+}
+
+/// The PNGs of `render`: the frame's buffers, the VPLs, the PDF pyramid, the method's and
+/// the temporal stage's views and the light tree, each redrawn from the last frame.
+fn write_pngs(
+    r: &mut Renderer,
+    out: &std::path::Path,
+    method: MethodId,
+    redraw: &dyn Fn(&mut Renderer, ViewBuffer),
+) -> anyhow::Result<()> {
+    let info = method.info();
+    let pngs = [
+        (ViewBuffer::Final, "final.png"),
+        (ViewBuffer::Direct, "direct.png"),
+        (ViewBuffer::Indirect, "indirect.png"),
+        (ViewBuffer::Albedo, "albedo.png"),
+        (ViewBuffer::Normal, "normal.png"),
+        (ViewBuffer::Depth, "depth.png"),
+        (ViewBuffer::ShadowMap, "shadow_map.png"),
+        (ViewBuffer::RsmFlux, "rsm_flux.png"),
+        (ViewBuffer::ImportanceRaw, "brsm_importance_raw.png"),
+        (ViewBuffer::ImportanceFiltered, "brsm_importance_filtered.png"),
+    ];
+    // Views are drawn from the last frame's buffers (no new frame: the averaged GI and
+    // its frame count stay those of the EXRs).
+    for (view, name) in pngs {
+        redraw(r, view);
+        let (w, h, bytes) = r.read_view_rgba8()?;
+        write_png(&out.join(name), w, h, &bytes)?;
+    }
+    // The VPLs over the RSM and in the camera view, and a coarse PDF-pyramid level.
+    let mut s2 = r.settings().clone();
+    s2.display.vpl_overlay = true;
+    s2.display.vpl_point_size = 1;
+    s2.display.pyramid_level = 4;
+    r.set_settings(s2)?;
+    for (view, name) in [
+        (ViewBuffer::RsmFlux, "vpls_over_rsm.png"),
+        (ViewBuffer::Final, "vpls_in_view.png"),
+        (ViewBuffer::PdfPyramid, "pdf_pyramid_level4.png"),
+    ] {
+        redraw(r, view);
+        let (w, h, bytes) = r.read_view_rgba8()?;
+        write_png(&out.join(name), w, h, &bytes)?;
+    }
+    // The method's own views (the tree samplers': thesis figs. 7.2, 7.4, 7.6).
+    if !info.views.is_empty() {
+        let mut s3 = r.settings().clone();
+        s3.display.vpl_overlay = false;
+        r.set_settings(s3)?;
+        for v in info.views {
+            redraw(r, ViewBuffer::Method(MethodView::new(v.name)));
+            let (w, h, bytes) = r.read_view_rgba8()?;
+            write_png(&out.join(format!("{}.png", v.file)), w, h, &bytes)?;
+        }
+    }
+    // The temporal stage's views (motion, disocclusion, history, variance, ...).
+    if r.settings().temporal.mode != crate::settings::TemporalMode::Off && method.per_frame() {
+        for v in crate::settings::TemporalView::ALL {
+            redraw(r, ViewBuffer::Temporal(v));
+            let (w, h, bytes) = r.read_view_rgba8()?;
+            write_png(&out.join(format!("{}.png", v.file())), w, h, &bytes)?;
+        }
+    }
+    // The light tree over the albedo (which shows the geometry): distributions by flux
+    // and by usable flag, and bounding boxes of a coarse level.
+    for (overlay, color, level, name) in [
+        (
+            TreeOverlay::Distributions,
+            TreeColor::Intensity,
+            6,
+            "tree_distributions_level6.png",
+        ),
+        (
+            TreeOverlay::Distributions,
+            TreeColor::Usable,
+            8,
+            "tree_usable_level8.png",
+        ),
+        (TreeOverlay::Boxes, TreeColor::Node, 4, "tree_boxes_level4.png"),
+    ] {
+        let mut s3 = r.settings().clone();
+        s3.display.vpl_overlay = false;
+        s3.display.tree_overlay = overlay;
+        s3.display.tree_color = color;
+        s3.display.tree_level = level;
+        r.set_settings(s3)?;
+        redraw(r, ViewBuffer::Albedo);
+        let (w, h, bytes) = r.read_view_rgba8()?;
+        write_png(&out.join(name), w, h, &bytes)?;
+    }
+    Ok(())
+}
+
+/// Prints the scene, the mean direct radiance and the GPU time per pass of the timed
+/// frames (`frames`: timed frames counted, asked).
+fn print_summary(
+    opened: &crate::scene::preset::OpenedScene,
+    camera: &crate::scene::Camera,
+    args: &RenderArgs,
+    direct: &ImageF32,
+    timings: Option<&PassTimings>,
+    frames: (usize, u32),
+    wall_ms: &[f64],
+) {
+    let (n_timed, n_timing) = frames;
     let mean = direct.mean_rgb();
     println!(
         "scene: {} ({} triangles, {} materials, {} textures), camera '{}', {}x{}",
@@ -535,7 +690,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         Some(t) => {
             println!(
                 "GPU time per pass (GPU timestamps, mean of {} timed frame(s) without diagnostics{}):",
-                timed.len(),
+                n_timed,
                 if n_timing > 1 {
                     ", after 1 warm-up frame"
                 } else {
@@ -548,26 +703,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             println!("  {:<14} {:>9.3} ms", "total", t.total_ms());
             println!(
                 "frame wall clock (render + submit + wait): {:.3} ms",
-                crate::harness::mean_std(&wall_ms).0
+                crate::harness::mean_std(wall_ms).0
             );
         }
         None => println!("GPU time per pass: timestamps not supported on this adapter"),
     }
-    // The capture record: what reproduces these files (`render --settings capture.toml`).
-    let mut capture =
-        crate::capture::Capture::new("render", &r.ctx.adapter_info, &args.scene, opened.file.as_deref());
-    capture.camera = (&camera).into();
-    capture.lights = lights.iter().map(Into::into).collect();
-    capture.width = args.width;
-    capture.height = args.height;
-    capture.seed = r.settings().vpl.seed;
-    capture.frames = args.sampling.frames;
-    capture.timing_frames = n_timing;
-    capture.frame_index = r.frame_index();
-    capture.first_frame = first_frame;
-    capture.files = written_files(out);
-    crate::capture::write_record(&out.join("capture.toml"), &capture, &image_settings_for_record)
-        .map_err(|e| anyhow!("{e}"))?;
-    println!("wrote {}", out.display());
-    Ok(())
 }

@@ -124,6 +124,43 @@ pub fn run(
         return Err(anyhow!("GPU error: {e}"));
     }
     super::render::write_resources(out, &watch.borrow().finish(&r.ctx))?;
+    write_sequence_csv(out, &m, &timed, metrics.as_deref(), method)?;
+    // The last frame's images.
+    write_exr(&out.join("final.exr"), &r.read(Buffer::Final)?)?;
+    write_exr(&out.join("indirect.exr"), &r.read(Buffer::Indirect)?)?;
+    write_exr(&out.join("direct.exr"), &r.read(Buffer::Direct)?)?;
+    print_sequence_summary(&timed, metrics.as_deref(), method);
+    // The capture record: `render --settings capture.toml` renders the same sequence again.
+    let mut capture = crate::capture::Capture::new(
+        "render sequence",
+        &r.ctx.adapter_info,
+        &args.scene,
+        opened.file.as_deref(),
+    );
+    capture.camera = camera.into();
+    capture.lights = opened.scene.lights.iter().map(Into::into).collect();
+    (capture.width, capture.height) = (args.width, args.height);
+    capture.seed = settings.vpl.seed;
+    capture.frames = 1;
+    capture.frame_index = r.frame_index();
+    capture.camera_path = args.camera_path.clone();
+    capture.sun_sweep = args.sun_sweep;
+    capture.path_frames = args.path_frames;
+    capture.files = vec!["sequence.csv".into(), "frames/".into()];
+    crate::capture::write_record(&out.join("capture.toml"), &capture, &settings)
+        .map_err(|e| anyhow!("{e}"))?;
+    println!("wrote {}", out.display());
+    Ok(())
+}
+
+/// sequence.csv: per frame its camera, sun, GPU times and (with the ground truths) errors.
+fn write_sequence_csv(
+    out: &std::path::Path,
+    m: &Motion,
+    timed: &[PassTimings],
+    metrics: Option<&[SeqFrame]>,
+    method: crate::methods::MethodId,
+) -> anyhow::Result<()> {
     let mut csv = Csv::new(&[
         "frame",
         "camera_x",
@@ -146,7 +183,7 @@ pub fn run(
         let c = &m.cameras[i];
         let az = m.lights[i].first().map_or(f64::NAN, |l| l.angles_deg().0 as f64);
         let t = timed.get(i);
-        let f = metrics.as_ref().and_then(|v| v.get(i)).copied();
+        let f = metrics.and_then(|v| v.get(i)).copied();
         let g = |x: Option<f64>| x.map_or(String::new(), num);
         csv.row(vec![
             i.to_string(),
@@ -168,10 +205,15 @@ pub fn run(
         ]);
     }
     csv.write(&out.join("sequence.csv"))?;
-    // The last frame's images.
-    write_exr(&out.join("final.exr"), &r.read(Buffer::Final)?)?;
-    write_exr(&out.join("indirect.exr"), &r.read(Buffer::Indirect)?)?;
-    write_exr(&out.join("direct.exr"), &r.read(Buffer::Direct)?)?;
+    Ok(())
+}
+
+/// Prints the sequence's mean GPU times and, with the ground truths, its mean errors.
+fn print_sequence_summary(
+    timed: &[PassTimings],
+    metrics: Option<&[SeqFrame]>,
+    method: crate::methods::MethodId,
+) {
     let col = |f: fn(&PassTimings) -> f64| mean_std(&timed.iter().map(f).collect::<Vec<_>>()).0;
     if timed.is_empty() {
         println!("GPU time per frame: timestamps not supported on this adapter");
@@ -186,7 +228,7 @@ pub fn run(
             col(|t| t.total_ms()),
         );
     }
-    if let Some(v) = &metrics {
+    if let Some(v) = metrics {
         let mean = |f: fn(&SeqFrame) -> f64| {
             let x: Vec<f64> = v.iter().map(f).filter(|x| x.is_finite()).collect();
             mean_std(&x).0
@@ -205,25 +247,4 @@ pub fn run(
             mean(|f| f.flicker_filtered),
         );
     }
-    // The capture record: `render --settings capture.toml` renders the same sequence again.
-    let mut capture = crate::capture::Capture::new(
-        "render sequence",
-        &r.ctx.adapter_info,
-        &args.scene,
-        opened.file.as_deref(),
-    );
-    capture.camera = camera.into();
-    capture.lights = opened.scene.lights.iter().map(Into::into).collect();
-    (capture.width, capture.height) = (args.width, args.height);
-    capture.seed = settings.vpl.seed;
-    capture.frames = 1;
-    capture.frame_index = r.frame_index();
-    capture.camera_path = args.camera_path.clone();
-    capture.sun_sweep = args.sun_sweep;
-    capture.path_frames = args.path_frames;
-    capture.files = vec!["sequence.csv".into(), "frames/".into()];
-    crate::capture::write_record(&out.join("capture.toml"), &capture, &settings)
-        .map_err(|e| anyhow!("{e}"))?;
-    println!("wrote {}", out.display());
-    Ok(())
 }

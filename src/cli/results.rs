@@ -371,69 +371,11 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         units_done.extend(figures.iter().map(|f| format!("{label}/{}", f.label)));
         let dir = args.out.join(&label);
         std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        let mut settings = args.settings.resolve(sc.exposure_ev)?;
-        if let Some(v) = args.vpls {
-            settings.vpl.count = v;
-        }
-        if let Some(v) = args.seed {
-            settings.vpl.seed = v;
-        }
-        settings.validate().map_err(|e| anyhow!("{e}"))?;
-        let camera = sc
-            .scene
-            .camera_or_default(sc.camera_name.as_deref())
-            .map_err(|e| anyhow!("{e}"))?;
-        let ctx = GpuContext::new_headless()?;
-        let adapter = ctx.describe();
-        println!(
-            "== {label}: {}x{}, camera '{}', adapter {adapter}",
-            o.size.0, o.size.1, camera.name
-        );
-        let r = Renderer::new(ctx, &sc.scene, o.size, settings.clone())?;
-        let mut b = Bench::new(
-            r,
-            camera.clone(),
-            sc.scene.lights.clone(),
-            settings,
-            label.clone(),
-            adapter.clone(),
-        );
-        b.bookmarks = sc.scene.cameras.clone();
-        b.scene_radius = sc.scene.bounds.radius().max(1e-30);
+        let (mut b, camera_name, adapter) = open_bench(args, &o, &label, &sc)?;
         let mut figure_times = Vec::new();
         for f in &figures {
-            let t = std::time::Instant::now();
-            let gpu0 = b.gpu_wall;
-            b.figure = f.label.to_string();
-            // Every figure starts at frame index 0 (the temporal figure's sequences set their
-            // settings without `Bench::apply`): its numbers do not depend on the figures run
-            // before it in this process (a shard runs other ones).
-            b.r.restart_frame_index();
-            let rep = (f.make)(&mut b, &o, &dir)?;
-            print!("{}", rep.table);
-            for c in &rep.checks {
-                println!("  check: {}", c.line());
-            }
-            // Wall time of the figure and the share of it not spent rendering / waiting for
-            // the GPU (readbacks, metrics, plots, PNGs: the CPU side).
-            let wall = t.elapsed().as_secs_f64();
-            let gpu = (b.gpu_wall - gpu0).as_secs_f64();
-            let outside = if wall > 0.0 {
-                (1.0 - gpu / wall).max(0.0)
-            } else {
-                0.0
-            };
-            println!(
-                "  ({} took {wall:.1} s wall, {:.0}% of it outside rendering and GPU waits)",
-                f.label,
-                100.0 * outside
-            );
-            figure_times.push(serde_json::json!({
-                "figure": f.label,
-                "wall_s": wall,
-                "rendering_and_gpu_wait_s": gpu,
-                "share_outside_gpu": outside,
-            }));
+            let (rep, time) = run_figure(&mut b, f, &o, &dir)?;
+            figure_times.push(time);
             checks.extend(rep.checks.into_iter().map(|c| (f.label.to_string(), c)));
         }
         checks.extend(
@@ -444,7 +386,7 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         run_info.push(serde_json::json!({
             "scene": label,
             "scene_arg": arg,
-            "camera": camera.name,
+            "camera": camera_name,
             "triangles": sc.scene.triangle_count(),
             "adapter": adapter,
             "settings": b.base,
@@ -507,6 +449,90 @@ pub fn run(args: &ResultsArgs) -> anyhow::Result<()> {
         return Err(anyhow!("{} check(s) not met: {}", unmet.len(), unmet.join("; ")));
     }
     Ok(())
+}
+
+/// Runs figure `f` on the bench from frame index 0 (its numbers do not depend on the figures
+/// run before it in this process: a shard runs other ones), prints its table and checks, and
+/// returns its report with its `figure_times` entry of run.json.
+fn run_figure(
+    b: &mut Bench,
+    f: &FigureDef,
+    o: &Opts,
+    dir: &std::path::Path,
+) -> anyhow::Result<(figures::Report, serde_json::Value)> {
+    let t = std::time::Instant::now();
+    let gpu0 = b.gpu_wall;
+    b.figure = f.label.to_string();
+    // The temporal figure's sequences set their settings without `Bench::apply`, so the frame
+    // index is restarted here.
+    b.r.restart_frame_index();
+    let rep = (f.make)(b, o, dir)?;
+    print!("{}", rep.table);
+    for c in &rep.checks {
+        println!("  check: {}", c.line());
+    }
+    // Wall time of the figure and the share of it not spent rendering / waiting for the GPU
+    // (readbacks, metrics, plots, PNGs: the CPU side).
+    let wall = t.elapsed().as_secs_f64();
+    let gpu = (b.gpu_wall - gpu0).as_secs_f64();
+    let outside = if wall > 0.0 {
+        (1.0 - gpu / wall).max(0.0)
+    } else {
+        0.0
+    };
+    println!(
+        "  ({} took {wall:.1} s wall, {:.0}% of it outside rendering and GPU waits)",
+        f.label,
+        100.0 * outside
+    );
+    let time = serde_json::json!({
+        "figure": f.label,
+        "wall_s": wall,
+        "rendering_and_gpu_wait_s": gpu,
+        "share_outside_gpu": outside,
+    });
+    Ok((rep, time))
+}
+
+/// A bench on scene `sc` (argument `label`) with the run's settings (`--vpls`, `--seed`
+/// applied) at the figures' size, its camera, and the adapter's description.
+fn open_bench(
+    args: &ResultsArgs,
+    o: &Opts,
+    label: &str,
+    sc: &crate::scene::preset::OpenedScene,
+) -> anyhow::Result<(Bench, String, String)> {
+    let mut settings = args.settings.resolve(sc.exposure_ev)?;
+    if let Some(v) = args.vpls {
+        settings.vpl.count = v;
+    }
+    if let Some(v) = args.seed {
+        settings.vpl.seed = v;
+    }
+    settings.validate().map_err(|e| anyhow!("{e}"))?;
+    let camera = sc
+        .scene
+        .camera_or_default(sc.camera_name.as_deref())
+        .map_err(|e| anyhow!("{e}"))?;
+    let ctx = GpuContext::new_headless()?;
+    let adapter = ctx.describe();
+    println!(
+        "== {label}: {}x{}, camera '{}', adapter {adapter}",
+        o.size.0, o.size.1, camera.name
+    );
+    let r = Renderer::new(ctx, &sc.scene, o.size, settings.clone())?;
+    let camera_name = camera.name.clone();
+    let mut b = Bench::new(
+        r,
+        camera,
+        sc.scene.lights.clone(),
+        settings,
+        label.to_string(),
+        adapter.clone(),
+    );
+    b.bookmarks = sc.scene.cameras.clone();
+    b.scene_radius = sc.scene.bounds.radius().max(1e-30);
+    Ok((b, camera_name, adapter))
 }
 
 /// The columns of checks.csv.

@@ -59,9 +59,9 @@ pub(super) fn files_under(dir: &std::path::Path) -> anyhow::Result<Vec<PathBuf>>
     Ok(out)
 }
 
-/// `results merge`: joins shard folders into one, as an unsharded run writes it.
-pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
-    // The shards: same options (all but the shard, the output and the times), one of each K.
+/// The shards' run.json, in shard order, and their N: the same options (all but the shard,
+/// the output and the times), each K once, none missing.
+fn read_shards(m: &MergeArgs) -> anyhow::Result<(Vec<(PathBuf, serde_json::Value)>, u32)> {
     let mut runs: Vec<(PathBuf, serde_json::Value)> = Vec::new();
     for d in &m.shards {
         let p = d.join("run.json");
@@ -111,28 +111,25 @@ pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
     if !missing.is_empty() {
         bail!("shard(s) {} missing: a merge needs all {n}", missing.join(", "));
     }
-    if m.out.join("run.json").exists() {
-        bail!(
-            "{} already holds a results run: merge into a new folder",
-            m.out.display()
-        );
-    }
-    std::fs::create_dir_all(&m.out).with_context(|| format!("cannot create {}", m.out.display()))?;
+    Ok((runs, n))
+}
 
-    // Every figure's files. A file two shards both wrote (a shared image) must be the same.
+/// Copies every figure's files of every shard into `out` (a file two shards both wrote, a
+/// shared image, must be the same); returns how many.
+fn copy_figure_files(runs: &[(PathBuf, serde_json::Value)], out: &std::path::Path) -> anyhow::Result<usize> {
     let merged_names = |rel: &std::path::Path| {
         rel == std::path::Path::new("run.json")
             || rel == std::path::Path::new("checks.csv")
             || rel.file_name().is_some_and(|n| n == "timing_agreement.csv")
     };
     let mut copied = 0usize;
-    for (d, _) in &runs {
+    for (d, _) in runs {
         for rel in files_under(d)? {
             if merged_names(&rel) {
                 continue;
             }
             let src = d.join(&rel);
-            let dst = m.out.join(&rel);
+            let dst = out.join(&rel);
             let bytes = std::fs::read(&src).with_context(|| format!("cannot read {}", src.display()))?;
             if dst.exists() {
                 if std::fs::read(&dst)? != bytes {
@@ -151,27 +148,19 @@ pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
         }
     }
 
-    // Per scene, the timing agreement over every shard's figures, and its checks.
-    // The scenes in the order of the run's --scenes, the figures in the order a run makes them.
-    let scene_order: Vec<String> = first["scene_order"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter_map(|s| s.as_str().map(str::to_string))
-        .collect();
-    let scene_pos = |s: &str| scene_order.iter().position(|x| x == s).unwrap_or(usize::MAX);
-    let figure_pos = |f: &str| {
-        Some(figure_rank(f))
-            .filter(|&r| r != usize::MAX)
-            .unwrap_or(if f == AGREEMENT_FIGURE {
-                usize::MAX - 1
-            } else {
-                usize::MAX
-            })
-    };
+    Ok(copied)
+}
+
+/// The units (scene/figure) of all shards, checked to be the sweep's, each once, in the order
+/// of an unsharded run.
+fn merged_units(
+    first: &serde_json::Value,
+    runs: &[(PathBuf, serde_json::Value)],
+    scene_order: &[String],
+) -> anyhow::Result<Vec<String>> {
     // Every unit of the sweep exactly once.
     let mut expected: Vec<String> = Vec::new();
-    for s in &scene_order {
+    for s in scene_order {
         for f in first["figures"].as_array().into_iter().flatten() {
             expected.push(format!("{s}/{}", f.as_str().unwrap_or_default()));
         }
@@ -190,8 +179,14 @@ pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
             expected.join(", ")
         );
     }
+    Ok(units)
+}
+
+/// Every shard's scenes of run.json, one entry per scene (its figure times joined in a run's
+/// order).
+fn merged_scenes(runs: &[(PathBuf, serde_json::Value)]) -> Vec<serde_json::Value> {
     let mut scenes: Vec<serde_json::Value> = Vec::new();
-    for (_, v) in &runs {
+    for (_, v) in runs {
         for sc in v["scenes"].as_array().into_iter().flatten() {
             match scenes.iter_mut().find(|s| s["scene"] == sc["scene"]) {
                 Some(s) => {
@@ -205,13 +200,22 @@ pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
             }
         }
     }
-    scenes.sort_by_key(|s| scene_pos(s["scene"].as_str().unwrap_or_default()));
+    scenes
+}
+
+/// Per scene, its timing_agreement.csv rewritten over every shard's figures into `out`, and
+/// the agreement checks recomputed over them.
+fn merged_agreement(
+    runs: &[(PathBuf, serde_json::Value)],
+    scenes: &[serde_json::Value],
+    out: &std::path::Path,
+) -> anyhow::Result<Vec<Check>> {
     let mut agreement: Vec<Check> = Vec::new();
-    for sc in &scenes {
+    for sc in scenes {
         let label = sc["scene"].as_str().unwrap_or_default();
         let mut rows: Vec<crate::harness::BaseTiming> = Vec::new();
         let mut header = None;
-        for (d, _) in &runs {
+        for (d, _) in runs {
             let Some((h, rs)) = read_csv_rows(&d.join(label).join("timing_agreement.csv"))? else {
                 continue;
             };
@@ -252,7 +256,7 @@ pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
                 ]));
                 text.push('\n');
             }
-            let p = m.out.join(label).join("timing_agreement.csv");
+            let p = out.join(label).join("timing_agreement.csv");
             std::fs::write(&p, text).with_context(|| format!("cannot write {}", p.display()))?;
             let refs: Vec<&crate::harness::BaseTiming> = rows.iter().collect();
             agreement.extend(agreement_checks(
@@ -262,6 +266,46 @@ pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
             ));
         }
     }
+
+    Ok(agreement)
+}
+
+/// `results merge`: joins shard folders into one, as an unsharded run writes it.
+pub fn merge(m: &MergeArgs) -> anyhow::Result<()> {
+    let (runs, n) = read_shards(m)?;
+    let first = &runs[0].1;
+    if m.out.join("run.json").exists() {
+        bail!(
+            "{} already holds a results run: merge into a new folder",
+            m.out.display()
+        );
+    }
+    std::fs::create_dir_all(&m.out).with_context(|| format!("cannot create {}", m.out.display()))?;
+
+    let copied = copy_figure_files(&runs, &m.out)?;
+
+    // Per scene, the timing agreement over every shard's figures, and its checks.
+    // The scenes in the order of the run's --scenes, the figures in the order a run makes them.
+    let scene_order: Vec<String> = first["scene_order"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|s| s.as_str().map(str::to_string))
+        .collect();
+    let scene_pos = |s: &str| scene_order.iter().position(|x| x == s).unwrap_or(usize::MAX);
+    let figure_pos = |f: &str| {
+        Some(figure_rank(f))
+            .filter(|&r| r != usize::MAX)
+            .unwrap_or(if f == AGREEMENT_FIGURE {
+                usize::MAX - 1
+            } else {
+                usize::MAX
+            })
+    };
+    let units = merged_units(first, &runs, &scene_order)?;
+    let mut scenes = merged_scenes(&runs);
+    scenes.sort_by_key(|s| scene_pos(s["scene"].as_str().unwrap_or_default()));
+    let agreement = merged_agreement(&runs, &scenes, &m.out)?;
 
     // checks.csv: every shard's checks in the order one run writes them (by scene, then by
     // figure), each scene's timing agreement recomputed over all shards at its end.
