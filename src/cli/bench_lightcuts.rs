@@ -214,7 +214,7 @@ fn print_tree_pairing(nodes: &[SstNode], leaves: usize) -> f64 {
                 .iter()
                 .filter(|&&i| box_gap(&nodes[2 * i], &nodes[2 * i + 1]) > 0.0)
                 .count();
-            let far = pairs.iter().filter(|&&i| far_paired(&nodes, i)).count();
+            let far = pairs.iter().filter(|&&i| far_paired(nodes, i)).count();
             let clusters = 4 * level_start < nodes.len();
             if clusters {
                 far_total.0 += far;
