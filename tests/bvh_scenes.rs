@@ -169,7 +169,7 @@ fn check_surfaces(scene: &Scene, n: usize) {
                 continue;
             };
             hits += 1;
-            let c = surface_at(scene, &mips, size, h.triangle as usize, h.u, h.v, r.dir, lod);
+            let c = surface_at(scene, &mips, size, &h, r.dir, lod);
             let scale = scene.bounds.radius().max(1.0);
             assert_eq!(g.valid, 1, "ray {i}");
             assert_eq!(g.material, c.material, "ray {i}: material");

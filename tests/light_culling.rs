@@ -20,11 +20,12 @@ use lightcut::{
     },
     methods::overlay::Prim,
     metrics,
-    reference::interleave::filter_pixel,
+    reference::interleave::{FilterImage, filter_pixel},
     reference::ism::{self, EMPTY, IsmLayout, IsmLight},
     reference::light_culling::{
-        Interleave, LightRange, RangeMode, RangeParams, ShadeVpl, TREE_STREAM_RESERVOIR, TREE_STREAM_RIS,
-        TileCamera, light_range, shade, tile_lists, tree_max_ranges, tree_rng, tree_shade, tree_traverse,
+        Interleave, LightRange, RangeMode, RangeParams, Reservoir, ShadeInputs, ShadeVpl, SphereTree,
+        TREE_STREAM_RESERVOIR, TREE_STREAM_RIS, TileCamera, light_range, shade, tile_lists, tree_max_ranges,
+        tree_rng, tree_shade, tree_traverse,
     },
     reference::vpl::{pcg_hash, u01},
     renderer::{
@@ -420,6 +421,11 @@ fn gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing()
     let alb = st.r.read(Buffer::Albedo).unwrap();
     let ind = st.indirect();
     let off = s.gi.ray_offset;
+    let inputs = ShadeInputs {
+        vpls: &sv,
+        lights: &gl,
+        eps: s.gi.distance_epsilon,
+    };
     let (mut lit, mut close) = (0, 0);
     let mut surf = Vec::new();
     for y in 0..H {
@@ -435,16 +441,7 @@ fn gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing()
             surf.push(Some((p, nx)));
             let t = grid.tile_of(x, y) as usize;
             let list = &lists[t * cap..t * cap + count[t] as usize];
-            let cpu = shade(
-                p,
-                nx,
-                list,
-                &sv,
-                &gl,
-                il,
-                s.gi.distance_epsilon,
-                visible(&bvh, &sv, p, nx, off),
-            );
+            let cpu = shade(p, nx, list, &inputs, il, visible(&bvh, &sv, p, nx, off));
             let gpu = Vec3::from_slice(&raw[k][..3]);
             // A shadow ray grazing an edge may differ between the BVH traversals.
             tally(&mut lit, &mut close, gpu, cpu);
@@ -454,22 +451,25 @@ fn gpu_shading_and_filter_equal_the_cpu_reference_and_overflow_changes_nothing()
     assert!(lit > 200 && close >= lit * 98 / 100, "{close} of {lit}");
     // The filter (from the GPU's raw estimates) x albedo / pi is the indirect image.
     let raw3: Vec<Vec3> = raw.iter().map(|r| Vec3::from_slice(&r[..3])).collect();
+    let img = FilterImage {
+        width: W,
+        height: H,
+        eye: cam.eye,
+        forward: cam.forward,
+        surf: &surf,
+        raw: &raw3,
+    };
     let mut worst = 0.0f32;
     for y in 0..H {
         for x in 0..W {
             let k = (y * W + x) as usize;
             let f = filter_pixel(
+                &img,
                 x,
                 y,
-                W,
-                H,
                 lc.interleave.filter_radius,
                 lc.interleave.filter_normal_cos,
                 lc.interleave.filter_plane_tolerance,
-                cam.eye,
-                cam.forward,
-                &surf,
-                &raw3,
             );
             let want = Vec3::from_slice(&alb.pixels[k][..3]) / std::f32::consts::PI * f;
             let got = Vec3::from_slice(&ind.pixels[k][..3]);
@@ -684,6 +684,17 @@ fn the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_trut
     let nrm = st.r.read(Buffer::Normal).unwrap();
     let seed = LightCulling::seed(&s, 0);
     let (eps, off, k) = (s.gi.distance_epsilon, s.gi.ray_offset, lc.reservoir_k);
+    let tree = SphereTree {
+        leaves,
+        boxes: &boxes,
+        max_range: &cpu_max,
+        lights: &gl,
+    };
+    let inputs = ShadeInputs {
+        vpls: &sv,
+        lights: &gl,
+        eps,
+    };
     let (mut px, mut same, mut over_k, mut lit, mut close) = (0, 0, 0, 0, 0);
     for y in 0..H {
         for x in 0..W {
@@ -694,16 +705,7 @@ fn the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_trut
             }
             px += 1;
             let xp = Vec3::new(g[0], g[1], g[2]);
-            let cpu = tree_traverse(
-                leaves,
-                &boxes,
-                &cpu_max,
-                &gl,
-                xp,
-                eps,
-                k,
-                tree_rng(seed, p as u32, TREE_STREAM_RESERVOIR),
-            );
+            let cpu = tree_traverse(&tree, xp, eps, k, tree_rng(seed, p as u32, TREE_STREAM_RESERVOIR));
             let (m, visited) = (mv[2 * p], mv[2 * p + 1]);
             let gpu_list = &list[p * k as usize..p * k as usize + m.min(k) as usize];
             if cpu.m == m && cpu.visited == visited && cpu.list == gpu_list {
@@ -713,18 +715,8 @@ fn the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_trut
             // The shading from the GPU's list, with the same resampling number.
             let nx = Vec3::from_slice(&nrm.pixels[p][..3]).normalize();
             let u = u01(pcg_hash(tree_rng(seed, p as u32, TREE_STREAM_RIS)));
-            let (want, _) = tree_shade(
-                xp,
-                nx,
-                gpu_list,
-                m,
-                k,
-                &sv,
-                &gl,
-                eps,
-                u,
-                visible(&bvh, &sv, xp, nx, off),
-            );
+            let r = Reservoir { list: gpu_list, m, k };
+            let (want, _) = tree_shade(xp, nx, r, &inputs, u, visible(&bvh, &sv, xp, nx, off));
             let got = Vec3::from_slice(&raw[p][..3]);
             tally(&mut lit, &mut close, got, want);
         }
@@ -883,6 +875,11 @@ fn ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays() {
     let bvh = Bvh::build(&st.scene.positions, &st.scene.indices);
     let pos = st.r.read(Buffer::Position).unwrap();
     let nrm = st.r.read(Buffer::Normal).unwrap();
+    let inputs = ShadeInputs {
+        vpls: &sv,
+        lights: &gl,
+        eps: s.gi.distance_epsilon,
+    };
     let (mut lit, mut close, mut pairs, mut agree, mut false_shadow, mut ray_lit) = (0, 0, 0, 0, 0, 0usize);
     for y in 0..H {
         for x in 0..W {
@@ -906,7 +903,7 @@ fn ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays() {
                     lc.ism.bias,
                 )
             };
-            let cpu = shade(p, nx, list, &sv, &gl, il, s.gi.distance_epsilon, ism_visible);
+            let cpu = shade(p, nx, list, &inputs, il, ism_visible);
             let gpu = Vec3::from_slice(&raw[k][..3]);
             tally(&mut lit, &mut close, gpu, cpu);
             // How often the map's answer is the shadow ray's, over the VPLs in range that
@@ -1057,6 +1054,11 @@ fn tree_shading_with_maps_matches(st: &Setup, lc: &LightCullingSettings, s: &Ren
     let nrm = st.r.read(Buffer::Normal).unwrap();
     let seed = LightCulling::seed(s, 0);
     let k = lc.reservoir_k as usize;
+    let inputs = ShadeInputs {
+        vpls: &sv,
+        lights: &gl,
+        eps: s.gi.distance_epsilon,
+    };
     let (mut lit, mut close) = (0, 0);
     for p in 0..(W * H) as usize {
         let g = pos.pixels[p];
@@ -1067,28 +1069,22 @@ fn tree_shading_with_maps_matches(st: &Setup, lc: &LightCullingSettings, s: &Ren
         let nx = Vec3::from_slice(&nrm.pixels[p][..3]).normalize();
         let m = mv[2 * p];
         let u = u01(pcg_hash(tree_rng(seed, p as u32, TREE_STREAM_RIS)));
-        let (want, _) = tree_shade(
-            xp,
-            nx,
-            &list[p * k..p * k + (m as usize).min(k)],
+        let r = Reservoir {
+            list: &list[p * k..p * k + (m as usize).min(k)],
             m,
-            k as u32,
-            &sv,
-            &gl,
-            s.gi.distance_epsilon,
-            u,
-            |i| {
-                ism::visible(
-                    layout,
-                    &atlas,
-                    i,
-                    sv[i as usize].position,
-                    sv[i as usize].normal,
-                    xp,
-                    lc.ism.bias,
-                )
-            },
-        );
+            k: k as u32,
+        };
+        let (want, _) = tree_shade(xp, nx, r, &inputs, u, |i| {
+            ism::visible(
+                layout,
+                &atlas,
+                i,
+                sv[i as usize].position,
+                sv[i as usize].normal,
+                xp,
+                lc.ism.bias,
+            )
+        });
         let got = Vec3::from_slice(&raw[p][..3]);
         tally(&mut lit, &mut close, got, want);
     }
@@ -1137,6 +1133,11 @@ fn with_ggx_the_shading_equals_the_cpu_and_the_means_converge_to_the_ggx_truth()
     let nrm = st.r.read(Buffer::Normal).unwrap();
     let alb = st.r.read(Buffer::Albedo).unwrap();
     let ind = st.indirect();
+    let inputs = ShadeInputs {
+        vpls: &sv,
+        lights: &gl,
+        eps: s.gi.distance_epsilon,
+    };
     let eye = st.cam.position;
     let (mut lit, mut close, mut same) = (0, 0, 0);
     for y in 0..H {
@@ -1159,7 +1160,7 @@ fn with_ggx_the_shading_equals_the_cpu_and_the_means_converge_to_the_ggx_truth()
             let t = grid.tile_of(x, y) as usize;
             let list = &lists[t * cap..t * cap + count[t] as usize];
             let vis = visible(&bvh, &sv, p, nx, s.gi.ray_offset);
-            let cpu = shade_shaded(p, nx, list, &sv, &gl, il, s.gi.distance_epsilon, vis, Some(&sh));
+            let cpu = shade_shaded(p, nx, list, &inputs, il, vis, Some(&sh));
             let gpu = Vec3::from_slice(&raw[k][..3]);
             tally(&mut lit, &mut close, gpu, cpu);
             // Filter radius 0: the image is the pixel's own radiance (checked where lit).

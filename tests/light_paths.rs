@@ -205,7 +205,7 @@ fn gpu_light_paths_equal_the_cpu_twin_on_the_default_scene() {
         );
         let ray = lightcut::scene::bvh::Ray::new(centre, d, 0.0, 1e30);
         if let Some(h) = bvh.closest_hit(&ray) {
-            let s = reference::surface::surface_at(&scene, &mips, size, h.triangle as usize, h.u, h.v, d, 0);
+            let s = reference::surface::surface_at(&scene, &mips, size, &h, d, 0);
             starts.push(GpuVpl {
                 position: s.position.extend(0.5).to_array(),
                 normal: s.normal.to_array(),

@@ -25,7 +25,7 @@ use lightcut::{
             harmonic_mean_distance, interpolate, pixel_footprint, place_tile, record_radius, select, shade,
             weight,
         },
-        lightcuts::{CutParams, lightcut},
+        lightcuts::{CutInputs, CutParams, lightcut},
     },
     renderer::{
         Buffer, FrameInput,
@@ -285,18 +285,8 @@ fn gpu_records_selection_and_interpolation_equal_the_cpu_reference() {
             let out = interpolate(&nodes, &cuts, &gpu.weights[..gpu.count as usize]);
             check_interpolated(&nodes, &out.cut).unwrap_or_else(|e| panic!("pixel ({x}, {y}): {e}"));
             same_size += (diag.pixels[k][0] as usize == out.cut.len()) as u32;
-            let (sum, _) = shade(
-                &nodes,
-                &lc,
-                &sorted,
-                &bvh,
-                &out.cut,
-                xp,
-                n,
-                s.gi.distance_epsilon,
-                Some(s.gi.ray_offset),
-                false,
-            );
+            let inputs = CutInputs::perfect(&nodes, &lc, &sorted, &bvh, &p);
+            let (sum, _) = shade(&inputs, &out.cut, xp, n, false);
             same_rad += close(got, albedo / std::f32::consts::PI * sum) as u32;
             if (x, y) == traced {
                 traced_cpu = Some((gpu, out));

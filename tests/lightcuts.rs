@@ -9,13 +9,16 @@ use common::Setup;
 
 use glam::Vec3;
 use lightcut::{
-    base::{gpu_layout::GpuVpl, sst_node::Topology},
+    base::{
+        gpu_layout::GpuVpl,
+        sst_node::{SstNode, Topology},
+    },
     methods::lightcuts::{self, Lightcuts, settings::LightcutsSettings},
     metrics,
     reference::{
         lightcuts::{
-            CONE_MARGIN, Cone, CutParams, LcTree, build_on, check_cut_on, cos_bound, geometry_bound,
-            lightcut_on, merge_cones, vpl_geometry,
+            CONE_MARGIN, Cone, CutInputs, CutParams, LcTree, build_on, check_cut_on, cos_bound,
+            geometry_bound, lightcut_on, merge_cones, vpl_geometry,
         },
         vpl::{pcg_hash, u01},
     },
@@ -244,6 +247,14 @@ fn check_lightcuts(ctx: &GpuContext, kind: TreeKind) {
         shadow_rays: Some(s.gi.ray_offset),
         trace_every_node: false,
     };
+    let inputs = CutInputs {
+        nodes: &nodes,
+        topo,
+        lc: &gpu_lc,
+        sorted: &sorted,
+        bvh: &bvh,
+        params: &p,
+    };
     let (mut pixels, mut same_size, mut close, mut at_max) = (0, 0, 0, 0);
     let mut traced_cpu = None;
     for y in 0..H {
@@ -255,7 +266,7 @@ fn check_lightcuts(ctx: &GpuContext, kind: TreeKind) {
             }
             let xp = Vec3::new(g[0], g[1], g[2]);
             let n = Vec3::from_slice(&nrm.pixels[k][..3]).normalize();
-            let cut = lightcut_on(&nodes, topo, &gpu_lc, &sorted, &bvh, xp, n, &p);
+            let cut = lightcut_on(&inputs, xp, n);
             let ids: Vec<u32> = cut.cut.iter().map(|c| c.node).collect();
             check_cut_on(&nodes, topo, &ids).unwrap_or_else(|e| panic!("pixel ({x}, {y}): {e}"));
             assert!(ids.len() as u32 <= p.max_cut);
@@ -431,7 +442,13 @@ fn the_ggx_error_bound_is_never_below_the_true_glossy_term() {
         let eps = 0.05;
         // A coloured VPL (its flux is the cluster's): the bound must hold per channel too.
         let flux = Vec3::new(rnd(), rnd(), rnd()) * Vec3::new(1.0, rnd(), rnd());
-        let bound = geometry_brdf_bound(x, n, lo, hi, cone, eps, &sh, flux);
+        let cluster = SstNode {
+            bbox_min: lo,
+            bbox_max: hi,
+            intensity: flux,
+            ..SstNode::EMPTY
+        };
+        let bound = geometry_brdf_bound(x, n, &cluster, cone, eps, &sh);
         let mut largest = 0.0f32;
         for _ in 0..64 {
             let p = lo + (hi - lo) * Vec3::new(rnd(), rnd(), rnd());
@@ -498,6 +515,14 @@ fn gpu_lightcuts_with_ggx_equal_the_cpu_reference() {
         shadow_rays: Some(s.gi.ray_offset),
         trace_every_node: false,
     };
+    let inputs = CutInputs {
+        nodes: &nodes,
+        topo,
+        lc: &gpu_lc,
+        sorted: &sorted,
+        bvh: &bvh,
+        params: &p,
+    };
     let eye = st.cam.position;
     let (mut pixels, mut same_size, mut close, mut metal) = (0, 0, 0, 0);
     let (mut ggx_nodes, mut lambert_nodes) = (0usize, 0usize);
@@ -519,10 +544,10 @@ fn gpu_lightcuts_with_ggx_equal_the_cpu_reference() {
                 },
             };
             metal += (sh.surface.metallic > 0.5) as u32;
-            let cut = lightcut_shaded_on(&nodes, topo, &gpu_lc, &sorted, &bvh, xp, n, &p, Some(&sh));
+            let cut = lightcut_shaded_on(&inputs, xp, n, Some(&sh));
             let ids: Vec<u32> = cut.cut.iter().map(|c| c.node).collect();
             check_cut_on(&nodes, topo, &ids).unwrap_or_else(|e| panic!("pixel ({x}, {y}): {e}"));
-            let lambert = lightcut_on(&nodes, topo, &gpu_lc, &sorted, &bvh, xp, n, &p);
+            let lambert = lightcut_on(&inputs, xp, n);
             (ggx_nodes, lambert_nodes) = (ggx_nodes + ids.len(), lambert_nodes + lambert.cut.len());
             pixels += 1;
             same_size += (diag.pixels[k][0] as usize == ids.len()) as u32;

@@ -511,24 +511,30 @@ fn filter_error(
     albedo: Option<&ImageF32>,
     got: impl Fn(u32, u32) -> Vec3,
 ) -> f32 {
-    use lightcut::reference::{interleave::filter_pixel, light_culling::TileCamera};
+    use lightcut::reference::{
+        interleave::{FilterImage, filter_pixel},
+        light_culling::TileCamera,
+    };
     let cam = TileCamera::new(&st.cam, W, H);
     let il = &st.r.settings().sampling.interleave;
+    let img = FilterImage {
+        width: size.0,
+        height: size.1,
+        eye: cam.eye,
+        forward: cam.forward,
+        surf,
+        raw,
+    };
     let mut worst = 0.0f32;
     for y in 0..size.1 {
         for x in 0..size.0 {
             let f = filter_pixel(
+                &img,
                 x,
                 y,
-                size.0,
-                size.1,
                 il.filter_radius,
                 il.filter_normal_cos,
                 il.filter_plane_tolerance,
-                cam.eye,
-                cam.forward,
-                surf,
-                raw,
             );
             let want = albedo.map_or(f, |a| f * v3(a.get(x, y)));
             worst = worst.max((got(x, y) - want).abs().max_element() / want.max_element().max(1e-4));
@@ -670,6 +676,12 @@ fn half_resolution_upsampling_equals_the_cpu_reference() {
     };
     let hn = |x: u32, y: u32| v3(hnrm.get(x, y)).normalize();
     let hv = |x: u32, y: u32| v3(hacc[(y * (W / 2) + x) as usize]);
+    let half = slc::HalfImage {
+        size: (W / 2, H / 2),
+        position: &hp,
+        normal: &hn,
+        value: &hv,
+    };
     let mut worst = 0.0f32;
     for y in 0..H {
         for x in 0..W {
@@ -680,7 +692,7 @@ fn half_resolution_upsampling_equals_the_cpu_reference() {
                 continue;
             }
             let n = v3(nrm.get(x, y)).normalize();
-            let e = slc::upsample_pixel(x, y, v3(p), n, (W / 2, H / 2), &hp, &hn, &hv, s.vpl.n_min, d_max);
+            let e = slc::upsample_pixel(x, y, v3(p), n, &half, s.vpl.n_min, d_max);
             let want = e * v3(alb.get(x, y));
             let err = (got - want).abs().max_element() / want.max_element().max(1e-6);
             worst = worst.max(err);
@@ -1233,7 +1245,7 @@ fn with_ggx_diffuse_samples_keep_their_substitutes() {
 fn glossy_walks_weigh_children_by_the_material_term_as_the_cpu_does() {
     use lightcut::base::sampling::GlossyWeights;
     use lightcut::methods::tree_samplers::pass::StopReason;
-    use lightcut::reference::brdf::Surface;
+    use lightcut::reference::brdf::{Shading, Surface};
     let Some(ctx) = common::gpu() else { return };
     for (method, weights) in [
         (SLC, GlossyWeights::Material),
@@ -1269,6 +1281,7 @@ fn glossy_walks_weigh_children_by_the_material_term_as_the_cpu_does() {
                 roughness: nrm.get(x, y)[3],
             };
             assert_eq!(surf.metallic, 1.0);
+            let sh = Shading { v, surface: surf };
             for smp in &trace.samples {
                 if smp.stop == StopReason::Dead || smp.start == 0 {
                     continue;
@@ -1281,8 +1294,9 @@ fn glossy_walks_weigh_children_by_the_material_term_as_the_cpu_does() {
                 let mut parent = smp.start;
                 for &(child, pc) in &smp.path {
                     let (l, r) = (&nodes[2 * parent as usize], &nodes[2 * parent as usize + 1]);
-                    let pl = slc::glossy_child_probability(l, r, p, n, v, &surf, eps, cp, weights)
-                        .expect("a live branch");
+                    let walk = slc::GlossyWalk { mode: cp, weights };
+                    let pl =
+                        slc::glossy_child_probability(l, r, p, n, &sh, eps, walk).expect("a live branch");
                     let want = if child % 2 == 0 { pl } else { 1.0 - pl };
                     assert!(
                         (pc - want).abs() < 2e-3 * want.max(1e-3),

@@ -179,8 +179,12 @@ fn passes_equal_the_twin(atrous: AtrousFilter) {
                 &gb,
                 Vec3::from_slice(&raw[k][..3]),
                 &cb,
-                &ca,
-                Some((&prev, &hist1, &mom1)),
+                Some(twin::Previous {
+                    gbuffer: &prev,
+                    cam: &ca,
+                    history: &hist1,
+                    moments: &mom1,
+                }),
                 &p,
             )
         })

@@ -13,7 +13,7 @@ use lightcut::methods::val::{
     self as val_method, Vals,
     settings::{InterleaveSettings, IsmSettings, ValSettings, ValVisibility},
 };
-use lightcut::reference::interleave::filter_pixel_window;
+use lightcut::reference::interleave::{FilterImage, filter_pixel_window};
 use lightcut::reference::ism::{self, IsmLayout, IsmLight};
 use lightcut::reference::light_culling::TileCamera;
 use lightcut::reference::val::{self, ClusterParams, MetricWeights, NONE, Rsm, RsmTexel};
@@ -577,17 +577,7 @@ fn seeds_shading_and_pcss_equal_the_cpu_reference() {
     };
     let (mut vis_pcss, mut vis_simple, mut vis_ray) = (0.0f64, 0.0f64, 0.0f64);
     let cpu = cpu_raw(&st, &vals, n, offset, false, |i, v, p, nx| {
-        let q = val::pcss(
-            layout,
-            &atlas,
-            i,
-            v.position,
-            v.normal,
-            v.area,
-            p,
-            vs.ism.bias,
-            &vs.pcss,
-        );
+        let q = val::pcss(layout, &atlas, i, v, p, vs.ism.bias, &vs.pcss);
         lookups += 1;
         blocked += q.blocked as usize;
         vis_pcss += q.visibility as f64;
@@ -632,23 +622,23 @@ fn seeds_shading_and_pcss_equal_the_cpu_reference() {
     let (alb, ind, raw) = (st.r.read(Buffer::Albedo).unwrap(), st.indirect(), gpu_raw(&st));
     let window = lightcut::renderer::passes::interleave_filter::window(vs.interleave.filter_radius, n);
     assert_eq!(window, (-1, 0), "a 2 x 2 pattern: one pixel of each subset");
+    let img = FilterImage {
+        width: W,
+        height: H,
+        eye: cam.eye,
+        forward: cam.forward,
+        surf: &surf,
+        raw: &raw,
+    };
+    let (normal_cos, plane_tolerance) = (
+        vs.interleave.filter_normal_cos,
+        vs.interleave.filter_plane_tolerance,
+    );
     let mut worst = 0.0f32;
     for y in 0..H {
         for x in 0..W {
             let k = (y * W + x) as usize;
-            let f = filter_pixel_window(
-                x,
-                y,
-                W,
-                H,
-                window,
-                vs.interleave.filter_normal_cos,
-                vs.interleave.filter_plane_tolerance,
-                cam.eye,
-                cam.forward,
-                &surf,
-                &raw,
-            );
+            let f = filter_pixel_window(&img, x, y, window, normal_cos, plane_tolerance);
             let want = Vec3::from_slice(&alb.pixels[k][..3]) / std::f32::consts::PI * f;
             let got = Vec3::from_slice(&ind.pixels[k][..3]);
             worst = worst.max((got - want).abs().max_element() / want.max_element().max(1e-4));
@@ -874,9 +864,7 @@ fn the_method_converges_to_its_own_sum_and_its_maps_agree_with_rays() {
                 ray_lit += r as usize;
                 agree +=
                     (ism::visible(layout, &atlas, i as u32, v.position, v.normal, p, bias) == r) as usize;
-                let q = val::pcss(
-                    layout, &atlas, i as u32, v.position, v.normal, v.area, p, bias, &vs.pcss,
-                );
+                let q = val::pcss(layout, &atlas, i as u32, v, p, bias, &vs.pcss);
                 pcss_err += (q.visibility as f64 - r as u32 as f64).abs();
                 // The disk's visible fraction: rays to 16 points of the VAL's disk.
                 let disk = val::disk_points(v)

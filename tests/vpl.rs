@@ -305,6 +305,12 @@ fn ground_truth_vs_cpu(scene: Scene, mut settings: RenderSettings, tol: f32) -> 
         .collect();
     let g = &settings.gi;
     let shadow = g.shadow_rays.then_some(g.ray_offset);
+    let em = reference::gi::Emitters {
+        texels: &emitters,
+        bvh: &bvh,
+        eps: g.distance_epsilon,
+        shadow_rays: shadow,
+    };
     let (mut got, mut checked, mut lit, mut glossy) = (Vec::new(), 0, 0, 0);
     for k in (0..(w * h) as usize).step_by(7) {
         let p = pos.pixels[k];
@@ -320,20 +326,14 @@ fn ground_truth_vs_cpu(scene: Scene, mut settings: RenderSettings, tol: f32) -> 
             roughness: nrm.pixels[k][3],
         };
         let want = match g.brdf {
-            reference::brdf::Brdf::Lambert => {
-                reference::gi::exact_indirect(&bvh, x, n, s.base, &emitters, g.distance_epsilon, shadow)
+            reference::brdf::Brdf::Lambert => reference::gi::exact_indirect(&em, x, n, s.base),
+            brdf => {
+                let sh = reference::brdf::Shading {
+                    v: (cam.position - x).normalize(),
+                    surface: s,
+                };
+                reference::gi::exact_indirect_brdf(&em, x, n, brdf, &sh)
             }
-            brdf => reference::gi::exact_indirect_brdf(
-                &bvh,
-                x,
-                n,
-                (cam.position - x).normalize(),
-                brdf,
-                &s,
-                &emitters,
-                g.distance_epsilon,
-                shadow,
-            ),
         };
         let v = Vec3::from_slice(&ind.pixels[k][..3]);
         assert!(
@@ -429,6 +429,12 @@ fn converged_reference_against_exact(scene: Scene, brdf: lightcut::renderer::set
         })
         .collect();
     let bvh = Bvh::build(&scene.positions, &scene.indices);
+    let em = reference::gi::Emitters {
+        texels: &texels,
+        bvh: &bvh,
+        eps: settings.gi.distance_epsilon,
+        shadow_rays: Some(settings.gi.ray_offset),
+    };
     let mut exact_sum = 0.0;
     for k in 0..(w * h) as usize {
         let p = pos.pixels[k];
@@ -441,16 +447,16 @@ fn converged_reference_against_exact(scene: Scene, brdf: lightcut::renderer::set
             metallic: alb.pixels[k][3],
             roughness: nrm.pixels[k][3],
         };
+        let sh = reference::brdf::Shading {
+            v: (cam.position - x).normalize(),
+            surface,
+        };
         let e = reference::gi::exact_indirect_brdf(
-            &bvh,
+            &em,
             x,
             Vec3::from_slice(&nrm.pixels[k][..3]).normalize(),
-            (cam.position - x).normalize(),
             brdf,
-            &surface,
-            &texels,
-            settings.gi.distance_epsilon,
-            Some(settings.gi.ray_offset),
+            &sh,
         );
         exact_sum += lum(e.to_array());
     }

@@ -13,51 +13,45 @@ pub struct Texel {
     pub flux: Vec3,
 }
 
-/// rho/pi x sum over texels of flux/pi x cos_x x cos_t / max(d^2, eps^2) x V, with V from a
-/// shadow ray whose end points are offset along their normals by `shadow_rays` (None: V = 1,
-/// `GiSettings::shadow_rays` off).
-pub fn exact_indirect(
-    bvh: &Bvh,
-    x: Vec3,
-    n: Vec3,
-    albedo: Vec3,
-    texels: &[Texel],
-    eps: f32,
-    shadow_rays: Option<f32>,
-) -> Vec3 {
-    albedo / std::f32::consts::PI * emitted_sum(bvh, x, n, texels, eps, shadow_rays, |_| Vec3::ONE)
+/// The emitting texels of the exact sum with what the sum needs besides the receiver: the
+/// distance bound `eps` and the BVH of the shadow rays, whose end points are offset along
+/// their normals by `shadow_rays` (None: V = 1, `GiSettings::shadow_rays` off).
+#[derive(Clone, Copy)]
+pub struct Emitters<'a> {
+    pub texels: &'a [Texel],
+    pub bvh: &'a Bvh,
+    pub eps: f32,
+    pub shadow_rays: Option<f32>,
+}
+
+/// rho/pi x sum over texels of flux/pi x cos_x x cos_t / max(d^2, eps^2) x V at (x, n).
+pub fn exact_indirect(em: &Emitters<'_>, x: Vec3, n: Vec3, albedo: Vec3) -> Vec3 {
+    albedo / std::f32::consts::PI * emitted_sum(em, x, n, |_| Vec3::ONE)
 }
 
 /// The same sum shaded with a BRDF (the ground truth's glossy path): sum over texels of
-/// f(v, l) x flux/pi x cos_x x cos_t / max(d^2, eps^2) x V, l towards the texel, `v` the unit
-/// direction to the eye.
-#[allow(clippy::too_many_arguments)]
+/// f(v, l) x flux/pi x cos_x x cos_t / max(d^2, eps^2) x V, l towards the texel, `sh.v` the
+/// unit direction to the eye.
 pub fn exact_indirect_brdf(
-    bvh: &Bvh,
+    em: &Emitters<'_>,
     x: Vec3,
     n: Vec3,
-    v: Vec3,
     model: crate::base::brdf::Brdf,
-    surface: &crate::reference::brdf::Surface,
-    texels: &[Texel],
-    eps: f32,
-    shadow_rays: Option<f32>,
+    sh: &crate::reference::brdf::Shading,
 ) -> Vec3 {
-    emitted_sum(bvh, x, n, texels, eps, shadow_rays, |l| {
-        crate::reference::brdf::eval(model, n, v, l, surface)
+    emitted_sum(em, x, n, |l| {
+        crate::reference::brdf::eval(model, n, sh.v, l, &sh.surface)
     })
 }
 
 /// Sum over texels of weight(l) x flux/pi x cos_x x cos_t / max(d^2, eps^2) x V.
-fn emitted_sum(
-    bvh: &Bvh,
-    x: Vec3,
-    n: Vec3,
-    texels: &[Texel],
-    eps: f32,
-    shadow_rays: Option<f32>,
-    weight: impl Fn(Vec3) -> Vec3,
-) -> Vec3 {
+fn emitted_sum(em: &Emitters<'_>, x: Vec3, n: Vec3, weight: impl Fn(Vec3) -> Vec3) -> Vec3 {
+    let Emitters {
+        texels,
+        bvh,
+        eps,
+        shadow_rays,
+    } = *em;
     let pi = std::f32::consts::PI;
     let mut sum = Vec3::ZERO;
     for t in texels {

@@ -94,57 +94,54 @@ pub fn slot_subset(n: u32, seed: u32, cut_size: u32, x: u32, y: u32, from_root: 
     slots
 }
 
-/// The geometry-aware filter of interleaved sampling (section 4.2; Segovia et al. 2006): the
-/// mean of the demodulated estimates in a (2 radius + 1)^2 window over the pixels on the same
-/// surface: normals within `normal_cos` and the neighbour within `plane_tolerance` x view depth
-/// of the pixel's tangent plane. `eye`, `forward`: the camera (view depth
-/// = (p - eye) . forward). Twin: `shaders/interleave_filter.wgsl`.
-#[allow(clippy::too_many_arguments)]
+/// The image the geometry-aware filter reads: its size, the camera (`eye`, `forward`: view
+/// depth = (p - eye) . forward), each pixel's surface (position, unit normal; None: nothing)
+/// and each pixel's demodulated estimate.
+#[derive(Clone, Copy, Debug)]
+pub struct FilterImage<'a> {
+    pub width: u32,
+    pub height: u32,
+    pub eye: Vec3,
+    pub forward: Vec3,
+    pub surf: &'a [Option<(Vec3, Vec3)>],
+    pub raw: &'a [Vec3],
+}
+
+/// The geometry-aware filter of interleaved sampling (section 4.2; Segovia et al. 2006) at
+/// pixel (x, y) of `img`: the mean of the demodulated estimates in a (2 radius + 1)^2 window
+/// over the pixels on the same surface: normals within `normal_cos` and the neighbour within
+/// `plane_tolerance` x view depth of the pixel's tangent plane. Twin:
+/// `shaders/interleave_filter.wgsl`.
 pub fn filter_pixel(
+    img: &FilterImage<'_>,
     x: u32,
     y: u32,
-    width: u32,
-    height: u32,
     radius: u32,
     normal_cos: f32,
     plane_tolerance: f32,
-    eye: Vec3,
-    forward: Vec3,
-    surf: &[Option<(Vec3, Vec3)>],
-    raw: &[Vec3],
 ) -> Vec3 {
     let r = radius as i32;
-    filter_pixel_window(
-        x,
-        y,
-        width,
-        height,
-        (-r, r),
-        normal_cos,
-        plane_tolerance,
-        eye,
-        forward,
-        surf,
-        raw,
-    )
+    filter_pixel_window(img, x, y, (-r, r), normal_cos, plane_tolerance)
 }
 
 /// [`filter_pixel`] over the window of offsets `lo ..= hi` along each axis
 /// (`interleave_filter::window`: the VAL method's p x p window).
-#[allow(clippy::too_many_arguments)]
 pub fn filter_pixel_window(
+    img: &FilterImage<'_>,
     x: u32,
     y: u32,
-    width: u32,
-    height: u32,
     (lo, hi): (i32, i32),
     normal_cos: f32,
     plane_tolerance: f32,
-    eye: Vec3,
-    forward: Vec3,
-    surf: &[Option<(Vec3, Vec3)>],
-    raw: &[Vec3],
 ) -> Vec3 {
+    let FilterImage {
+        width,
+        height,
+        eye,
+        forward,
+        surf,
+        raw,
+    } = *img;
     let k = (y * width + x) as usize;
     let Some((p, n)) = surf[k] else { return Vec3::ZERO };
     let tol = plane_tolerance * (p - eye).dot(forward).max(1e-6);
@@ -223,17 +220,19 @@ mod tests {
             None,
         ];
         let raw: Vec<Vec3> = (1..=5).map(|i| Vec3::splat(i as f32)).collect();
-        let f = filter_pixel(2, 0, 5, 1, 2, 0.9, 0.02, eye, fwd, &surf, &raw);
+        let img = FilterImage {
+            width: 5,
+            height: 1,
+            eye,
+            forward: fwd,
+            surf: &surf,
+            raw: &raw,
+        };
+        let f = filter_pixel(&img, 2, 0, 2, 0.9, 0.02);
         // Pixels 0 and 2 (the tilted normal, the one 1 m behind and the empty one are out).
         assert_eq!(f, Vec3::splat(2.0));
         // Radius 0: the pixel itself; no surface: 0.
-        assert_eq!(
-            filter_pixel(2, 0, 5, 1, 0, 0.9, 0.02, eye, fwd, &surf, &raw),
-            Vec3::splat(3.0)
-        );
-        assert_eq!(
-            filter_pixel(4, 0, 5, 1, 2, 0.9, 0.02, eye, fwd, &surf, &raw),
-            Vec3::ZERO
-        );
+        assert_eq!(filter_pixel(&img, 2, 0, 0, 0.9, 0.02), Vec3::splat(3.0));
+        assert_eq!(filter_pixel(&img, 4, 0, 2, 0.9, 0.02), Vec3::ZERO);
     }
 }

@@ -13,7 +13,7 @@
 use crate::reference::brdf;
 use glam::{UVec2, Vec3};
 
-pub use super::interleave::{Interleave, filter_pixel};
+pub use super::interleave::{FilterImage, Interleave, filter_pixel};
 use super::vpl::{pcg_hash, u01};
 
 /// Largest range we store (a VPL whose xi is 0 lights everything).
@@ -324,37 +324,41 @@ pub struct ShadeVpl {
     pub flux: Vec3,
 }
 
+/// The VPLs a pixel's list indexes, as shading reads them: each one's position, normal and
+/// flux (`vpls`), its range and fall-off (`lights`), and the fall-off's distance bound `eps`.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadeInputs<'a> {
+    pub vpls: &'a [ShadeVpl],
+    pub lights: &'a [LightRange],
+    pub eps: f32,
+}
+
 /// The pixel's demodulated estimate (before albedo / pi): n^2 x sum over `list` of
 /// flux / pi x cos_x x cos_v x falloff(l) x V, with `visible(i)` the shadow ray (Algorithm 1,
 /// step 3). Twin: `lcull_shade.wgsl`.
-#[allow(clippy::too_many_arguments)]
 pub fn shade(
     x: Vec3,
     nx: Vec3,
     list: &[u32],
-    vpls: &[ShadeVpl],
-    lights: &[LightRange],
+    s: &ShadeInputs<'_>,
     il: Interleave,
-    eps: f32,
     visible: impl FnMut(u32) -> bool,
 ) -> Vec3 {
-    shade_shaded(x, nx, list, vpls, lights, il, eps, visible, None)
+    shade_shaded(x, nx, list, s, il, visible, None)
 }
 
 /// [`shade`], each term times the glossy BRDF f(v, l) where `sh` is given (radiance: no
 /// albedo / pi after). Twin: `term` in `lcull_term.wgsl` with `gi.brdf = GGX`.
-#[allow(clippy::too_many_arguments)]
 pub fn shade_shaded(
     x: Vec3,
     nx: Vec3,
     list: &[u32],
-    vpls: &[ShadeVpl],
-    lights: &[LightRange],
+    s: &ShadeInputs<'_>,
     il: Interleave,
-    eps: f32,
     mut visible: impl FnMut(u32) -> bool,
     sh: Option<&brdf::Shading>,
 ) -> Vec3 {
+    let ShadeInputs { vpls, lights, eps } = *s;
     let pi = std::f32::consts::PI;
     let mut sum = Vec3::ZERO;
     for &i in list {
@@ -429,21 +433,27 @@ pub struct TreeList {
     pub visited: u32,
 }
 
+/// The bounding-sphere tree the walk descends (section 5): `leaves` leaves, each node n's VPL
+/// box `boxes[n]` and largest range below it `max_range[n]` ([`tree_max_ranges`]), and the
+/// leaves' ranges and fall-offs (`lights`).
+#[derive(Clone, Copy, Debug)]
+pub struct SphereTree<'a> {
+    pub leaves: u32,
+    pub boxes: &'a [(Vec3, Vec3)],
+    pub max_range: &'a [f32],
+    pub lights: &'a [LightRange],
+}
+
 /// The stackless walk of the implicit tree from the root: a node is entered when its sphere
-/// holds x, a leaf listed when its fall-off is non-zero at x; k of the m listed by reservoir
-/// sampling (Algorithm 3) with the stream `rng`. `boxes[n]` is node n's VPL box, `lights`
-/// the leaves' ranges and fall-offs. Twin: `traverse_main`.
-#[allow(clippy::too_many_arguments)]
-pub fn tree_traverse(
-    leaves: u32,
-    boxes: &[(Vec3, Vec3)],
-    max_range: &[f32],
-    lights: &[LightRange],
-    x: Vec3,
-    eps: f32,
-    k: u32,
-    mut rng: u32,
-) -> TreeList {
+/// holds x, a leaf listed when its fall-off (with `eps`) is non-zero at x; k of the m listed
+/// by reservoir sampling (Algorithm 3) with the stream `rng`. Twin: `traverse_main`.
+pub fn tree_traverse(tree: &SphereTree<'_>, x: Vec3, eps: f32, k: u32, mut rng: u32) -> TreeList {
+    let SphereTree {
+        leaves,
+        boxes,
+        max_range,
+        lights,
+    } = *tree;
     let mut list = vec![0u32; k as usize];
     let (mut m, mut visited, mut n) = (0u32, 0u32, 1u32);
     loop {
@@ -498,23 +508,28 @@ pub fn tree_importance(v: &ShadeVpl, x: Vec3, nx: Vec3, eps: f32) -> f32 {
     v.flux.max_element() / std::f32::consts::PI * cv * cx / l2.max(eps * eps)
 }
 
-/// The pixel's demodulated estimate from its list (section 5.3.2): one VPL i resampled by
-/// q(i) = g_i / sum g (eq. 8) with the uniform `u`, its contribution (stochastic fall-off,
+/// A pixel's reservoir after the walk (Algorithm 3): the VPLs it listed (at most `k`, the
+/// list's capacity) of the `m` in range.
+#[derive(Clone, Copy, Debug)]
+pub struct Reservoir<'a> {
+    pub list: &'a [u32],
+    pub m: u32,
+    pub k: u32,
+}
+
+/// The pixel's demodulated estimate from its reservoir (section 5.3.2): one VPL i resampled
+/// by q(i) = g_i / sum g (eq. 8) with the uniform `u`, its contribution (stochastic fall-off,
 /// i.e. f / p_i, and the shadow ray `visible(i)`) over min(k / m, 1) q(i) (eq. 10). Returns
 /// the estimate and the VPL shaded. Twin: `shade_main` of `lcull_tree.wgsl`.
-#[allow(clippy::too_many_arguments)]
 pub fn tree_shade(
     x: Vec3,
     nx: Vec3,
-    list: &[u32],
-    m: u32,
-    k: u32,
-    vpls: &[ShadeVpl],
-    lights: &[LightRange],
-    eps: f32,
+    r: Reservoir<'_>,
+    s: &ShadeInputs<'_>,
     u: f32,
     mut visible: impl FnMut(u32) -> bool,
 ) -> (Vec3, Option<u32>) {
+    let (Reservoir { list, m, k }, ShadeInputs { vpls, eps, .. }) = (r, *s);
     let g: Vec<f32> = list
         .iter()
         .map(|&i| tree_importance(&vpls[i as usize], x, nx, eps))
@@ -536,9 +551,7 @@ pub fn tree_shade(
         }
     }
     let i = list[pick];
-    let c = shade(x, nx, &[i], vpls, lights, Interleave::new(1, 1, 0), eps, |_| {
-        visible(i)
-    });
+    let c = shade(x, nx, &[i], s, Interleave::new(1, 1, 0), |_| visible(i));
     let keep = (k as f32 / m as f32).min(1.0);
     (c * total / (keep * g_pick), Some(i))
 }
@@ -732,6 +745,12 @@ mod tests {
     #[test]
     fn the_tree_lists_exactly_the_vpls_in_range_and_its_one_sample_estimate_is_unbiased() {
         let (vpls, lights, boxes, max) = small_tree(3);
+        let tree = SphereTree {
+            leaves: 16,
+            boxes: &boxes,
+            max_range: &max,
+            lights: &lights,
+        };
         let eps = 0.05;
         let in_range = |x: Vec3| -> Vec<u32> {
             (0..16u32)
@@ -749,7 +768,7 @@ mod tests {
         for _ in 0..300 {
             h = pcg_hash(h);
             let x = Vec3::new(u01(h), u01(pcg_hash(h ^ 1)), u01(pcg_hash(h ^ 2))) * 6.0 - 1.0;
-            let t = tree_traverse(16, &boxes, &max, &lights, x, eps, 16, h);
+            let t = tree_traverse(&tree, x, eps, 16, h);
             let want = in_range(x);
             assert_eq!(t.list, want, "at {x}");
             assert_eq!(t.m as usize, want.len());
@@ -769,27 +788,28 @@ mod tests {
             .expect("a point with 5 VPLs in range");
         let m = want.len() as f64;
         let nx = (vpls[want[0] as usize].position - x).normalize();
-        let exact = shade(
-            x,
-            nx,
-            &want,
-            &vpls,
-            &lights,
-            Interleave::new(1, 1, 0),
+        let si = ShadeInputs {
+            vpls: &vpls,
+            lights: &lights,
             eps,
-            |_| true,
-        );
+        };
+        let exact = shade(x, nx, &want, &si, Interleave::new(1, 1, 0), |_| true);
         let trials = 200_000u32;
         let mut listed = [0u32; 16];
         let mut sum = glam::DVec3::ZERO;
         for s in 0..trials {
-            let t = tree_traverse(16, &boxes, &max, &lights, x, eps, 2, pcg_hash(s ^ 0x9e37));
+            let t = tree_traverse(&tree, x, eps, 2, pcg_hash(s ^ 0x9e37));
             assert_eq!(t.list.len(), 2);
             for &j in &t.list {
                 listed[j as usize] += 1;
             }
             let u = u01(pcg_hash(s ^ 0x1234_5678));
-            let (v, _) = tree_shade(x, nx, &t.list, t.m, 2, &vpls, &lights, eps, u, |_| true);
+            let r = Reservoir {
+                list: &t.list,
+                m: t.m,
+                k: 2,
+            };
+            let (v, _) = tree_shade(x, nx, r, &si, u, |_| true);
             sum += v.as_dvec3();
         }
         let p = 2.0 / m;

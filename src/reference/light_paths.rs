@@ -152,18 +152,9 @@ pub fn trace_path(
                 tmin: 0.0,
                 tmax: 3.0e38,
             };
-            hit = bvh.closest_hit(&ray).map(|h| {
-                crate::reference::surface::surface_at(
-                    scene,
-                    mips,
-                    size,
-                    h.triangle as usize,
-                    h.u,
-                    h.v,
-                    dir,
-                    rules.lod,
-                )
-            });
+            hit = bvh
+                .closest_hit(&ray)
+                .map(|h| crate::reference::surface::surface_at(scene, mips, size, &h, dir, rules.lod));
         }
         let Some(s) = hit else {
             alive = false;

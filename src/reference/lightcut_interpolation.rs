@@ -42,8 +42,8 @@
 
 use glam::Vec3;
 
-use crate::base::{gpu_layout::GpuVpl, sst_node::SstNode};
-use crate::reference::lightcuts::{LcTree, cluster_estimate, representative_visible};
+use crate::base::sst_node::SstNode;
+use crate::reference::lightcuts::{CutInputs, cluster_estimate, representative_visible};
 use crate::reference::vpl::{pcg_hash, u01};
 use crate::scene::bvh::{Bvh, Ray};
 
@@ -445,21 +445,26 @@ pub fn disagreements(cuts: &[&[u32]], levels: u32) -> Vec<(u32, u32)> {
     out
 }
 
-/// An interpolated cut's shading: sum of the nodes' estimates x visibility (shadow rays with
-/// `shadow_ray_offset`, or the interpolated visibility when None) and the rays traced.
-#[allow(clippy::too_many_arguments)]
+/// An interpolated cut's shading: sum of the nodes' estimates (with `c.params.eps`) x
+/// visibility (the interpolated visibility with `interpolated_visibility`, else shadow rays
+/// with the offset `c.params.shadow_rays`, else 1) and the rays traced. The inputs' `topo`
+/// and refinement settings play no part.
 pub fn shade(
-    nodes: &[SstNode],
-    lc: &LcTree,
-    sorted: &[GpuVpl],
-    bvh: &Bvh,
+    c: &CutInputs<'_>,
     cut: &[InterpNode],
     x: Vec3,
     n: Vec3,
-    eps: f32,
-    shadow_ray_offset: Option<f32>,
     interpolated_visibility: bool,
 ) -> (Vec3, u32) {
+    let CutInputs {
+        nodes,
+        lc,
+        sorted,
+        bvh,
+        params,
+        ..
+    } = *c;
+    let (eps, shadow_ray_offset) = (params.eps, params.shadow_rays);
     let mut sum = Vec3::ZERO;
     let mut rays = 0;
     for c in cut {

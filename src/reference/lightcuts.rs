@@ -315,26 +315,17 @@ pub fn ggx_cos_bound(x: Vec3, n: Vec3, lo: Vec3, hi: Vec3, cx: f32, sh: &Shading
 }
 
 /// With the glossy BRDF: an upper bound of luminance(sum of flux_i x f(v, l_i) x cos_x x
-/// cos_v / max(d^2, eps^2)) over VPLs in the box and the cone whose fluxes sum to
-/// `intensity`: luminance(intensity x [`ggx_cos_bound`]) x the emitter cosine and distance
-/// bounds (per channel first: the flux and the BRDF may share a colour). Twin:
-/// `lc_geometry_brdf_bound`.
-#[allow(clippy::too_many_arguments)]
-pub fn geometry_brdf_bound(
-    x: Vec3,
-    n: Vec3,
-    lo: Vec3,
-    hi: Vec3,
-    cone: Cone,
-    eps: f32,
-    sh: &Shading,
-    intensity: Vec3,
-) -> f32 {
+/// cos_v / max(d^2, eps^2)) over VPLs in cluster `c`'s box (`bbox_min`, `bbox_max`) with
+/// normals in `cone` whose fluxes sum to its `intensity`: luminance(intensity x
+/// [`ggx_cos_bound`]) x the emitter cosine and distance bounds (per channel first: the flux
+/// and the BRDF may share a colour). Twin: `lc_geometry_brdf_bound`.
+pub fn geometry_brdf_bound(x: Vec3, n: Vec3, c: &SstNode, cone: Cone, eps: f32, sh: &Shading) -> f32 {
+    let (lo, hi) = (c.bbox_min, c.bbox_max);
     let Some((cx, cv)) = cosines(x, n, lo, hi, cone) else {
         return 0.0;
     };
     let m = ggx_cos_bound(x, n, lo, hi, cx, sh);
-    luminance(intensity * m) * cv / box_distance2(x, lo, hi).max(eps * eps)
+    luminance(c.intensity * m) * cv / box_distance2(x, lo, hi).max(eps * eps)
 }
 
 /// The error bound of node `node` at (x, n): 0 for leaves (exact) and empty nodes.
@@ -361,10 +352,7 @@ pub fn error_bound_shaded(
     }
     let cone = lc.cones[node as usize];
     match sh {
-        Some(sh) => {
-            geometry_brdf_bound(x, n, c.bbox_min, c.bbox_max, cone, eps, sh, c.intensity)
-                / std::f32::consts::PI
-        }
+        Some(sh) => geometry_brdf_bound(x, n, c, cone, eps, sh) / std::f32::consts::PI,
         None => {
             luminance(c.intensity) / std::f32::consts::PI
                 * geometry_bound(x, n, c.bbox_min, c.bbox_max, cone, eps)
@@ -415,24 +403,14 @@ pub fn cluster_estimate(
     flux * (luminance(nodes[node as usize].intensity) / lf) / std::f32::consts::PI * g
 }
 
-/// [`cluster_estimate`] times the glossy BRDF f(v, l) towards the representative where `sh`
-/// is given (radiance; Lambert leaves the albedo / pi to [`PixelCut::radiance`]). Twin:
-/// `estimate` in `lightcuts.wgsl`.
-#[allow(clippy::too_many_arguments)]
-pub fn cluster_estimate_shaded(
-    nodes: &[SstNode],
-    lc: &LcTree,
-    sorted: &[GpuVpl],
-    node: u32,
-    x: Vec3,
-    n: Vec3,
-    eps: f32,
-    sh: Option<&Shading>,
-) -> Vec3 {
-    let e = cluster_estimate(nodes, lc, sorted, node, x, n, eps);
+/// [`cluster_estimate`] (with the inputs' `params.eps`) times the glossy BRDF f(v, l) towards
+/// the representative where `sh` is given (radiance; Lambert leaves the albedo / pi to
+/// [`PixelCut::radiance`]). Twin: `estimate` in `lightcuts.wgsl`.
+pub fn cluster_estimate_shaded(c: &CutInputs<'_>, node: u32, x: Vec3, n: Vec3, sh: Option<&Shading>) -> Vec3 {
+    let e = cluster_estimate(c.nodes, c.lc, c.sorted, node, x, n, c.params.eps);
     match sh {
         Some(sh) if e != Vec3::ZERO => {
-            let v = &sorted[lc.reps[node as usize] as usize];
+            let v = &c.sorted[c.lc.reps[node as usize] as usize];
             let l = (Vec3::from_slice(&v.position[..3]) - x).normalize();
             e * brdf::eval(brdf::Brdf::Ggx, n, sh.v, l, &sh.surface)
         }
@@ -474,6 +452,40 @@ pub struct CutParams {
     /// Interpolation's records: their visibility bits are interpolated to pixels where the
     /// node does contribute). Lightcuts itself skips those rays.
     pub trace_every_node: bool,
+}
+
+/// What a pixel's cut depends on besides the receiver: the frame's tree (`nodes`, 2 x leaves,
+/// and its `topo`), its Lightcuts build, the sorted VPLs (one per leaf), the BVH of the
+/// shadow rays and the refinement's settings.
+#[derive(Clone, Copy)]
+pub struct CutInputs<'a> {
+    pub nodes: &'a [SstNode],
+    pub topo: Topology<'a>,
+    pub lc: &'a LcTree,
+    pub sorted: &'a [GpuVpl],
+    pub bvh: &'a Bvh,
+    pub params: &'a CutParams,
+}
+
+impl<'a> CutInputs<'a> {
+    /// The inputs on the perfect tree of `nodes`.
+    pub fn perfect(
+        nodes: &'a [SstNode],
+        lc: &'a LcTree,
+        sorted: &'a [GpuVpl],
+        bvh: &'a Bvh,
+        params: &'a CutParams,
+    ) -> Self {
+        let topo = Topology::perfect_of(nodes);
+        CutInputs {
+            nodes,
+            topo,
+            lc,
+            sorted,
+            bvh,
+            params,
+        }
+    }
 }
 
 /// One node of a pixel's final cut.
@@ -528,40 +540,27 @@ pub fn lightcut(
     n: Vec3,
     p: &CutParams,
 ) -> PixelCut {
-    lightcut_on(nodes, Topology::perfect_of(nodes), lc, sorted, bvh, x, n, p)
+    lightcut_on(&CutInputs::perfect(nodes, lc, sorted, bvh, p), x, n)
 }
 
-/// [`lightcut`] on either tree.
-#[allow(clippy::too_many_arguments)]
-pub fn lightcut_on(
-    nodes: &[SstNode],
-    topo: Topology<'_>,
-    lc: &LcTree,
-    sorted: &[GpuVpl],
-    bvh: &Bvh,
-    x: Vec3,
-    n: Vec3,
-    p: &CutParams,
-) -> PixelCut {
-    lightcut_shaded_on(nodes, topo, lc, sorted, bvh, x, n, p, None)
+/// [`lightcut`] on either tree (the inputs' `topo`).
+pub fn lightcut_on(c: &CutInputs<'_>, x: Vec3, n: Vec3) -> PixelCut {
+    lightcut_shaded_on(c, x, n, None)
 }
 
 /// [`lightcut_on`] with the glossy BRDF where `sh` is given: its bounds
 /// ([`error_bound_shaded`]) and estimates ([`cluster_estimate_shaded`]; the sum is radiance).
-#[allow(clippy::too_many_arguments)]
-pub fn lightcut_shaded_on(
-    nodes: &[SstNode],
-    topo: Topology<'_>,
-    lc: &LcTree,
-    sorted: &[GpuVpl],
-    bvh: &Bvh,
-    x: Vec3,
-    n: Vec3,
-    p: &CutParams,
-    sh: Option<&Shading>,
-) -> PixelCut {
+pub fn lightcut_shaded_on(c: &CutInputs<'_>, x: Vec3, n: Vec3, sh: Option<&Shading>) -> PixelCut {
+    let CutInputs {
+        nodes,
+        topo,
+        lc,
+        sorted,
+        bvh,
+        params: p,
+    } = *c;
     let leaves = topo.leaves;
-    let estimate = |node: u32| cluster_estimate_shaded(nodes, lc, sorted, node, x, n, p.eps, sh);
+    let estimate = |node: u32| cluster_estimate_shaded(c, node, x, n, sh);
     let mut rays = 0u32;
     let mut visible = |node: u32, e: Vec3| -> bool {
         if e == Vec3::ZERO && !p.trace_every_node {

@@ -183,22 +183,30 @@ pub fn glossy_term(lo: Vec3, hi: Vec3, x: Vec3, n: Vec3, v: Vec3, s: &brdf::Surf
     luminance(f) * brdf::ggx_d(nh, a2) * vis
 }
 
-/// A glossy walk's probability of the left child (`traverse` in `slc_sample.wgsl`): the
-/// geometric [`child_probability`], with `weights` times the children's [`glossy_term`]s
-/// (`Material`), or those mixed with [`GLOSSY_DEFENSIVE`] of the geometric one
-/// (`Defensive`; the geometric one alone where the material terms are both 0).
-#[allow(clippy::too_many_arguments)]
+/// How a glossy walk weighs a step's two children: the geometric rule and the material
+/// term's part (`sampling.child_probability`, `sampling.glossy_weights`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GlossyWalk {
+    pub mode: ChildProbability,
+    pub weights: GlossyWeights,
+}
+
+/// A glossy walk's probability of the left child (`traverse` in `slc_sample.wgsl`) at (x, n)
+/// seen along `sh.v` with `sh.surface`: the geometric [`child_probability`], with `weights`
+/// times the children's [`glossy_term`]s (`Material`), or those mixed with
+/// [`GLOSSY_DEFENSIVE`] of the geometric one (`Defensive`; the geometric one alone where the
+/// material terms are both 0).
 pub fn glossy_child_probability(
     l: &SstNode,
     r: &SstNode,
     x: Vec3,
     n: Vec3,
-    v: Vec3,
-    s: &brdf::Surface,
+    sh: &brdf::Shading,
     eps: f32,
-    mode: ChildProbability,
-    weights: GlossyWeights,
+    walk: GlossyWalk,
 ) -> Option<f32> {
+    let (v, s) = (sh.v, &sh.surface);
+    let GlossyWalk { mode, weights } = walk;
     if weights == GlossyWeights::Geometric {
         return child_probability(l, r, x, n, eps, mode);
     }
@@ -462,24 +470,36 @@ pub fn subtree_sum_on(nodes: &[SstNode], topo: Topology<'_>, node: u32, g: &dyn 
         .sum()
 }
 
-/// Reference of `shaders/methods/tree_samplers/slc_upsample.wgsl`: full-resolution pixel (x, y) from the 4
-/// half-resolution samples around (x/2, y/2) (half pixel h holds full pixel 2h), with
-/// bilinear weights x S (eq. 5.3); if none is similar, the neighbour with the most similar
-/// normal. Returns the demodulated value (multiply by the albedo for radiance); None without
-/// geometry.
-#[allow(clippy::too_many_arguments)]
+/// The half-resolution image [`upsample_pixel`] reads (half pixel h holds full pixel 2h): its
+/// size and, per pixel, its position (None without geometry), unit normal and demodulated
+/// value.
+#[derive(Clone, Copy)]
+pub struct HalfImage<'a> {
+    pub size: (u32, u32),
+    pub position: &'a dyn Fn(u32, u32) -> Option<Vec3>,
+    pub normal: &'a dyn Fn(u32, u32) -> Vec3,
+    pub value: &'a dyn Fn(u32, u32) -> Vec3,
+}
+
+/// Reference of `shaders/methods/tree_samplers/slc_upsample.wgsl`: full-resolution pixel (x, y)
+/// at (p, n) from the 4 samples of `half` around (x/2, y/2), with bilinear weights x S
+/// (eq. 5.3); if none is similar, the neighbour with the most similar normal. Returns the
+/// demodulated value (multiply by the albedo for radiance).
 pub fn upsample_pixel(
     x: u32,
     y: u32,
     p: Vec3,
     n: Vec3,
-    half_size: (u32, u32),
-    half_pos: &dyn Fn(u32, u32) -> Option<Vec3>,
-    half_nrm: &dyn Fn(u32, u32) -> Vec3,
-    half_val: &dyn Fn(u32, u32) -> Vec3,
+    half: &HalfImage<'_>,
     n_min: f32,
     d_max: f32,
 ) -> Vec3 {
+    let HalfImage {
+        size: half_size,
+        position: half_pos,
+        normal: half_nrm,
+        value: half_val,
+    } = *half;
     let (fx, fy) = (x as f32 * 0.5, y as f32 * 0.5);
     let (bx, by) = (fx.floor(), fy.floor());
     let (tx, ty) = (fx - bx, fy - by);

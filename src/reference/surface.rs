@@ -15,7 +15,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::base::display::srgb8_to_linear;
-use crate::scene::Scene;
+use crate::scene::{Scene, bvh::Hit};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Surface {
@@ -47,19 +47,17 @@ pub fn texel(mips: &[Vec<u8>], size: u32, uv: Vec2, lod: u32) -> Vec3 {
     )
 }
 
-/// The surface of triangle `tri` at barycentrics (u, v), hit along `dir`. `mips[t]`: texture
-/// t's mip chain at `size` (the GPU's texture array).
-#[allow(clippy::too_many_arguments)]
+/// The surface `hit` found (its triangle at its barycentrics (u, v)) along `dir`. `mips[t]`:
+/// texture t's mip chain at `size` (the GPU's texture array).
 pub fn surface_at(
     scene: &Scene,
     mips: &[Vec<Vec<u8>>],
     size: u32,
-    tri: usize,
-    u: f32,
-    v: f32,
+    hit: &Hit,
     dir: Vec3,
     lod: u32,
 ) -> Surface {
+    let (tri, u, v) = (hit.triangle as usize, hit.u, hit.v);
     let idx = &scene.indices[3 * tri..3 * tri + 3];
     let w = 1.0 - u - v;
     let [p0, p1, p2] = scene.triangle(tri);

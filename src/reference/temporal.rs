@@ -102,9 +102,15 @@ pub fn demodulate(c: Vec3, a: Vec3) -> Vec3 {
     Vec3::new(f(c.x, a.x), f(c.y, a.y), f(c.z, a.z))
 }
 
-/// The previous frame as `reproject` reads it: its G-buffer (normals as stored) and history
-/// colour and moments.
-pub type Previous<'a> = (&'a Gbuffer, &'a [[f32; 4]], &'a [[f32; 4]]);
+/// The previous frame as `reproject` reads it: its G-buffer (normals as stored), camera and
+/// history colour and moments.
+#[derive(Clone, Copy, Debug)]
+pub struct Previous<'a> {
+    pub gbuffer: &'a Gbuffer,
+    pub cam: &'a Cam,
+    pub history: &'a [[f32; 4]],
+    pub moments: &'a [[f32; 4]],
+}
 
 /// What the twin keeps of a frame: its G-buffer, camera, history colour and moments.
 pub type Kept = (Gbuffer, Cam, Vec<[f32; 4]>, Vec<[f32; 4]>);
@@ -133,16 +139,14 @@ fn tap_ok(prev: &Gbuffer, q: (i32, i32), g: [f32; 4], n: Vec3, tol: f32, p: &Par
 }
 
 /// The `reproject` entry point at pixel (x, y): `radiance` the method's estimate there,
-/// `prev` the previous frame's G-buffer (normals as the pass stored them), `history` /
-/// `moments` the previous frame's history buffers, None on a first frame.
-#[allow(clippy::too_many_arguments)]
+/// `prev` the previous frame (its G-buffer with normals as the pass stored them, camera and
+/// history buffers), None on a first frame.
 pub fn reproject_pixel(
     x: u32,
     y: u32,
     cur: &Gbuffer,
     radiance: Vec3,
     cam: &Cam,
-    prev_cam: &Cam,
     prev: Option<Previous<'_>>,
     p: &Params,
 ) -> Reprojected {
@@ -157,9 +161,10 @@ pub fn reproject_pixel(
         current: [c.x, c.y, c.z, luminance(c)],
         ..Default::default()
     };
-    let Some((prev, hist, mom)) = prev else {
+    let Some(pf) = prev else {
         return out;
     };
+    let (prev, prev_cam, hist, mom) = (pf.gbuffer, pf.cam, pf.history, pf.moments);
     let (pp, z) = prev_cam.pixel_of(cur.point(k));
     out.motion = pp - Vec2::new(x as f32, y as f32);
     if z <= 0.0 || !(pp.x.abs() < 1e6 && pp.y.abs() < 1e6) {
@@ -298,19 +303,18 @@ pub fn depth_fwidth(gb: &Gbuffer, cam: &Cam, x: i32, y: i32, z: f32) -> f32 {
     fw
 }
 
-/// SVGF's edge-stopping weight (depth, normal, luminance), without the kernel.
-#[allow(clippy::too_many_arguments)]
-pub fn edge_weight(
-    zp: f32,
-    zq: f32,
-    phi_z: f32,
-    np: Vec3,
-    nq: Vec3,
-    lp: f32,
-    lq: f32,
-    phi_l: f32,
-    sigma_n: f32,
-) -> f32 {
+/// A pixel as SVGF's edge-stopping weight sees it: view depth, unit normal, luminance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgePoint {
+    pub z: f32,
+    pub n: Vec3,
+    pub l: f32,
+}
+
+/// SVGF's edge-stopping weight (depth, normal, luminance) between pixels p and q, without
+/// the kernel.
+pub fn edge_weight(p: EdgePoint, q: EdgePoint, phi_z: f32, phi_l: f32, sigma_n: f32) -> f32 {
+    let (EdgePoint { z: zp, n: np, l: lp }, EdgePoint { z: zq, n: nq, l: lq }) = (p, q);
     let wz = if phi_z == 0.0 {
         0.0
     } else {
@@ -340,6 +344,7 @@ pub fn variance_pixel(k: usize, gb: &Gbuffer, cam: &Cam, acc: &[Accumulated], p:
     let z = cam.view_depth(gb.point(k));
     let fw = depth_fwidth(gb, cam, x, y, z).max(DEPTH_FLOOR * z);
     let lp = luminance(Vec3::from_slice(&it[..3]));
+    let at_k = EdgePoint { z, n, l: lp };
     let (mut wsum, mut c, mut mm) = (0.0f32, Vec3::ZERO, Vec2::ZERO);
     for dy in -3..=3i32 {
         for dx in -3..=3i32 {
@@ -348,17 +353,12 @@ pub fn variance_pixel(k: usize, gb: &Gbuffer, cam: &Cam, acc: &[Accumulated], p:
             };
             let iq = Vec3::from_slice(&acc[q].color[..3]);
             let phi_z = 3.0 * p.sigma_z * fw * Vec2::new(dx as f32, dy as f32).length();
-            let w = edge_weight(
-                z,
-                cam.view_depth(gb.point(q)),
-                phi_z,
-                n,
-                gb.normal[q].normalize_or_zero(),
-                lp,
-                luminance(iq),
-                p.sigma_l,
-                p.sigma_n,
-            );
+            let at_q = EdgePoint {
+                z: cam.view_depth(gb.point(q)),
+                n: gb.normal[q].normalize_or_zero(),
+                l: luminance(iq),
+            };
+            let w = edge_weight(at_k, at_q, phi_z, p.sigma_l, p.sigma_n);
             wsum += w;
             c += w * iq;
             mm += w * Vec2::new(acc[q].moments[0], acc[q].moments[1]);
@@ -410,6 +410,7 @@ pub fn atrous_pixel(k: usize, gb: &Gbuffer, cam: &Cam, src: &[[f32; 4]], step: i
     let fw = depth_fwidth(gb, cam, x, y, z).max(DEPTH_FLOOR * z);
     let phi_l = p.sigma_l * (prefiltered_variance(gb, src, x, y) + 1e-10).sqrt();
     let lp = luminance(Vec3::from_slice(&c[..3]));
+    let at_k = EdgePoint { z, n, l: lp };
     let mut wsum = B3[0] * B3[0];
     let mut sc = wsum * Vec3::from_slice(&c[..3]);
     let mut sv = wsum * wsum * c[3];
@@ -423,19 +424,14 @@ pub fn atrous_pixel(k: usize, gb: &Gbuffer, cam: &Cam, src: &[[f32; 4]], step: i
             };
             let sq = Vec3::from_slice(&src[q][..3]);
             let phi_z = p.sigma_z * fw * step as f32 * Vec2::new(dx as f32, dy as f32).length();
+            let at_q = EdgePoint {
+                z: cam.view_depth(gb.point(q)),
+                n: gb.normal[q].normalize_or_zero(),
+                l: luminance(sq),
+            };
             let w = B3[dx.unsigned_abs() as usize]
                 * B3[dy.unsigned_abs() as usize]
-                * edge_weight(
-                    z,
-                    cam.view_depth(gb.point(q)),
-                    phi_z,
-                    n,
-                    gb.normal[q].normalize_or_zero(),
-                    lp,
-                    luminance(sq),
-                    phi_l,
-                    p.sigma_n,
-                );
+                * edge_weight(at_k, at_q, phi_z, phi_l, p.sigma_n);
             wsum += w;
             sc += w * sq;
             sv += w * w * src[q][3];
@@ -474,7 +470,8 @@ pub fn symmetric_weight(
 ) -> f32 {
     let phi_z = p.sigma_z * a[1].max(b[1]) * step as f32 * dist;
     let phi_l = p.sigma_l * (a[3].max(b[3]) + 1e-10).sqrt();
-    edge_weight(a[0], b[0], phi_z, na, nb, a[2], b[2], phi_l, p.sigma_n)
+    let at = |r: [f32; 4], n: Vec3| EdgePoint { z: r[0], n, l: r[2] };
+    edge_weight(at(a, na), at(b, nb), phi_z, phi_l, p.sigma_n)
 }
 
 /// Calls `f(q, kernel x symmetric weight)` for each covered tap q != k of pixel k's 5x5
@@ -615,16 +612,17 @@ impl Frame {
         iterations: u32,
         feedback: u32,
     ) -> FrameOut {
-        let prev = self
-            .prev
-            .as_ref()
-            .map(|(g, c, h, m)| ((g, h.as_slice(), m.as_slice()), c));
+        let prev = self.prev.as_ref().map(|(g, c, h, m)| Previous {
+            gbuffer: g,
+            cam: c,
+            history: h,
+            moments: m,
+        });
         let n = radiance.len();
         let reprojected: Vec<Reprojected> = (0..n)
             .map(|k| {
                 let (x, y) = (k as u32 % gb.width, k as u32 / gb.width);
-                let prev_cam = prev.map_or(cam, |(_, c)| c);
-                reproject_pixel(x, y, gb, radiance[k], cam, prev_cam, prev.map(|(b, _)| b), p)
+                reproject_pixel(x, y, gb, radiance[k], cam, prev, p)
             })
             .collect();
         let accumulated: Vec<Accumulated> = (0..n)

@@ -588,8 +588,8 @@ pub struct PcssLookup {
     pub penumbra: f32,
 }
 
-/// The PCSS-style lookup of `x` in map `m` of a VAL at `c` (normal `n`, area `area`), section
-/// 6, in the paraboloid map (map coordinates per radian near a direction at cos theta = z to
+/// The PCSS-style lookup of `x` in map `m` of VAL `light` (its centre c = `light.position`,
+/// normal n and area; the rest unused), section 6, in the paraboloid map (map coordinates per radian near a direction at cos theta = z to
 /// the normal: 0.5 / (1 + z)):
 /// - blocker search: the Poisson samples over a disk of angular radius atan(r_L / z_r) around
 ///   x's texel (the light's disk seen from the receiver; 1 texel .. `max_radius`); depths
@@ -600,19 +600,17 @@ pub struct PcssLookup {
 ///   that see x.
 ///
 /// Twin: `val_pcss` in `val_shade.wgsl`.
-#[allow(clippy::too_many_arguments)]
 pub fn pcss(
     layout: crate::reference::ism::IsmLayout,
     atlas: &[f32],
     m: u32,
-    c: Vec3,
-    n: Vec3,
-    area: f32,
+    light: &Val,
     x: Vec3,
     bias: f32,
     p: &Pcss,
 ) -> PcssLookup {
     use crate::reference::ism::{project, texel_of};
+    let (c, n, area) = (light.position, light.normal, light.area);
     let unseen = PcssLookup {
         visibility: 1.0,
         ..Default::default()
