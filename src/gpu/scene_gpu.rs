@@ -158,135 +158,10 @@ impl SceneGpu {
             usage: wgpu::BufferUsages::INDEX,
         });
 
-        // Texture array: every base-colour texture resampled to one power-of-two size.
-        let limit = device
-            .limits()
-            .max_texture_dimension_2d
-            .min(max_texture_size.max(1));
-        let largest = scene
-            .textures
-            .iter()
-            .map(|t| t.width.max(t.height))
-            .max()
-            .unwrap_or(1)
-            .max(1);
-        let size = largest
-            .min(limit)
-            .next_power_of_two()
-            .min(limit.next_power_of_two());
-        let size = if size > limit { size / 2 } else { size }.max(1);
-        let layers = scene.textures.len().max(1) as u32;
-        let mip_count = 32 - size.leading_zeros();
-        let textures = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("scene::base_color_textures"),
-            size: wgpu::Extent3d {
-                width: size,
-                height: size,
-                depth_or_array_layers: layers,
-            },
-            mip_level_count: mip_count,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba8UnormSrgb,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        let placeholder = TextureImage {
-            name: "white".into(),
-            width: 1,
-            height: 1,
-            rgba8: vec![255; 4],
-        };
-        let sources: Vec<&TextureImage> = if scene.textures.is_empty() {
-            vec![&placeholder]
-        } else {
-            scene.textures.iter().collect()
-        };
-        // Resample/mip in parallel (2 threads are common here), upload in order.
-        let all_mips: Vec<Vec<Vec<u8>>> = std::thread::scope(|s| {
-            let threads = std::thread::available_parallelism()
-                .map(|n| n.get())
-                .unwrap_or(2)
-                .min(8);
-            let chunk = sources.len().div_ceil(threads).max(1);
-            let handles: Vec<_> = sources
-                .chunks(chunk)
-                .map(|c| s.spawn(move || c.iter().map(|t| texture_mips(t, size)).collect::<Vec<_>>()))
-                .collect();
-            handles
-                .into_iter()
-                .flat_map(|h| h.join().unwrap_or_default())
-                .collect()
-        });
-        for (layer, mips) in all_mips.iter().enumerate() {
-            for (level, data) in mips.iter().enumerate() {
-                let s = (size >> level).max(1);
-                queue.write_texture(
-                    wgpu::TexelCopyTextureInfo {
-                        texture: &textures,
-                        mip_level: level as u32,
-                        origin: wgpu::Origin3d {
-                            x: 0,
-                            y: 0,
-                            z: layer as u32,
-                        },
-                        aspect: wgpu::TextureAspect::All,
-                    },
-                    data,
-                    wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(4 * s),
-                        rows_per_image: Some(s),
-                    },
-                    wgpu::Extent3d {
-                        width: s,
-                        height: s,
-                        depth_or_array_layers: 1,
-                    },
-                );
-            }
-        }
-        let textures_view = textures.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("scene::base_color_textures_view"),
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
+        let (textures, textures_view) = upload_textures(device, queue, scene, max_texture_size);
         let sampler = texture_sampler(device, anisotropy);
 
-        let layer = |t: Option<usize>| {
-            t.filter(|&t| t < scene.textures.len())
-                .map(|t| t as i32)
-                .unwrap_or(-1)
-        };
-        let mut mats: Vec<GpuMaterial> = scene
-            .materials
-            .iter()
-            .map(|m| GpuMaterial {
-                base_color: m.base_color_factor,
-                texture: [
-                    layer(m.base_color_texture),
-                    layer(m.roughness_texture),
-                    layer(m.metallic_texture),
-                    0,
-                ],
-                // In [0, 1] whatever built the scene (the GGX bounds assume alpha <= 1).
-                params: [m.metallic.clamp(0.0, 1.0), m.roughness.clamp(0.0, 1.0), 0.0, 0.0],
-                mr_uv: m.metal_rough_uv.map(|[a, b, c]| [a, b, c, 0.0]),
-            })
-            .collect();
-        if mats.is_empty() {
-            mats.push(GpuMaterial {
-                base_color: [0.8, 0.8, 0.8, 1.0],
-                texture: [-1, -1, -1, 0],
-                params: [0.0, 1.0, 0.0, 0.0],
-                mr_uv: crate::scene::UV_IDENTITY.map(|[a, b, c]| [a, b, c, 0.0]),
-            });
-        }
-        let materials = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene::materials"),
-            contents: bytemuck::cast_slice(&mats),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
+        let materials = upload_materials(device, scene);
 
         let bvh = Bvh::build(&scene.positions, &scene.indices);
         let (bvh_nodes, bvh_triangles) = match frame_bvh_layout() {
@@ -310,6 +185,147 @@ impl SceneGpu {
             generation: GENERATION.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
     }
+}
+
+/// Every base-colour texture resampled to one power-of-two size (at most `max_texture_size`
+/// and the device's limit) with its mips, as one texture array, and its view.
+fn upload_textures(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    scene: &Scene,
+    max_texture_size: u32,
+) -> (wgpu::Texture, wgpu::TextureView) {
+    let limit = device
+        .limits()
+        .max_texture_dimension_2d
+        .min(max_texture_size.max(1));
+    let largest = scene
+        .textures
+        .iter()
+        .map(|t| t.width.max(t.height))
+        .max()
+        .unwrap_or(1)
+        .max(1);
+    let size = largest
+        .min(limit)
+        .next_power_of_two()
+        .min(limit.next_power_of_two());
+    let size = if size > limit { size / 2 } else { size }.max(1);
+    let layers = scene.textures.len().max(1) as u32;
+    let mip_count = 32 - size.leading_zeros();
+    let textures = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("scene::base_color_textures"),
+        size: wgpu::Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: layers,
+        },
+        mip_level_count: mip_count,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8UnormSrgb,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let placeholder = TextureImage {
+        name: "white".into(),
+        width: 1,
+        height: 1,
+        rgba8: vec![255; 4],
+    };
+    let sources: Vec<&TextureImage> = if scene.textures.is_empty() {
+        vec![&placeholder]
+    } else {
+        scene.textures.iter().collect()
+    };
+    // Resample/mip in parallel (2 threads are common here), upload in order.
+    let all_mips: Vec<Vec<Vec<u8>>> = std::thread::scope(|s| {
+        let threads = std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(2)
+            .min(8);
+        let chunk = sources.len().div_ceil(threads).max(1);
+        let handles: Vec<_> = sources
+            .chunks(chunk)
+            .map(|c| s.spawn(move || c.iter().map(|t| texture_mips(t, size)).collect::<Vec<_>>()))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_default())
+            .collect()
+    });
+    for (layer, mips) in all_mips.iter().enumerate() {
+        for (level, data) in mips.iter().enumerate() {
+            let s = (size >> level).max(1);
+            queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &textures,
+                    mip_level: level as u32,
+                    origin: wgpu::Origin3d {
+                        x: 0,
+                        y: 0,
+                        z: layer as u32,
+                    },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                data,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4 * s),
+                    rows_per_image: Some(s),
+                },
+                wgpu::Extent3d {
+                    width: s,
+                    height: s,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+    }
+    let textures_view = textures.create_view(&wgpu::TextureViewDescriptor {
+        label: Some("scene::base_color_textures_view"),
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    (textures, textures_view)
+}
+
+/// The scene's materials (a grey one when it has none), texture indices into the array.
+fn upload_materials(device: &wgpu::Device, scene: &Scene) -> wgpu::Buffer {
+    let layer = |t: Option<usize>| {
+        t.filter(|&t| t < scene.textures.len())
+            .map(|t| t as i32)
+            .unwrap_or(-1)
+    };
+    let mut mats: Vec<GpuMaterial> = scene
+        .materials
+        .iter()
+        .map(|m| GpuMaterial {
+            base_color: m.base_color_factor,
+            texture: [
+                layer(m.base_color_texture),
+                layer(m.roughness_texture),
+                layer(m.metallic_texture),
+                0,
+            ],
+            // In [0, 1] whatever built the scene (the GGX bounds assume alpha <= 1).
+            params: [m.metallic.clamp(0.0, 1.0), m.roughness.clamp(0.0, 1.0), 0.0, 0.0],
+            mr_uv: m.metal_rough_uv.map(|[a, b, c]| [a, b, c, 0.0]),
+        })
+        .collect();
+    if mats.is_empty() {
+        mats.push(GpuMaterial {
+            base_color: [0.8, 0.8, 0.8, 1.0],
+            texture: [-1, -1, -1, 0],
+            params: [0.0, 1.0, 0.0, 0.0],
+            mr_uv: crate::scene::UV_IDENTITY.map(|[a, b, c]| [a, b, c, 0.0]),
+        });
+    }
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("scene::materials"),
+        contents: bytemuck::cast_slice(&mats),
+        usage: wgpu::BufferUsages::STORAGE,
+    })
 }
 
 /// The base-colour sampler: repeat, trilinear, `anisotropy`x anisotropic (1..=16).

@@ -455,6 +455,17 @@ impl Default for TextureSettings {
 impl RenderSettings {
     /// Checks every value's range; the message names the setting and its valid range.
     pub fn validate(&self) -> Result<(), String> {
+        self.validate_shadow()?;
+        self.validate_display()?;
+        self.validate_vpl()?;
+        self.validate_gi_and_tree()?;
+        self.validate_method_tables()?;
+        self.temporal.validate()?;
+        crate::methods::validate_all(self)
+    }
+
+    /// `[shadow]`: the shadow map's size and biases.
+    fn validate_shadow(&self) -> Result<(), String> {
         let s = &self.shadow;
         if !(16..=4096).contains(&s.resolution) || !s.resolution.is_power_of_two() {
             return Err(format!(
@@ -486,6 +497,11 @@ impl RenderSettings {
                 s.pcf_radius
             ));
         }
+        Ok(())
+    }
+
+    /// `[display]`'s overlay sizes and exposure, `textures.max_size`.
+    fn validate_display(&self) -> Result<(), String> {
         if self.display.vpl_point_size > 16 || self.display.pyramid_level > 12 {
             return Err(format!(
                 "display.vpl_point_size {} (0..=16) or display.pyramid_level {} (0..=12) out of range",
@@ -504,6 +520,11 @@ impl RenderSettings {
                 self.textures.max_size
             ));
         }
+        Ok(())
+    }
+
+    /// `[vpl]`: count, sampling, bounces.
+    fn validate_vpl(&self) -> Result<(), String> {
         let v = &self.vpl;
         if !(1..=1 << 20).contains(&v.count) {
             return Err(format!("vpl.count {} is out of range (1..=1048576)", v.count));
@@ -554,6 +575,11 @@ impl RenderSettings {
                 v.bounces, v.count
             ));
         }
+        Ok(())
+    }
+
+    /// `[gi]`'s distances, `[tree]`, the display's split and tree level, texture anisotropy.
+    fn validate_gi_and_tree(&self) -> Result<(), String> {
         let g = &self.gi;
         if !(g.distance_epsilon > 0.0 && g.distance_epsilon.is_finite()) {
             return Err(format!(
@@ -596,8 +622,13 @@ impl RenderSettings {
                 self.textures.anisotropy
             ));
         }
-        // Each GI method checks its own settings (the tree samplers' [sampling], the
-        // progressive methods' budgets, the [methods.<name>] tables).
+        Ok(())
+    }
+
+    /// The `[methods.<name>]` tables are named by registered methods' CLI names (each GI
+    /// method checks its own settings: the tree samplers' [sampling], the progressive
+    /// methods' budgets, the tables).
+    fn validate_method_tables(&self) -> Result<(), String> {
         if let Some(k) = self
             .methods
             .keys()
@@ -611,8 +642,7 @@ impl RenderSettings {
                 ),
             });
         }
-        self.temporal.validate()?;
-        crate::methods::validate_all(self)
+        Ok(())
     }
 }
 
