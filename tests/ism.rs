@@ -8,7 +8,7 @@ use glam::Vec3;
 use lightcut::reference::ism::{self, EMPTY, IsmLayout, IsmLight};
 use lightcut::renderer::{
     context::GpuContext,
-    passes::ism::{IsmPass, IsmPoints, IsmTargets},
+    passes::ism::{IsmBuild, IsmPass, IsmPoints, IsmTargets},
     readback::read_storage_buffer,
     settings::IsmSettings,
     timing::GpuTimer,
@@ -21,17 +21,13 @@ fn build(ctx: &GpuContext, s: &IsmSettings, points: &[Vec3], lights: &[IsmLight]
     let pts = IsmPoints::new(&ctx.device, &ctx.queue, points, (points.len() as u32, 0));
     let mut timer = GpuTimer::new(&ctx.device, &ctx.queue);
     let mut enc = ctx.device.create_command_encoder(&Default::default());
-    pass.record(
-        &ctx.device,
-        &ctx.queue,
-        &mut enc,
-        &mut timer,
-        "ism",
-        s,
-        &pts,
-        lights,
-        &t,
-    );
+    let b = IsmBuild {
+        name: "ism",
+        settings: s,
+        points: &pts,
+        targets: &t,
+    };
+    pass.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, &b, lights);
     ctx.queue.submit([enc.finish()]);
     assert!(ctx.errors.take().is_empty());
     bytemuck::pod_collect_to_vec(&read_storage_buffer(ctx, &t.depth).unwrap())

@@ -9,8 +9,8 @@ use lightcut::{
         Buffer, FrameInput, Renderer,
         context::GpuContext,
         passes::{
-            display::{DisplayPass, VIEW_FORMAT},
-            visualise::{VisMode, VisSource, VisualisePass},
+            display::{DisplayInputs, DisplayPass, VIEW_FORMAT},
+            visualise::{VisInputs, VisMode, VisSource, VisualisePass},
         },
         readback::read_texture_bytes,
         settings::{RenderSettings, Tonemap, ViewBuffer},
@@ -129,16 +129,13 @@ fn display_pass_matches_reference_within_one_lsb() {
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         let sv = src.create_view(&Default::default());
         let dv = dst.create_view(&Default::default());
-        pass.record(
-            &ctx.device,
-            &ctx.queue,
-            &mut enc,
-            &mut timer,
-            &look,
-            &sv,
-            &dv,
-            (w, h),
-        );
+        let inputs = DisplayInputs {
+            look: &look,
+            src: &sv,
+            dst: &dv,
+            size: (w, h),
+        };
+        pass.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, &inputs);
         ctx.queue.submit([enc.finish()]);
         let got = read_texture_bytes(&ctx, &dst, 0).unwrap();
         let want: Vec<u8> = px
@@ -184,18 +181,15 @@ fn visualise_uint_ids_and_heat_match_reference() {
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         let sv = src.create_view(&Default::default());
         let dv = dst.create_view(&Default::default());
-        pass.record(
-            &ctx.device,
-            &ctx.queue,
-            &mut enc,
-            &mut timer,
+        let v = VisInputs {
             mode,
-            VisSource::Uint(&sv),
-            [0.0; 4],
-            [max, 0.0, 0.0, 0.0],
-            &dv,
-            (w, h),
-        );
+            src: VisSource::Uint(&sv),
+            range_min: [0.0; 4],
+            range_max: [max, 0.0, 0.0, 0.0],
+            dst: &dv,
+            size: (w, h),
+        };
+        pass.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, v);
         ctx.queue.submit([enc.finish()]);
         let got = read_texture_bytes(&ctx, &dst, 0).unwrap();
         let want: Vec<u8> = ids

@@ -147,7 +147,9 @@ use lightcut::{
     reference::sst_tree::{self, SstNode, build_with_leaves, classify},
     renderer::{
         gpu_data::GpuVpl,
-        passes::sst_build::{BuildPass, TreeBuffers, read_flags, read_nodes, read_sorted_vpls},
+        passes::sst_build::{
+            BuildInputs, BuildPass, TreeBuffers, UsableThresholds, read_flags, read_nodes, read_sorted_vpls,
+        },
     },
 };
 use wgpu::util::DeviceExt;
@@ -236,17 +238,13 @@ fn gpu_tree_of(
     let mut enc = ctx.device.create_command_encoder(&Default::default());
     let mut timer = GpuTimer::new(&ctx.device, &ctx.queue);
     sort.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, &buf, &sb);
-    build.record(
-        &ctx.device,
-        &ctx.queue,
-        &mut enc,
-        &mut timer,
-        &buf,
-        &sb,
-        &tb,
-        v_min,
-        sigma_max,
-    );
+    let inputs = BuildInputs {
+        vpls: &buf,
+        sort: &sb,
+        tree: &tb,
+        usable: UsableThresholds { v_min, sigma_max },
+    };
+    build.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, &inputs);
     ctx.queue.submit([enc.finish()]);
     GpuTree {
         nodes: read_nodes(ctx, &tb)
@@ -445,7 +443,11 @@ fn gpu_radix_tree_node_data_equals_the_cpu_twin() {
         let mut timer = GpuTimer::new(&ctx.device, &ctx.queue);
         sort.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, &buf, &sb);
         pass.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, &sb, &lb);
-        pass.record_node_data(&ctx.device, &ctx.queue, &mut enc, &mut timer, &sb, &buf, &lb);
+        let leaves = lightcut::renderer::passes::lbvh::LeafSource {
+            keys: &sb,
+            vpls: &buf,
+        };
+        pass.record_node_data(&ctx.device, &ctx.queue, &mut enc, &mut timer, leaves, &lb);
         ctx.queue.submit([enc.finish()]);
         let pairs = read_pairs(&ctx, &sb).unwrap();
         let keys: Vec<u64> = pairs.iter().take(n).map(|p| p.0).collect();

@@ -23,7 +23,9 @@ use lightcut::renderer::{
     context::GpuContext,
     gpu_data::light_frustum,
     passes::ism::{bvh_area, cloud_of_bvh},
-    passes::val_cluster::{GpuVal, GpuValParams, ValClusterPass, ValSeeds, ValTargets, key_cluster},
+    passes::val_cluster::{
+        ClusterRun, GpuVal, GpuValParams, ValClusterPass, ValSeeds, ValTargets, key_cluster,
+    },
     readback::{read_storage_buffer, read_texture_f32},
     settings::RenderSettings,
     timing::GpuTimer,
@@ -150,20 +152,16 @@ fn gpu_cluster(
     let params = GpuValParams::new(rsm.view_proj, rsm.light_dir, rsm.texel_area.sqrt(), rsm.res, 0, p);
     let mut timer = GpuTimer::new(&ctx.device, &ctx.queue);
     let mut enc = ctx.device.create_command_encoder(&Default::default());
-    pass.record(
-        &ctx.device,
-        &ctx.queue,
-        &mut enc,
-        &mut timer,
-        "val_cluster",
-        [&views[0], &views[1], &views[2]],
+    let run = ClusterRun {
+        name: "val_cluster",
+        rsm: [&views[0], &views[1], &views[2]],
         params,
-        ValSeeds::Cpu(seeds),
+        seeds: ValSeeds::Cpu(seeds),
         iterations,
-        false,
-        &mut t,
-    )
-    .unwrap();
+        carry: false,
+    };
+    pass.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, run, &mut t)
+        .unwrap();
     ctx.queue.submit([enc.finish()]);
     let vals: Vec<GpuVal> = bytemuck::pod_collect_to_vec(&read_storage_buffer(ctx, t.vals()).unwrap());
     let keys: Vec<u32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(ctx, &t.keys).unwrap());
@@ -305,19 +303,15 @@ fn a_mismatched_clustering_is_refused() {
     let mut enc = ctx.device.create_command_encoder(&Default::default());
     let mut run = |res: u32, seeds: &[UVec2]| {
         let p = GpuValParams::new(glam::Mat4::IDENTITY, -Vec3::Y, 0.1, res, 0, &params());
-        pass.record(
-            &ctx.device,
-            &ctx.queue,
-            &mut enc,
-            &mut timer,
-            "val_cluster",
-            [&views[0], &views[1], &views[2]],
-            p,
-            ValSeeds::Cpu(seeds),
-            1,
-            false,
-            &mut t,
-        )
+        let run = ClusterRun {
+            name: "val_cluster",
+            rsm: [&views[0], &views[1], &views[2]],
+            params: p,
+            seeds: ValSeeds::Cpu(seeds),
+            iterations: 1,
+            carry: false,
+        };
+        pass.record(&ctx.device, &ctx.queue, &mut enc, &mut timer, run, &mut t)
     };
     assert!(run(128, &[UVec2::ZERO]).unwrap_err().contains("128"));
     assert!(run(64, &[UVec2::ZERO; 5]).unwrap_err().contains("5 seeds"));

@@ -24,8 +24,8 @@ use crate::{
         gpu_data::{GpuCamera, GpuRay, GpuVpl},
         passes::{
             gbuffer::{COLOR_BYTES_PER_FRAGMENT, DEPTH_BYTES, GbufferPass, OverdrawCounter},
-            lbvh::{LbvhPass, read_topology},
-            sst_build::{BuildPass, TreeBuffers},
+            lbvh::{LbvhPass, LeafSource, read_topology},
+            sst_build::{BuildInputs, BuildPass, TreeBuffers, UsableThresholds},
             sst_sort::{SORT_TILE, SortBuffers, SortPass, SortVariant},
         },
         scene_gpu::{BvhLayout, SceneGpu, set_frame_bvh_layout, upload_bvh, upload_wide_bvh},
@@ -446,19 +446,18 @@ fn run_tree(args: &BenchArgs) -> anyhow::Result<()> {
             // The first repetition includes pipeline warm-up: dropped. Repetitions run back
             // to back (no CPU work between them but the timestamp readback).
             let d = crate::settings::TreeSettings::default();
+            let inputs = BuildInputs {
+                vpls: &buf,
+                sort: &sb,
+                tree: &tb,
+                usable: UsableThresholds {
+                    v_min: d.v_min,
+                    sigma_max: d.sigma_max,
+                },
+            };
             let timed = time_back_to_back(&ctx, &mut timer, args.repeat, |enc, timer| {
                 sort.record(device, &ctx.queue, enc, timer, &buf, &sb);
-                build.record(
-                    device,
-                    &ctx.queue,
-                    enc,
-                    timer,
-                    &buf,
-                    &sb,
-                    &tb,
-                    d.v_min,
-                    d.sigma_max,
-                );
+                build.record(device, &ctx.queue, enc, timer, &inputs);
             })?;
             let samples: [Vec<f64>; 4] = std::array::from_fn(|k| {
                 timed
@@ -522,7 +521,8 @@ fn radix_tree(
     let timed = time_back_to_back(ctx, timer, repeat, |enc, timer| {
         sort.record(device, &ctx.queue, enc, timer, buf, sb);
         lbvh.record(device, &ctx.queue, enc, timer, sb, &lb);
-        lbvh.record_node_data(device, &ctx.queue, enc, timer, sb, buf, &lb);
+        let leaves = LeafSource { keys: sb, vpls: buf };
+        lbvh.record_node_data(device, &ctx.queue, enc, timer, leaves, &lb);
     })?;
     let med = |name: &str| {
         median(timed.iter().map(|t| t.get(name).unwrap_or(f64::NAN)).collect()).unwrap_or(f64::NAN)

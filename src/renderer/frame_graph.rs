@@ -122,15 +122,12 @@ impl Renderer {
             && (diagnostic || !self.compare_settled(input, lights, size));
         self.timer.begin_frame(!diagnostic);
         let t = &self.targets;
-        self.rsm.record(
-            &device,
-            &queue,
-            &mut enc,
-            &mut self.timer,
-            &gpu_lights,
-            &self.scene,
-            &t.shadow,
-        );
+        let rsm = RsmInputs {
+            lights: &gpu_lights,
+            scene: &self.scene,
+            out: &t.shadow,
+        };
+        self.rsm.record(&device, &queue, &mut enc, &mut self.timer, &rsm);
         self.gbuffer.record(
             &device,
             &mut enc,
@@ -184,14 +181,17 @@ impl Renderer {
             // Frozen VPLs and tree (debugging): only the flags follow new thresholds.
             let th = (s.tree.v_min, s.tree.sigma_max);
             if self.freeze != Some(th) {
+                let usable = UsableThresholds {
+                    v_min: th.0,
+                    sigma_max: th.1,
+                };
                 self.sst_build.record_classify(
                     &device,
                     &queue,
                     &mut enc,
                     &mut self.timer,
                     &self.tree,
-                    th.0,
-                    th.1,
+                    usable,
                 );
                 self.freeze = Some(th);
             }
@@ -200,21 +200,20 @@ impl Renderer {
                 self.freeze = Some((s.tree.v_min, s.tree.sigma_max));
             }
             let t = &self.targets;
-            self.vpl_frame = self.vpl_gen.record(
-                &device,
-                &queue,
-                &mut enc,
-                &mut self.timer,
-                &s.vpl,
-                &s.gi,
+            let inputs = passes::vpl_gen::VplGenInputs {
+                settings: &s.vpl,
+                gi: &s.gi,
                 seed,
-                self.scene.bounds.radius().max(1e-30),
+                scene_radius: self.scene.bounds.radius().max(1e-30),
                 lights,
-                &self.camera_buf,
-                &t.shadow,
-                &t.gbuffer,
-                &self.vpl_buffers,
-            );
+                camera: &self.camera_buf,
+                rsm: &t.shadow,
+                gbuffer: &t.gbuffer,
+                out: &self.vpl_buffers,
+            };
+            self.vpl_frame = self
+                .vpl_gen
+                .record(&device, &queue, &mut enc, &mut self.timer, &inputs);
             // Bounces 2..=N (`vpl.bounces`): light paths from RSM texels drawn by flux.
             let vf = &self.vpl_frame;
             if vf.paths > 0 {
@@ -229,19 +228,16 @@ impl Renderer {
                     flux_scale: 1.0,
                     flux_mix: s.vpl.path_flux_mix,
                 };
-                self.light_paths.record(
-                    &device,
-                    &queue,
-                    &mut enc,
-                    &mut self.timer,
-                    &job,
+                let inputs = passes::light_paths::PathInputs {
                     lights,
-                    self.vpl_gen.params_buffer(),
-                    &self.targets.shadow,
-                    &self.vpl_buffers,
-                    &self.scene,
-                    &self.vpl_buffers.vpls,
-                );
+                    vpl_params: self.vpl_gen.params_buffer(),
+                    rsm: &self.targets.shadow,
+                    pyramids: &self.vpl_buffers,
+                    scene: &self.scene,
+                    out: &self.vpl_buffers.vpls,
+                };
+                self.light_paths
+                    .record(&device, &queue, &mut enc, &mut self.timer, &job, &inputs);
             }
             // SST stages 8-9: sort keys and the bitonic sort of (key, index) pairs.
             if self.sort_buffers.count != self.vpl_frame.count {
@@ -260,17 +256,18 @@ impl Renderer {
             if !self.tree.matches(self.vpl_frame.count, tree_kind) {
                 self.tree = TreeBuffers::new(&device, self.vpl_frame.count, tree_kind);
             }
-            self.sst_build.record(
-                &device,
-                &queue,
-                &mut enc,
-                &mut self.timer,
-                &self.vpl_buffers.vpls,
-                &self.sort_buffers,
-                &self.tree,
-                s.tree.v_min,
-                s.tree.sigma_max,
-            );
+            let usable = UsableThresholds {
+                v_min: s.tree.v_min,
+                sigma_max: s.tree.sigma_max,
+            };
+            let build = BuildInputs {
+                vpls: &self.vpl_buffers.vpls,
+                sort: &self.sort_buffers,
+                tree: &self.tree,
+                usable,
+            };
+            self.sst_build
+                .record(&device, &queue, &mut enc, &mut self.timer, &build);
             // The overlay's comparison: the other tree over the same keys, untimed.
             let d = &s.display;
             if d.tree_compare && d.tree_overlay != TreeOverlay::Off {
@@ -283,17 +280,14 @@ impl Renderer {
                     self.tree_other = Some(TreeBuffers::new(&device, count, other));
                 }
                 if let Some(t) = &self.tree_other {
-                    self.sst_build.record(
-                        &device,
-                        &queue,
-                        &mut enc,
-                        &mut self.quiet_timer,
-                        &self.vpl_buffers.vpls,
-                        &self.sort_buffers,
-                        t,
-                        s.tree.v_min,
-                        s.tree.sigma_max,
-                    );
+                    let other = BuildInputs {
+                        vpls: &self.vpl_buffers.vpls,
+                        sort: &self.sort_buffers,
+                        tree: t,
+                        usable,
+                    };
+                    self.sst_build
+                        .record(&device, &queue, &mut enc, &mut self.quiet_timer, &other);
                 }
             } else {
                 self.tree_other = None;
@@ -351,18 +345,16 @@ impl Renderer {
             Some(b) => (b, 1.0),
             None => (&t.lighting.gi_accum, indirect_scale),
         };
-        self.composite.record(
-            &device,
-            &queue,
-            &mut enc,
-            &mut self.timer,
+        let inputs = CompositeInputs {
             size,
-            scale,
-            &t.lighting.direct_view,
+            indirect_scale: scale,
+            direct: &t.lighting.direct_view,
             accum,
-            &t.lighting.indirect_view,
-            &t.lighting.final_view,
-        );
+            out_indirect: &t.lighting.indirect_view,
+            out_final: &t.lighting.final_view,
+        };
+        self.composite
+            .record(&device, &queue, &mut enc, &mut self.timer, &inputs);
         self.record_view_with_overlays(&mut enc, &first, input.camera, vpl_ok);
         queue.submit([enc.finish()]);
         // The other views, each into its own texture.
@@ -446,21 +438,21 @@ impl Renderer {
             && !spec.buffer.is_rsm_space()
             && spec.effective_ab().is_none()
         {
-            self.sst_overlay.record(
-                &device,
-                &queue,
-                enc,
-                &mut self.timer,
-                d.tree_overlay,
-                d.tree_color,
-                d.tree_level,
-                0.003 * self.scene.bounds.radius().max(1e-30),
-                &self.camera_buf,
-                (&self.tree, self.tree_other.as_ref().filter(|_| d.tree_compare)),
-                &self.targets.gbuffer.position_view,
-                &self.targets.view.view,
-                self.targets.view.size,
-            );
+            let look = passes::sst_overlay::OverlayLook {
+                mode: d.tree_overlay,
+                color: d.tree_color,
+                level: d.tree_level,
+                min_radius: 0.003 * self.scene.bounds.radius().max(1e-30),
+            };
+            let inputs = passes::sst_overlay::OverlayInputs {
+                camera: &self.camera_buf,
+                trees: (&self.tree, self.tree_other.as_ref().filter(|_| d.tree_compare)),
+                gb_position: &self.targets.gbuffer.position_view,
+                dst: &self.targets.view.view,
+                size: self.targets.view.size,
+            };
+            self.sst_overlay
+                .record(&device, &queue, enc, &mut self.timer, look, &inputs);
         }
     }
 
@@ -590,18 +582,16 @@ impl Renderer {
         // While it converges, the truth's views show the VPLs so far scaled to all of them.
         let scale = cmp.truth.record(&mut cx, enc);
         cmp.key = key;
-        self.compare_composite.record(
-            &device,
-            &queue,
-            enc,
-            &mut self.quiet_timer,
+        let inputs = CompositeInputs {
             size,
-            scale,
-            &self.targets.lighting.direct_view,
-            &cmp.targets.gi_accum,
-            &cmp.targets.indirect_view,
-            &cmp.targets.final_view,
-        );
+            indirect_scale: scale,
+            direct: &self.targets.lighting.direct_view,
+            accum: &cmp.targets.gi_accum,
+            out_indirect: &cmp.targets.indirect_view,
+            out_final: &cmp.targets.final_view,
+        };
+        self.compare_composite
+            .record(&device, &queue, enc, &mut self.quiet_timer, &inputs);
         self.compare = Some(cmp);
     }
 

@@ -371,15 +371,9 @@ impl Renderer {
             label: Some("sst_classify::encoder"),
         });
         let mut timer = GpuTimer::new(&device, &self.ctx.queue);
-        self.sst_build.record_classify(
-            &device,
-            &self.ctx.queue,
-            &mut enc,
-            &mut timer,
-            &self.tree,
-            v_min,
-            sigma_max,
-        );
+        let usable = UsableThresholds { v_min, sigma_max };
+        self.sst_build
+            .record_classify(&device, &self.ctx.queue, &mut enc, &mut timer, &self.tree, usable);
         self.ctx.queue.submit([enc.finish()]);
     }
 

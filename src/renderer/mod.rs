@@ -39,15 +39,15 @@ use context::{GpuContext, GpuError};
 use frame::{FrameTargets, ShadowTargets, ViewTarget};
 use gpu_data::{GpuCamera, GpuLights, GpuVpl, MAX_LIGHTS};
 use passes::{
-    composite::CompositePass,
+    composite::{CompositeInputs, CompositePass},
     direct::DirectPass,
-    display::DisplayPass,
+    display::{DisplayInputs, DisplayPass},
     gbuffer::GbufferPass,
-    rsm::RsmPass,
-    sst_build::{BuildPass, TreeBuffers},
+    rsm::{RsmInputs, RsmPass},
+    sst_build::{BuildInputs, BuildPass, TreeBuffers, UsableThresholds},
     sst_overlay::SstOverlayPass,
     sst_sort::{SortBuffers, SortPass},
-    visualise::{VisMode, VisSource, VisualisePass},
+    visualise::{VisInputs, VisMode, VisSource, VisualisePass},
     vpl_gen::{VplBuffers, VplFrame, VplGenPass},
     vpl_splat::{GpuSplatParams, VplSplatPass},
 };

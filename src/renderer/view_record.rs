@@ -22,18 +22,15 @@ impl Renderer {
             color_mode: (self.settings.display.vpl_color == settings::VplColor::Bounce) as u32,
             _pad: [0; 3],
         };
-        self.vpl_splat.record(
-            &device,
-            &queue,
-            enc,
-            &mut self.timer,
-            p,
-            &self.camera_buf,
-            &vb.vpls,
-            &vb.flux_pyramid,
-            &self.targets.gbuffer.position_view,
-            &self.targets.view.view,
-        );
+        let inputs = passes::vpl_splat::SplatInputs {
+            camera: &self.camera_buf,
+            vpls: &vb.vpls,
+            flux_pyramid: &vb.flux_pyramid,
+            gb_position: &self.targets.gbuffer.position_view,
+            dst: &self.targets.view.view,
+        };
+        self.vpl_splat
+            .record(&device, &queue, enc, &mut self.timer, p, &inputs);
     }
 
     pub(super) fn record_view(&mut self, enc: &mut wgpu::CommandEncoder, spec: &ViewSpec, camera: &Camera) {
@@ -106,18 +103,15 @@ impl Renderer {
                 diff_scale: ab.diff_scale,
                 _pad: [0; 3],
             };
-            self.compare_views.record(
-                &device,
-                &queue,
-                enc,
-                &mut self.timer,
-                p,
-                a,
-                b,
-                &t.gbuffer.position_view,
+            let inputs = passes::compare::CompareInputs {
+                method_image: a,
+                reference_image: b,
+                gb_position: &t.gbuffer.position_view,
                 dst,
-                want,
-            );
+                size: want,
+            };
+            self.compare_views
+                .record(&device, &queue, enc, &mut self.timer, p, &inputs);
             return;
         }
         if view.is_compare_view() {
@@ -135,8 +129,14 @@ impl Renderer {
             } else {
                 &cmp.targets.indirect_view
             };
+            let inputs = DisplayInputs {
+                look: &look,
+                src,
+                dst,
+                size: want,
+            };
             self.display
-                .record(&device, &queue, enc, &mut self.timer, &look, src, dst, want);
+                .record(&device, &queue, enc, &mut self.timer, &inputs);
             return;
         }
         if let ViewBuffer::Temporal(tv) = view {
@@ -145,19 +145,24 @@ impl Renderer {
                 clear_view(enc, &self.targets.view.view);
                 return;
             }
-            let shown = self.temporal.record_view(
-                &device,
-                &queue,
-                enc,
-                &mut self.timer,
-                tv,
-                &self.targets.gbuffer,
-                &self.camera_buf,
-                &self.targets.view.view,
-            );
+            let inputs = passes::temporal::TemporalViewInputs {
+                view: tv,
+                gbuffer: &self.targets.gbuffer,
+                camera_buf: &self.camera_buf,
+                dst: &self.targets.view.view,
+            };
+            let shown = self
+                .temporal
+                .record_view(&device, &queue, enc, &mut self.timer, &inputs);
             if let Some(src) = shown {
+                let inputs = DisplayInputs {
+                    look: &look,
+                    src,
+                    dst,
+                    size: want,
+                };
                 self.display
-                    .record(&device, &queue, enc, &mut self.timer, &look, src, dst, want);
+                    .record(&device, &queue, enc, &mut self.timer, &inputs);
             }
             return;
         }
@@ -199,8 +204,14 @@ impl Renderer {
                     ViewBuffer::Direct => &t.lighting.direct_view,
                     _ => &t.lighting.indirect_view,
                 };
+                let inputs = DisplayInputs {
+                    look: &look,
+                    src,
+                    dst,
+                    size: want,
+                };
                 self.display
-                    .record(&device, &queue, enc, &mut self.timer, &look, src, dst, want);
+                    .record(&device, &queue, enc, &mut self.timer, &inputs);
                 return;
             }
             ViewBuffer::RsmFlux => {
@@ -303,18 +314,15 @@ impl Renderer {
                 [1.0; 4],
             ),
         };
-        self.visualise.record(
-            &device,
-            &queue,
-            enc,
-            &mut self.timer,
+        let v = VisInputs {
             mode,
             src,
-            lo,
-            hi,
+            range_min: lo,
+            range_max: hi,
             dst,
-            want,
-        );
+            size: want,
+        };
+        self.visualise.record(&device, &queue, enc, &mut self.timer, v);
     }
 
     /// The `Rgba8Unorm` texture holding the last rendered view, and its generation (bumped

@@ -25,6 +25,17 @@ pub struct GpuCmpParams {
     pub _pad: [u32; 3],
 }
 
+/// What one comparison dispatch reads and writes: the method's and the reference's images,
+/// the G-buffer's positions, and the view texture `dst` of `size`.
+#[derive(Clone, Copy)]
+pub struct CompareInputs<'a> {
+    pub method_image: &'a wgpu::TextureView,
+    pub reference_image: &'a wgpu::TextureView,
+    pub gb_position: &'a wgpu::TextureView,
+    pub dst: &'a wgpu::TextureView,
+    pub size: (u32, u32),
+}
+
 pub struct CompareViewsPass {
     kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
@@ -41,7 +52,6 @@ impl CompareViewsPass {
         })
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         device: &wgpu::Device,
@@ -49,12 +59,15 @@ impl CompareViewsPass {
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
         p: GpuCmpParams,
-        method_image: &wgpu::TextureView,
-        reference_image: &wgpu::TextureView,
-        gb_position: &wgpu::TextureView,
-        dst: &wgpu::TextureView,
-        size: (u32, u32),
+        i: &CompareInputs<'_>,
     ) {
+        let CompareInputs {
+            method_image,
+            reference_image,
+            gb_position,
+            dst,
+            size,
+        } = *i;
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         let bind = self.kernel.bind(
             device,

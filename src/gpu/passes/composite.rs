@@ -19,6 +19,18 @@ pub struct GpuCompositeParams {
     pub _pad: u32,
 }
 
+/// What the composite reads and writes: the direct image and the GI accumulation (times
+/// `indirect_scale`) in, the indirect and final images out, all of `size`.
+#[derive(Clone, Copy)]
+pub struct CompositeInputs<'a> {
+    pub size: (u32, u32),
+    pub indirect_scale: f32,
+    pub direct: &'a wgpu::TextureView,
+    pub accum: &'a wgpu::Buffer,
+    pub out_indirect: &'a wgpu::TextureView,
+    pub out_final: &'a wgpu::TextureView,
+}
+
 pub struct CompositePass {
     kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
@@ -37,20 +49,22 @@ impl CompositePass {
         })
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        size: (u32, u32),
-        indirect_scale: f32,
-        direct: &wgpu::TextureView,
-        accum: &wgpu::Buffer,
-        out_indirect: &wgpu::TextureView,
-        out_final: &wgpu::TextureView,
+        c: &CompositeInputs<'_>,
     ) {
+        let CompositeInputs {
+            size,
+            indirect_scale,
+            direct,
+            accum,
+            out_indirect,
+            out_final,
+        } = *c;
         let p = GpuCompositeParams {
             width: size.0,
             height: size.1,

@@ -11,6 +11,16 @@ use super::{groups_image, run_compute, uniform_buffer};
 
 pub const VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
+/// What one display dispatch reads and writes: the linear-radiance `src` shown with `look`
+/// into the view texture `dst` of `size`.
+#[derive(Clone, Copy)]
+pub struct DisplayInputs<'a> {
+    pub look: &'a ViewLook,
+    pub src: &'a wgpu::TextureView,
+    pub dst: &'a wgpu::TextureView,
+    pub size: (u32, u32),
+}
+
 pub struct DisplayPass {
     kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
@@ -29,18 +39,15 @@ impl DisplayPass {
         })
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        look: &ViewLook,
-        src: &wgpu::TextureView,
-        dst: &wgpu::TextureView,
-        size: (u32, u32),
+        i: &DisplayInputs<'_>,
     ) {
+        let DisplayInputs { look, src, dst, size } = *i;
         let p = DisplayParams::new(look);
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         let bind = self.kernel.bind(

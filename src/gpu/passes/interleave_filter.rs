@@ -86,6 +86,14 @@ pub struct FilterInputs<'a> {
     pub accum: &'a wgpu::Buffer,
 }
 
+/// One filter dispatch: its timer name (the method's: the filter is part of its GI cost) and
+/// its parameters with the uniform they are written to.
+pub struct FilterDispatch<'a> {
+    pub name: &'static str,
+    pub uniform: &'a FilterUniform,
+    pub params: GpuFilterParams,
+}
+
 pub struct InterleaveFilter {
     kernel: Kernel,
     pipeline: wgpu::ComputePipeline,
@@ -106,20 +114,21 @@ impl InterleaveFilter {
         })
     }
 
-    /// Records the filter under the timer name `name` (the method's: it is part of its GI
-    /// cost).
-    #[allow(clippy::too_many_arguments)]
+    /// Records the filter as dispatch `d` says (its timer name, parameters and uniform).
     pub fn record(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        name: &'static str,
-        uniform: &FilterUniform,
-        p: GpuFilterParams,
+        d: FilterDispatch<'_>,
         f: &FilterInputs<'_>,
     ) {
+        let FilterDispatch {
+            name,
+            uniform,
+            params: p,
+        } = d;
         queue.write_buffer(&uniform.0, 0, bytemuck::bytes_of(&p));
         let bind = self.kernel.bind(
             device,

@@ -231,6 +231,27 @@ impl IsmTargets {
     }
 }
 
+/// One build of the maps: its timer name, the settings, the point cloud and the targets it
+/// fills.
+pub struct IsmBuild<'a, D: IsmDefault> {
+    pub name: &'a str,
+    pub settings: &'a IsmSettings<D>,
+    pub points: &'a IsmPoints,
+    pub targets: &'a IsmTargets,
+}
+
+/// A view of the maps: the first `maps` maps, distances on a log scale `range` (lo, hi
+/// metres), drawn into `dst` of `size`, their linear data into `data` (vec4 per view pixel;
+/// at least `dst`'s size).
+#[derive(Clone, Copy)]
+pub struct IsmView<'a> {
+    pub maps: u32,
+    pub range: (f32, f32),
+    pub size: (u32, u32),
+    pub dst: &'a wgpu::TextureView,
+    pub data: &'a wgpu::Buffer,
+}
+
 pub struct IsmPass {
     kernel: Kernel,
     splat: wgpu::ComputePipeline,
@@ -266,22 +287,19 @@ impl IsmPass {
         })
     }
 
-    /// Builds the maps of `lights` (at most the atlas's capacity) from `points` (shared out as
-    /// `s.points_per_light` says), timed as `name`: uploads the lights, then
+    /// Builds the maps of `lights` (at most the atlas's capacity) from `b.points` (shared out
+    /// as `b.settings.points_per_light` says), timed as `b.name`: uploads the lights, then
     /// [`Self::record_maps`].
-    #[allow(clippy::too_many_arguments)]
     pub fn record<D: IsmDefault>(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        name: &str,
-        s: &IsmSettings<D>,
-        points: &IsmPoints,
+        b: &IsmBuild<'_, D>,
         lights: &[IsmLight],
-        t: &IsmTargets,
     ) {
+        let t = b.targets;
         let n = (lights.len() as u32).min(t.capacity);
         let data: Vec<[f32; 4]> = lights[..n as usize]
             .iter()
@@ -293,25 +311,27 @@ impl IsmPass {
         if !data.is_empty() {
             queue.write_buffer(&t.lights, 0, bytemuck::cast_slice(&data));
         }
-        self.record_maps(device, queue, encoder, timer, name, s, points, n, t);
+        self.record_maps(device, queue, encoder, timer, b, n);
     }
 
-    /// Builds the maps of the first `n` lights of `t.lights` (written by the caller: per
-    /// light (position, squared range), (normal, 0)), timed as `name`: clear, splat, resolve,
-    /// pull-push over `t`'s levels.
-    #[allow(clippy::too_many_arguments)]
+    /// Builds the maps of the first `n` lights of `b.targets.lights` (written by the caller:
+    /// per light (position, squared range), (normal, 0)), timed as `b.name`: clear, splat,
+    /// resolve, pull-push over the targets' levels.
     pub fn record_maps<D: IsmDefault>(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        name: &str,
-        s: &IsmSettings<D>,
-        points: &IsmPoints,
+        b: &IsmBuild<'_, D>,
         n: u32,
-        t: &IsmTargets,
     ) {
+        let IsmBuild {
+            name,
+            settings: s,
+            points,
+            targets: t,
+        } = *b;
         let n = n.min(t.capacity);
         let base = GpuIsmParams {
             point_radius: s.point_radius(points.area, s.points_per_map(points.count, n)),
@@ -388,10 +408,7 @@ impl IsmPass {
         encoder.pop_debug_group();
     }
 
-    /// Draws `t`'s first `maps` maps into `dst` (`ism_view.wgsl`: a grid shaped like the view,
-    /// fitted, distances on a log scale lo .. hi metres) and its linear data into `data`
-    /// (vec4 per view pixel; at least `dst`'s size).
-    #[allow(clippy::too_many_arguments)]
+    /// Draws view `v` of `t`'s maps (`ism_view.wgsl`: a grid shaped like the view, fitted).
     pub fn record_view(
         &self,
         device: &wgpu::Device,
@@ -399,12 +416,15 @@ impl IsmPass {
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
         t: &IsmTargets,
-        maps: u32,
-        (lo, hi): (f32, f32),
-        size: (u32, u32),
-        dst: &wgpu::TextureView,
-        data: &wgpu::Buffer,
+        v: &IsmView<'_>,
     ) {
+        let IsmView {
+            maps,
+            range: (lo, hi),
+            size,
+            dst,
+            data,
+        } = *v;
         let l = t.layout;
         let maps = maps.min(t.capacity).max(1);
         let (w, h) = (size.0.max(1) as f32, size.1.max(1) as f32);

@@ -73,6 +73,13 @@ pub fn read_parents(ctx: &GpuContext, tree: &TreeBuffers) -> Result<Vec<u32>, Gp
         .collect())
 }
 
+/// Where the radix tree's leaves come from: the sorted keys and the VPL buffer they index.
+#[derive(Clone, Copy)]
+pub struct LeafSource<'a> {
+    pub keys: &'a SortBuffers,
+    pub vpls: &'a wgpu::Buffer,
+}
+
 pub struct LbvhPass {
     pipeline: wgpu::ComputePipeline,
     kernel: Kernel,
@@ -145,19 +152,18 @@ impl LbvhPass {
         );
     }
 
-    /// Records the node data of the tree `record` built over `keys`, the leaves from `vpls`
-    /// (the buffer the keys index).
-    #[allow(clippy::too_many_arguments)]
+    /// Records the node data of the tree `record` built over `leaves.keys`, the leaves from
+    /// `leaves.vpls` (the buffer the keys index).
     pub fn record_node_data(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        keys: &SortBuffers,
-        vpls: &wgpu::Buffer,
+        leaves: LeafSource<'_>,
         out: &TreeBuffers,
     ) {
+        let LeafSource { keys, vpls } = leaves;
         let p = self.write_params(queue, keys, out);
         encoder.clear_buffer(&out.counters, 0, None);
         let bind = self.node_kernel.bind(

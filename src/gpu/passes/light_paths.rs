@@ -58,6 +58,19 @@ pub struct GpuPathParams {
     pub ranges: [[u32; 4]; 4],
 }
 
+/// What the paths start from, trace through and write: the lights, the VPL stage's
+/// parameters, RSM and pyramids (the starts are drawn from them), the scene, and the VPL
+/// buffer `out`.
+#[derive(Clone, Copy)]
+pub struct PathInputs<'a> {
+    pub lights: &'a [DirectionalLight],
+    pub vpl_params: &'a wgpu::Buffer,
+    pub rsm: &'a ShadowTargets,
+    pub pyramids: &'a VplBuffers,
+    pub scene: &'a SceneGpu,
+    pub out: &'a wgpu::Buffer,
+}
+
 /// One dispatch's paths: where they go and how they run.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathJob {
@@ -174,9 +187,8 @@ impl LightPathPass {
         )
     }
 
-    /// Records the starts and the paths of `job` into `out` (timer names `light_path_starts`,
-    /// `light_paths`).
-    #[allow(clippy::too_many_arguments)]
+    /// Records the starts and the paths of `job` into `i.out` (timer names
+    /// `light_path_starts`, `light_paths`).
     pub fn record(
         &mut self,
         device: &wgpu::Device,
@@ -184,13 +196,16 @@ impl LightPathPass {
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
         job: &PathJob,
-        lights: &[DirectionalLight],
-        vpl_params: &wgpu::Buffer,
-        rsm: &ShadowTargets,
-        pyramids: &VplBuffers,
-        scene: &SceneGpu,
-        out: &wgpu::Buffer,
+        i: &PathInputs<'_>,
     ) {
+        let PathInputs {
+            lights,
+            vpl_params,
+            rsm,
+            pyramids,
+            scene,
+            out,
+        } = *i;
         if job.paths == 0 || job.bounces < 2 || lights.is_empty() {
             return;
         }

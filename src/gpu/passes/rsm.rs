@@ -25,6 +25,15 @@ pub struct GpuRsmLight {
     pub irradiance: [f32; 4],
 }
 
+/// What the RSM pass renders: the frame's lights (one layer each), the scene, and the
+/// shadow targets it draws into.
+#[derive(Clone, Copy)]
+pub struct RsmInputs<'a> {
+    pub lights: &'a GpuLights,
+    pub scene: &'a SceneGpu,
+    pub out: &'a ShadowTargets,
+}
+
 pub struct RsmPass {
     pipeline: wgpu::RenderPipeline,
     kernel: Kernel,
@@ -92,18 +101,16 @@ impl RsmPass {
         })
     }
 
-    /// Renders one layer per light of `lights` (its first `count` entries).
-    #[allow(clippy::too_many_arguments)]
+    /// Renders one layer per light of `r.lights` (its first `count` entries).
     pub fn record(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        lights: &GpuLights,
-        scene: &SceneGpu,
-        out: &ShadowTargets,
+        r: &RsmInputs<'_>,
     ) {
+        let RsmInputs { lights, scene, out } = *r;
         let count = (lights.count[0] as usize).min(MAX_LIGHTS);
         for (i, l) in lights.lights.iter().take(count).enumerate() {
             let texel = l.shadow[0];

@@ -131,6 +131,24 @@ impl TreeBuffers {
     }
 }
 
+/// The classify pass's thresholds (`tree.v_min`, `tree.sigma_max`): a node is usable where
+/// v >= v_min and sigma_z < sigma_max.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UsableThresholds {
+    pub v_min: f32,
+    pub sigma_max: f32,
+}
+
+/// What a build reads and writes: the VPLs and their sorted keys in, the tree out, with the
+/// thresholds of its usable flags.
+#[derive(Clone, Copy)]
+pub struct BuildInputs<'a> {
+    pub vpls: &'a wgpu::Buffer,
+    pub sort: &'a SortBuffers,
+    pub tree: &'a TreeBuffers,
+    pub usable: UsableThresholds,
+}
+
 pub struct BuildPass {
     lbvh: LbvhPass,
     build: wgpu::ComputePipeline,
@@ -162,24 +180,26 @@ impl BuildPass {
     /// Records the build of `tree`'s kind over `sort`'s first `tree.count` sorted pairs
     /// (the perfect tree: `sst_build`; the radix tree: `lbvh_build` + `lbvh_nodes`), then the
     /// flags.
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        vpls: &wgpu::Buffer,
-        sort: &SortBuffers,
-        tree: &TreeBuffers,
-        v_min: f32,
-        sigma_max: f32,
+        b: &BuildInputs<'_>,
     ) {
+        let BuildInputs {
+            vpls,
+            sort,
+            tree,
+            usable,
+        } = *b;
         if tree.kind == TreeKind::Lbvh {
             self.lbvh.record(device, queue, encoder, timer, sort, tree);
+            let leaves = super::lbvh::LeafSource { keys: sort, vpls };
             self.lbvh
-                .record_node_data(device, queue, encoder, timer, sort, vpls, tree);
-            self.record_classify(device, queue, encoder, timer, tree, v_min, sigma_max);
+                .record_node_data(device, queue, encoder, timer, leaves, tree);
+            self.record_classify(device, queue, encoder, timer, tree, usable);
             return;
         }
         let p = GpuTreeParams {
@@ -209,11 +229,10 @@ impl BuildPass {
             &bind,
             ((tree.leaves / 2).div_ceil(WG_1D), 1, 1),
         );
-        self.record_classify(device, queue, encoder, timer, tree, v_min, sigma_max);
+        self.record_classify(device, queue, encoder, timer, tree, usable);
     }
 
     /// Recomputes only the usable flags (v >= v_min and sigma_z < sigma_max).
-    #[allow(clippy::too_many_arguments)]
     pub fn record_classify(
         &self,
         device: &wgpu::Device,
@@ -221,9 +240,9 @@ impl BuildPass {
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
         tree: &TreeBuffers,
-        v_min: f32,
-        sigma_max: f32,
+        usable: UsableThresholds,
     ) {
+        let UsableThresholds { v_min, sigma_max } = usable;
         let nodes = 2 * tree.leaves;
         let p = GpuClassifyParams {
             nodes,

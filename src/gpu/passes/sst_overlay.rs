@@ -26,6 +26,27 @@ pub struct GpuOverlayParams {
     pub _pad: [u32; 3],
 }
 
+/// How the overlay draws: `mode` (distributions or boxes), the colouring, the tree level
+/// (clamped to the leaves) and the smallest drawn semi-axis `min_radius` (metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OverlayLook {
+    pub mode: TreeOverlay,
+    pub color: TreeColor,
+    pub level: u32,
+    pub min_radius: f32,
+}
+
+/// What the overlay draws and over what: the camera, the frame's tree with, optionally, the
+/// other kind of tree over the same VPLs, the G-buffer's positions, and `dst` of `size`.
+#[derive(Clone, Copy)]
+pub struct OverlayInputs<'a> {
+    pub camera: &'a wgpu::Buffer,
+    pub trees: (&'a TreeBuffers, Option<&'a TreeBuffers>),
+    pub gb_position: &'a wgpu::TextureView,
+    pub dst: &'a wgpu::TextureView,
+    pub size: (u32, u32),
+}
+
 pub struct SstOverlayPass {
     ellipses: wgpu::RenderPipeline,
     boxes: wgpu::RenderPipeline,
@@ -91,27 +112,31 @@ impl SstOverlayPass {
         })
     }
 
-    /// Draws level `level` (clamped to the leaves) of `tree` over `dst`. `min_radius`
-    /// (metres) is the smallest drawn semi-axis. With `other` (the other kind of tree over the
-    /// same VPLs), the two side by side: the perfect tree in the left half of `dst`, the
-    /// radix tree in the right half (`size`: dst's).
-    #[allow(clippy::too_many_arguments)]
+    /// Draws level `look.level` (clamped to the leaves) of the tree over `dst`. With the
+    /// other tree (`trees.1`), the two side by side: the perfect tree in the left half of
+    /// `dst`, the radix tree in the right half (`size`: dst's).
     pub fn record(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        mode: TreeOverlay,
-        color: TreeColor,
-        level: u32,
-        min_radius: f32,
-        camera: &wgpu::Buffer,
-        trees: (&TreeBuffers, Option<&TreeBuffers>),
-        gb_position: &wgpu::TextureView,
-        dst: &wgpu::TextureView,
-        size: (u32, u32),
+        look: OverlayLook,
+        i: &OverlayInputs<'_>,
     ) {
+        let OverlayLook {
+            mode,
+            color,
+            level,
+            min_radius,
+        } = look;
+        let OverlayInputs {
+            camera,
+            trees,
+            gb_position,
+            dst,
+            size,
+        } = *i;
         let (pipeline, verts) = match mode {
             TreeOverlay::Off => return,
             TreeOverlay::Distributions => (&self.ellipses, 6),

@@ -212,6 +212,25 @@ pub struct TemporalInputs<'a> {
     pub key: u64,
 }
 
+/// What a view of the stage reads and draws into: the view, this frame's G-buffer and camera,
+/// and the view texture `dst`.
+#[derive(Clone, Copy)]
+pub struct TemporalViewInputs<'a> {
+    pub view: TemporalView,
+    pub gbuffer: &'a GbufferTargets,
+    pub camera_buf: &'a wgpu::Buffer,
+    pub dst: &'a wgpu::TextureView,
+}
+
+/// The bindings an entry point adds to the stage's shared table: the filter's `src` and `dst`
+/// buffers and the view texture it writes.
+#[derive(Clone, Copy, Default)]
+struct OwnBindings<'a> {
+    src: Option<&'a wgpu::Buffer>,
+    dst: Option<&'a wgpu::Buffer>,
+    view_out: Option<&'a wgpu::TextureView>,
+}
+
 /// What the last frame of the stage did (its views and the tests read this).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TemporalFrame {
@@ -336,17 +355,15 @@ impl TemporalPass {
         self.frame.filter(|_| self.ran_last)
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn bind(
         &self,
         device: &wgpu::Device,
         pipe: &Pipe,
         i: &TemporalInputs<'_>,
         parity: usize,
-        src: Option<&wgpu::Buffer>,
-        dst: Option<&wgpu::Buffer>,
-        view_out: Option<&wgpu::TextureView>,
+        own: OwnBindings<'_>,
     ) -> Option<wgpu::BindGroup> {
+        let OwnBindings { src, dst, view_out } = own;
         let b = self.buffers.as_ref()?;
         let prev = 1 - parity;
         let g = i.gbuffer;
@@ -448,14 +465,15 @@ impl TemporalPass {
             }
             enc.pop_debug_group();
         };
-        let reproject = self.bind(device, &self.reproject, i, parity, None, None, None)?;
+        let none = OwnBindings::default();
+        let reproject = self.bind(device, &self.reproject, i, parity, none)?;
         dispatch(
             enc,
             timer,
             "temporal_reproject",
             &[(&self.reproject, &reproject, SLOT_REPROJECT)],
         );
-        let accumulate = self.bind(device, &self.accumulate, i, parity, None, None, None)?;
+        let accumulate = self.bind(device, &self.accumulate, i, parity, none)?;
         dispatch(
             enc,
             timer,
@@ -463,15 +481,11 @@ impl TemporalPass {
             &[(&self.accumulate, &accumulate, SLOT_ACCUMULATE)],
         );
         let result = if svgf {
-            let variance = self.bind(
-                device,
-                &self.variance,
-                i,
-                parity,
-                None,
-                Some(&b.filter_input),
-                None,
-            )?;
+            let own = OwnBindings {
+                dst: Some(&b.filter_input),
+                ..none
+            };
+            let variance = self.bind(device, &self.variance, i, parity, own)?;
             dispatch(
                 enc,
                 timer,
@@ -495,7 +509,12 @@ impl TemporalPass {
                 p.iteration = it;
                 write(SLOT_ATROUS + it - 1, p);
                 for &pipe in pipes {
-                    let bind = self.bind(device, pipe, i, parity, Some(src), Some(dst), None)?;
+                    let own = OwnBindings {
+                        src: Some(src),
+                        dst: Some(dst),
+                        ..none
+                    };
+                    let bind = self.bind(device, pipe, i, parity, own)?;
                     binds.push((pipe, bind, SLOT_ATROUS + it - 1));
                 }
                 src = dst;
@@ -506,7 +525,11 @@ impl TemporalPass {
         } else {
             &b.integrated
         };
-        let modulate = self.bind(device, &self.modulate, i, parity, Some(result), None, None)?;
+        let own = OwnBindings {
+            src: Some(result),
+            ..none
+        };
+        let modulate = self.bind(device, &self.modulate, i, parity, own)?;
         dispatch(
             enc,
             timer,
@@ -539,20 +562,22 @@ impl TemporalPass {
             }
     }
 
-    /// Draws `view` of the last frame: a radiance view into its texture (returned, for the
-    /// display pass to draw with the view's look), a diagnostic view straight into `dst`.
-    #[allow(clippy::too_many_arguments)]
+    /// Draws `v.view` of the last frame: a radiance view into its texture (returned, for the
+    /// display pass to draw with the view's look), a diagnostic view straight into `v.dst`.
     pub fn record_view(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         enc: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        view: TemporalView,
-        gbuffer: &GbufferTargets,
-        camera_buf: &wgpu::Buffer,
-        dst: &wgpu::TextureView,
+        v: &TemporalViewInputs<'_>,
     ) -> Option<&wgpu::TextureView> {
+        let TemporalViewInputs {
+            view,
+            gbuffer,
+            camera_buf,
+            dst,
+        } = *v;
         let (Some(f), Some(b)) = (self.last_frame(), self.buffers.as_ref()) else {
             return None;
         };
@@ -594,7 +619,12 @@ impl TemporalPass {
         } else {
             &self.view_heat
         };
-        let bind = self.bind(device, pipe, &i, f.parity, Some(src), None, Some(dst))?;
+        let own = OwnBindings {
+            src: Some(src),
+            dst: None,
+            view_out: Some(dst),
+        };
+        let bind = self.bind(device, pipe, &i, f.parity, own)?;
         let groups = groups_image(b.size.0, b.size.1);
         enc.push_debug_group("temporal_view");
         {

@@ -151,6 +151,18 @@ impl ValTargets {
     }
 }
 
+/// One clustering run: its timer name, the RSM's position, normal and flux array views, the
+/// parameters, the seeds, the steps and whether it carries the last run's clusters over.
+#[derive(Clone, Copy)]
+pub struct ClusterRun<'a> {
+    pub name: &'a str,
+    pub rsm: [&'a wgpu::TextureView; 3],
+    pub params: GpuValParams,
+    pub seeds: ValSeeds<'a>,
+    pub iterations: u32,
+    pub carry: bool,
+}
+
 /// Where a clustering run's seeds come from.
 #[derive(Clone, Copy, Debug)]
 pub enum ValSeeds<'a> {
@@ -212,7 +224,7 @@ impl ValClusterPass {
         })
     }
 
-    /// Clusters seeded at `seeds` (one per cluster, at most the targets' clusters; a seed on a
+    /// Runs `run`: clusters seeded at `seeds` (one per cluster, at most the targets' clusters; a seed on a
     /// texel without flux gives a cluster of no flux that may still take texels), or with `carry` the clusters the
     /// last run left in `t` (their empty ones re-seeded first; the first run seeds), then
     /// `iterations` steps, in one compute pass timed as `name`: a cluster left empty by a step
@@ -220,21 +232,23 @@ impl ValClusterPass {
     /// the position, normal and flux array views. The parameters and seeds live in the pass
     /// and the targets: one `record` per submission. Refused (nothing recorded) when the
     /// targets were made for another resolution or fewer clusters, or without seeds.
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        name: &str,
-        rsm: [&wgpu::TextureView; 3],
-        p: GpuValParams,
-        seeds: ValSeeds<'_>,
-        iterations: u32,
-        carry: bool,
+        run: ClusterRun<'_>,
         t: &mut ValTargets,
     ) -> Result<(), String> {
+        let ClusterRun {
+            name,
+            rsm,
+            params: p,
+            seeds,
+            iterations,
+            carry,
+        } = run;
         if p.res != t.res {
             return Err(format!(
                 "VAL clustering: a {0}^2 RSM in targets made for {1}^2",

@@ -25,6 +25,17 @@ pub enum VisMode {
     ArrayPosition = 11,
 }
 
+/// One visualisation: `src` drawn in `mode` into `dst` (of `size`). `range_min`/`range_max`
+/// depend on the mode (see `shaders/visualise.wgsl`).
+pub struct VisInputs<'a> {
+    pub mode: VisMode,
+    pub src: VisSource<'a>,
+    pub range_min: [f32; 4],
+    pub range_max: [f32; 4],
+    pub dst: &'a wgpu::TextureView,
+    pub size: (u32, u32),
+}
+
 /// What to visualise.
 pub enum VisSource<'a> {
     /// A float buffer with mode Normal/Albedo/Position/Depth/IdFromW.
@@ -72,22 +83,23 @@ impl VisualisePass {
         })
     }
 
-    /// Records the visualisation of `src` into `dst` (of `size`). `range_min`/`range_max`
-    /// depend on the mode (see `shaders/visualise.wgsl`).
-    #[allow(clippy::too_many_arguments)]
+    /// Records the visualisation `v` (its `src` into its `dst`).
     pub fn record(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        mode: VisMode,
-        src: VisSource<'_>,
-        range_min: [f32; 4],
-        range_max: [f32; 4],
-        dst: &wgpu::TextureView,
-        size: (u32, u32),
+        v: VisInputs<'_>,
     ) {
+        let VisInputs {
+            mode,
+            src,
+            range_min,
+            range_max,
+            dst,
+            size,
+        } = v;
         let layer = match src {
             VisSource::Depth(_, l) | VisSource::Array(_, l) => l,
             _ => 0,

@@ -132,6 +132,22 @@ impl VplBuffers {
     }
 }
 
+/// What the VPL stage reads and writes: its settings (`vpl`, `gi`), the frame's seed, the
+/// scene's bounding radius (metres, > 0), the lights (at most MAX_LIGHTS, one RSM layer
+/// each), the camera, the RSM and G-buffer targets, and the VPL buffers it fills.
+#[derive(Clone, Copy)]
+pub struct VplGenInputs<'a> {
+    pub settings: &'a VplSettings,
+    pub gi: &'a GiSettings,
+    pub seed: u32,
+    pub scene_radius: f32,
+    pub lights: &'a [DirectionalLight],
+    pub camera: &'a wgpu::Buffer,
+    pub rsm: &'a ShadowTargets,
+    pub gbuffer: &'a GbufferTargets,
+    pub out: &'a VplBuffers,
+}
+
 /// What one VPL frame produced.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct VplFrame {
@@ -199,24 +215,26 @@ impl VplGenPass {
         &self.params
     }
 
-    /// Records the whole VPL stage for `lights` (at most MAX_LIGHTS, one RSM layer each).
-    #[allow(clippy::too_many_arguments)]
+    /// Records the whole VPL stage for `v.lights` (at most MAX_LIGHTS, one RSM layer each).
     pub fn record(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        settings: &VplSettings,
-        gi: &GiSettings,
-        seed: u32,
-        scene_radius: f32,
-        lights: &[DirectionalLight],
-        camera: &wgpu::Buffer,
-        rsm: &ShadowTargets,
-        gbuffer: &GbufferTargets,
-        out: &VplBuffers,
+        v: &VplGenInputs<'_>,
     ) -> VplFrame {
+        let VplGenInputs {
+            settings,
+            gi,
+            seed,
+            scene_radius,
+            lights,
+            camera,
+            rsm,
+            gbuffer,
+            out,
+        } = *v;
         let lights = &lights[..lights.len().min(MAX_LIGHTS)];
         let count = settings.count.min(out.capacity);
         let (first_bounce, paths) = super::light_paths::split_bounces(count, settings.bounces.max(1));

@@ -27,6 +27,17 @@ pub struct GpuSplatParams {
     pub _pad: [u32; 3],
 }
 
+/// What the splat reads and draws into: the camera, the VPLs and their flux pyramid, the
+/// G-buffer's positions and the view texture `dst`.
+#[derive(Clone, Copy)]
+pub struct SplatInputs<'a> {
+    pub camera: &'a wgpu::Buffer,
+    pub vpls: &'a wgpu::Buffer,
+    pub flux_pyramid: &'a wgpu::Buffer,
+    pub gb_position: &'a wgpu::TextureView,
+    pub dst: &'a wgpu::TextureView,
+}
+
 pub struct VplSplatPass {
     pipeline: wgpu::ComputePipeline,
     kernel: Kernel,
@@ -45,7 +56,6 @@ impl VplSplatPass {
         })
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         device: &wgpu::Device,
@@ -53,12 +63,15 @@ impl VplSplatPass {
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
         p: GpuSplatParams,
-        camera: &wgpu::Buffer,
-        vpls: &wgpu::Buffer,
-        flux_pyramid: &wgpu::Buffer,
-        gb_position: &wgpu::TextureView,
-        dst: &wgpu::TextureView,
+        i: &SplatInputs<'_>,
     ) {
+        let SplatInputs {
+            camera,
+            vpls,
+            flux_pyramid,
+            gb_position,
+            dst,
+        } = *i;
         if p.count == 0 {
             return;
         }

@@ -131,18 +131,16 @@ impl Method for LightCulling {
             }
             if let (Some(t), Some((_, data))) = (self.ism_targets.as_ref(), self.ism_view_data.as_ref()) {
                 let r = self.scene_radius;
-                self.pass.ism.record_view(
-                    cx.device,
-                    cx.queue,
-                    enc,
-                    cx.timer,
-                    t,
-                    self.ism_maps,
-                    (0.005 * r, 2.0 * r),
+                let v = crate::gpu::passes::ism::IsmView {
+                    maps: self.ism_maps,
+                    range: (0.005 * r, 2.0 * r),
                     size,
-                    cx.dst,
+                    dst: cx.dst,
                     data,
-                );
+                };
+                self.pass
+                    .ism
+                    .record_view(cx.device, cx.queue, enc, cx.timer, t, &v);
             }
             return;
         }

@@ -16,8 +16,8 @@ use crate::gpu::frame::GbufferTargets;
 use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
 use crate::gpu::passes::{
     WG_1D, groups_image,
-    interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
-    ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
+    interleave_filter::{FilterDispatch, FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
+    ism::{GpuIsmParams, IsmBuild, IsmPass, IsmPoints, IsmTargets},
     run_compute, storage_buffer, uniform_buffer,
 };
 use crate::gpu::readback::CounterReadback;

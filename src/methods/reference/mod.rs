@@ -13,7 +13,7 @@ use super::{FrameCx, Kind, Method, MethodId, MethodInfo, Module, Resource};
 use crate::base::field::Field;
 use crate::base::progress::GiProgress;
 use crate::gpu::gpu_data::GpuVpl;
-use crate::gpu::passes::light_paths::{LightPathPass, PathJob};
+use crate::gpu::passes::light_paths::{LightPathPass, PathInputs, PathJob};
 use crate::gpu::shaders::ShaderError;
 use crate::methods::ground_truth::pass::GpuGtParams;
 use crate::methods::ground_truth::pass::{GroundTruthPass, MAX_BATCHES};
@@ -219,19 +219,16 @@ impl Method for Reference {
                         flux_scale: n as f32,
                         flux_mix: g.reference_flux_mix,
                     };
-                    self.paths.record(
-                        cx.device,
-                        cx.queue,
-                        enc,
-                        cx.timer,
-                        &job,
-                        cx.lights,
-                        cx.vpl_params,
-                        &cx.targets.shadow,
-                        cx.vpl_buffers,
-                        cx.scene,
-                        vpls,
-                    );
+                    let inputs = PathInputs {
+                        lights: cx.lights,
+                        vpl_params: cx.vpl_params,
+                        rsm: &cx.targets.shadow,
+                        pyramids: cx.vpl_buffers,
+                        scene: cx.scene,
+                        out: vpls,
+                    };
+                    self.paths
+                        .record(cx.device, cx.queue, enc, cx.timer, &job, &inputs);
                     let base = GpuGtParams {
                         begin: 0,
                         end: count,

@@ -376,9 +376,11 @@ impl TreeSamplers {
             cx.queue,
             enc,
             cx.timer,
-            "slc_filter",
-            &self.filter_params,
-            fp,
+            FilterDispatch {
+                name: "slc_filter",
+                uniform: &self.filter_params,
+                params: fp,
+            },
             &inputs,
         );
     }

@@ -22,7 +22,9 @@ use super::{
 };
 use crate::base::sst_node::TreeKind;
 use crate::gpu::context::{GpuContext, GpuError};
-use crate::gpu::passes::interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter};
+use crate::gpu::passes::interleave_filter::{
+    FilterDispatch, FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter,
+};
 use crate::gpu::readback::{self, ImageF32};
 use crate::gpu::shaders::ShaderError;
 use crate::reference::interleave::Interleave;

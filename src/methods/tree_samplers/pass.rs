@@ -18,7 +18,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::gpu::passes::{
     WG_1D, groups_image,
-    ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
+    ism::{GpuIsmParams, IsmBuild, IsmPass, IsmPoints, IsmTargets},
     run_compute,
     sst_build::TreeBuffers,
 };
@@ -518,9 +518,13 @@ impl SlcPass {
                 &bind,
                 (m.maps.div_ceil(WG_1D).max(1), 1, 1),
             );
-            self.ism.record_maps(
-                device, queue, encoder, timer, "slc_ism", m.settings, m.points, m.maps, m.targets,
-            );
+            let b = IsmBuild {
+                name: "slc_ism",
+                settings: m.settings,
+                points: m.points,
+                targets: m.targets,
+            };
+            self.ism.record_maps(device, queue, encoder, timer, &b, m.maps);
         }
         if diagnostics {
             encoder.clear_buffer(&out.stats, 0, None);

@@ -169,18 +169,16 @@ impl Method for Vals {
         let ism = self.ism_targets.as_ref().filter(|_| self.ism_maps > 0);
         if view == ISM_ATLAS {
             if let Some(t) = ism {
-                self.pass.ism.record_view(
-                    cx.device,
-                    cx.queue,
-                    enc,
-                    cx.timer,
-                    t,
-                    self.ism_maps,
-                    self.depth_range(),
+                let v = crate::gpu::passes::ism::IsmView {
+                    maps: self.ism_maps,
+                    range: self.depth_range(),
                     size,
-                    cx.dst,
+                    dst: cx.dst,
                     data,
-                );
+                };
+                self.pass
+                    .ism
+                    .record_view(cx.device, cx.queue, enc, cx.timer, t, &v);
             }
             return;
         }

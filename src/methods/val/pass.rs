@@ -16,10 +16,10 @@ use crate::gpu::frame::GbufferTargets;
 use crate::gpu::kernel::{Kernel, KernelOptions, buf, tex};
 use crate::gpu::passes::{
     WG_1D, groups_image,
-    interleave_filter::{FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
-    ism::{GpuIsmParams, IsmPass, IsmPoints, IsmTargets},
+    interleave_filter::{FilterDispatch, FilterInputs, FilterUniform, GpuFilterParams, InterleaveFilter},
+    ism::{GpuIsmParams, IsmBuild, IsmPass, IsmPoints, IsmTargets},
     run_compute, storage_buffer, uniform_buffer,
-    val_cluster::{GpuValParams, ValClusterPass, ValSeeds, ValTargets},
+    val_cluster::{ClusterRun, GpuValParams, ValClusterPass, ValSeeds, ValTargets},
 };
 use crate::gpu::scene_gpu::SceneGpu;
 use crate::gpu::shaders;
@@ -359,19 +359,15 @@ impl ValPass {
         // The seeds (the VALs bound are not read).
         let before = bind(t.vals(), &t.seeds);
         self.record_seeds(encoder, cx.timer, f, &before, &p);
-        self.cluster.record(
-            device,
-            queue,
-            encoder,
-            cx.timer,
-            "val_cluster",
-            [&f.coarse.arrays[0], &f.coarse.arrays[1], &f.coarse.arrays[2]],
-            cp,
-            ValSeeds::Written(p.clusters),
+        let run = ClusterRun {
+            name: "val_cluster",
+            rsm: [&f.coarse.arrays[0], &f.coarse.arrays[1], &f.coarse.arrays[2]],
+            params: cp,
+            seeds: ValSeeds::Written(p.clusters),
             iterations,
             carry,
-            t,
-        )?;
+        };
+        self.cluster.record(device, queue, encoder, cx.timer, run, t)?;
         // The clusters as the last step left them; the seeds buffer is bound again unread.
         let after = bind(t.vals(), &t.seeds);
         if let Some(m) = ism {
@@ -383,9 +379,14 @@ impl ValPass {
                 &after,
                 per_cluster,
             );
-            self.ism.record_maps(
-                device, queue, encoder, cx.timer, "val_ism", m.settings, m.points, p.clusters, m.targets,
-            );
+            let b = IsmBuild {
+                name: "val_ism",
+                settings: m.settings,
+                points: m.points,
+                targets: m.targets,
+            };
+            self.ism
+                .record_maps(device, queue, encoder, cx.timer, &b, p.clusters);
         }
         let shade = if diagnostics {
             &self.shade
@@ -405,9 +406,11 @@ impl ValPass {
             queue,
             encoder,
             cx.timer,
-            "val_filter",
-            &self.filter_params,
-            fp,
+            FilterDispatch {
+                name: "val_filter",
+                uniform: &self.filter_params,
+                params: fp,
+            },
             &FilterInputs {
                 gbuffer: f.gbuffer,
                 camera: f.camera,

@@ -140,9 +140,13 @@ impl LcullPass {
         run_compute(encoder, cx.timer, names[0], &self.ranges, &rbind, (gx, gy, 1));
         let sbind = self.shade_bind_group(device, params, f, b, ism_depth);
         if let Some(m) = ism {
-            let (ms, mp, mt) = (m.settings, m.points, m.targets);
-            self.ism
-                .record_maps(device, queue, encoder, cx.timer, names[4], ms, mp, m.maps, mt);
+            let b = IsmBuild {
+                name: names[4],
+                settings: m.settings,
+                points: m.points,
+                targets: m.targets,
+            };
+            self.ism.record_maps(device, queue, encoder, cx.timer, &b, m.maps);
         }
 
         if diagnostics {
@@ -181,9 +185,11 @@ impl LcullPass {
             queue,
             encoder,
             cx.timer,
-            names[3],
-            filter_params,
-            fp,
+            FilterDispatch {
+                name: names[3],
+                uniform: filter_params,
+                params: fp,
+            },
             &f.filter_inputs(b),
         );
         if diagnostics {
@@ -285,9 +291,13 @@ impl LcullPass {
             (gx, gy, 1),
         );
         if let Some(m) = ism {
-            let (ms, mp, mt) = (m.settings, m.points, m.targets);
-            self.ism
-                .record_maps(device, queue, encoder, cx.timer, "lcull_ism", ms, mp, m.maps, mt);
+            let b = IsmBuild {
+                name: "lcull_ism",
+                settings: m.settings,
+                points: m.points,
+                targets: m.targets,
+            };
+            self.ism.record_maps(device, queue, encoder, cx.timer, &b, m.maps);
         }
         let groups = groups_image(p.width, p.height);
         let (traverse, shade) = if diagnostics {
@@ -302,9 +312,11 @@ impl LcullPass {
             queue,
             encoder,
             cx.timer,
-            "lcull_filter",
-            &self.filter_params,
-            fp,
+            FilterDispatch {
+                name: "lcull_filter",
+                uniform: &self.filter_params,
+                params: fp,
+            },
             &f.filter_inputs(b),
         );
         if diagnostics {
