@@ -27,7 +27,7 @@ const LIMITS: &[(&str, usize)] = &[
     // cut kernels) were split into four to keep files under 700 lines: the same code.
     ("lightcuts", 8),
     ("reference", 0),
-    ("tree_samplers", 16),
+    ("tree_samplers", 15),
     ("val", 1),
 ];
 
@@ -348,8 +348,8 @@ fn the_scan_finds_paths_groups_types_and_ids() {
 /// never grow; lower `SHAPE_LIMITS` when a change improves one). Its goal: every count 0.
 const SHAPE_LIMITS: &[(&str, usize)] = &[
     ("files over 700 lines", 0),
-    ("functions over 150 lines", 15),
-    ("too_many_arguments allows", 4),
+    ("functions over 150 lines", 11),
+    ("too_many_arguments allows", 0),
     ("files in src/gpu and src/settings that name methods", 1),
     (
         "files in src/methods, src/gpu and src/settings that name crate::renderer",

@@ -5,7 +5,7 @@
 //! disagree as a red band under the leaves. Data: `Renderer::read_cut_story`.
 
 use crate::base::sst_node::Topology;
-use crate::methods::CutStory;
+use crate::base::story::CutStory;
 
 /// Colours of up to three input cuts.
 const INPUT: [egui::Color32; 3] = [

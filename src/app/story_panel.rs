@@ -9,7 +9,7 @@ use glam::Vec3;
 
 use super::image_views::{Prim, rgba8};
 use crate::base::sst_node::{SstNode, Topology, basis, flag, luminance};
-use crate::methods::tree_samplers::pass::{PixelTrace, SampleVisibility, StopReason};
+use crate::base::story::{CutStory, PixelTrace, SampleVisibility, StopReason};
 use crate::renderer::Renderer;
 
 /// Colours shared by the window and the overlays.
@@ -44,7 +44,7 @@ pub struct StoryPanel {
     /// Why there is no story (shown in the window).
     pub note: String,
     /// The cut-based methods' story (Lightcuts, Lightcut Interpolation) and the tree's leaves.
-    pub cut_story: Option<crate::methods::CutStory>,
+    pub cut_story: Option<CutStory>,
     /// A method's own overlay of the pixel (light culling: its tile's range spheres).
     pub method_overlay: Option<crate::methods::overlay::MethodOverlay>,
 }

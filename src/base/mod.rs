@@ -15,3 +15,4 @@ pub mod progress;
 pub mod sampling;
 pub mod settings_ui;
 pub mod sst_node;
+pub mod story;

@@ -401,7 +401,6 @@ pub fn run(args: &ExportSceneArgs) -> anyhow::Result<()> {
 /// every camera (the chosen one first) and every sun as a KHR_lights_punctual directional light
 /// whose `intensity` x `color` is its irradiance in W/m^2.
 fn write_gltf(scene: &Scene, cam: &Camera, parts: &[MeshPart], out: &Path) -> anyhow::Result<()> {
-    use glam::{Mat3, Quat};
     use serde_json::{Value, json};
     let mut bin: Vec<u8> = Vec::new();
     let mut views: Vec<Value> = Vec::new();
@@ -467,57 +466,9 @@ fn write_gltf(scene: &Scene, cam: &Camera, parts: &[MeshPart], out: &Path) -> an
         }));
     }
     let mut nodes: Vec<Value> = vec![json!({"name": scene.name, "mesh": 0})];
-    let mut cameras: Vec<Value> = Vec::new();
-    let mut cams: Vec<&Camera> = vec![cam];
-    cams.extend(scene.cameras.iter().filter(|c| c.name != cam.name));
-    for c in cams {
-        let f = c.forward.normalize_or(Vec3::NEG_Z);
-        let r = f.cross(c.up).normalize_or(Vec3::X);
-        let u = r.cross(f);
-        let q = Quat::from_mat3(&Mat3::from_cols(r, u, -f)).normalize();
-        cameras.push(json!({"name": c.name, "type": "perspective",
-            "perspective": {"yfov": c.yfov, "znear": c.znear, "zfar": c.zfar}}));
-        nodes.push(json!({"name": c.name, "camera": cameras.len() - 1,
-            "translation": c.position.to_array(), "rotation": q.to_array()}));
-    }
-    let mut lights: Vec<Value> = Vec::new();
-    for l in &scene.lights {
-        let z = -l.direction.normalize_or(Vec3::NEG_Y);
-        let x = if z.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
-        let y = z.cross(x).normalize();
-        let x = y.cross(z);
-        let q = Quat::from_mat3(&Mat3::from_cols(x, y, z)).normalize();
-        let intensity = l.irradiance.max_element().max(0.0);
-        let color = if intensity > 0.0 {
-            l.irradiance / intensity
-        } else {
-            Vec3::ONE
-        };
-        lights.push(
-            json!({"name": l.name, "type": "directional", "color": color.to_array(), "intensity": intensity}),
-        );
-        nodes.push(json!({"name": l.name, "rotation": q.to_array(),
-            "extensions": {"KHR_lights_punctual": {"light": lights.len() - 1}}}));
-    }
-    let mut images: Vec<Value> = Vec::new();
-    if !textures.is_empty() {
-        std::fs::create_dir_all(out.join("textures"))
-            .with_context(|| format!("cannot create {}", out.join("textures").display()))?;
-    }
-    for &t in &textures {
-        let tex = &scene.textures[t];
-        if tex.rgba8.len() != (tex.width as usize) * (tex.height as usize) * 4 {
-            return Err(anyhow!(
-                "texture '{}' is not {}x{} RGBA8",
-                tex.name,
-                tex.width,
-                tex.height
-            ));
-        }
-        let rel = format!("textures/tex_{t}.png");
-        write_png(&out.join(&rel), tex.width, tex.height, &tex.rgba8).map_err(|e| anyhow!("{e}"))?;
-        images.push(json!({"uri": rel, "name": tex.name}));
-    }
+    let cameras = camera_nodes(scene, cam, &mut nodes);
+    let lights = light_nodes(scene, &mut nodes);
+    let images = write_textures(scene, &textures, out)?;
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": "lightcut-workbench export-scene"},
         "scene": 0,
@@ -558,4 +509,76 @@ fn write_gltf(scene: &Scene, cam: &Camera, parts: &[MeshPart], out: &Path) -> an
         lights.len()
     );
     Ok(())
+}
+
+/// The glTF cameras (`cam` first, then the scene's others), each with its node in `nodes`.
+fn camera_nodes(scene: &Scene, cam: &Camera, nodes: &mut Vec<serde_json::Value>) -> Vec<serde_json::Value> {
+    use glam::{Mat3, Quat};
+    use serde_json::{Value, json};
+    let mut cameras: Vec<Value> = Vec::new();
+    let mut cams: Vec<&Camera> = vec![cam];
+    cams.extend(scene.cameras.iter().filter(|c| c.name != cam.name));
+    for c in cams {
+        let f = c.forward.normalize_or(Vec3::NEG_Z);
+        let r = f.cross(c.up).normalize_or(Vec3::X);
+        let u = r.cross(f);
+        let q = Quat::from_mat3(&Mat3::from_cols(r, u, -f)).normalize();
+        cameras.push(json!({"name": c.name, "type": "perspective",
+            "perspective": {"yfov": c.yfov, "znear": c.znear, "zfar": c.zfar}}));
+        nodes.push(json!({"name": c.name, "camera": cameras.len() - 1,
+            "translation": c.position.to_array(), "rotation": q.to_array()}));
+    }
+    cameras
+}
+
+/// The suns as `KHR_lights_punctual` directional lights (colour and intensity in W/m²), each
+/// with its node in `nodes`.
+fn light_nodes(scene: &Scene, nodes: &mut Vec<serde_json::Value>) -> Vec<serde_json::Value> {
+    use glam::{Mat3, Quat};
+    use serde_json::{Value, json};
+    let mut lights: Vec<Value> = Vec::new();
+    for l in &scene.lights {
+        let z = -l.direction.normalize_or(Vec3::NEG_Y);
+        let x = if z.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+        let y = z.cross(x).normalize();
+        let x = y.cross(z);
+        let q = Quat::from_mat3(&Mat3::from_cols(x, y, z)).normalize();
+        let intensity = l.irradiance.max_element().max(0.0);
+        let color = if intensity > 0.0 {
+            l.irradiance / intensity
+        } else {
+            Vec3::ONE
+        };
+        lights.push(
+            json!({"name": l.name, "type": "directional", "color": color.to_array(), "intensity": intensity}),
+        );
+        nodes.push(json!({"name": l.name, "rotation": q.to_array(),
+            "extensions": {"KHR_lights_punctual": {"light": lights.len() - 1}}}));
+    }
+    lights
+}
+
+/// The used textures as PNGs under `out/textures/`, and their glTF images.
+fn write_textures(scene: &Scene, textures: &[usize], out: &Path) -> anyhow::Result<Vec<serde_json::Value>> {
+    use serde_json::{Value, json};
+    let mut images: Vec<Value> = Vec::new();
+    if !textures.is_empty() {
+        std::fs::create_dir_all(out.join("textures"))
+            .with_context(|| format!("cannot create {}", out.join("textures").display()))?;
+    }
+    for &t in textures {
+        let tex = &scene.textures[t];
+        if tex.rgba8.len() != (tex.width as usize) * (tex.height as usize) * 4 {
+            return Err(anyhow!(
+                "texture '{}' is not {}x{} RGBA8",
+                tex.name,
+                tex.width,
+                tex.height
+            ));
+        }
+        let rel = format!("textures/tex_{t}.png");
+        write_png(&out.join(&rel), tex.width, tex.height, &tex.rgba8).map_err(|e| anyhow!("{e}"))?;
+        images.push(json!({"uri": rel, "name": tex.name}));
+    }
+    Ok(images)
 }

@@ -65,28 +65,7 @@ pub static REGISTRY: &[&MethodInfo] = &[
     &direct_only::INFO,
 ];
 
-/// One cut of a cut story: nodes of the frame's light tree (root 1).
-#[derive(Clone, Debug, PartialEq)]
-pub struct StoryCut {
-    pub label: String,
-    pub nodes: Vec<u32>,
-}
-
-/// The pinned pixel's cuts as a cut-based method tells them (Lightcuts: its cut; Lightcut
-/// Interpolation: the records' cuts, the interpolated cut and where the inputs disagree).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct CutStory {
-    /// (what, value) rows of the story's table.
-    pub rows: Vec<(String, String)>,
-    /// Input cuts (drawn in colours) and the pixel's own cut (drawn last, white).
-    pub inputs: Vec<StoryCut>,
-    pub cut: Option<StoryCut>,
-    /// Leaf intervals [start, end) where the inputs disagree.
-    pub disagreements: Vec<(u32, u32)>,
-    /// The radix tree's links when the cuts are on it (`base::sst_node::Topology::radix`;
-    /// the renderer fills them in), empty on the perfect tree.
-    pub links: Vec<[u32; 4]>,
-}
+pub use crate::base::story::{CutStory, Story, StoryCut};
 
 /// How a method produces its image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -394,15 +373,11 @@ pub trait Method: Any {
     fn legend(&self, _view: MethodView, _tree_levels: u32) -> Option<Legend> {
         None
     }
-    /// The pinned pixel's story in the last frame (methods whose `MethodInfo::story` is set;
-    /// the story panel draws `PixelTrace`: blocks, blend weights, each sample's path, stop,
-    /// point, shadow ray and contribution).
-    fn read_story(&self, _ctx: &GpuContext) -> Result<Option<tree_samplers::pass::PixelTrace>, GpuError> {
-        Ok(None)
-    }
-    /// The pinned pixel's cut story in the last diagnostic frame (cut-based methods: the
-    /// story panel draws its cuts over the tree's levels and its table).
-    fn read_cut_story(&self, _ctx: &GpuContext) -> Result<Option<CutStory>, GpuError> {
+    /// The pinned pixel's story in the last (diagnostic) frame, None when it tells none: a
+    /// sampling method's samples (`Story::Samples`: blocks, blend weights, each sample's path,
+    /// stop, point, shadow ray and contribution; `MethodInfo::story` set) or a cut-based
+    /// method's cuts (`Story::Cuts`: a table and cuts drawn over the tree's levels).
+    fn read_story(&self, _ctx: &GpuContext) -> Result<Option<Story>, GpuError> {
         Ok(None)
     }
     /// Its overlay for the pinned frame pixel (x, y) whose surface point is `position`: a

@@ -73,42 +73,7 @@ impl Renderer {
         let s = self.settings.clone();
 
         let lights = &input.lights[..input.lights.len().min(MAX_LIGHTS)];
-        self.frame_lights.clear();
-        self.frame_lights.extend_from_slice(lights);
-        self.frame_brdf = s.gi.method.brdf(s.gi.brdf);
-        self.frame_eye = input.camera.position;
-        let layers = lights.len().max(1) as u32;
-        if layers != self.targets.shadow.layers() {
-            self.targets.shadow = ShadowTargets::new(&device, s.shadow.resolution, layers);
-        }
-        let gpu_lights = GpuLights::new(
-            lights,
-            &self.scene.bounds,
-            s.shadow.resolution,
-            s.shadow.depth_bias,
-            s.shadow.normal_offset,
-            s.shadow.slope_bias,
-            s.shadow.pcf_radius,
-        );
-        let gpu_camera = GpuCamera::new(input.camera, size.0, size.1);
-        queue.write_buffer(&self.camera_buf, 0, bytemuck::bytes_of(&gpu_camera));
-        queue.write_buffer(&self.lights_buf, 0, bytemuck::bytes_of(&gpu_lights));
-        self.light0_lum = lights
-            .first()
-            .map(|l| l.irradiance.dot(Vec3::new(0.2126, 0.7152, 0.0722)))
-            .unwrap_or(1.0);
-        self.lights_texel = gpu_lights.lights[0].shadow[0];
-        self.rsm_raster = lights.first().map(|l| {
-            let (view_proj, texel, _) =
-                crate::gpu::gpu_data::light_frustum(l.direction, &self.scene.bounds, s.shadow.resolution);
-            crate::gpu::gpu_data::RsmRaster {
-                view_proj,
-                direction: l.direction.normalize_or(glam::Vec3::NEG_Y),
-                texel,
-                res: s.shadow.resolution,
-                lights: lights.len() as u32,
-            }
-        });
+        let setup = self.upload_frame_uniforms(input.camera, lights, size, &s);
 
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("frame::encoder"),
@@ -121,189 +86,9 @@ impl Renderer {
             && s.gi.method.per_frame()
             && (diagnostic || !self.compare_settled(input, lights, size));
         self.timer.begin_frame(!diagnostic);
-        let t = &self.targets;
-        let rsm = RsmInputs {
-            lights: &gpu_lights,
-            scene: &self.scene,
-            out: &t.shadow,
-        };
-        self.rsm.record(&device, &queue, &mut enc, &mut self.timer, &rsm);
-        self.gbuffer.record(
-            &device,
-            &mut enc,
-            &mut self.timer,
-            &self.camera_buf,
-            &self.scene,
-            &t.gbuffer,
-        );
-        self.direct.record(
-            &device,
-            &queue,
-            &mut enc,
-            &mut self.timer,
-            &crate::gpu::passes::direct::DirectInputs {
-                brdf: self.frame_brdf.gpu(),
-                camera: &self.camera_buf,
-                lights: &self.lights_buf,
-                shadow: &t.shadow,
-                gbuffer: &t.gbuffer,
-                out: &t.lighting.direct_view,
-                size,
-            },
-        );
-        // VPLs (thesis 4.1): resources follow the RSM resolution, light count and VPL budget.
-        let vb = &self.vpl_buffers;
-        let mut vpl_ok = true;
-        if vb.res != s.shadow.resolution || vb.layers != layers || vb.capacity != s.vpl.count {
-            match check_device_limits(&device, &s, layers) {
-                // More lights than the buffers fit: say so and keep the frame direct-only.
-                Err(e) => {
-                    self.ctx.errors.report(e.to_string());
-                    vpl_ok = false;
-                }
-                Ok(()) => {
-                    self.vpl_buffers = VplBuffers::new(&device, s.shadow.resolution, layers, s.vpl.count);
-                    for (_, m) in &mut self.methods {
-                        m.reset();
-                    }
-                    self.compare = None;
-                }
-            }
-        }
-        let seed = s
-            .vpl
-            .seed
-            .wrapping_add(if s.vpl.animate { self.frames as u32 } else { 0 });
-        // The tree the method runs on: `tree.kind` where it follows links, else the perfect one.
-        let tree_kind = s.gi.method.tree_kind(s.tree.kind);
-        let frozen = self.freeze.is_some() && vpl_ok && self.tree.matches(self.vpl_frame.count, tree_kind);
-        if frozen {
-            // Frozen VPLs and tree (debugging): only the flags follow new thresholds.
-            let th = (s.tree.v_min, s.tree.sigma_max);
-            if self.freeze != Some(th) {
-                let usable = UsableThresholds {
-                    v_min: th.0,
-                    sigma_max: th.1,
-                };
-                self.sst_build.record_classify(
-                    &device,
-                    &queue,
-                    &mut enc,
-                    &mut self.timer,
-                    &self.tree,
-                    usable,
-                );
-                self.freeze = Some(th);
-            }
-        } else if vpl_ok {
-            if self.freeze.is_some() {
-                self.freeze = Some((s.tree.v_min, s.tree.sigma_max));
-            }
-            let t = &self.targets;
-            let inputs = passes::vpl_gen::VplGenInputs {
-                settings: &s.vpl,
-                gi: &s.gi,
-                seed,
-                scene_radius: self.scene.bounds.radius().max(1e-30),
-                lights,
-                camera: &self.camera_buf,
-                rsm: &t.shadow,
-                gbuffer: &t.gbuffer,
-                out: &self.vpl_buffers,
-            };
-            self.vpl_frame = self
-                .vpl_gen
-                .record(&device, &queue, &mut enc, &mut self.timer, &inputs);
-            // Bounces 2..=N (`vpl.bounces`): light paths from RSM texels drawn by flux.
-            let vf = &self.vpl_frame;
-            if vf.paths > 0 {
-                let job = passes::light_paths::PathJob {
-                    paths: vf.paths,
-                    first: vf.first_bounce,
-                    bounces: vf.bounces,
-                    roulette: s.vpl.roulette,
-                    seed,
-                    ray_offset: s.gi.ray_offset,
-                    lod: 0,
-                    flux_scale: 1.0,
-                    flux_mix: s.vpl.path_flux_mix,
-                };
-                let inputs = passes::light_paths::PathInputs {
-                    lights,
-                    vpl_params: self.vpl_gen.params_buffer(),
-                    rsm: &self.targets.shadow,
-                    pyramids: &self.vpl_buffers,
-                    scene: &self.scene,
-                    out: &self.vpl_buffers.vpls,
-                };
-                self.light_paths
-                    .record(&device, &queue, &mut enc, &mut self.timer, &job, &inputs);
-            }
-            // SST stages 8-9: sort keys and the bitonic sort of (key, index) pairs.
-            if self.sort_buffers.count != self.vpl_frame.count {
-                self.sort_buffers = SortBuffers::new(&device, self.vpl_frame.count);
-            }
-            self.sst_sort.record(
-                &device,
-                &queue,
-                &mut enc,
-                &mut self.timer,
-                &self.vpl_buffers.vpls,
-                &self.sort_buffers,
-            );
-            // SST stage 10: the tree over the sorted VPLs (the perfect tree or the radix tree,
-            // `tree.kind`), then its usable flags.
-            if !self.tree.matches(self.vpl_frame.count, tree_kind) {
-                self.tree = TreeBuffers::new(&device, self.vpl_frame.count, tree_kind);
-            }
-            let usable = UsableThresholds {
-                v_min: s.tree.v_min,
-                sigma_max: s.tree.sigma_max,
-            };
-            let build = BuildInputs {
-                vpls: &self.vpl_buffers.vpls,
-                sort: &self.sort_buffers,
-                tree: &self.tree,
-                usable,
-            };
-            self.sst_build
-                .record(&device, &queue, &mut enc, &mut self.timer, &build);
-            // The overlay's comparison: the other tree over the same keys, untimed.
-            let d = &s.display;
-            if d.tree_compare && d.tree_overlay != TreeOverlay::Off {
-                let other = match tree_kind {
-                    TreeKind::Perfect => TreeKind::Lbvh,
-                    TreeKind::Lbvh => TreeKind::Perfect,
-                };
-                let count = self.vpl_frame.count;
-                if !self.tree_other.as_ref().is_some_and(|t| t.matches(count, other)) {
-                    self.tree_other = Some(TreeBuffers::new(&device, count, other));
-                }
-                if let Some(t) = &self.tree_other {
-                    let other = BuildInputs {
-                        vpls: &self.vpl_buffers.vpls,
-                        sort: &self.sort_buffers,
-                        tree: t,
-                        usable,
-                    };
-                    self.sst_build
-                        .record(&device, &queue, &mut enc, &mut self.quiet_timer, &other);
-                }
-            } else {
-                self.tree_other = None;
-            }
-            // The flux-pyramid tops (one float per light), read back on a later frame: a
-            // readback, so in diagnostic frames only.
-            let (per_layer, offsets) = passes::vpl_gen::pyramid_layout(self.vpl_buffers.res);
-            let top = *offsets.last().unwrap_or(&0) as u64;
-            let fp = &self.vpl_buffers.flux_pyramid;
-            let copies: Vec<(&wgpu::Buffer, u64, u64, u64)> = (0..self.vpl_frame.ranges.len() as u64)
-                .map(|l| (fp, 4 * (l * per_layer as u64 + top), 4 * l, 4))
-                .collect();
-            if diagnostic {
-                self.flux_readback.record(&mut enc, &copies);
-            }
-        }
+        self.record_raster(&mut enc, &setup, size);
+        let vpl_ok = self.vpl_resources_ok(&s, setup.layers);
+        self.record_vpls_and_tree(&mut enc, &s, lights, vpl_ok, diagnostic);
         let indirect_scale = if vpl_ok {
             let key = self.gt_key(input, lights, size);
             let scale = self.record_method(&mut enc, s.gi.method, key, size, diagnostic);
@@ -314,81 +99,11 @@ impl Renderer {
         } else {
             0.0
         };
-        // The temporal stage after a per-frame method (reprojection, history, SVGF): the
-        // composite then reads its result at scale 1.
-        let temporal_on = vpl_ok && s.temporal.mode != TemporalMode::Off && s.gi.method.per_frame();
-        // Off frees its buffers; a frame of a progressive method (the ground truth of the
-        // same view, say) leaves the history as it was: the next per-frame frame reprojects
-        // from the last frame the stage ran (its camera and G-buffer are kept with it).
-        if s.temporal.mode == TemporalMode::Off {
-            self.temporal.release();
-        } else if !temporal_on {
-            self.temporal.skipped();
-        }
-        let t = &self.targets;
-        let filtered = if temporal_on {
-            let inputs = passes::temporal::TemporalInputs {
-                gbuffer: &t.gbuffer,
-                camera_buf: &self.camera_buf,
-                camera: gpu_camera,
-                accum: &t.lighting.gi_accum,
-                scale: indirect_scale,
-                size,
-                key: temporal_key(s.gi.method, &s.temporal),
-            };
-            self.temporal
-                .record(&device, &queue, &mut enc, &mut self.timer, &s.temporal, &inputs)
-        } else {
-            None
-        };
-        let (accum, scale) = match filtered {
-            Some(b) => (b, 1.0),
-            None => (&t.lighting.gi_accum, indirect_scale),
-        };
-        let inputs = CompositeInputs {
-            size,
-            indirect_scale: scale,
-            direct: &t.lighting.direct_view,
-            accum,
-            out_indirect: &t.lighting.indirect_view,
-            out_final: &t.lighting.final_view,
-        };
-        self.composite
-            .record(&device, &queue, &mut enc, &mut self.timer, &inputs);
+        self.record_temporal_and_composite(&mut enc, &s, setup.gpu_camera, indirect_scale, vpl_ok);
         self.record_view_with_overlays(&mut enc, &first, input.camera, vpl_ok);
         queue.submit([enc.finish()]);
-        // The other views, each into its own texture.
-        self.extra_views.truncate(views.len().saturating_sub(1));
-        for (i, spec) in views.iter().enumerate().skip(1) {
-            if self.extra_views.len() < i {
-                self.view_generation += 1;
-                self.extra_views
-                    .push(ViewTarget::new(&device, (1, 1), self.view_generation));
-            }
-            let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("frame::view_encoder"),
-            });
-            std::mem::swap(&mut self.targets.view, &mut self.extra_views[i - 1]);
-            self.record_view_with_overlays(&mut enc, spec, input.camera, vpl_ok);
-            std::mem::swap(&mut self.targets.view, &mut self.extra_views[i - 1]);
-            queue.submit([enc.finish()]);
-        }
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("frame::resolve_encoder"),
-        });
-        self.timer.resolve(&mut enc);
-        queue.submit([enc.finish()]);
-        self.timer.after_submit();
-        self.flux_readback.after_submit();
-        for (_, m) in &mut self.methods {
-            m.after_submit();
-        }
-        self.frames += 1;
-        self.last_diagnostic = diagnostic;
-        if diagnostic {
-            self.diagnostic_requested = false;
-        }
-        self.last_vpl_ok = vpl_ok;
+        self.submit_extra_views(views, input.camera, vpl_ok);
+        self.finish_frame(diagnostic, vpl_ok);
     }
 
     /// Draws `input.view` (with its overlays) from the last frame's buffers without rendering
@@ -621,7 +336,7 @@ pub(super) fn create_methods(device: &wgpu::Device) -> Result<Vec<MethodInstance
 
 /// What the temporal history belongs to: the method and the stage's mode and history
 /// parameters (not the filter's, which act on each frame anew).
-fn temporal_key(method: MethodId, t: &TemporalSettings) -> u64 {
+pub(super) fn temporal_key(method: MethodId, t: &TemporalSettings) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();
     method.cli().hash(&mut h);

@@ -57,31 +57,38 @@ impl Renderer {
         self.trace_pixel = pixel;
     }
 
-    /// What the traced pixel's samples did in the last tree-sampling frame (None: no trace,
-    /// or the pixel saw no geometry).
-    pub fn read_pixel_trace(&self) -> Result<Option<PixelTrace>, GpuError> {
-        if self.trace_pixel.is_none() || !self.settings.gi.method.info().story {
-            return Ok(None);
-        }
-        match self.method_instance(self.settings.gi.method) {
-            Some(m) => m.read_story(&self.ctx),
-            None => Ok(None),
-        }
-    }
-
-    /// The pinned pixel's cut story (cut-based methods; None without a pinned pixel).
-    pub fn read_cut_story(&self) -> Result<Option<methods::CutStory>, GpuError> {
+    /// The pinned pixel's story in the last (diagnostic) frame as the method tells it (None
+    /// without a pinned pixel or when it tells none); a cut story carries the radix tree's
+    /// links when its cuts are on it.
+    pub fn read_story(&self) -> Result<Option<methods::Story>, GpuError> {
         if self.trace_pixel.is_none() {
             return Ok(None);
         }
         let Some(m) = self.method_instance(self.settings.gi.method) else {
             return Ok(None);
         };
-        let mut story = m.read_cut_story(&self.ctx)?;
-        if let Some(s) = story.as_mut() {
+        let mut story = m.read_story(&self.ctx)?;
+        if let Some(methods::Story::Cuts(s)) = story.as_mut() {
             s.links = self.read_tree_links()?;
         }
         Ok(story)
+    }
+
+    /// What the traced pixel's samples did in the last tree-sampling frame (None: no trace,
+    /// the pixel saw no geometry, or the method tells no sample story).
+    pub fn read_pixel_trace(&self) -> Result<Option<PixelTrace>, GpuError> {
+        Ok(match self.read_story()? {
+            Some(methods::Story::Samples(t)) => Some(t),
+            _ => None,
+        })
+    }
+
+    /// The pinned pixel's cut story (cut-based methods; None without a pinned pixel).
+    pub fn read_cut_story(&self) -> Result<Option<crate::base::story::CutStory>, GpuError> {
+        Ok(match self.read_story()? {
+            Some(methods::Story::Cuts(s)) => Some(s),
+            _ => None,
+        })
     }
 
     /// The method's overlay for the pinned pixel (None without a pinned pixel, without

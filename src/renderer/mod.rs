@@ -17,6 +17,7 @@ pub use crate::settings::temporal as temporal_settings;
 
 mod frame_graph;
 mod inspect;
+mod stages;
 mod view_data;
 mod view_record;
 
@@ -27,11 +28,12 @@ use glam::Vec3;
 use thiserror::Error;
 
 use crate::base::sst_node::SstNode;
+use crate::base::story::PixelTrace;
 use crate::methods::{
     self, FrameCx, Method, MethodId, MethodView, ViewCx,
     tree_samplers::{
         TreeSamplers,
-        pass::{PixelTrace, SamplingStats, SlcBuffers},
+        pass::{SamplingStats, SlcBuffers},
     },
 };
 use crate::scene::{Camera, DirectionalLight, Scene};
@@ -57,7 +59,7 @@ use settings::{
     RenderSettings, TemporalMode, TemporalSettings, TemporalView, TreeKind, TreeOverlay, ViewBuffer,
 };
 use timing::{GpuTimer, PassTimings};
-use views::{AbMode, AbSource, ViewSpec};
+use views::{AbMode, AbSource, AbSpec, ViewLook, ViewSpec};
 
 #[derive(Debug, Error)]
 pub enum RenderError {

@@ -37,10 +37,29 @@ impl Renderer {
         let view = spec.buffer;
         let look = spec.look;
         let ab = spec.effective_ab();
-        let device = self.ctx.device.clone();
-        let queue = self.ctx.queue.clone();
+        let want = self.wanted_view_size(view, ab);
+        if self.targets.view.size != want {
+            self.view_generation += 1;
+            self.targets.view = ViewTarget::new(&self.ctx.device, want, self.view_generation);
+        }
+        if let Some(ab) = ab {
+            self.record_ab_view(enc, ab, &look, want);
+        } else if view.is_compare_view() {
+            self.record_truth_view(enc, view, &look, want);
+        } else if let ViewBuffer::Temporal(tv) = view {
+            self.record_temporal_view(enc, tv, &look, want);
+        } else if let ViewBuffer::Method(view) = view {
+            self.record_method_view(enc, view, &look);
+        } else {
+            self.record_buffer_view(enc, view, &look, want, camera);
+        }
+    }
+
+    /// The size of the view texture `view` needs (an RSM's, a pyramid level's enlarged, a
+    /// method view's, an A/B's).
+    fn wanted_view_size(&self, view: ViewBuffer, ab: Option<AbSpec>) -> (u32, u32) {
         let rsm_res = self.targets.shadow.resolution;
-        let want = match view {
+        match view {
             ViewBuffer::ShadowMap
             | ViewBuffer::RsmFlux
             | ViewBuffer::RsmNormal
@@ -72,11 +91,164 @@ impl Renderer {
                 }
                 None => self.targets.size,
             },
-        };
-        if self.targets.view.size != want {
-            self.view_generation += 1;
-            self.targets.view = ViewTarget::new(&device, want, self.view_generation);
         }
+    }
+
+    /// An A/B comparison of two images (cleared when one does not exist: no comparison
+    /// running, snapshot gone).
+    fn record_ab_view(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        ab: AbSpec,
+        look: &ViewLook,
+        want: (u32, u32),
+    ) {
+        let (device, queue) = (self.ctx.device.clone(), self.ctx.queue.clone());
+        let t = &self.targets;
+        let dst = &t.view.view;
+        let images = (
+            ab_source(&self.targets, self.compare.as_ref(), &self.snapshots, ab.a),
+            ab_source(&self.targets, self.compare.as_ref(), &self.snapshots, ab.b),
+        );
+        let (Some((a, _)), Some((b, _))) = images else {
+            // An image that does not exist (no comparison running, snapshot gone).
+            clear_view(enc, &self.targets.view.view);
+            return;
+        };
+        let p = passes::compare::GpuCmpParams {
+            mode: ab.mode.gpu_id(),
+            split_x: (ab.split.clamp(0.0, 1.0) * want.0 as f32) as u32,
+            exposure: look.exposure_ev.exp2(),
+            tonemap: look.tonemap.gpu_id(),
+            diff_scale: ab.diff_scale,
+            _pad: [0; 3],
+        };
+        let inputs = passes::compare::CompareInputs {
+            method_image: a,
+            reference_image: b,
+            gb_position: &t.gbuffer.position_view,
+            dst,
+            size: want,
+        };
+        self.compare_views
+            .record(&device, &queue, enc, &mut self.timer, p, &inputs);
+    }
+
+    /// The comparison truth's final or indirect image (cleared without a comparison at this
+    /// size).
+    fn record_truth_view(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        view: ViewBuffer,
+        look: &ViewLook,
+        want: (u32, u32),
+    ) {
+        let (device, queue) = (self.ctx.device.clone(), self.ctx.queue.clone());
+        let dst = &self.targets.view.view;
+        let Some(cmp) = self
+            .compare
+            .as_ref()
+            .filter(|c| c.targets_size == self.targets.size)
+        else {
+            // No comparison running (or not at this size): nothing to show.
+            clear_view(enc, &self.targets.view.view);
+            return;
+        };
+        let src = if view == ViewBuffer::GroundTruthFinal {
+            &cmp.targets.final_view
+        } else {
+            &cmp.targets.indirect_view
+        };
+        let inputs = DisplayInputs {
+            look,
+            src,
+            dst,
+            size: want,
+        };
+        self.display
+            .record(&device, &queue, enc, &mut self.timer, &inputs);
+    }
+
+    /// One of the temporal stage's views (cleared when the stage has not run at this size).
+    fn record_temporal_view(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        tv: TemporalView,
+        look: &ViewLook,
+        want: (u32, u32),
+    ) {
+        let (device, queue) = (self.ctx.device.clone(), self.ctx.queue.clone());
+        let dst = &self.targets.view.view;
+        if !self.temporal.has_view(tv, self.targets.size) {
+            // The stage has not run at this size (off, or a progressive method).
+            clear_view(enc, &self.targets.view.view);
+            return;
+        }
+        let inputs = passes::temporal::TemporalViewInputs {
+            view: tv,
+            gbuffer: &self.targets.gbuffer,
+            camera_buf: &self.camera_buf,
+            dst: &self.targets.view.view,
+        };
+        let shown = self
+            .temporal
+            .record_view(&device, &queue, enc, &mut self.timer, &inputs);
+        if let Some(src) = shown {
+            let inputs = DisplayInputs {
+                look,
+                src,
+                dst,
+                size: want,
+            };
+            self.display
+                .record(&device, &queue, enc, &mut self.timer, &inputs);
+        }
+    }
+
+    /// A method's own view, drawn by its owner (cleared without a frame of it at this size).
+    fn record_method_view(&mut self, enc: &mut wgpu::CommandEncoder, view: MethodView, look: &ViewLook) {
+        let (device, queue) = (self.ctx.device.clone(), self.ctx.queue.clone());
+        let frame = self.targets.size;
+        let Some((_, owner)) = view.find() else {
+            clear_view(enc, &self.targets.view.view);
+            return;
+        };
+        let module = owner.info().module.name;
+        let Some((_, m)) = self.methods.iter_mut().find(|(n, _)| *n == module) else {
+            clear_view(enc, &self.targets.view.view);
+            return;
+        };
+        if m.view_size(view, frame).is_none() {
+            // No frame of the method at this size yet: nothing to show.
+            clear_view(enc, &self.targets.view.view);
+            return;
+        }
+        let mut cx = ViewCx {
+            scene: &self.scene,
+            camera: &self.camera_buf,
+            device: &device,
+            queue: &queue,
+            timer: &mut self.timer,
+            look,
+            targets: &self.targets,
+            tree: &self.tree,
+            dst: &self.targets.view.view,
+            selected_block: self.selected_block,
+        };
+        m.record_view(view, &mut cx, enc);
+    }
+
+    /// A frame buffer: the lighting images through the display pass, the others (RSM,
+    /// pyramid, G-buffer, shadow map) through the visualise pass.
+    fn record_buffer_view(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        view: ViewBuffer,
+        look: &ViewLook,
+        want: (u32, u32),
+        camera: &Camera,
+    ) {
+        let (device, queue) = (self.ctx.device.clone(), self.ctx.queue.clone());
         let t = &self.targets;
         let dst = &t.view.view;
         let b = self.scene.bounds;
@@ -85,118 +257,6 @@ impl Renderer {
         } else {
             (b.min, b.max)
         };
-        if let Some(ab) = ab {
-            let images = (
-                ab_source(&self.targets, self.compare.as_ref(), &self.snapshots, ab.a),
-                ab_source(&self.targets, self.compare.as_ref(), &self.snapshots, ab.b),
-            );
-            let (Some((a, _)), Some((b, _))) = images else {
-                // An image that does not exist (no comparison running, snapshot gone).
-                clear_view(enc, &self.targets.view.view);
-                return;
-            };
-            let p = passes::compare::GpuCmpParams {
-                mode: ab.mode.gpu_id(),
-                split_x: (ab.split.clamp(0.0, 1.0) * want.0 as f32) as u32,
-                exposure: look.exposure_ev.exp2(),
-                tonemap: look.tonemap.gpu_id(),
-                diff_scale: ab.diff_scale,
-                _pad: [0; 3],
-            };
-            let inputs = passes::compare::CompareInputs {
-                method_image: a,
-                reference_image: b,
-                gb_position: &t.gbuffer.position_view,
-                dst,
-                size: want,
-            };
-            self.compare_views
-                .record(&device, &queue, enc, &mut self.timer, p, &inputs);
-            return;
-        }
-        if view.is_compare_view() {
-            let Some(cmp) = self
-                .compare
-                .as_ref()
-                .filter(|c| c.targets_size == self.targets.size)
-            else {
-                // No comparison running (or not at this size): nothing to show.
-                clear_view(enc, &self.targets.view.view);
-                return;
-            };
-            let src = if view == ViewBuffer::GroundTruthFinal {
-                &cmp.targets.final_view
-            } else {
-                &cmp.targets.indirect_view
-            };
-            let inputs = DisplayInputs {
-                look: &look,
-                src,
-                dst,
-                size: want,
-            };
-            self.display
-                .record(&device, &queue, enc, &mut self.timer, &inputs);
-            return;
-        }
-        if let ViewBuffer::Temporal(tv) = view {
-            if !self.temporal.has_view(tv, self.targets.size) {
-                // The stage has not run at this size (off, or a progressive method).
-                clear_view(enc, &self.targets.view.view);
-                return;
-            }
-            let inputs = passes::temporal::TemporalViewInputs {
-                view: tv,
-                gbuffer: &self.targets.gbuffer,
-                camera_buf: &self.camera_buf,
-                dst: &self.targets.view.view,
-            };
-            let shown = self
-                .temporal
-                .record_view(&device, &queue, enc, &mut self.timer, &inputs);
-            if let Some(src) = shown {
-                let inputs = DisplayInputs {
-                    look: &look,
-                    src,
-                    dst,
-                    size: want,
-                };
-                self.display
-                    .record(&device, &queue, enc, &mut self.timer, &inputs);
-            }
-            return;
-        }
-        if let ViewBuffer::Method(view) = view {
-            let frame = self.targets.size;
-            let Some((_, owner)) = view.find() else {
-                clear_view(enc, &self.targets.view.view);
-                return;
-            };
-            let module = owner.info().module.name;
-            let Some((_, m)) = self.methods.iter_mut().find(|(n, _)| *n == module) else {
-                clear_view(enc, &self.targets.view.view);
-                return;
-            };
-            if m.view_size(view, frame).is_none() {
-                // No frame of the method at this size yet: nothing to show.
-                clear_view(enc, &self.targets.view.view);
-                return;
-            }
-            let mut cx = ViewCx {
-                scene: &self.scene,
-                camera: &self.camera_buf,
-                device: &device,
-                queue: &queue,
-                timer: &mut self.timer,
-                look: &look,
-                targets: &self.targets,
-                tree: &self.tree,
-                dst: &self.targets.view.view,
-                selected_block: self.selected_block,
-            };
-            m.record_view(view, &mut cx, enc);
-            return;
-        }
         let (mode, src, lo, hi) = match view {
             ViewBuffer::Final | ViewBuffer::Direct | ViewBuffer::Indirect => {
                 let src = match view {
@@ -205,7 +265,7 @@ impl Renderer {
                     _ => &t.lighting.indirect_view,
                 };
                 let inputs = DisplayInputs {
-                    look: &look,
+                    look,
                     src,
                     dst,
                     size: want,

@@ -175,7 +175,7 @@ impl Method for LightcutInterpolation {
 
     /// The pinned pixel: its records (pixel, weight, cut), the interpolated cut, and where
     /// the records' cuts disagree.
-    fn read_cut_story(&self, ctx: &GpuContext) -> Result<Option<CutStory>, GpuError> {
+    fn read_story(&self, ctx: &GpuContext) -> Result<Option<Story>, GpuError> {
         let Some(b) = &self.buffers else { return Ok(None) };
         let Some(t) = self.read_traced(ctx)? else {
             return Ok(None);
@@ -245,7 +245,7 @@ impl Method for LightcutInterpolation {
             label: format!("interpolated ({} nodes)", t.nodes.len()),
             nodes: t.nodes.iter().map(|n| n.0).collect(),
         });
-        Ok(Some(story))
+        Ok(Some(Story::Cuts(story)))
     }
 
     /// Per pixel: cut size, level spread (-1: fallback), records used, shadow rays.

@@ -14,8 +14,8 @@ pub mod settings;
 mod ui;
 
 use super::{
-    CutStory, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, StoryCut,
-    ViewCx, ViewInfo,
+    CutStory, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, Story,
+    StoryCut, ViewCx, ViewInfo,
 };
 use crate::gpu::context::{GpuContext, GpuError};
 use crate::gpu::readback::{self, ImageF32};

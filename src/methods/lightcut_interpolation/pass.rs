@@ -18,7 +18,9 @@ use crate::gpu::readback::CounterReadback;
 use crate::gpu::scene_gpu::SceneGpu;
 use crate::gpu::shaders;
 use crate::gpu::timing::GpuTimer;
-use crate::methods::lightcuts::pass::{BuildKernel, CutBindings, CutKernel, GpuLcParams, slice_pixels};
+use crate::methods::lightcuts::pass::{
+    BuildKernel, BuildRun, CutBindings, CutKernel, CutRun, GpuLcParams, slice_pixels,
+};
 use crate::reference::lightcut_interpolation::{TILE, TILE_CAP};
 
 /// Workgroup size of `li_records.wgsl`'s tile kernels (`TILE_WG_ENTRIES`): a 16 x 16 tile

@@ -8,13 +8,14 @@
 //! (the per-pixel cut), `lightcuts_views`. CPU twins in `crate::reference::lightcuts` (which
 //! documents the bound); docs/lightcuts.md.
 
+mod kernels;
 pub mod pass;
 pub mod settings;
 mod ui;
 
 use super::{
-    CutStory, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, StoryCut,
-    ViewCx, ViewInfo,
+    CutStory, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, Story,
+    StoryCut, ViewCx, ViewInfo,
 };
 use crate::gpu::context::{GpuContext, GpuError};
 use crate::gpu::readback::{self, ImageF32};
@@ -356,13 +357,13 @@ impl Method for Lightcuts {
     }
 
     /// The pinned pixel's cut with its refinement counters.
-    fn read_cut_story(&self, ctx: &GpuContext) -> Result<Option<CutStory>, GpuError> {
+    fn read_story(&self, ctx: &GpuContext) -> Result<Option<Story>, GpuError> {
         let Some(t) = self.read_traced_cut(ctx)? else {
             return Ok(None);
         };
         let w = self.buffers.size.0.max(1);
         let visible = t.nodes.iter().filter(|n| n.estimate != [0.0; 3]).count();
-        Ok(Some(CutStory {
+        Ok(Some(Story::Cuts(CutStory {
             rows: vec![
                 ("pixel".into(), format!("({}, {})", t.pixel % w, t.pixel / w)),
                 (
@@ -386,7 +387,7 @@ impl Method for Lightcuts {
             }),
             disagreements: Vec::new(),
             links: Vec::new(),
-        }))
+        })))
     }
 
     /// Per pixel: cut size, refinements, largest bound left / estimate, shadow rays.

@@ -124,20 +124,17 @@ impl Method for TreeSamplers {
             }),
             _ => None,
         };
-        self.pass.record(
-            cx.diagnostics,
-            device,
-            cx.queue,
-            enc,
-            cx.timer,
-            p,
-            cx.tree,
-            cx.scene,
+        let inputs = pass::SlcInputs {
+            diagnostics: cx.diagnostics,
+            params: p,
+            tree: cx.tree,
+            scene: cx.scene,
             gbuffer,
-            raw.unwrap_or(accum),
-            &self.buffers,
-            ism.as_ref(),
-        );
+            accum: raw.unwrap_or(accum),
+            out: &self.buffers,
+            ism: ism.as_ref(),
+        };
+        self.pass.record(device, cx.queue, enc, cx.timer, inputs);
         if let Some(raw) = raw {
             self.record_filter(cx, enc, half_targets.as_ref(), gi_size, frames, raw);
         }
@@ -199,15 +196,17 @@ impl Method for TreeSamplers {
         readback::read_vec4_image(ctx, &self.buffers.diag, self.buffers.size)
     }
 
-    fn read_story(&self, ctx: &GpuContext) -> Result<Option<PixelTrace>, GpuError> {
+    fn read_story(&self, ctx: &GpuContext) -> Result<Option<Story>, GpuError> {
         if !self.traced {
             return Ok(None);
         }
         let bytes = readback::read_storage_buffer(ctx, &self.buffers.trace)?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-        Ok(PixelTrace::parse(&words).map(|t| PixelTrace {
-            filtered: self.raw.is_some(),
-            ..t
+        Ok(pass::parse_trace(&words).map(|t| {
+            Story::Samples(PixelTrace {
+                filtered: self.raw.is_some(),
+                ..t
+            })
         }))
     }
 

@@ -18,7 +18,8 @@ pub mod settings;
 mod ui;
 
 use super::{
-    Bias, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, ViewCx, ViewInfo,
+    Bias, FrameCx, Kind, Legend, Method, MethodId, MethodInfo, MethodView, Module, Resource, Story, ViewCx,
+    ViewInfo,
 };
 use crate::base::sst_node::TreeKind;
 use crate::gpu::context::{GpuContext, GpuError};

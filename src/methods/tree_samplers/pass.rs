@@ -91,6 +91,8 @@ impl SamplingStats {
     }
 }
 
+pub use crate::base::story::{PixelTrace, SampleVisibility, StopReason, TraceSample};
+
 /// Layout of the pixel story (twin of the constants in `shaders/methods/tree_samplers/slc_sample.wgsl`).
 pub const TRACE_HEADER: usize = 32;
 pub const TRACE_RECORD: usize = 64;
@@ -98,174 +100,64 @@ pub const TRACE_SAMPLES: usize = 64;
 pub const TRACE_PATH: usize = 24;
 pub const TRACE_WORDS: usize = TRACE_HEADER + TRACE_RECORD * TRACE_SAMPLES;
 
-/// Where a traversal stopped.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum StopReason {
-    /// At a usable node (v >= v_min and sigma_z < sigma_max): its distribution is sampled.
-    Usable,
-    /// At a leaf (a single VPL).
-    Leaf,
-    /// Both children of a node weigh 0 (nothing there can light the point).
-    Dead,
-    /// The cut slot was empty (fewer nodes than the cut size).
-    EmptySlot,
-}
-
-impl StopReason {
-    pub fn name(self) -> &'static str {
-        match self {
-            StopReason::Usable => "usable node",
-            StopReason::Leaf => "leaf (VPL)",
-            StopReason::Dead => "dead branch",
-            StopReason::EmptySlot => "empty cut slot",
-        }
+/// Parses `slc_sample`'s trace buffer (None: the pixel was not traced this frame).
+pub fn parse_trace(w: &[u32]) -> Option<PixelTrace> {
+    if w.len() < TRACE_WORDS || w[0] != 1 {
+        return None;
     }
-}
-
-/// Whether the sampled light point reached the pixel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SampleVisibility {
-    /// G = 0: the point and the pixel face away from each other (no shadow ray).
-    FacingAway,
-    /// The shadow ray hit geometry.
-    Blocked,
-    Visible,
-}
-
-/// One sample of the traced pixel.
-#[derive(Clone, Debug, PartialEq)]
-pub struct TraceSample {
-    /// Which of the 4 surrounding blocks' cuts it came from (0-3), or None (mock cut, root,
-    /// recomputed cut).
-    pub slot: Option<usize>,
-    /// The cut slot it sampled (its index in the cut; SST: the sample's number).
-    pub cut_slot: u32,
-    /// The node the traversal started at (0: empty slot).
-    pub start: u32,
-    /// The node it stopped at (0: dead branch).
-    pub end: u32,
-    pub steps: u32,
-    pub stop: StopReason,
-    /// Probability of the path (product of the child probabilities).
-    pub prob: f32,
-    /// The nodes taken below `start`, each with the probability of taking it (at most
-    /// [`TRACE_PATH`]).
-    pub path: Vec<(u32, f32)>,
-    /// The sampled light point (world) and what its shadow ray found (None: not evaluated).
-    pub point: Option<(glam::Vec3, SampleVisibility)>,
-    /// Flux/pi x G x V / prob: the sample's estimate of the incident sum (times rho/pi is
-    /// radiance; SST divides by the sample count).
-    pub contribution: glam::Vec3,
-    /// With ISM visibility: the light-tree leaf whose map it looked up.
-    pub ism_map: Option<u32>,
-}
-
-/// The story of one pixel in the last tree-sampling frame: the 4 surrounding blocks, their
-/// bilinear and blend weights, whether it fell back, and every sample (at most
-/// [`TRACE_SAMPLES`]).
-#[derive(Clone, Debug, PartialEq)]
-pub struct PixelTrace {
-    /// 0 blended cuts, 1 mock cut, 2 from the root, 3 recomputed cut.
-    pub mode: u32,
-    pub fell_back: bool,
-    pub blocks: [u32; 4],
-    pub bilinear: [f32; 4],
-    /// Bilinear x similarity (the blend weights before normalising).
-    pub weights: [f32; 4],
-    pub weight_sum: f32,
-    /// Samples the pixel took this frame: the cut size, or with interleaving its subset's
-    /// share of the slots.
-    pub taken: u32,
-    /// The interleaving's n^2 (1: off) and the pixel's subset.
-    pub cells: u32,
-    pub subset: u32,
-    /// Whether the interleaving's geometry-aware filter ran after the samples (the GI buffer
-    /// then holds the filtered value, not this pixel's estimate).
-    pub filtered: bool,
-    pub samples: Vec<TraceSample>,
-}
-
-impl PixelTrace {
-    /// Parses the trace buffer (None: the pixel was not traced this frame).
-    pub fn parse(w: &[u32]) -> Option<Self> {
-        if w.len() < TRACE_WORDS || w[0] != 1 {
-            return None;
-        }
-        let f = |i: usize| f32::from_bits(w[i]);
-        let taken = w[16];
-        let samples = (0..(taken as usize).min(TRACE_SAMPLES))
-            .map(|i| {
-                let b = TRACE_HEADER + i * TRACE_RECORD;
-                let stop = match w[b + 4] {
-                    0 => StopReason::Usable,
-                    1 => StopReason::Leaf,
-                    2 => StopReason::Dead,
-                    _ => StopReason::EmptySlot,
+    let f = |i: usize| f32::from_bits(w[i]);
+    let taken = w[16];
+    let samples = (0..(taken as usize).min(TRACE_SAMPLES))
+        .map(|i| {
+            let b = TRACE_HEADER + i * TRACE_RECORD;
+            let stop = match w[b + 4] {
+                0 => StopReason::Usable,
+                1 => StopReason::Leaf,
+                2 => StopReason::Dead,
+                _ => StopReason::EmptySlot,
+            };
+            let steps = w[b + 3];
+            let path = (0..(steps as usize).min(TRACE_PATH))
+                .map(|k| (w[b + 16 + 2 * k], f(b + 17 + 2 * k)))
+                .collect();
+            let end = w[b + 2];
+            let evaluated = matches!(stop, StopReason::Usable | StopReason::Leaf);
+            let point = evaluated.then(|| {
+                let vis = match w[b + 9] {
+                    0 => SampleVisibility::FacingAway,
+                    1 => SampleVisibility::Blocked,
+                    _ => SampleVisibility::Visible,
                 };
-                let steps = w[b + 3];
-                let path = (0..(steps as usize).min(TRACE_PATH))
-                    .map(|k| (w[b + 16 + 2 * k], f(b + 17 + 2 * k)))
-                    .collect();
-                let end = w[b + 2];
-                let evaluated = matches!(stop, StopReason::Usable | StopReason::Leaf);
-                let point = evaluated.then(|| {
-                    let vis = match w[b + 9] {
-                        0 => SampleVisibility::FacingAway,
-                        1 => SampleVisibility::Blocked,
-                        _ => SampleVisibility::Visible,
-                    };
-                    (glam::Vec3::new(f(b + 6), f(b + 7), f(b + 8)), vis)
-                });
-                TraceSample {
-                    slot: (w[b] < 4).then_some(w[b] as usize),
-                    cut_slot: w[b + 13],
-                    start: w[b + 1],
-                    end,
-                    steps,
-                    stop,
-                    prob: f(b + 5),
-                    path,
-                    point,
-                    contribution: glam::Vec3::new(f(b + 10), f(b + 11), f(b + 12)),
-                    ism_map: w[b + 14].checked_sub(1),
-                }
-            })
-            .collect();
-        Some(Self {
-            mode: w[1],
-            fell_back: w[2] != 0,
-            blocks: [w[3], w[4], w[5], w[6]],
-            bilinear: [f(7), f(8), f(9), f(10)],
-            weights: [f(11), f(12), f(13), f(14)],
-            weight_sum: f(15),
-            taken,
-            cells: w[17].max(1),
-            subset: w[18],
-            filtered: false,
-            samples,
+                (glam::Vec3::new(f(b + 6), f(b + 7), f(b + 8)), vis)
+            });
+            TraceSample {
+                slot: (w[b] < 4).then_some(w[b] as usize),
+                cut_slot: w[b + 13],
+                start: w[b + 1],
+                end,
+                steps,
+                stop,
+                prob: f(b + 5),
+                path,
+                point,
+                contribution: glam::Vec3::new(f(b + 10), f(b + 11), f(b + 12)),
+                ism_map: w[b + 14].checked_sub(1),
+            }
         })
-    }
-
-    /// The pixel's estimate of the incident sum from its samples (times rho / pi it is the
-    /// radiance; before the interleaving's filter): their sum x n^2, or from the root their
-    /// mean.
-    pub fn estimate(&self) -> glam::Vec3 {
-        let sum: glam::Vec3 = self.samples.iter().map(|s| s.contribution).sum();
-        if self.mode == 2 {
-            sum / self.taken.max(1) as f32
-        } else {
-            sum * self.cells as f32
-        }
-    }
-
-    pub fn mode_name(&self) -> &'static str {
-        match self.mode {
-            0 => "blended cuts of the 4 surrounding blocks",
-            1 => "mock cut (no similar block cut)",
-            2 => "from the root",
-            _ => "own cut, recomputed at the pixel",
-        }
-    }
+        .collect();
+    Some(PixelTrace {
+        mode: w[1],
+        fell_back: w[2] != 0,
+        blocks: [w[3], w[4], w[5], w[6]],
+        bilinear: [f(7), f(8), f(9), f(10)],
+        weights: [f(11), f(12), f(13), f(14)],
+        weight_sum: f(15),
+        taken,
+        cells: w[17].max(1),
+        subset: w[18],
+        filtered: false,
+        samples,
+    })
 }
 
 /// Per-frame buffers: the cuts (cut_size node ids per block, 0 = empty slot; then the radix
@@ -348,6 +240,20 @@ pub struct GpuSlcViewParams {
     /// 1: the radix tree (cut depths along its links).
     pub radix: u32,
     pub leaves: u32,
+}
+
+/// What one sampling frame reads and writes: its parameters, the frame's light tree, scene
+/// and G-buffer, the buffer it adds its estimate to, its own buffers, and the leaves' maps
+/// with ISM visibility; `diagnostics` also writes the per-pixel diagnostics, counters and story.
+pub struct SlcInputs<'a> {
+    pub diagnostics: bool,
+    pub params: GpuSlcParams,
+    pub tree: &'a TreeBuffers,
+    pub scene: &'a SceneGpu,
+    pub gbuffer: &'a GbufferTargets,
+    pub accum: &'a wgpu::Buffer,
+    pub out: &'a SlcBuffers,
+    pub ism: Option<&'a SlcIsm<'a>>,
 }
 
 /// The leaves' maps of a frame with ISM visibility.
@@ -437,22 +343,24 @@ impl SlcPass {
     /// Records the cuts (skipped for SST, which starts at the root) and the sampling; with
     /// `diagnostics` the sampling also writes the per-pixel diagnostics, the counters (read
     /// back after the frame) and the story, otherwise it touches none of them.
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
-        diagnostics: bool,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
-        p: GpuSlcParams,
-        tree: &TreeBuffers,
-        scene: &SceneGpu,
-        gbuffer: &GbufferTargets,
-        accum: &wgpu::Buffer,
-        out: &SlcBuffers,
-        ism: Option<&SlcIsm<'_>>,
+        inputs: SlcInputs<'_>,
     ) {
+        let SlcInputs {
+            diagnostics,
+            params: p,
+            tree,
+            scene,
+            gbuffer,
+            accum,
+            out,
+            ism,
+        } = inputs;
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         let (ism_depth, ism_lights) = match ism {
             Some(m) => {
@@ -619,7 +527,7 @@ pub struct GpuSlcParams {
     /// 1: the estimate without the albedo (half-resolution GI, upsampled at full resolution;
     /// interleaving, whose filter applies it).
     pub demodulate: u32,
-    /// x | y << 16 of the pixel whose samples are recorded (`methods::tree_samplers::pass::PixelTrace`);
+    /// x | y << 16 of the pixel whose samples are recorded (`base::story::PixelTrace`);
     /// `u32::MAX` = none.
     pub trace_pixel: u32,
     /// Near-field refinement factor (`SamplingSettings::near_field`; 0 = off).

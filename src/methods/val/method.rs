@@ -211,23 +211,15 @@ impl Method for Vals {
             res: t.res,
             _pad: [0; 2],
         };
-        self.pass.record_view(
-            cx.device,
-            cx.queue,
-            enc,
-            cx.timer,
-            p,
+        let inputs = pass::ValViewInputs {
+            params: p,
             size,
-            &cx.targets.lighting.final_view,
-            &cx.targets.gbuffer.position_view,
-            cx.scene,
-            cx.camera,
-            &self.buffers,
-            t,
-            ism.map(|it| (it, &self.settings.ism, self.ism_maps)),
-            cx.dst,
+            buffers: &self.buffers,
+            targets: t,
+            ism: ism.map(|it| (it, &self.settings.ism, self.ism_maps)),
             data,
-        );
+        };
+        self.pass.record_view(cx, enc, inputs);
     }
 
     fn read_view(&self, ctx: &GpuContext, view: MethodView) -> Result<Option<ImageF32>, GpuError> {

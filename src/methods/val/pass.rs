@@ -423,25 +423,23 @@ impl ValPass {
 
     /// Draws a view (`val_views.wgsl`, `p.mode`) into `dst`, its linear data into `data`
     /// (vec4 per `dst` pixel).
-    #[allow(clippy::too_many_arguments)]
     pub fn record_view(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        cx: &mut crate::methods::ViewCx<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-        p: GpuValViewParams,
-        size: (u32, u32),
-        final_image: &wgpu::TextureView,
-        gb_position: &wgpu::TextureView,
-        scene: &SceneGpu,
-        camera: &wgpu::Buffer,
-        b: &ValBuffers,
-        t: &ValTargets,
-        ism: Option<(&IsmTargets, &IsmSettings<IsmVal>, u32)>,
-        dst: &wgpu::TextureView,
-        data: &wgpu::Buffer,
+        v: ValViewInputs<'_>,
     ) {
+        let ValViewInputs {
+            params: p,
+            size,
+            buffers: b,
+            targets: t,
+            ism,
+            data,
+        } = v;
+        let (device, queue, scene, camera, dst) = (cx.device, cx.queue, cx.scene, cx.camera, cx.dst);
+        let final_image = &cx.targets.lighting.final_view;
+        let gb_position = &cx.targets.gbuffer.position_view;
         queue.write_buffer(&self.view_params, 0, bytemuck::bytes_of(&p));
         let depth = match ism {
             Some((it, s, maps)) => {
@@ -472,13 +470,26 @@ impl ValPass {
         );
         run_compute(
             encoder,
-            timer,
+            cx.timer,
             "val_views",
             &self.views,
             &bind,
             groups_image(size.0, size.1),
         );
     }
+}
+
+/// What a VAL view draws from (the frame's final image, G-buffer, scene and camera come
+/// with the view's `ViewCx`): its parameters, size, the method's buffers and targets, the
+/// VALs' shadow maps when it has them (targets, settings, map count), and the buffer of its
+/// linear data (vec4 per pixel).
+pub struct ValViewInputs<'a> {
+    pub params: GpuValViewParams,
+    pub size: (u32, u32),
+    pub buffers: &'a ValBuffers,
+    pub targets: &'a ValTargets,
+    pub ism: Option<(&'a IsmTargets, &'a IsmSettings<IsmVal>, u32)>,
+    pub data: &'a wgpu::Buffer,
 }
 
 /// The structs this method shares with WGSL (its `Module::wgsl_twins`: the registry test

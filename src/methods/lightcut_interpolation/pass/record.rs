@@ -101,9 +101,14 @@ impl LiPass {
             .collect();
         self.params.write(device, queue, &all);
 
-        self.build.record(
-            device, queue, encoder, cx.timer, "li_build", seed, f.tree, &b.cones, &b.reps,
-        );
+        let build = BuildRun {
+            name: "li_build",
+            seed,
+            tree: f.tree,
+            cones: &b.cones,
+            reps: &b.reps,
+        };
+        self.build.record(device, queue, encoder, cx.timer, build);
 
         self.record_records(device, encoder, cx.timer, &p, f, b);
 
@@ -112,22 +117,19 @@ impl LiPass {
             encoder.clear_buffer(&b.trace, 0, None);
         }
         let rb = cut_bindings(f, b, &b.records);
-        self.record_cuts.record(
-            diagnostics,
-            device,
-            queue,
-            encoder,
-            cx.timer,
-            "li_record_cuts",
-            GpuLcParams {
+        let run = CutRun {
+            name: "li_record_cuts",
+            params: GpuLcParams {
                 trace_pixel: u32::MAX,
                 accumulate: 0,
                 ..lc
             },
-            b.capacity,
-            b.record_slice,
-            &rb,
-        );
+            items: b.capacity,
+            slice: b.record_slice,
+            diagnostics,
+        };
+        self.record_cuts
+            .record(device, queue, encoder, cx.timer, run, &rb);
 
         self.record_select(device, encoder, cx.timer, &p, f, b);
 
@@ -153,21 +155,17 @@ impl LiPass {
         encoder.pop_debug_group();
 
         let fb = cut_bindings(f, b, &b.sel);
-        self.fallback.record(
-            diagnostics,
-            device,
-            queue,
-            encoder,
-            cx.timer,
-            "li_fallback",
-            GpuLcParams {
+        let run = CutRun {
+            name: "li_fallback",
+            params: GpuLcParams {
                 trace_pixel: u32::MAX,
                 ..lc
             },
-            p.width * p.height,
-            b.fallback_slice,
-            &fb,
-        );
+            items: p.width * p.height,
+            slice: b.fallback_slice,
+            diagnostics,
+        };
+        self.fallback.record(device, queue, encoder, cx.timer, run, &fb);
         if diagnostics {
             self.stats
                 .record(encoder, &[(&b.stats, 0, 0, 96), (&b.rec_meta, 0, 96, 32)]);
