@@ -45,7 +45,7 @@ pub struct Sheet {
 }
 
 enum Stage {
-    GroundTruth {
+    Truth {
         frame: u32,
     },
     Method {
@@ -108,7 +108,7 @@ impl SheetJob {
             methods,
             frames,
             gt_rays_per_frame,
-            stage: Stage::GroundTruth { frame: 0 },
+            stage: Stage::Truth { frame: 0 },
             gt: None,
             columns: Vec::new(),
             title,
@@ -132,7 +132,7 @@ impl SheetJob {
         };
         let n_methods = self.methods.len() as f32;
         match &mut self.stage {
-            Stage::GroundTruth { frame: f } => {
+            Stage::Truth { frame: f } => {
                 if *f == 0 {
                     let mut s = self.base.clone();
                     s.gi.method = crate::methods::comparison_truth();
@@ -527,7 +527,7 @@ mod tests {
             pixels: vec![[0.5, 0.5, 0.5, 1.0]; 4],
         };
         SheetColumn {
-            method: crate::methods::tree_samplers::SLC,
+            method: crate::methods::per_frame()[0],
             final_: img.clone(),
             indirect: img,
             metrics: m,
