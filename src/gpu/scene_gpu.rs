@@ -227,14 +227,14 @@ fn upload_textures(
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
-    let placeholder = TextureImage {
+    let white = TextureImage {
         name: "white".into(),
         width: 1,
         height: 1,
         rgba8: vec![255; 4],
     };
     let sources: Vec<&TextureImage> = if scene.textures.is_empty() {
-        vec![&placeholder]
+        vec![&white]
     } else {
         scene.textures.iter().collect()
     };
