@@ -173,7 +173,7 @@ impl SheetJob {
                 if *f == 0 {
                     let mut s = self.base.clone();
                     s.gi.method = method;
-                    s.sampling.accumulate = true;
+                    s.frame.accumulate = true;
                     r.set_settings(s).map_err(|e| e.to_string())?;
                     // Every frame of the method timed, without diagnostics; drain the timings
                     // of earlier frames (the readback skips frames while one is pending).

@@ -174,7 +174,7 @@ fn fixed_frame(
 ) -> (LightCullingSettings, RenderSettings, Setup, Vec<GpuVpl>) {
     let lc = small(0.002);
     let mut s = settings(lc.clone());
-    s.sampling.fixed_seed = true;
+    s.frame.fixed_seed = true;
     let mut st = Setup::new(ctx, s.clone(), (W, H));
     st.frame();
     let vpls = st.r.read_vpls().unwrap();
@@ -190,7 +190,7 @@ fn converges(
     what: &str,
     ratio_tol: f64,
 ) -> Vec<(&'static str, f64)> {
-    st.set(|s| s.sampling.accumulate = true);
+    st.set(|s| s.frame.accumulate = true);
     let mut errs = Vec::new();
     for target in [16u32, 256] {
         while st.r.sampling_frames() < target {
@@ -532,7 +532,7 @@ fn the_mean_over_frames_converges_to_the_unshadowed_ground_truth_and_clamping_da
     // all), by at most eps_max / E (appendix A's bound, albedo <= 1), and the image measurably.
     st.set(|s| {
         s.gi.method = light_culling::CLAMPED;
-        s.sampling.accumulate = false;
+        s.frame.accumulate = false;
         let mut l: LightCullingSettings = s.method(light_culling::ID).unwrap();
         l.interleave.n = 1;
         s.set_method(light_culling::ID, &l).unwrap();
@@ -583,7 +583,7 @@ fn the_mean_over_frames_converges_to_the_unshadowed_ground_truth_and_clamping_da
     st.r.keep_views(vec![light_culling::DIFFERENCE]);
     st.set(|s| {
         s.gi.method = light_culling::ID;
-        s.sampling.accumulate = true;
+        s.frame.accumulate = true;
     });
     while st.r.sampling_frames() < 16 {
         st.frame();
@@ -649,7 +649,7 @@ fn the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_trut
     };
     let mut s = settings(lc.clone());
     s.gi.method = light_culling::TREE;
-    s.sampling.fixed_seed = true;
+    s.frame.fixed_seed = true;
     let mut st = Setup::new(&ctx, s.clone(), (W, H));
     st.frame();
     let (_, tb) = st.r.tree_buffers();
@@ -752,7 +752,7 @@ fn the_tree_variant_equals_the_cpu_and_its_mean_converges_to_the_unshadowed_trut
     // Unbiased: without visibility the mean over frames converges to the unshadowed truth.
     st.set(|s| {
         s.gi.shadow_rays = false;
-        s.sampling.fixed_seed = false;
+        s.frame.fixed_seed = false;
     });
     st.frame();
     let gt = st.ground_truth_of_these_vpls();
@@ -847,7 +847,7 @@ fn ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays() {
     let Some(ctx) = common::gpu() else { return };
     let lc = ism_small();
     let mut s = settings(lc.clone());
-    s.sampling.fixed_seed = true;
+    s.frame.fixed_seed = true;
     let mut st = Setup::new(&ctx, s.clone(), (W, H));
     st.frame();
     assert!(ctx.errors.take().is_empty());
@@ -1105,7 +1105,7 @@ fn with_ggx_the_shading_equals_the_cpu_and_the_means_converge_to_the_ggx_truth()
     lc.interleave.filter_radius = 0;
     let mut s = settings(lc.clone());
     s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
-    s.sampling.fixed_seed = true;
+    s.frame.fixed_seed = true;
     let scene = || {
         let mut scene = lightcut::scene::default_scene::build();
         for (i, m) in scene.materials.iter_mut().enumerate() {
@@ -1179,7 +1179,7 @@ fn with_ggx_the_shading_equals_the_cpu_and_the_means_converge_to_the_ggx_truth()
         let mut s = s.clone();
         s.gi.method = method;
         s.gi.shadow_rays = false;
-        s.sampling.fixed_seed = false;
+        s.frame.fixed_seed = false;
         let mut st = Setup::with_scene(&ctx, scene(), s, (W, H));
         st.frame();
         let gt = st.ground_truth_of_these_vpls();

@@ -44,7 +44,7 @@ fn settings(li_s: LightcutInterpolationSettings) -> RenderSettings {
     s.gi.method = li::ID;
     s.vpl.count = 256;
     s.shadow.resolution = 256;
-    s.sampling.fixed_seed = true;
+    s.frame.fixed_seed = true;
     s.set_method(li::ID, &li_s).unwrap();
     s
 }

@@ -191,7 +191,7 @@ fn check_lightcuts(ctx: &GpuContext, kind: TreeKind) {
     let ctx = ctx.clone();
     // A max cut that some pixels reach, so that both stopping rules are exercised.
     let mut s = settings(0.05, 64);
-    s.sampling.fixed_seed = true;
+    s.frame.fixed_seed = true;
     s.tree.kind = kind;
     let mut st = setup(&ctx, s.clone());
     let traced = (W / 2, H / 2);
@@ -371,7 +371,7 @@ fn the_mean_over_builds_of_a_fixed_cut_converges_to_the_ground_truth() {
     let mut st = setup(&ctx, settings(0.0, 64));
     st.frame();
     let gt = st.ground_truth_of_these_vpls();
-    st.set(|s| s.sampling.accumulate = true);
+    st.set(|s| s.frame.accumulate = true);
     let mut errs = Vec::new();
     for target in [16u32, 256] {
         while st.r.sampling_frames() < target {
@@ -491,7 +491,7 @@ fn gpu_lightcuts_with_ggx_equal_the_cpu_reference() {
     use lightcut::reference::lightcuts::{Shading, lightcut_shaded_on};
     let Some(ctx) = common::gpu() else { return };
     let mut s = settings(0.05, 64);
-    s.sampling.fixed_seed = true;
+    s.frame.fixed_seed = true;
     s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
     let mut st = Setup::with_scene(&ctx, mixed_glossy_room(), s.clone(), (W, H));
     st.frame();

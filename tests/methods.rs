@@ -207,8 +207,8 @@ fn timed_frames_record_no_diagnostics_and_compute_the_same_gi() {
     let truth_passes = methods::comparison_truth().info().timed_passes;
     for m in [SLC, SST, RTSLC] {
         let mut s = tiny(m);
-        s.sampling.fixed_seed = true;
-        s.sampling.accumulate = false;
+        s.frame.fixed_seed = true;
+        s.frame.accumulate = false;
         let mut r = Renderer::new(ctx.clone(), &scene, (48, 32), s).unwrap();
         r.set_trace_pixel(Some((20, 10)));
         r.set_compare_ground_truth(true);
@@ -303,7 +303,7 @@ fn cut_size_64_counts_like_cut_size_32() {
     let stats = |r: &mut Renderer, m: MethodId, cut: u32| {
         let mut s = tiny(m);
         s.sampling.cut_size = cut;
-        s.sampling.accumulate = false;
+        s.frame.accumulate = false;
         r.set_settings(s).unwrap();
         r.render(&FrameInput {
             camera: &cam,
@@ -411,8 +411,8 @@ fn bias_contract(scene: &str) {
         let mut base = tiny(methods::tree_samplers::RTSLC);
         // The thesis's 32 samples per pixel: the leaf samplers are heavy-tailed at 8.
         base.sampling.cut_size = 32;
-        base.sampling.accumulate = false;
-        base.sampling.fixed_seed = false;
+        base.frame.accumulate = false;
+        base.frame.fixed_seed = false;
         let mut st = common::Setup::with_scene(&ctx, (b.build)(), base.clone(), (48, 32));
         st.frame();
         // The truths of the same VPLs (the tree frozen: the VPLs stay for every method).

@@ -306,7 +306,7 @@ fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
         st.set(|s| {
             s.gi.method = RTSLC;
             s.sampling.block_size = 1;
-            s.sampling.accumulate = true;
+            s.frame.accumulate = true;
             s.sampling.child_probability = cp;
             s.sampling.interleave = InterleaveSettings {
                 filter_radius: 0,
@@ -360,7 +360,7 @@ fn rtslc_on_the_radix_tree_converges_to_the_ground_truth() {
         s.gi.method = RTSLC;
         s.tree.kind = TreeKind::Lbvh;
         s.sampling.block_size = 1;
-        s.sampling.accumulate = true;
+        s.frame.accumulate = true;
     });
     st.frame();
     assert_eq!(st.r.tree_buffers().1.kind, TreeKind::Lbvh);
@@ -450,7 +450,7 @@ fn the_comparison_ground_truth_equals_the_ground_truth_method() {
     st.set(|s| {
         s.gi.rays_per_frame = 1 << 22;
         // Accumulating: the sampler's composite scale (1/frames) must not reach the ground truth's.
-        s.sampling.accumulate = true;
+        s.frame.accumulate = true;
     });
     st.r.set_compare_ground_truth(true);
     let mut frames = 0;
@@ -559,7 +559,7 @@ fn interleaved_sampling_shares_the_cut_slots_out_and_its_filter_equals_the_cpu_r
     // whole sum: the pixel averages its share; the filter leaves the albedo to the upsampler).
     for (method, half) in [(SLC, false), (SST, true)] {
         let mut s = settings(method);
-        s.sampling.fixed_seed = true;
+        s.frame.fixed_seed = true;
         s.sampling.half_resolution = half;
         // Visibility is not what this checks (and without it most samples light the pixel).
         s.gi.shadow_rays = false;
@@ -745,7 +745,7 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
     ] {
         let mut st = setup(&ctx, settings(method));
         st.set(|s| {
-            s.sampling.accumulate = false;
+            s.frame.accumulate = false;
             s.sampling.child_probability = cp;
         });
         st.frame();
@@ -916,7 +916,7 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
 /// run) after `f` changes the settings.
 fn fixed_seed_frame(ctx: &GpuContext, method: MethodId, f: impl FnOnce(&mut RenderSettings)) -> ImageF32 {
     let mut s = settings(method);
-    s.sampling.fixed_seed = true;
+    s.frame.fixed_seed = true;
     f(&mut s);
     let mut st = setup(ctx, s);
     st.frame();
@@ -999,7 +999,7 @@ fn ism_visibility_looks_samples_up_in_the_leaves_maps_as_the_cpu_does() {
     let mut s = RenderSettings::default();
     s.gi.method = SLC;
     s.vpl.count = 256;
-    s.sampling.fixed_seed = true;
+    s.frame.fixed_seed = true;
     s.sampling.visibility = SamplerVisibility::Ism;
     s.sampling.ism = IsmSettings {
         points: 1 << 17,
@@ -1129,8 +1129,8 @@ fn ism_visibility_looks_samples_up_in_the_leaves_maps_as_the_cpu_does() {
     let mean = |st: &mut Setup, ism_on: bool| {
         st.r.set_trace_pixel(None);
         st.set(|s| {
-            s.sampling.fixed_seed = false;
-            s.sampling.accumulate = true;
+            s.frame.fixed_seed = false;
+            s.frame.accumulate = true;
             s.sampling.visibility = if ism_on {
                 SamplerVisibility::Ism
             } else {
@@ -1194,7 +1194,7 @@ fn with_ggx_glossy_samples_walk_to_leaves_so_the_samplers_converge_on_metal() {
         st.set(|s| {
             s.gi.method = method;
             s.sampling.block_size = 1;
-            s.sampling.accumulate = true;
+            s.frame.accumulate = true;
         });
         let errs = converge(&mut st, &gt);
         eprintln!("{method} with GGX vs ground truth (frames, RMSE, block error, mean ratio): {errs:?}");
@@ -1254,7 +1254,7 @@ fn glossy_walks_weigh_children_by_the_material_term_as_the_cpu_does() {
     ] {
         let mut s = settings(method);
         s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
-        s.sampling.accumulate = false;
+        s.frame.accumulate = false;
         s.sampling.glossy_weights = weights;
         let mut st = Setup::with_scene(&ctx, glossy_room(1.0, 0.3), s, (W, H));
         st.frame();
@@ -1343,7 +1343,7 @@ fn the_defensive_glossy_weights_lower_the_error_on_polished_metal() {
             st.set(|s| {
                 s.gi.method = method;
                 s.sampling.block_size = 1;
-                s.sampling.accumulate = true;
+                s.frame.accumulate = true;
             });
             let errs = converge(&mut st, &gt);
             eprintln!("{method} metal 0.3, {weights:?} (frames, RMSE, block error, mean ratio): {errs:?}");

@@ -28,7 +28,7 @@ fn settings(method: &str, mode: TemporalMode) -> RenderSettings {
     s.gi.method = lightcut::methods::MethodId::parse(method).unwrap();
     s.vpl.count = 256;
     s.shadow.resolution = 256;
-    s.sampling.accumulate = false;
+    s.frame.accumulate = false;
     s.temporal.mode = mode;
     s
 }

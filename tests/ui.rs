@@ -343,7 +343,7 @@ fn raising_v_min_changes_the_traversal_steps_image() {
 fn a_view_exported_from_the_gui_renders_again_bit_for_bit_from_its_record() {
     use lightcut::app::image_views::ExportKind;
     let mut settings = slc_settings();
-    settings.sampling.accumulate = true;
+    settings.frame.accumulate = true;
     let options = AppOptions {
         settings: Some(settings),
         views: vec![ViewBuffer::Final],

@@ -351,7 +351,7 @@ fn method_settings(vs: &ValSettings, method: lightcut::methods::MethodId) -> Ren
     s.gi.method = method;
     s.vpl.count = 250;
     s.shadow.resolution = METHOD_RES;
-    s.sampling.fixed_seed = true;
+    s.frame.fixed_seed = true;
     s.set_method(val_method::ID, vs).unwrap();
     s
 }
@@ -738,8 +738,8 @@ fn the_method_converges_to_its_own_sum_and_its_maps_agree_with_rays() {
     vs.interleave.filter_radius = 0;
     vs.paper_filter = false;
     let mut s = method_settings(&vs, val_method::ID);
-    s.sampling.fixed_seed = false;
-    s.sampling.accumulate = true;
+    s.frame.fixed_seed = false;
+    s.frame.accumulate = true;
     let mut st = Setup::new(&ctx, s.clone(), (W, H));
     let f0 = st.r.frame_index();
     let frames = 12u64;

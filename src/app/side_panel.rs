@@ -308,7 +308,7 @@ impl WorkbenchApp {
             {
                 self.anim.step = true;
             }
-            ui.checkbox(&mut self.settings.sampling.fixed_seed, "fixed seed")
+            ui.checkbox(&mut self.settings.frame.fixed_seed, "fixed seed")
                 .on_hover_text("the samplers draw the same random numbers every frame");
         });
     }

@@ -95,8 +95,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let mut s = RenderSettings::default();
     s.display.exposure_ev = opened.exposure_ev;
     s.gi.method = lightcuts::ID;
-    s.sampling.accumulate = false;
-    s.sampling.fixed_seed = true;
+    s.frame.accumulate = false;
+    s.frame.fixed_seed = true;
     if let Some(n) = args.vpls {
         s.vpl.count = n;
     }

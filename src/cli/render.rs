@@ -234,7 +234,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let image_settings_for_record = image_settings.clone();
     if method.per_frame() {
         let mut s = image_settings.clone();
-        s.sampling.accumulate = false;
+        s.frame.accumulate = false;
         r.set_settings(s)?;
     }
     let n_timing = args.timing_frames.max(1);

@@ -68,7 +68,7 @@ pub fn run(
         ));
     }
     let m = motion(args, opened, camera)?;
-    settings.sampling.accumulate = false;
+    settings.frame.accumulate = false;
     settings.vpl.animate = false;
     let ctx = GpuContext::new_headless()?;
     println!("adapter: {}", ctx.describe());

@@ -315,8 +315,8 @@ impl Bench {
         // Same VPLs every frame (the ground truth must match them); a new sampler seed per
         // frame (independent frames).
         base.vpl.animate = false;
-        base.sampling.accumulate = false;
-        base.sampling.fixed_seed = false;
+        base.frame.accumulate = false;
+        base.frame.fixed_seed = false;
         let gi_exposure = base.display.exposure_ev + 3.0;
         Self {
             r,

@@ -74,7 +74,7 @@ pub enum Kind {
     DirectOnly,
     /// Accumulates towards a converged image over frames (progress bar, restarts on change).
     Progressive,
-    /// One estimate per frame (averaged over frames only while `sampling.accumulate`).
+    /// One estimate per frame (averaged over frames only while `frame.accumulate`).
     PerFrame,
 }
 

@@ -1,10 +1,15 @@
 //! Renderer settings: one serde struct per pass, documented field by field. The same structs
 //! are edited by the UI, saved with the app state, read from presets and set by CLI flags.
 
+mod frame;
+mod legacy;
+mod method_tables;
 mod shared_passes;
 pub mod temporal;
 mod view_buffer;
 
+pub use frame::FrameSettings;
+pub use method_tables::MethodTables;
 pub use shared_passes::*;
 pub use view_buffer::ViewBuffer;
 
@@ -12,10 +17,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::base::field::{self, Field};
 
-/// All settings of the frame.
+/// All settings of the frame. Read through [`legacy::migrate`] first, so files written
+/// before a key moved still load (`Deserialize` below).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(default, deny_unknown_fields, remote = "Self")]
 pub struct RenderSettings {
+    /// Frame-wide: accumulation over frames, a fixed seed.
+    pub frame: FrameSettings,
     pub shadow: ShadowSettings,
     pub vpl: VplSettings,
     pub gi: GiSettings,
@@ -28,21 +36,33 @@ pub struct RenderSettings {
     /// Settings of the methods that own no section above: `[methods.<cli name>]` tables, each
     /// read and written as the method's own serde struct ([`RenderSettings::method`]), so a
     /// new method brings its settings in its folder without a field here.
-    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
-    pub methods: std::collections::BTreeMap<String, toml::Table>,
+    #[serde(skip_serializing_if = "MethodTables::is_empty")]
+    pub methods: MethodTables,
+}
+
+impl Serialize for RenderSettings {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        RenderSettings::serialize(self, s)
+    }
+}
+
+impl<'de> Deserialize<'de> for RenderSettings {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let mut t = toml::Table::deserialize(d)?;
+        legacy::migrate(&mut t).map_err(D::Error::custom)?;
+        RenderSettings::deserialize(t).map_err(|e| D::Error::custom(e.message()))
+    }
 }
 
 impl RenderSettings {
     /// A method's settings from its `[methods.<cli name>]` table (its defaults where the table
     /// or a field is absent); the error names the table and the field.
-    pub fn method<T: serde::de::DeserializeOwned + Default>(&self, id: MethodId) -> Result<T, String> {
-        match self.methods.get(id.cli()) {
-            None => Ok(T::default()),
-            Some(t) => t
-                .clone()
-                .try_into()
-                .map_err(|e: toml::de::Error| format!("methods.{}: {}", id.cli(), e.message())),
-        }
+    pub fn method<T: serde::de::DeserializeOwned + Default + Clone + Send + Sync + 'static>(
+        &self,
+        id: MethodId,
+    ) -> Result<T, String> {
+        self.methods.get(id.cli())
     }
 
     /// Sets one field by its TOML path (`methods.lightcuts.max_cut`, `gi.distance_epsilon`) to
@@ -83,9 +103,7 @@ impl RenderSettings {
 
     /// Stores a method's settings as its `[methods.<cli name>]` table.
     pub fn set_method<T: Serialize>(&mut self, id: MethodId, value: &T) -> Result<(), String> {
-        let t = toml::Table::try_from(value).map_err(|e| format!("methods.{}: {e}", id.cli()))?;
-        self.methods.insert(id.cli().to_string(), t);
-        Ok(())
+        self.methods.set(id.cli(), value)
     }
 }
 
@@ -651,6 +669,24 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_file_from_before_the_frame_section_still_loads() {
+        let old: RenderSettings =
+            toml::from_str("[sampling]\naccumulate = true\nfixed_seed = true\ncut_size = 8").unwrap();
+        assert!(old.frame.accumulate && old.frame.fixed_seed);
+        assert_eq!(old.sampling.cut_size, 8);
+        let now = toml::to_string(&old).unwrap();
+        assert!(
+            now.contains("[frame]") && !now.contains("sampling.accumulate"),
+            "{now}"
+        );
+        let clash =
+            toml::from_str::<RenderSettings>("[sampling]\naccumulate = true\n[frame]\naccumulate = false");
+        assert!(clash.unwrap_err().to_string().contains("sampling.accumulate"));
+        let unknown = toml::from_str::<RenderSettings>("[frame]\nspeed = 2");
+        assert!(unknown.unwrap_err().to_string().contains("speed"));
+    }
+
+    #[test]
     fn defaults_are_valid_and_round_trip_through_toml() {
         let s = RenderSettings::default();
         assert!(s.validate().is_ok());
@@ -718,7 +754,7 @@ mod tests {
 
     #[test]
     fn a_methods_own_table_round_trips_and_errors_name_it() {
-        #[derive(Debug, Default, PartialEq, Serialize, Deserialize)]
+        #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
         #[serde(default, deny_unknown_fields)]
         struct Knobs {
             threshold: f32,

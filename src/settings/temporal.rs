@@ -14,7 +14,7 @@ pub const MAX_ATROUS_ITERATIONS: u32 = 8;
 #[serde(rename_all = "lowercase")]
 pub enum TemporalMode {
     /// The method's estimate as it is (today's frames; a still view may still average frames
-    /// with `sampling.accumulate`).
+    /// with `frame.accumulate`).
     #[default]
     Off,
     /// Temporal reprojection and exponential history only (no spatial filter).

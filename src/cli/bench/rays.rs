@@ -247,7 +247,7 @@ pub(super) fn in_frame_settings(opened: &crate::scene::preset::OpenedScene) -> R
     let mut s = RenderSettings::default();
     s.display.exposure_ev = opened.exposure_ev;
     s.gi.method = crate::methods::tree_samplers::SLC;
-    s.sampling.accumulate = false;
+    s.frame.accumulate = false;
     s
 }
 

@@ -357,7 +357,7 @@ impl SamplingArgs {
         if let Some(v) = self.d_max {
             s.vpl.d_max = v;
         }
-        s.sampling.accumulate = self.frames > 1;
+        s.frame.accumulate = self.frames > 1;
     }
 }
 

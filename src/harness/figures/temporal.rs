@@ -42,7 +42,7 @@ fn motions(b: &Bench, o: &Opts) -> anyhow::Result<Vec<Motion>> {
 fn stage(b: &Bench, method: MethodId) -> RenderSettings {
     with(b, |s| {
         s.gi.method = method;
-        s.sampling.accumulate = false;
+        s.frame.accumulate = false;
         if s.temporal.mode == TemporalMode::Off {
             s.temporal.mode = TemporalMode::Svgf;
         }

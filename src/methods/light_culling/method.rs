@@ -21,7 +21,7 @@ impl Method for LightCulling {
             return 1.0;
         }
         let frames = match self.state {
-            Some((k, m, n)) if s.sampling.accumulate && k == cx.key && m == cx.method => n + 1,
+            Some((k, m, n)) if s.frame.accumulate && k == cx.key && m == cx.method => n + 1,
             _ => 1,
         };
         let seed = Self::seed(s, cx.frame_index);

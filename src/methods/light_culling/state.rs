@@ -11,9 +11,9 @@ impl LightCulling {
     pub fn tree_buffers(&self) -> Option<&TreeCullBuffers> {
         self.tree.as_ref()
     }
-    /// The frame's xi seed (a new one per frame unless `sampling.fixed_seed`).
+    /// The frame's xi seed (a new one per frame unless `frame.fixed_seed`).
     pub fn seed(s: &RenderSettings, frame_index: u64) -> u32 {
-        if s.sampling.fixed_seed {
+        if s.frame.fixed_seed {
             s.vpl.seed ^ 0x1b87_3593
         } else {
             (s.vpl.seed ^ 0x1b87_3593) ^ (frame_index as u32).wrapping_mul(0x9e37_79b9)
@@ -265,7 +265,7 @@ impl LightCulling {
         self.buffers.ensure_companion(cx.device);
         let other = if cx.method == CLAMPED { ID } else { CLAMPED };
         let n = match self.companion {
-            Some((k, m, n)) if cx.settings.sampling.accumulate && k == cx.key && m == other => n + 1,
+            Some((k, m, n)) if cx.settings.frame.accumulate && k == cx.key && m == other => n + 1,
             _ => 1,
         };
         self.companion = Some((cx.key, other, n));

@@ -16,7 +16,7 @@ pub fn settings_ui(ui: &mut dyn SettingsUi, method: MethodId, s: &mut RenderSett
     };
     let before = lc.clone();
     ui.toggle(
-        &mut s.sampling.accumulate,
+        &mut s.frame.accumulate,
         "accumulate frames while static",
         "average the frames' estimates while the view, lights and settings stay (the \
          clamped-vs-stochastic view then compares converged means)",

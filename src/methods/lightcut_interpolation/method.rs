@@ -58,7 +58,7 @@ impl Method for LightcutInterpolation {
             return 1.0;
         };
         let frames = match self.state {
-            Some((k, n)) if s.sampling.accumulate && k == cx.key => n + 1,
+            Some((k, n)) if s.frame.accumulate && k == cx.key => n + 1,
             _ => 1,
         };
         self.state = Some((cx.key, frames));

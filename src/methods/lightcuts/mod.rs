@@ -246,7 +246,7 @@ impl Lightcuts {
     }
     /// The seed of frame `frame_index`'s representatives.
     pub fn seed(s: &RenderSettings, frame_index: u64) -> u32 {
-        if s.sampling.fixed_seed {
+        if s.frame.fixed_seed {
             s.vpl.seed
         } else {
             s.vpl.seed ^ (frame_index as u32).wrapping_mul(0x9e37_79b9)
@@ -283,7 +283,7 @@ impl Method for Lightcuts {
             self.buffers = LcBuffers::new(cx.device, leaves, cx.size, max_cut, budget);
         }
         let frames = match self.state {
-            Some((k, n)) if s.sampling.accumulate && k == cx.key => n + 1,
+            Some((k, n)) if s.frame.accumulate && k == cx.key => n + 1,
             _ => 1,
         };
         self.state = Some((cx.key, frames));

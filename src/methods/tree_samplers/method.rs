@@ -5,7 +5,7 @@ use super::*;
 
 impl Method for TreeSamplers {
     /// One frame; returns 1 / the frames summed in the accumulation (1 unless
-    /// `sampling.accumulate` and nothing changed).
+    /// `frame.accumulate` and nothing changed).
     fn record(&mut self, cx: &mut FrameCx<'_>, enc: &mut wgpu::CommandEncoder) -> f32 {
         let s = cx.settings;
         let sm = &s.sampling;
@@ -23,14 +23,14 @@ impl Method for TreeSamplers {
         // Accumulate while nothing changes (the key also covers the method and its settings);
         // a frozen tree keeps its VPLs, otherwise new VPLs average in too.
         let key = cx.key;
-        if half && self.state.is_none_or(|(k, _)| k != key || !sm.accumulate) {
+        if half && self.state.is_none_or(|(k, _)| k != key || !s.frame.accumulate) {
             // The half-resolution sum restarts with the accumulation.
             if let Some(h) = &half_targets {
                 enc.clear_buffer(&h.accum, 0, None);
             }
         }
         let frames = match self.state {
-            Some((k, n)) if sm.accumulate && k == key => n + 1,
+            Some((k, n)) if s.frame.accumulate && k == key => n + 1,
             _ => 1,
         };
         self.state = Some((key, frames));
@@ -39,7 +39,7 @@ impl Method for TreeSamplers {
         let il = &sm.interleave;
         let filtered = il.filters();
         self.fit_raw(device, filtered, gi_size);
-        let seed = if sm.fixed_seed {
+        let seed = if s.frame.fixed_seed {
             s.vpl.seed
         } else {
             s.vpl.seed ^ (cx.frame_index as u32).wrapping_mul(0x9e37_79b9)

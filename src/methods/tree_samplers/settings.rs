@@ -119,9 +119,6 @@ pub struct SamplingSettings {
     pub glossy_weights: GlossyWeights,
     pub blending: CutBlending,
     pub fallback: CutFallback,
-    /// Average successive frames while the view, lights and settings stay (progressive);
-    /// off shows each frame's estimate alone, as a real-time renderer would.
-    pub accumulate: bool,
     /// Render GI at half resolution and upsample it with a joint bilateral filter using S.
     pub half_resolution: bool,
     /// Interleaved sampling over the cut's slots (`[sampling.interleave]`; ours, after
@@ -132,9 +129,6 @@ pub struct SamplingSettings {
     /// (at the GI resolution, before the upsampling). n^2 fewer shadow rays per pixel for a
     /// blur within surfaces. Default off (n = 1, the thesis).
     pub interleave: InterleaveSettings,
-    /// The samplers' random numbers are the same every frame (debugging: a pixel's story
-    /// repeats); off, the seed changes per frame (needed to accumulate).
-    pub fixed_seed: bool,
     /// Visibility of the samples while shadow rays are on: rays, or the leaves' maps.
     pub visibility: SamplerVisibility,
     /// The leaves' maps (`[sampling.ism]`; light culling's adaptive-map defaults).
@@ -206,10 +200,8 @@ impl Default for SamplingSettings {
             glossy_weights: GlossyWeights::Defensive,
             blending: CutBlending::Stochastic,
             fallback: CutFallback::MockCut,
-            accumulate: false,
             half_resolution: false,
             interleave: InterleaveSettings::pattern(1),
-            fixed_seed: false,
             visibility: SamplerVisibility::Rays,
             ism: IsmSettings::default(),
         }

@@ -79,7 +79,7 @@ pub fn settings_ui(ui: &mut dyn SettingsUi, method: MethodId, s: &mut RenderSett
         lights,
         "RTSLC's code 2 x 2 or 4 x 4",
     );
-    ui.toggle(&mut sm.accumulate, "accumulate frames while static", "");
+    ui.toggle(&mut s.frame.accumulate, "accumulate frames while static", "");
     let shadow_rays = s.gi.shadow_rays;
     let sm = &mut s.sampling;
     radio(

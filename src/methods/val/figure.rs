@@ -77,8 +77,8 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         with(b, |s| {
             s.gi.method = method;
             s.gi.shadow_rays = true;
-            s.sampling.fixed_seed = true;
-            s.sampling.accumulate = false;
+            s.frame.fixed_seed = true;
+            s.frame.accumulate = false;
             let _ = s.set_method(
                 val_method::ID,
                 &ValSettings {

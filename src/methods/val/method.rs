@@ -18,7 +18,7 @@ impl Method for Vals {
         let factor = (rsm.res / res).max(1);
         self.fit_targets(cx, &vs, res);
         let frames = match self.state {
-            Some((k, m, n)) if s.sampling.accumulate && k == cx.key && m == cx.method => n + 1,
+            Some((k, m, n)) if s.frame.accumulate && k == cx.key && m == cx.method => n + 1,
             _ => 1,
         };
         let visibility = visibility_of(s, &vs);

@@ -407,9 +407,9 @@ impl Vals {
     pub fn poll_stats(&mut self) -> Option<ValStats> {
         self.stats.as_mut()?.poll()
     }
-    /// The frame's interleaving offset (a new one per frame unless `sampling.fixed_seed`).
+    /// The frame's interleaving offset (a new one per frame unless `frame.fixed_seed`).
     pub fn offset(s: &RenderSettings, n: u32, frame_index: u64) -> u32 {
-        let seed = if s.sampling.fixed_seed {
+        let seed = if s.frame.fixed_seed {
             s.vpl.seed ^ 0x7a15
         } else {
             (s.vpl.seed ^ 0x7a15) ^ (frame_index as u32).wrapping_mul(0x9e37_79b9)

@@ -16,7 +16,7 @@ pub fn settings_ui(ui: &mut dyn SettingsUi, _method: MethodId, s: &mut RenderSet
     };
     let before = vs.clone();
     ui.toggle(
-        &mut s.sampling.accumulate,
+        &mut s.frame.accumulate,
         "accumulate frames while static",
         "average the frames' estimates (new interleaving offsets) while nothing changes",
     );
