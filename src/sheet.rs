@@ -8,6 +8,7 @@
 //! shows progress and can cancel; the `sheet` command loops it. [`compose`] draws the sheet
 //! (text with the Hack font egui ships, rasterised by `ab_glyph`).
 
+use crate::methods::tree_samplers::settings::SamplingSettings;
 use ab_glyph::{Font, FontRef, PxScale, ScaleFont};
 
 use crate::{
@@ -425,8 +426,8 @@ pub fn compose(sheet: &Sheet) -> Result<Canvas, String> {
             sheet.vpls,
             st.tree.v_min,
             st.tree.sigma_max,
-            st.sampling.block_size,
-            st.sampling.cut_size,
+            SamplingSettings::of(st).block_size,
+            SamplingSettings::of(st).cut_size,
             d.exposure_ev,
             d.tonemap.name()
         ),

@@ -106,7 +106,7 @@ fn bad_input_gives_one_clear_line() {
         "--out",
         "/tmp/x",
     ]);
-    assert!(e.contains("sampling.cut_size"), "{e}");
+    assert!(e.contains("methods.slc.cut_size"), "{e}");
     let e = one_line_error(&["--view", "nope", "--frames", "1"]);
     assert!(e.contains("unknown view 'nope'"), "{e}");
     // Temporal sequences: an unknown bookmark, a frame count without a sequence, a converging
@@ -248,7 +248,10 @@ fn ggx_is_refused_by_methods_that_shade_with_lambert_only() {
         "--out",
         "/tmp/x",
     ]);
-    assert!(e.contains("gi.brdf = Ggx with sampling.half_resolution"), "{e}");
+    assert!(
+        e.contains("gi.brdf = Ggx with methods.slc.half_resolution"),
+        "{e}"
+    );
     let e = one_line_error(&["render", "--brdf", "phong", "--out", "/tmp/x"]);
     assert!(e.contains("phong"), "{e}");
     let e = one_line_error(&[

@@ -5,6 +5,7 @@
 
 mod common;
 
+use lightcut::methods::tree_samplers::settings::SamplingSettings;
 use lightcut::methods::{self, Kind, MethodId, REGISTRY};
 use lightcut::renderer::{
     Buffer, FrameInput, Renderer,
@@ -21,7 +22,7 @@ fn tiny(method: MethodId) -> RenderSettings {
     s.gi.rays_per_frame = 1 << 22;
     s.gi.reference_samples = 8;
     s.gi.reference_spp_per_frame = 8;
-    s.sampling.cut_size = 8;
+    SamplingSettings::edit(&mut s, |m| m.cut_size = 8);
     s
 }
 
@@ -302,7 +303,7 @@ fn cut_size_64_counts_like_cut_size_32() {
     let mut r = Renderer::new(ctx, &scene, (48, 32), tiny(SST)).unwrap();
     let stats = |r: &mut Renderer, m: MethodId, cut: u32| {
         let mut s = tiny(m);
-        s.sampling.cut_size = cut;
+        SamplingSettings::edit(&mut s, |m| m.cut_size = cut);
         s.frame.accumulate = false;
         r.set_settings(s).unwrap();
         r.render(&FrameInput {
@@ -410,7 +411,7 @@ fn bias_contract(scene: &str) {
     for b in test_scenes::BUILTIN.iter().filter(|b| b.name == scene) {
         let mut base = tiny(methods::tree_samplers::RTSLC);
         // The thesis's 32 samples per pixel: the leaf samplers are heavy-tailed at 8.
-        base.sampling.cut_size = 32;
+        SamplingSettings::edit(&mut base, |m| m.cut_size = 32);
         base.frame.accumulate = false;
         base.frame.fixed_seed = false;
         let mut st = common::Setup::with_scene(&ctx, (b.build)(), base.clone(), (48, 32));
@@ -600,13 +601,22 @@ fn branch_configs(m: MethodId, defaults: &RenderSettings) -> Vec<(&'static str, 
         vec![
             (
                 "ism visibility",
-                with(&|s| s.sampling.visibility = tree_samplers::settings::SamplerVisibility::Ism),
+                with(&|s| {
+                    SamplingSettings::edit(s, |m| {
+                        m.visibility = tree_samplers::settings::SamplerVisibility::Ism
+                    })
+                }),
             ),
-            ("half resolution", with(&|s| s.sampling.half_resolution = true)),
+            (
+                "half resolution",
+                with(&|s| SamplingSettings::edit(s, |m| m.half_resolution = true)),
+            ),
             (
                 "2 x 2 interleave + filter",
                 with(&|s| {
-                    s.sampling.interleave = lightcut::renderer::settings::InterleaveSettings::pattern(2)
+                    SamplingSettings::edit(s, |m| {
+                        m.interleave = lightcut::renderer::settings::InterleaveSettings::pattern(2)
+                    })
                 }),
             ),
         ]

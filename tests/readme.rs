@@ -7,6 +7,7 @@
 
 mod common;
 
+use lightcut::methods::tree_samplers::settings::SamplingSettings;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -261,7 +262,7 @@ fn gui_examples_open_what_they_promise() {
     assert!(h.state().tree_stats_shown());
     let s = h.state().renderer().expect("renderer").settings();
     assert_eq!(
-        (s.shadow.resolution, s.vpl.count, s.sampling.cut_size),
+        (s.shadow.resolution, s.vpl.count, SamplingSettings::of(s).cut_size),
         (1024, 2048, 16)
     );
     drop(h);

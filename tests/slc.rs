@@ -5,6 +5,7 @@
 mod common;
 
 use common::{Setup, glossy_room};
+use lightcut::methods::tree_samplers::settings::SamplingSettings;
 
 use glam::Vec3;
 use lightcut::base::sst_node::Topology;
@@ -43,8 +44,8 @@ fn settings(method: MethodId) -> RenderSettings {
     let mut s = RenderSettings::default();
     s.gi.method = method;
     s.vpl.count = 1024;
-    s.sampling.cut_size = 16;
-    s.sampling.block_size = 4;
+    SamplingSettings::edit(&mut s, |m| m.cut_size = 16);
+    SamplingSettings::edit(&mut s, |m| m.block_size = 4);
     s
 }
 
@@ -74,8 +75,8 @@ fn check_cuts(ctx: &GpuContext, kind: TreeKind, cases: &[(bool, u32)]) {
     for &(cull, cut_size) in cases {
         let mut st = setup(ctx, settings(SLC));
         st.set(|s| {
-            s.sampling.cull_behind = cull;
-            s.sampling.cut_size = cut_size;
+            SamplingSettings::edit(s, |m| m.cull_behind = cull);
+            SamplingSettings::edit(s, |m| m.cut_size = cut_size);
             s.tree.kind = kind;
         });
         st.frame();
@@ -305,13 +306,15 @@ fn rtslc_averaged_over_frames_converges_to_the_ground_truth() {
     for (cp, n) in cases {
         st.set(|s| {
             s.gi.method = RTSLC;
-            s.sampling.block_size = 1;
+            SamplingSettings::edit(s, |m| m.block_size = 1);
             s.frame.accumulate = true;
-            s.sampling.child_probability = cp;
-            s.sampling.interleave = InterleaveSettings {
-                filter_radius: 0,
-                ..InterleaveSettings::pattern(n)
-            };
+            SamplingSettings::edit(s, |m| m.child_probability = cp);
+            SamplingSettings::edit(s, |m| {
+                m.interleave = InterleaveSettings {
+                    filter_radius: 0,
+                    ..InterleaveSettings::pattern(n)
+                }
+            });
         });
         // The first frame of the new setting restarts the average.
         st.frame();
@@ -359,7 +362,7 @@ fn rtslc_on_the_radix_tree_converges_to_the_ground_truth() {
     st.set(|s| {
         s.gi.method = RTSLC;
         s.tree.kind = TreeKind::Lbvh;
-        s.sampling.block_size = 1;
+        SamplingSettings::edit(s, |m| m.block_size = 1);
         s.frame.accumulate = true;
     });
     st.frame();
@@ -516,7 +519,7 @@ fn filter_error(
         light_culling::TileCamera,
     };
     let cam = TileCamera::new(&st.cam, W, H);
-    let il = &st.r.settings().sampling.interleave;
+    let il = &SamplingSettings::of(st.r.settings()).interleave;
     let img = FilterImage {
         width: size.0,
         height: size.1,
@@ -560,14 +563,16 @@ fn interleaved_sampling_shares_the_cut_slots_out_and_its_filter_equals_the_cpu_r
     for (method, half) in [(SLC, false), (SST, true)] {
         let mut s = settings(method);
         s.frame.fixed_seed = true;
-        s.sampling.half_resolution = half;
+        SamplingSettings::edit(&mut s, |m| m.half_resolution = half);
         // Visibility is not what this checks (and without it most samples light the pixel).
         s.gi.shadow_rays = false;
-        s.sampling.interleave = InterleaveSettings {
-            filter_radius: 1,
-            ..InterleaveSettings::pattern(n)
-        };
-        let cut_size = s.sampling.cut_size;
+        SamplingSettings::edit(&mut s, |m| {
+            m.interleave = InterleaveSettings {
+                filter_radius: 1,
+                ..InterleaveSettings::pattern(n)
+            }
+        });
+        let cut_size = SamplingSettings::of(&s).cut_size;
         let seed = s.vpl.seed;
         let mut st = setup(&ctx, s);
         st.frame();
@@ -654,7 +659,7 @@ fn interleaved_sampling_shares_the_cut_slots_out_and_its_filter_equals_the_cpu_r
 fn half_resolution_upsampling_equals_the_cpu_reference() {
     let Some(ctx) = common::gpu() else { return };
     let mut st = setup(&ctx, settings(SLC));
-    st.set(|s| s.sampling.half_resolution = true);
+    st.set(|s| SamplingSettings::edit(s, |m| m.half_resolution = true));
     st.frame();
     let (hpos, hnrm, hacc) = st.r.read_half_resolution().unwrap().expect("half resolution on");
     assert_eq!((hpos.width, hpos.height), (W / 2, H / 2));
@@ -746,19 +751,19 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
         let mut st = setup(&ctx, settings(method));
         st.set(|s| {
             s.frame.accumulate = false;
-            s.sampling.child_probability = cp;
+            SamplingSettings::edit(s, |m| m.child_probability = cp);
         });
         st.frame();
         let pos = st.r.read(Buffer::Position).unwrap();
         let nrm = st.r.read(Buffer::Normal).unwrap();
         let alb = st.r.read(Buffer::Albedo).unwrap();
         let eps = st.r.settings().gi.distance_epsilon;
-        let near_field = st.r.settings().sampling.near_field;
+        let near_field = SamplingSettings::of(st.r.settings()).near_field;
         assert!(
             near_field > 0.0,
             "the story checks the near-field rule (on by default)"
         );
-        let cut_size = st.r.settings().sampling.cut_size;
+        let cut_size = SamplingSettings::of(st.r.settings()).cut_size;
         // Five hand-picked pixels and a 4 x 3 grid (enough substitute samples to trace).
         let grid = (0..12).map(|i| (4 + 16 * (i % 4), 4 + 12 * (i / 4)));
         let pixels: Vec<(u32, u32)> = [(10, 30), (33, 21), (50, 12), (5, 5), (60, 38)]
@@ -773,7 +778,7 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
         let bvh = Bvh::build(&st.scene.positions, &st.scene.indices);
         let (ray_offset, sub_offset) = (
             st.r.settings().gi.ray_offset,
-            st.r.settings().sampling.substitute_offset,
+            SamplingSettings::of(st.r.settings()).substitute_offset,
         );
         assert!(
             sub_offset > 0.0,
@@ -963,8 +968,12 @@ fn the_substitute_ray_offset_only_shortens_substitute_shadow_rays() {
     // leaf VPLs' rays are untouched, so RTSLC is bit for bit the same.
     let Some(ctx) = common::gpu() else { return };
     for method in [SLC, SST, RTSLC] {
-        let off = fixed_seed_frame(&ctx, method, |s| s.sampling.substitute_offset = 0.0);
-        let on = fixed_seed_frame(&ctx, method, |s| s.sampling.substitute_offset = 0.5);
+        let off = fixed_seed_frame(&ctx, method, |s| {
+            SamplingSettings::edit(s, |m| m.substitute_offset = 0.0)
+        });
+        let on = fixed_seed_frame(&ctx, method, |s| {
+            SamplingSettings::edit(s, |m| m.substitute_offset = 0.5)
+        });
         if method == RTSLC {
             assert_eq!(off.pixels, on.pixels, "RTSLC has no substitute samples");
             continue;
@@ -1000,14 +1009,16 @@ fn ism_visibility_looks_samples_up_in_the_leaves_maps_as_the_cpu_does() {
     s.gi.method = SLC;
     s.vpl.count = 256;
     s.frame.fixed_seed = true;
-    s.sampling.visibility = SamplerVisibility::Ism;
-    s.sampling.ism = IsmSettings {
-        points: 1 << 17,
-        points_per_light: 4096,
-        atlas: 512,
-        tile: 32,
-        ..Default::default()
-    };
+    SamplingSettings::edit(&mut s, |m| m.visibility = SamplerVisibility::Ism);
+    SamplingSettings::edit(&mut s, |m| {
+        m.ism = IsmSettings {
+            points: 1 << 17,
+            points_per_light: 4096,
+            atlas: 512,
+            tile: 32,
+            ..Default::default()
+        }
+    });
     let mut st = Setup::new(&ctx, s.clone(), (W, H));
     st.frame();
     assert!(ctx.errors.take().is_empty());
@@ -1020,12 +1031,12 @@ fn ism_visibility_looks_samples_up_in_the_leaves_maps_as_the_cpu_does() {
     // The maps: the CPU twin's splat of the same cloud (each leaf's share, front faces
     // culled) and pull-push.
     let layout = IsmLayout {
-        atlas: s.sampling.ism.atlas,
-        tile: s.sampling.ism.tile,
+        atlas: SamplingSettings::of(&s).ism.atlas,
+        tile: SamplingSettings::of(&s).ism.tile,
     };
     let cloud = cloud_of_bvh(
         &st.r.scene_gpu().bvh,
-        s.sampling.ism.points,
+        SamplingSettings::of(&s).ism.points,
         lightcut::methods::tree_samplers::ISM_CLOUD_SEED,
     );
     let (points, normals): (Vec<Vec3>, Vec<Vec3>) = cloud.into_iter().unzip();
@@ -1041,9 +1052,9 @@ fn ism_visibility_looks_samples_up_in_the_leaves_maps_as_the_cpu_does() {
         &lights,
         &points,
         Some(&normals),
-        s.sampling.ism.points_per_light,
+        SamplingSettings::of(&s).ism.points_per_light,
     );
-    ism::pull_push(layout, &mut cpu, maps, s.sampling.ism.levels());
+    ism::pull_push(layout, &mut cpu, maps, SamplingSettings::of(&s).ism.levels());
     let gpu: Vec<f32> = bytemuck::pod_collect_to_vec(&read_storage_buffer(&ctx, &targets.depth).unwrap());
     let texels = leaves * (layout.tile * layout.tile) as usize;
     let same = (0..maps)
@@ -1108,7 +1119,7 @@ fn ism_visibility_looks_samples_up_in_the_leaves_maps_as_the_cpu_does() {
                     Vec3::from_slice(&lv.position[..3]),
                     Vec3::from_array(lv.normal),
                     p,
-                    s.sampling.ism.bias,
+                    SamplingSettings::of(&s).ism.bias,
                 );
             assert_eq!(
                 vis == SampleVisibility::Visible,
@@ -1131,11 +1142,13 @@ fn ism_visibility_looks_samples_up_in_the_leaves_maps_as_the_cpu_does() {
         st.set(|s| {
             s.frame.fixed_seed = false;
             s.frame.accumulate = true;
-            s.sampling.visibility = if ism_on {
-                SamplerVisibility::Ism
-            } else {
-                SamplerVisibility::Rays
-            };
+            SamplingSettings::edit(s, |m| {
+                m.visibility = if ism_on {
+                    SamplerVisibility::Ism
+                } else {
+                    SamplerVisibility::Rays
+                }
+            });
         });
         for _ in 0..16 {
             st.frame();
@@ -1193,7 +1206,7 @@ fn with_ggx_glossy_samples_walk_to_leaves_so_the_samplers_converge_on_metal() {
         let gt = st.ground_truth_of_these_vpls();
         st.set(|s| {
             s.gi.method = method;
-            s.sampling.block_size = 1;
+            SamplingSettings::edit(s, |m| m.block_size = 1);
             s.frame.accumulate = true;
         });
         let errs = converge(&mut st, &gt);
@@ -1255,14 +1268,14 @@ fn glossy_walks_weigh_children_by_the_material_term_as_the_cpu_does() {
         let mut s = settings(method);
         s.gi.brdf = lightcut::renderer::settings::Brdf::Ggx;
         s.frame.accumulate = false;
-        s.sampling.glossy_weights = weights;
+        SamplingSettings::edit(&mut s, |m| m.glossy_weights = weights);
         let mut st = Setup::with_scene(&ctx, glossy_room(1.0, 0.3), s, (W, H));
         st.frame();
         let pos = st.r.read(Buffer::Position).unwrap();
         let nrm = st.r.read(Buffer::Normal).unwrap();
         let alb = st.r.read(Buffer::Albedo).unwrap();
         let eps = st.r.settings().gi.distance_epsilon;
-        let cp = st.r.settings().sampling.child_probability;
+        let cp = SamplingSettings::of(st.r.settings()).child_probability;
         let eye = st.cam.position;
         let (mut steps, mut moved) = (0, 0);
         for (x, y) in [(10, 30), (33, 21), (50, 12), (60, 38), (20, 8)] {
@@ -1337,12 +1350,12 @@ fn the_defensive_glossy_weights_lower_the_error_on_polished_metal() {
         for weights in GlossyWeights::ALL {
             let mut s = settings(method);
             s.gi.brdf = ggx;
-            s.sampling.glossy_weights = weights;
+            SamplingSettings::edit(&mut s, |m| m.glossy_weights = weights);
             let mut st = Setup::with_scene(&ctx, glossy_room(1.0, 0.3), s, (W, H));
             let gt = st.ground_truth_of_these_vpls();
             st.set(|s| {
                 s.gi.method = method;
-                s.sampling.block_size = 1;
+                SamplingSettings::edit(s, |m| m.block_size = 1);
                 s.frame.accumulate = true;
             });
             let errs = converge(&mut st, &gt);

@@ -11,6 +11,7 @@
 
 mod common;
 
+use lightcut::methods::tree_samplers::settings::SamplingSettings;
 use std::{path::Path, process::Command, sync::Arc};
 
 use egui_kittest::Harness;
@@ -174,7 +175,7 @@ fn the_gui_switching_everything_holds_the_same_objects_and_memory_round_after_ro
     let mut s = RenderSettings::default();
     s.gi.method = MethodId::parse("slc").unwrap();
     s.vpl.count = 256;
-    s.sampling.cut_size = 8;
+    SamplingSettings::edit(&mut s, |m| m.cut_size = 8);
     s.shadow.resolution = 128;
     let options = AppOptions {
         settings: Some(s),

@@ -3,6 +3,7 @@
 
 mod common;
 
+use lightcut::methods::tree_samplers::settings::SamplingSettings;
 use lightcut::methods::tree_samplers::{RTSLC, SLC};
 use std::sync::Arc;
 
@@ -58,7 +59,7 @@ fn slc_settings() -> lightcut::renderer::settings::RenderSettings {
     let mut s = lightcut::renderer::settings::RenderSettings::default();
     s.gi.method = SLC;
     s.vpl.count = 1024;
-    s.sampling.cut_size = 16;
+    SamplingSettings::edit(&mut s, |m| m.cut_size = 16);
     s
 }
 
@@ -681,26 +682,26 @@ fn tree_sampler_controls_reach_the_renderer() {
     h.run_steps(3);
     let settings = |h: &Harness<'_, WorkbenchApp>| h.state().renderer().expect("renderer").settings().clone();
     assert!(settings(&h).gi.shadow_rays);
-    assert_eq!(settings(&h).sampling.near_field, 1.0);
+    assert_eq!(SamplingSettings::of(&settings(&h)).near_field, 1.0);
     assert!(
         h.query_all_by_label("near-field refinement").next().is_some(),
         "no near-field slider for SLC"
     );
-    assert_eq!(settings(&h).sampling.substitute_offset, 0.05);
+    assert_eq!(SamplingSettings::of(&settings(&h)).substitute_offset, 0.05);
     assert!(
         h.query_all_by_label("substitute ray offset").next().is_some(),
         "no substitute ray offset slider for SLC"
     );
     // The child-probability combo: open it, pick the thesis's.
     let want = ChildProbability::Mean;
-    assert_ne!(settings(&h).sampling.child_probability, want);
+    assert_ne!(SamplingSettings::of(&settings(&h)).child_probability, want);
     h.get_by_label("child probability").click();
     h.run_steps(2);
     // (get_by_* panics when no such node is shown, or several are.)
     h.get_by_label(want.name()).click();
     h.run_steps(3);
     assert_eq!(
-        settings(&h).sampling.child_probability,
+        SamplingSettings::of(&settings(&h)).child_probability,
         want,
         "the child-probability combo did not reach the renderer"
     );
@@ -886,7 +887,7 @@ fn the_brdf_combo_reaches_the_renderer_and_lambert_only_methods_say_so() {
     h.run_steps(2);
     let r = h.state().renderer().expect("renderer");
     assert_eq!(
-        r.settings().sampling.glossy_weights,
+        SamplingSettings::of(r.settings()).glossy_weights,
         lightcut::base::sampling::GlossyWeights::Material
     );
     assert!(h.state().errors().is_empty(), "errors: {:?}", h.state().errors());

@@ -101,9 +101,12 @@ fn write_metrics(
         "gpu_ms": timings.map(|t| t.passes.iter().map(|(n, ms)| (n.clone(), *ms)).collect::<std::collections::BTreeMap<_, _>>()),
         "indirect_mean_rgb": indirect.mean_rgb(),
     });
-    // The tree samplers' settings and traversal statistics.
+    // The method's own settings as it read them (defaults filled in).
+    if let Some((section, table)) = crate::methods::own_settings(s.gi.method, &s) {
+        json["method_settings"] = serde_json::json!({ "section": section, "values": table });
+    }
+    // The tree samplers' traversal statistics.
     if let Some(st) = st {
-        json["sampling"] = serde_json::to_value(&s.sampling)?;
         json["steps_per_traversal"] = st.steps_per_traversal().into();
         json["steps_per_pixel"] = st.steps_per_pixel().into();
         json["fallback_pixel_fraction"] = st.fallback_fraction().into();

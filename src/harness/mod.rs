@@ -14,6 +14,7 @@ pub mod figures;
 pub mod plot;
 pub mod sequence;
 
+use crate::methods::tree_samplers::settings::SamplingSettings;
 use std::{
     collections::HashMap,
     path::Path,
@@ -536,7 +537,7 @@ impl Bench {
             }
             let ind = self.r.read(Buffer::Indirect)?;
             // Steps and fallback flags are per GI pixel: read at full GI resolution only.
-            if samples_tree && m.steps.is_none() && !s.sampling.half_resolution {
+            if samples_tree && m.steps.is_none() && !SamplingSettings::of(s).half_resolution {
                 let (w, h, steps, fb) = self.read_steps()?;
                 m.steps = Some((w, h, steps));
                 fallback_mask = Some(fb.clone());

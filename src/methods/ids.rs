@@ -217,6 +217,33 @@ pub fn validate_all(s: &RenderSettings) -> Result<(), String> {
     Ok(())
 }
 
+/// The settings table `id` reads as it reads it: its own `[methods.*]` section (declared by
+/// `MethodInfo::fields`, the tree samplers' shared by the three) with the defaults filled in
+/// where the settings leave a key out; None for a method without a table of its own.
+pub fn own_settings(id: MethodId, s: &RenderSettings) -> Option<(String, toml::Table)> {
+    let own = (id.info().fields)()
+        .into_iter()
+        .find(|f| f.table.is_some() && f.section.starts_with("methods."))?;
+    let key = own.section.strip_prefix("methods.")?.to_string();
+    let mut t = own.table.unwrap_or_default();
+    if let Some(raw) = s.methods.raw(&key) {
+        overlay(&mut t, raw);
+    }
+    Some((own.section, t))
+}
+
+/// `over`'s keys written onto `base`, nested tables key by key.
+fn overlay(base: &mut toml::Table, over: &toml::Table) {
+    for (k, v) in over {
+        match (base.get_mut(k), v) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => overlay(b, o),
+            _ => {
+                base.insert(k.clone(), v.clone());
+            }
+        }
+    }
+}
+
 /// A view a method draws beside final / direct / GI (the tree samplers' traversal steps, ...).
 pub struct ViewInfo {
     /// Its name in every buffer menu, in `--views` and in saved layouts (unique over the

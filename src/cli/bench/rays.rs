@@ -3,6 +3,7 @@
 //! any ray differently.
 
 use super::*;
+use crate::methods::tree_samplers::settings::SamplingSettings;
 
 pub(super) fn run_rays(args: &BenchArgs) -> anyhow::Result<()> {
     let opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
@@ -232,7 +233,10 @@ pub(super) fn in_frame_rays(
         "in-frame shadow rays, {layout:?} BVH (SLC's sampling pass, {}x{}, {} spp, {} VPLs; GPU \
          timestamps of slc_sample): {rays} rays per frame; pass {with:.3} ms with them, \
          {without:.3} ms without: {rate:.2} Mrays/s",
-        size.0, size.1, s.sampling.cut_size, s.vpl.count,
+        size.0,
+        size.1,
+        SamplingSettings::of(&s).cut_size,
+        s.vpl.count,
     );
     if let Some(e) = r.ctx.errors.take().into_iter().next() {
         return Err(anyhow!("GPU error: {e}"));
@@ -279,12 +283,12 @@ pub(super) fn in_frame_proxy(
     let nodes = sst_tree::build(&sst_tree::sort_vpls(vpls));
     let leaves = (nodes.len() / 2) as u32;
     let (eps, offset) = (s.gi.distance_epsilon, s.gi.ray_offset);
-    let cp = s.sampling.child_probability;
+    let cp = SamplingSettings::of(&s).child_probability;
     let mut rng = Pcg32::new(args.seed ^ 0x51C);
     let mut rays = Vec::new();
     for smp in samples.iter().flatten() {
         let (p, n) = (smp.position, smp.normal);
-        for start in slc::build_cut(&nodes, p, n, eps, s.sampling.cut_size, true) {
+        for start in slc::build_cut(&nodes, p, n, eps, SamplingSettings::of(&s).cut_size, true) {
             let mut k = start;
             while k < leaves {
                 let (l, r) = (&nodes[2 * k as usize], &nodes[2 * k as usize + 1]);
@@ -314,7 +318,7 @@ pub(super) fn in_frame_proxy(
             pw,
             ph,
             vpls.len(),
-            s.sampling.cut_size
+            SamplingSettings::of(&s).cut_size
         ),
         &cb,
         &cw,

@@ -2,6 +2,7 @@
 //! value enums of the flags, and how they become settings.
 
 use super::*;
+use crate::methods::tree_samplers::settings::SamplingSettings;
 
 /// `--method NAME`: a registered GI method by its CLI name (`crate::methods::REGISTRY`).
 pub fn parse_method(name: &str) -> Result<MethodId, String> {
@@ -249,42 +250,48 @@ impl SamplingArgs {
     }
 
     pub fn apply(&self, s: &mut crate::settings::RenderSettings) {
-        use crate::settings::{ChildProbability, CutBlending, CutFallback};
+        use crate::methods::tree_samplers::settings::{ChildProbability, CutBlending, CutFallback};
         if let Some(v) = self.block {
-            s.sampling.block_size = v;
+            SamplingSettings::edit(s, |m| m.block_size = v);
         }
         if let Some(v) = self.cut_size {
-            s.sampling.cut_size = v;
+            SamplingSettings::edit(s, |m| m.cut_size = v);
         }
         if let Some(b) = self.blending {
-            s.sampling.blending = match b {
-                BlendingArg::Stochastic => CutBlending::Stochastic,
-                BlendingArg::Off => CutBlending::Off,
-            };
+            SamplingSettings::edit(s, |m| {
+                m.blending = match b {
+                    BlendingArg::Stochastic => CutBlending::Stochastic,
+                    BlendingArg::Off => CutBlending::Off,
+                }
+            });
         }
         if let Some(f) = self.fallback {
-            s.sampling.fallback = match f {
-                FallbackArg::Mock => CutFallback::MockCut,
-                FallbackArg::Average => CutFallback::Average,
-                FallbackArg::Root => CutFallback::Root,
-                FallbackArg::Recompute => CutFallback::Recompute,
-            };
+            SamplingSettings::edit(s, |m| {
+                m.fallback = match f {
+                    FallbackArg::Mock => CutFallback::MockCut,
+                    FallbackArg::Average => CutFallback::Average,
+                    FallbackArg::Root => CutFallback::Root,
+                    FallbackArg::Recompute => CutFallback::Recompute,
+                }
+            });
         }
         if self.no_cull {
-            s.sampling.cull_behind = false;
+            SamplingSettings::edit(s, |m| m.cull_behind = false);
         }
         if let Some(v) = self.near_field {
-            s.sampling.near_field = v;
+            SamplingSettings::edit(s, |m| m.near_field = v);
         }
         if let Some(v) = self.substitute_offset {
-            s.sampling.substitute_offset = v;
+            SamplingSettings::edit(s, |m| m.substitute_offset = v);
         }
         if let Some(c) = self.child_probability {
-            s.sampling.child_probability = match c {
-                ChildProbabilityArg::Mean => ChildProbability::Mean,
-                ChildProbabilityArg::MinMax => ChildProbability::MinMax,
-                ChildProbabilityArg::Defensive => ChildProbability::Defensive,
-            };
+            SamplingSettings::edit(s, |m| {
+                m.child_probability = match c {
+                    ChildProbabilityArg::Mean => ChildProbability::Mean,
+                    ChildProbabilityArg::MinMax => ChildProbability::MinMax,
+                    ChildProbabilityArg::Defensive => ChildProbability::Defensive,
+                }
+            });
         }
         if self.no_shadow_rays {
             s.gi.shadow_rays = false;
@@ -308,7 +315,7 @@ impl SamplingArgs {
             );
         }
         if self.half_res {
-            s.sampling.half_resolution = true;
+            SamplingSettings::edit(s, |m| m.half_resolution = true);
         }
         if let Some(t) = self.temporal {
             use crate::settings::TemporalMode;
@@ -326,11 +333,13 @@ impl SamplingArgs {
         }
         if let Some(g) = self.glossy_weights {
             use crate::base::sampling::GlossyWeights;
-            s.sampling.glossy_weights = match g {
-                GlossyWeightsArg::Geometric => GlossyWeights::Geometric,
-                GlossyWeightsArg::Material => GlossyWeights::Material,
-                GlossyWeightsArg::Defensive => GlossyWeights::Defensive,
-            };
+            SamplingSettings::edit(s, |m| {
+                m.glossy_weights = match g {
+                    GlossyWeightsArg::Geometric => GlossyWeights::Geometric,
+                    GlossyWeightsArg::Material => GlossyWeights::Material,
+                    GlossyWeightsArg::Defensive => GlossyWeights::Defensive,
+                }
+            });
         }
         if let Some(b) = self.brdf {
             s.gi.brdf = match b {

@@ -10,13 +10,12 @@
 
 mod bounces;
 mod resolution;
-mod sampling;
 mod temporal;
 mod trees;
 
+use crate::methods::tree_samplers::settings::SamplingSettings;
 pub use bounces::bounces;
 pub use resolution::{scaling, upsampling};
-pub use sampling::{blending, blocks, steps};
 pub use temporal::temporal;
 pub use trees::trees;
 
@@ -72,14 +71,14 @@ use std::path::Path;
 use anyhow::Context;
 
 use super::{
-    Bench, Csv, Frames, Measured, PASS_GROUPS, SAMPLE_PASSES, SORT_PASSES, TREE_BUILD_PASSES, gi_passes,
-    mean_std, num, plot,
+    Bench, Csv, Frames, PASS_GROUPS, SAMPLE_PASSES, SORT_PASSES, TREE_BUILD_PASSES, gi_passes, mean_std, num,
+    plot,
 };
 use crate::methods::{
     self as gi_methods, MethodId,
     tree_samplers::{RTSLC, SLC, SST},
 };
-use crate::settings::{CutBlending, CutFallback, RenderSettings};
+use crate::settings::RenderSettings;
 
 /// What every figure needs besides the bench.
 #[derive(Clone, Debug)]
@@ -405,7 +404,7 @@ inventory::submit! {
 /// base cut size), and the images, error maps and FLIP of each method at its knob's value
 /// for that time. Frame wall clock stays a separate column.
 pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
-    let base_spp = b.base.sampling.cut_size;
+    let base_spp = SamplingSettings::of(&b.base).cut_size;
     let mut csv = Csv::new(&[
         "scene",
         "method",

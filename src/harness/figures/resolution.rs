@@ -1,6 +1,7 @@
 //! Thesis figures of resolution: half-resolution GI with upsampling (7.8) and VPL scaling.
 
 use super::*;
+use crate::methods::tree_samplers::settings::SamplingSettings;
 
 inventory::submit! {
     FigureDef {
@@ -43,7 +44,7 @@ pub fn upsampling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
         for half in [false, true] {
             let s = with(b, |s| {
                 s.gi.method = SLC;
-                s.sampling.half_resolution = half;
+                SamplingSettings::edit(s, |m| m.half_resolution = half);
             });
             let m = b.measure(&s, size, o.per_config(), true)?;
             let (r, rs) = m.rmse();

@@ -8,6 +8,7 @@
 //! and `bench lightcuts` measures the trees' far-paired clusters.
 
 use super::*;
+use crate::methods::tree_samplers::settings::SamplingSettings;
 use crate::settings::TreeKind;
 
 /// One tree's sweep: (total ms, RMSE) and (total ms, image-mean ratio) points, and at the
@@ -31,7 +32,7 @@ inventory::submit! {
 }
 
 pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
-    let base_spp = b.base.sampling.cut_size;
+    let base_spp = SamplingSettings::of(&b.base).cut_size;
     let mut csv = Csv::new(&[
         "scene",
         "method",

@@ -30,6 +30,7 @@ use crate::gpu::passes::interleave_filter::GpuFilterParams;
 use crate::gpu::passes::ism::{IsmPoints, IsmTargets};
 use crate::gpu::readback::{self, ImageF32};
 use crate::gpu::shaders::ShaderError;
+use crate::methods::tree_samplers::settings::SamplingSettings;
 use crate::reference::light_culling::{Interleave, TileGrid};
 use crate::settings::RenderSettings;
 use pass::{
@@ -401,11 +402,13 @@ pub fn has_ism(m: MethodId) -> bool {
 /// Sets light culling's and the tree samplers' visibility (while `gi.shadow_rays` is on):
 /// maps or rays.
 pub fn set_visibility(s: &mut RenderSettings, ism: bool) {
-    s.sampling.visibility = if ism {
-        super::tree_samplers::settings::SamplerVisibility::Ism
-    } else {
-        super::tree_samplers::settings::SamplerVisibility::Rays
-    };
+    SamplingSettings::edit(s, |m| {
+        m.visibility = if ism {
+            super::tree_samplers::settings::SamplerVisibility::Ism
+        } else {
+            super::tree_samplers::settings::SamplerVisibility::Rays
+        }
+    });
     // A malformed table is left for validation to name.
     let Ok(mut lc) = s.method::<LightCullingSettings>(ID) else {
         return;

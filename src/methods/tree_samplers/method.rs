@@ -1,6 +1,7 @@
 //! The tree samplers' frame: `Method` for [`TreeSamplers`] (traversal and shading at full or half
 //! resolution, the diagnostics, views, pixel story, overlay and statistics).
 
+use super::settings::SamplingSettings;
 use super::*;
 
 impl Method for TreeSamplers {
@@ -8,7 +9,7 @@ impl Method for TreeSamplers {
     /// `frame.accumulate` and nothing changed).
     fn record(&mut self, cx: &mut FrameCx<'_>, enc: &mut wgpu::CommandEncoder) -> f32 {
         let s = cx.settings;
-        let sm = &s.sampling;
+        let sm = &SamplingSettings::of(s);
         let device = cx.device;
         let size = cx.size;
         // Half-resolution GI: the sampler runs on every other G-buffer sample (demodulated)
@@ -117,7 +118,7 @@ impl Method for TreeSamplers {
         let raw = self.raw.as_ref().map(|(b, _)| b);
         let ism = match (ism_maps, self.ism_points.as_ref(), self.ism_targets.as_ref()) {
             (Some(maps), Some((_, points)), Some(targets)) => Some(pass::SlcIsm {
-                settings: &s.sampling.ism,
+                settings: &SamplingSettings::of(s).ism,
                 points,
                 targets,
                 maps,
@@ -276,7 +277,7 @@ impl TreeSamplers {
         enc: &mut wgpu::CommandEncoder,
         gi_size: (u32, u32),
     ) -> bool {
-        let sm = &cx.settings.sampling;
+        let sm = &SamplingSettings::of(cx.settings);
         let device = cx.device;
         if self.buffers.matches(gi_size, sm.block_size, sm.cut_size) {
             return true;
@@ -287,7 +288,7 @@ impl TreeSamplers {
             // Refuse (once per change) rather than fail validation; GI stays black.
             cx.errors.report(format!(
                 "sampling: {}x{} pixels with {}x{} blocks and cuts of {} need a {} MiB buffer; \
-                 this device binds at most {} MiB (raise sampling.block_size or lower cut_size)",
+                 this device binds at most {} MiB (raise methods.slc.block_size or lower cut_size)",
                 gi_size.0,
                 gi_size.1,
                 sm.block_size,
@@ -316,7 +317,7 @@ impl TreeSamplers {
         let s = cx.settings;
         let device = cx.device;
         let size = cx.size;
-        if s.sampling.half_resolution {
+        if SamplingSettings::of(s).half_resolution {
             let h = match self.half.take() {
                 Some(h) if h.size == gi_size => h,
                 _ => HalfTargets::new(device, size),
@@ -362,7 +363,7 @@ impl TreeSamplers {
         let fp = GpuFilterParams {
             accumulate: (frames > 1) as u32,
             modulate: half.is_none() as u32,
-            ..GpuFilterParams::new(gi_size, &cx.settings.sampling.interleave)
+            ..GpuFilterParams::new(gi_size, &SamplingSettings::of(cx.settings).interleave)
         };
         let inputs = FilterInputs {
             gbuffer,

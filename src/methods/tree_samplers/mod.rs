@@ -11,6 +11,7 @@
 //! geometry-aware filter, `sampling.interleave`), optional `gi_upsample`. CPU twins in
 //! `crate::reference::slc` and `crate::reference::interleave`; docs/sampling.md.
 
+mod figure;
 pub mod half;
 mod method;
 pub mod pass;
@@ -33,6 +34,7 @@ use crate::settings::RenderSettings;
 use half::{HalfPass, HalfTargets};
 use pass::GpuSlcParams;
 use pass::{GpuSlcViewParams, PixelTrace, SamplingStats, SlcBuffers, SlcPass};
+use settings::SamplingSettings;
 use settings::{ChildProbability, CutBlending, CutFallback, SamplerVisibility};
 
 pub const SLC: MethodId = MethodId::new("slc");
@@ -143,13 +145,13 @@ const TESTS: &[&str] = &[
 pub static SPP_SWEEP: super::Sweep = super::Sweep {
     name: "spp",
     values: &[],
-    apply: |s, v| s.sampling.cut_size = v.round() as u32,
+    apply: |s, v| SamplingSettings::edit(s, |m| m.cut_size = v.round() as u32),
     integer: true,
 };
 
 fn invalid_cut_size(s: &mut RenderSettings) -> &'static str {
-    s.sampling.cut_size = 0;
-    "sampling.cut_size"
+    SamplingSettings::edit(s, |m| m.cut_size = 0);
+    "methods.slc.cut_size"
 }
 
 pub static SLC_INFO: MethodInfo = MethodInfo {
@@ -186,8 +188,8 @@ pub static SLC_INFO: MethodInfo = MethodInfo {
     sweep: Some(&SPP_SWEEP),
     bias: slc_bias,
     unbiased: Some(super::Unbiased {
-        how: "tree.v_min = 1, tree.sigma_max = 0 (only leaves usable: RTSLC's traversal), sampling.block_size = 1",
-        apply: |s| (s.tree.v_min, s.tree.sigma_max, s.sampling.block_size) = (1.0, 0.0, 1),
+        how: "tree.v_min = 1, tree.sigma_max = 0 (only leaves usable: RTSLC's traversal), methods.slc.block_size = 1",
+        apply: |s| (s.tree.v_min, s.tree.sigma_max, SamplingSettings::of(s).block_size) = (1.0, 0.0, 1),
     }),
 };
 
@@ -263,15 +265,15 @@ pub static RTSLC_INFO: MethodInfo = MethodInfo {
     sweep: Some(&SPP_SWEEP),
     bias: rtslc_bias,
     unbiased: Some(super::Unbiased {
-        how: "sampling.block_size = 1 (a cut per pixel: culling drops only nodes that cannot light it)",
-        apply: |s| s.sampling.block_size = 1,
+        how: "methods.slc.block_size = 1 (a cut per pixel: culling drops only nodes that cannot light it)",
+        apply: |s| SamplingSettings::edit(s, |m| m.block_size = 1),
     }),
 };
 
 /// What biases every tree sampler alike: imperfect shadow maps, the interleaving's filter,
 /// half-resolution upsampling (docs/sampling.md); None when none of them is on.
 fn shared_bias(s: &RenderSettings) -> Option<Bias> {
-    let sm = &s.sampling;
+    let sm = &SamplingSettings::of(s);
     if s.gi.shadow_rays && sm.visibility == SamplerVisibility::Ism {
         Some(Bias::Biased {
             tolerance: 0.35,
@@ -296,7 +298,7 @@ fn shared_bias(s: &RenderSettings) -> Option<Bias> {
 /// otherwise a node culled behind the block centre's surface may still light a pixel of the
 /// block (docs/sampling.md, *Unbiasedness*).
 fn rtslc_bias(s: &RenderSettings) -> Bias {
-    shared_bias(s).unwrap_or(if !s.sampling.cull_behind || s.sampling.block_size == 1 {
+    shared_bias(s).unwrap_or(if !SamplingSettings::of(s).cull_behind || SamplingSettings::of(s).block_size == 1 {
         Bias::Unbiased
     } else {
         Bias::Biased {
@@ -329,10 +331,18 @@ fn sst_bias(s: &RenderSettings) -> Bias {
     substitute_bias(s, Bias::Unbiased)
 }
 
-/// `[sampling]`: every field in range, or a message naming it.
+/// `[methods.slc]`: every field in range, or a message naming it.
 fn validate(s: &RenderSettings) -> Result<(), String> {
-    let sm = &s.sampling;
-    sm.ism.validate("sampling")?;
+    for other in [SST, RTSLC] {
+        if s.methods.raw(other.cli()).is_some() {
+            return Err(format!(
+                "methods.{}: SLC, SST and RTSLC share one table; write it as [{SECTION}]",
+                other.cli()
+            ));
+        }
+    }
+    let sm = &s.method::<SamplingSettings>(settings::TABLE)?;
+    sm.ism.validate(SECTION)?;
     // Half-resolution GI and the interleaving's filter work on the GI without the albedo
     // (Lambert's rho / pi factored out), which a glossy BRDF does not allow.
     if s.gi.method.samples_tree()
@@ -342,15 +352,18 @@ fn validate(s: &RenderSettings) -> Result<(), String> {
         return Err(format!(
             "gi.brdf = Ggx with {}: the tree samplers' half-resolution GI and interleaving filter divide out Lambert's albedo / pi; use gi.brdf = Lambert or turn them off",
             if sm.half_resolution {
-                "sampling.half_resolution"
+                "methods.slc.half_resolution"
             } else {
-                "sampling.interleave (n > 1 or a filter radius)"
+                "methods.slc.interleave (n > 1 or a filter radius)"
             }
         ));
     }
-    crate::base::field::check("sampling", settings::FIELDS, sm)?;
-    sm.interleave.validate("sampling", settings::MAX_SLOT_INTERLEAVE)
+    crate::base::field::check(SECTION, settings::FIELDS, sm)?;
+    sm.interleave.validate(SECTION, settings::MAX_SLOT_INTERLEAVE)
 }
+
+/// The tree samplers' settings table, as settings paths and messages name it.
+const SECTION: &str = "methods.slc";
 
 /// The samplers' GPU state: pipelines, per-frame buffers, accumulation and half-resolution
 /// targets.
@@ -411,7 +424,7 @@ impl TreeSamplers {
     /// atlas beyond the device's binding size: reported, the frame traces rays).
     fn plan_ism(&mut self, cx: &FrameCx<'_>) -> Option<u32> {
         let s = cx.settings;
-        let sm = &s.sampling;
+        let sm = &SamplingSettings::of(s);
         self.ism_maps = 0;
         if !(s.gi.shadow_rays && sm.visibility == settings::SamplerVisibility::Ism) {
             return None;
@@ -423,7 +436,7 @@ impl TreeSamplers {
             cx.errors.report(format!(
                 "tree samplers: ISM visibility needs a map per light-tree leaf ({leaves}) in an \
                  atlas of {0} x {0} ({1} maps of {2}^2, {3} MiB; this device binds {4} MiB): \
-                 tracing shadow rays instead (raise sampling.ism.atlas, lower sampling.ism.tile \
+                 tracing shadow rays instead (raise methods.slc.ism.atlas, lower methods.slc.ism.tile \
                  or the VPL count)",
                 sm.ism.atlas,
                 sm.ism.capacity(),
@@ -492,12 +505,12 @@ pub fn steps_scale(levels: u32) -> f32 {
 fn fields() -> Vec<super::FieldSection> {
     use crate::settings::{InterleaveOff, InterleaveSettings, IsmAdaptive, IsmSettings};
     vec![
-        super::FieldSection::of("sampling", settings::FIELDS, true),
+        super::FieldSection::of(SECTION, settings::FIELDS, true),
         super::FieldSection::of(
-            "sampling.interleave",
+            "methods.slc.interleave",
             &InterleaveSettings::<InterleaveOff>::fields(settings::MAX_SLOT_INTERLEAVE),
             false,
         ),
-        super::FieldSection::of("sampling.ism", &IsmSettings::<IsmAdaptive>::fields(), false),
+        super::FieldSection::of("methods.slc.ism", &IsmSettings::<IsmAdaptive>::fields(), false),
     ]
 }

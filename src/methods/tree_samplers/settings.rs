@@ -4,6 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::base::field::Field;
+use crate::methods::MethodId;
+use crate::settings::RenderSettings;
 
 pub use crate::settings::{IsmAdaptive, IsmSettings};
 
@@ -182,6 +184,33 @@ pub static FIELDS: &[Field<SamplingSettings>] = &[
     ),
 ];
 
+impl SamplingSettings {
+    /// The tree samplers' settings in `s`: the table `[methods.slc]` (SLC's, which its
+    /// baselines SST and RTSLC share: the same cuts and samples; `[sampling]` in files from
+    /// before issue 38), parsed once per change. Its defaults where the table does not parse
+    /// (validation names the error).
+    pub fn of(s: &RenderSettings) -> Self {
+        s.method::<Self>(TABLE).unwrap_or_default()
+    }
+
+    /// Changes the tree samplers' settings in `s` by `f`.
+    pub fn edit(s: &mut RenderSettings, f: impl FnOnce(&mut Self)) {
+        let mut v = Self::of(s);
+        f(&mut v);
+        // Cannot fail: the struct serialises to a table.
+        let _ = s.set_method(TABLE, &v);
+    }
+}
+
+/// Whose `[methods.*]` table holds the tree samplers' settings: SLC's.
+pub const TABLE: MethodId = super::SLC;
+
+// Files from before issue 38 wrote the table as `[sampling]` (its frame-wide keys moved to
+// `[frame]` first: `settings::legacy::MOVED`).
+inventory::submit! {
+    crate::settings::legacy::Moved { old: "sampling", new: "methods.slc" }
+}
+
 impl Default for SamplingSettings {
     fn default() -> Self {
         // The thesis's defaults: 8 x 8 blocks, 32 samples per pixel.
@@ -205,5 +234,43 @@ impl Default for SamplingSettings {
             visibility: SamplerVisibility::Rays,
             ism: IsmSettings::default(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_partial_interleave_table_keeps_the_samplers_defaults() {
+        // The tree samplers do not interleave unless told (light culling does, 8 x 8).
+        let sm: SamplingSettings = toml::from_str("[interleave]\nfilter_radius = 2").unwrap();
+        assert_eq!((sm.interleave.n, sm.interleave.filter_radius), (1, 2));
+        let sm: SamplingSettings = toml::from_str("[interleave]\nn = 4").unwrap();
+        assert_eq!((sm.interleave.n, sm.interleave.filter_radius), (4, 0));
+    }
+
+    #[test]
+    fn a_file_from_before_issue_38_keeps_its_sampling_section() {
+        let old: RenderSettings = toml::from_str(
+            "[sampling]\naccumulate = true\nfixed_seed = true\ncut_size = 8\n[sampling.interleave]\nn = 2",
+        )
+        .unwrap();
+        assert!(old.frame.accumulate && old.frame.fixed_seed);
+        let sm = SamplingSettings::of(&old);
+        assert_eq!((sm.cut_size, sm.interleave.n), (8, 2));
+        assert!(old.validate().is_ok());
+        let mut set = RenderSettings::default();
+        set.set_path("sampling.block_size", "4").unwrap();
+        assert_eq!(SamplingSettings::of(&set).block_size, 4);
+        // What `render` records: the table as the samplers read it, defaults filled in.
+        let (section, t) = crate::methods::own_settings(super::super::RTSLC, &set).unwrap();
+        assert_eq!(section, "methods.slc");
+        assert_eq!(t["block_size"].as_integer(), Some(4));
+        assert_eq!(t["cut_size"].as_integer(), Some(32));
+        assert!(t["interleave"].get("n").is_some());
+        // The other samplers' tables are SLC's: a table of their own is refused by name.
+        let own: RenderSettings = toml::from_str("[methods.rtslc]\ncut_size = 8").unwrap();
+        assert!(own.validate().unwrap_err().contains("methods.rtslc"));
     }
 }

@@ -1,14 +1,19 @@
 //! The tree samplers' settings in the GUI (SST hides the cut and blending controls it does
 //! not use; RTSLC hides the substitute controls).
 
-use super::settings::{ChildProbability, CutBlending, CutFallback, GlossyWeights, SamplerVisibility};
+use super::settings::{
+    ChildProbability, CutBlending, CutFallback, GlossyWeights, SamplerVisibility, SamplingSettings,
+};
 use super::{RTSLC, SST};
 use crate::base::settings_ui::{SettingsUi, choose, radio, slider};
 use crate::methods::MethodId;
 use crate::settings::RenderSettings;
 
 pub fn settings_ui(ui: &mut dyn SettingsUi, method: MethodId, s: &mut RenderSettings) {
-    let sm = &mut s.sampling;
+    // Edited as a copy, stored back only when changed (the table is parsed once per change).
+    let before = SamplingSettings::of(s);
+    let mut edited = before.clone();
+    let sm = &mut edited;
     let field = |key: &str| crate::base::field::find(super::settings::FIELDS, key);
     slider(ui, field("cut_size"), sm);
     if method != SST {
@@ -81,7 +86,6 @@ pub fn settings_ui(ui: &mut dyn SettingsUi, method: MethodId, s: &mut RenderSett
     );
     ui.toggle(&mut s.frame.accumulate, "accumulate frames while static", "");
     let shadow_rays = s.gi.shadow_rays;
-    let sm = &mut s.sampling;
     radio(
         ui,
         "visibility",
@@ -106,5 +110,8 @@ pub fn settings_ui(ui: &mut dyn SettingsUi, method: MethodId, s: &mut RenderSett
         ui.indented("sampler_ism", &mut |ui| {
             crate::methods::ism_ui::settings_ui(ui, &mut sm.ism, "leaf", "32^2", "8192");
         });
+    }
+    if edited != before {
+        SamplingSettings::edit(s, |m| *m = edited);
     }
 }

@@ -1,7 +1,9 @@
 //! Thesis figures of the sampler's choices: traversal steps (fig. 7.2), block sizes (7.4)
 //! and cut blending / fallbacks (7.6).
 
-use super::*;
+use super::SLC;
+use super::settings::{CutBlending, CutFallback, SamplingSettings};
+use crate::harness::figures::prelude::*;
 
 inventory::submit! {
     FigureDef {
@@ -61,7 +63,10 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         .filter_map(|m| m.steps.as_ref().map(|s| quant(&s.2, 0.99)))
         .fold(1.0f64, f64::max) as f32;
     let img = images(dir)?;
-    let mut table = format!("traversal steps ({} spp):\n", b.base.sampling.cut_size);
+    let mut table = format!(
+        "traversal steps ({} spp):\n",
+        SamplingSettings::of(&b.base).cut_size
+    );
     let mut bars = Vec::new();
     let mut hist = Vec::new();
     for (i, ((m, (_, label)), (with_rays, no_rays, with_rays_min))) in
@@ -77,7 +82,7 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         csv.row(vec![
             b.scene.clone(),
             label.to_string(),
-            b.base.sampling.cut_size.to_string(),
+            SamplingSettings::of(&b.base).cut_size.to_string(),
             num(m.steps_per_traversal()),
             num(m.steps_per_pixel()),
             num(med),
@@ -137,7 +142,8 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         &dir.join("steps.png"),
         &format!(
             "{}: traversal steps per traversal ({} spp)",
-            b.scene, b.base.sampling.cut_size
+            b.scene,
+            SamplingSettings::of(&b.base).cut_size
         ),
         "steps",
         &bars,
@@ -155,7 +161,7 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let v: Vec<f64> = ms.iter().map(|m| m.steps_per_traversal()).collect();
     let detail = format!(
         "mean steps per traversal, {} spp each (= per pixel at equal samples)",
-        b.base.sampling.cut_size
+        SamplingSettings::of(&b.base).cut_size
     );
     Ok(Report {
         table,
@@ -211,7 +217,7 @@ pub fn blocks(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     for &k in &o.blocks {
         let s = with(b, |s| {
             s.gi.method = SLC;
-            s.sampling.block_size = k;
+            SamplingSettings::edit(s, |m| m.block_size = k);
         });
         let m = b.measure(&s, o.size, o.per_config(), true)?;
         let cuts = o.size.0.div_ceil(k) * o.size.1.div_ceil(k);
@@ -372,8 +378,8 @@ pub fn blending(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     for (i, (label, file, blend, fb)) in configs.iter().enumerate() {
         let s = with(b, |s| {
             s.gi.method = SLC;
-            s.sampling.blending = *blend;
-            s.sampling.fallback = *fb;
+            SamplingSettings::edit(s, |m| m.blending = *blend);
+            SamplingSettings::edit(s, |m| m.fallback = *fb);
         });
         let m = b.measure(&s, o.size, o.per_config(), true)?;
         let (r, rs) = m.rmse();
