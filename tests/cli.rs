@@ -89,6 +89,39 @@ fn bad_input_gives_one_clear_line() {
         "render", "--scene", "default", "--camera", "Nope", "--out", "/tmp/x",
     ]);
     assert!(e.contains("Nope"), "{e}");
+    // A visibility mode the method does not offer: refused with the modes it has.
+    let e = one_line_error(&[
+        "render",
+        "--method",
+        "lightcuts",
+        "--visibility",
+        "ism",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("--visibility ism") && e.contains("rays"), "{e}");
+    let e = one_line_error(&[
+        "render",
+        "--method",
+        "slc",
+        "--visibility",
+        "pcss",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("ism") && e.contains("not pcss"), "{e}");
+    let e = one_line_error(&[
+        "render",
+        "--method",
+        "val",
+        "--visibility",
+        "ism",
+        "--val-visibility",
+        "disk",
+        "--out",
+        "/tmp/x",
+    ]);
+    assert!(e.contains("--val-visibility"), "{e}");
     let e = one_line_error(&["bench", "tree", "--min-log2", "12", "--max-log2", "21"]);
     assert!(e.contains("--max-log2"), "{e}");
     let e = one_line_error(&[

@@ -956,7 +956,7 @@ fn ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays() {
         st.set(|s| {
             s.gi.method = method;
             s.gi.shadow_rays = vis.is_some();
-            light_culling::set_visibility(s, vis == Some(true));
+            (light_culling::VISIBILITY.set)(s, if vis == Some(true) { "ism" } else { "rays" });
         });
         st.frame();
         st.indirect()
@@ -1011,7 +1011,7 @@ fn ism_visibility_equals_the_cpu_lookups_and_agrees_with_shadow_rays() {
     st.set(|s| {
         s.gi.method = light_culling::ID;
         s.gi.shadow_rays = true;
-        light_culling::set_visibility(s, true);
+        (light_culling::VISIBILITY.set)(s, "ism");
         s.vpl.count = 300;
     });
     st.frame();

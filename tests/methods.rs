@@ -5,6 +5,7 @@
 
 mod common;
 
+use lightcut::methods::tree_samplers::TreeSamplers;
 use lightcut::methods::tree_samplers::settings::SamplingSettings;
 use lightcut::methods::{self, Kind, MethodId, REGISTRY};
 use lightcut::renderer::{
@@ -233,7 +234,10 @@ fn timed_frames_record_no_diagnostics_and_compute_the_same_gi() {
         let stats = r.sampling_stats_blocking().unwrap();
         assert!(stats.pixels > 0 && stats.traversals > 0, "{m}: {stats:?}");
         // Poison the diagnostics buffers; a timed frame must leave them as they are.
-        let b = r.slc_buffers();
+        let b = r
+            .method_module::<TreeSamplers>()
+            .expect("tree samplers")
+            .buffers();
         let sentinel = |buf: &wgpu::Buffer| {
             let words = vec![0x7f7f_7f7fu32; (buf.size() / 4) as usize];
             ctx.queue.write_buffer(buf, 0, bytemuck::cast_slice(&words));
@@ -245,7 +249,10 @@ fn timed_frames_record_no_diagnostics_and_compute_the_same_gi() {
         r.set_frame_mode(FrameMode::Timed);
         frame(&mut r);
         assert!(!r.last_frame_diagnostic());
-        let b = r.slc_buffers();
+        let b = r
+            .method_module::<TreeSamplers>()
+            .expect("tree samplers")
+            .buffers();
         for (name, buf) in [
             ("diagnostics", &b.diag),
             ("counters", &b.stats),

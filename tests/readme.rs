@@ -37,7 +37,7 @@ const EXAMPLES: &[&str] = &[
     "-- render --scene default --width 320 --height 240 --method lightcuts --set methods.lightcuts.relative_error=0.02 --compare-gt --out out/lc",
     "-- render --scene default --width 320 --height 240 --method lightcut-interpolation --set methods.lightcut-interpolation.visibility=interpolated --compare-gt --out out/li",
     "-- render --scene default --width 320 --height 240 --method light-culling --visibility none --compare-gt --out out/lcull",
-    "-- render --scene default --width 320 --height 240 --method val --val-visibility pcss --compare-gt --out out/val",
+    "-- render --scene default --width 320 --height 240 --method val --visibility pcss --compare-gt --out out/val",
     "-- results val --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
     "-- render --scene default --width 320 --height 240 --method slc --temporal svgf --camera-path --path-frames 60 --compare-gt --out out/temporal",
     "-- results temporal --scenes scenes/sponza.toml,scenes/breakfast_room.toml --out results",
@@ -221,7 +221,7 @@ fn gui_examples_open_what_they_promise() {
     let r = h.state().renderer().expect("renderer");
     assert_eq!(r.settings().gi.method, tree_samplers::SLC);
     let views: Vec<ViewBuffer> = h.state().layout().panes().iter().map(|p| p.spec.buffer).collect();
-    assert_eq!(views, lightcut::app::FIRST_SCREEN.to_vec());
+    assert_eq!(views, lightcut::app::first_screen());
     assert!(gi_mean(&h)[1] > 0.0, "GI is black");
     assert!(r.compare_progress().is_some(), "no ground truth beside SLC");
     drop(h);
@@ -580,7 +580,7 @@ fn cli_examples_write_what_they_promise() {
     // Virtual Area Lights with PCSS lookups: its maps built, its views written.
     let val = tmp("val");
     run_cli(&args(
-        "-- render --scene default --width 320 --height 240 --method val --val-visibility pcss --compare-gt --out out/val",
+        "-- render --scene default --width 320 --height 240 --method val --visibility pcss --compare-gt --out out/val",
         &[
             ("--width", "32"),
             ("--height", "24"),

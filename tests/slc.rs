@@ -9,7 +9,7 @@ use lightcut::methods::tree_samplers::settings::SamplingSettings;
 
 use glam::Vec3;
 use lightcut::base::sst_node::Topology;
-use lightcut::methods::tree_samplers::{RTSLC, SLC, SST};
+use lightcut::methods::tree_samplers::{RTSLC, SLC, SST, TreeSamplers};
 use lightcut::{
     metrics,
     reference::{
@@ -36,7 +36,15 @@ fn setup(ctx: &GpuContext, s: RenderSettings) -> Setup {
 
 /// The sampler's per-pixel diagnostics.
 fn diag(st: &Setup) -> Vec<[f32; 4]> {
-    let bytes = read_storage_buffer(&st.r.ctx, &st.r.slc_buffers().diag).unwrap();
+    let bytes = read_storage_buffer(
+        &st.r.ctx,
+        &st.r
+            .method_module::<TreeSamplers>()
+            .expect("tree samplers")
+            .buffers()
+            .diag,
+    )
+    .unwrap();
     bytemuck::cast_slice(&bytes).to_vec()
 }
 
@@ -92,7 +100,10 @@ fn check_cuts(ctx: &GpuContext, kind: TreeKind, cases: &[(bool, u32)]) {
             TreeKind::Perfect => Topology::perfect_of(&nodes),
         };
         assert_eq!(nodes.len(), 2 * topo.leaves as usize);
-        let b = st.r.slc_buffers();
+        let b =
+            st.r.method_module::<TreeSamplers>()
+                .expect("tree samplers")
+                .buffers();
         let cuts: Vec<u32> = bytemuck::cast_slice(&read_storage_buffer(ctx, &b.cuts).unwrap()).to_vec();
         let (grid, k) = (b.grid, b.block);
         let pos = st.r.read(Buffer::Position).unwrap();
@@ -156,7 +167,16 @@ fn blending_picks_cuts_by_their_weights_and_falls_back_to_the_mock_cut() {
     st.frame();
     let pos = st.r.read(Buffer::Position).unwrap();
     let nrm = st.r.read(Buffer::Normal).unwrap();
-    let (grid, k) = (st.r.slc_buffers().grid, st.r.slc_buffers().block);
+    let (grid, k) = (
+        st.r.method_module::<TreeSamplers>()
+            .expect("tree samplers")
+            .buffers()
+            .grid,
+        st.r.method_module::<TreeSamplers>()
+            .expect("tree samplers")
+            .buffers()
+            .block,
+    );
     let s = st.r.settings().clone();
     let d_max = s.vpl.d_max * st.scene.bounds.radius();
     // CPU weights per pixel: bilinear x S (eq. 5.3).
@@ -634,7 +654,12 @@ fn interleaved_sampling_shares_the_cut_slots_out_and_its_filter_equals_the_cpu_r
         // or demodulated into the half-resolution accumulation.
         let raw = read_raw(&st);
         let worst = if half {
-            let (hpos, hnrm, hacc) = st.r.read_half_resolution().unwrap().expect("half resolution on");
+            let (hpos, hnrm, hacc) =
+                st.r.method_module::<TreeSamplers>()
+                    .expect("tree samplers")
+                    .read_half_resolution(&st.r.ctx)
+                    .unwrap()
+                    .expect("half resolution on");
             filter_error(&st, gi, &surfaces(&hpos, &hnrm), &raw, None, |x, y| {
                 v3(hacc[(y * gi.0 + x) as usize])
             })
@@ -661,7 +686,12 @@ fn half_resolution_upsampling_equals_the_cpu_reference() {
     let mut st = setup(&ctx, settings(SLC));
     st.set(|s| SamplingSettings::edit(s, |m| m.half_resolution = true));
     st.frame();
-    let (hpos, hnrm, hacc) = st.r.read_half_resolution().unwrap().expect("half resolution on");
+    let (hpos, hnrm, hacc) =
+        st.r.method_module::<TreeSamplers>()
+            .expect("tree samplers")
+            .read_half_resolution(&st.r.ctx)
+            .unwrap()
+            .expect("half resolution on");
     assert_eq!((hpos.width, hpos.height), (W / 2, H / 2));
     let pos = st.r.read(Buffer::Position).unwrap();
     let nrm = st.r.read(Buffer::Normal).unwrap();
@@ -792,7 +822,10 @@ fn the_pixel_story_matches_the_frame_and_the_tree() {
             let trace = st.r.read_pixel_trace().unwrap().expect("a trace");
             let (nodes, flags) = st.r.read_tree().unwrap();
             let leaves = (nodes.len() / 2) as u32;
-            let b = st.r.slc_buffers();
+            let b =
+                st.r.method_module::<TreeSamplers>()
+                    .expect("tree samplers")
+                    .buffers();
             let cuts: Vec<u32> = bytemuck::cast_slice(&read_storage_buffer(&ctx, &b.cuts).unwrap()).to_vec();
             let (p, n) = (v3(pos.get(x, y)), v3(nrm.get(x, y)).normalize());
             assert_eq!((trace.taken, trace.cells), (cut_size, 1));

@@ -5,17 +5,49 @@ use super::*;
 
 impl WorkbenchApp {
     pub(super) fn viewport(&mut self, ui: &mut egui::Ui) {
-        let avail = ui.available_size();
-        let ppp = ui.ctx().pixels_per_point();
-        let (Some(rs), Some(open)) = (self.render_state.clone(), self.open.as_mut()) else {
+        let (Some(rs), Some(_)) = (self.render_state.clone(), self.open.as_ref()) else {
             ui.centered_and_justified(|ui| ui.label("No scene is open."));
             return;
         };
+        if self.renderer.is_none() || self.device_lost_notice(ui) {
+            return;
+        }
+        self.sync_renderer(ui);
+        let job_running = self.sheet_job.is_some();
+        let render_now = self.camera_and_animation(ui, job_running);
+        let comparing = self.compare_gt && self.settings.gi.method.per_frame() && !job_running;
+        self.render_frame(render_now, comparing);
+        let now = ui.input(|i| i.time);
+        self.after_frame(now, comparing);
+        let mut events = self.draw_views(ui, &rs);
+        self.update_ab_metrics(now);
+        self.pointer_and_story(ui, &events, now);
+        self.pick_cut(&events);
         let Some(renderer) = self.renderer.as_mut() else {
             return;
         };
-        // A lost device the app has no next window for (`recovery.rs`: an app without a
-        // handover, as in a test harness): rendering stops and says why.
+        if let Some(src) = events.snapshot {
+            let label = format!(
+                "{} · {} · frame {}",
+                self.settings.gi.method.name(),
+                src.name(),
+                renderer.sampling_frames()
+            );
+            if let Err(e) = renderer.take_snapshot(src, label) {
+                self.errors.push(format!("snapshot: {e}"));
+            }
+        }
+        self.pending_export = events.export.take();
+        self.events = events;
+        self.frames += 1;
+    }
+
+    /// A lost device the app has no next window for (`recovery.rs`: an app without a
+    /// handover, as in a test harness): rendering stops and says why (true).
+    fn device_lost_notice(&mut self, ui: &mut egui::Ui) -> bool {
+        let Some(renderer) = self.renderer.as_mut() else {
+            return false;
+        };
         if renderer.ctx.errors.device_lost() {
             for e in renderer.ctx.errors.take() {
                 if !self.errors.contains(&e) {
@@ -36,8 +68,19 @@ impl WorkbenchApp {
                     ),
                 )
             });
-            return;
+            return true;
         }
+        false
+    }
+
+    /// The render size (the largest view at the render scale) and the settings to the
+    /// renderer (not while a sheet drives it).
+    fn sync_renderer(&mut self, ui: &egui::Ui) {
+        let avail = ui.available_size();
+        let ppp = ui.ctx().pixels_per_point();
+        let Some(renderer) = self.renderer.as_mut() else {
+            return;
+        };
         // Render resolution: the largest view's image area (last layout) at the render scale.
         let px = self.layout.largest_view_px().unwrap_or(avail * ppp);
         let w = ((px.x * self.render_scale) as u32).clamp(16, 8192);
@@ -56,8 +99,14 @@ impl WorkbenchApp {
         if self.settings.gi.method.kind() != crate::methods::Kind::Progressive {
             self.last_fast_method = self.settings.gi.method;
         }
+    }
 
-        // The views' input of the last frame -> camera.
+    /// The views' input of the last frame to the camera, and the dynamic scene's step (sun
+    /// sweep, orbit, camera path); true when this UI frame renders.
+    fn camera_and_animation(&mut self, ui: &egui::Ui, job_running: bool) -> bool {
+        let Some(open) = self.open.as_mut() else {
+            return false;
+        };
         let ev = std::mem::take(&mut self.events);
         let dt = ui.input(|i| i.stable_dt).min(0.1);
         if let Some((d, primary)) = ev.camera_drag {
@@ -106,9 +155,15 @@ impl WorkbenchApp {
         if open.camera_index.is_none() {
             open.controller.apply(&mut open.camera);
         }
+        render_now
+    }
 
+    /// One frame: a comparison sheet's step while one runs, else the docked views' frame.
+    fn render_frame(&mut self, render_now: bool, comparing: bool) {
+        let (Some(renderer), Some(open)) = (self.renderer.as_mut(), self.open.as_mut()) else {
+            return;
+        };
         let lights = lights_with_sun(&open.scene, self.sun.as_ref());
-        let comparing = self.compare_gt && self.settings.gi.method.per_frame() && !job_running;
         let specs = self.layout.assign_slots(self.hover_view);
         if self.cancel_sheet {
             self.cancel_sheet = false;
@@ -159,7 +214,14 @@ impl WorkbenchApp {
                 &specs,
             );
         }
-        let now = ui.input(|i| i.time);
+    }
+
+    /// After the frame: live metrics against the comparison's truth, the tree panel, the
+    /// timings, the method's statistics and the GPU's errors.
+    fn after_frame(&mut self, now: f64, comparing: bool) {
+        let Some(renderer) = self.renderer.as_mut() else {
+            return;
+        };
         // Live metrics against the finished comparison ground truth (twice a second).
         if comparing
             && now - self.last_metrics_time > 0.5
@@ -187,17 +249,20 @@ impl WorkbenchApp {
             self.timings_panel.push(&t);
             self.timings = Some(t);
         }
-        if self.settings.gi.method.samples_tree() {
-            self.sampling_stats = renderer.sampling_stats();
-        }
+        self.sampling_stats = renderer.sampling_stats();
         self.method_status = renderer.method_status();
         for e in renderer.ctx.errors.take() {
             if !self.errors.contains(&e) {
                 self.errors.push(e);
             }
         }
+    }
 
-        // The docked views.
+    /// The docked views; returns their input events.
+    fn draw_views(&mut self, ui: &mut egui::Ui, rs: &egui_wgpu::RenderState) -> ViewEvents {
+        let (Some(renderer), Some(open)) = (self.renderer.as_mut(), self.open.as_mut()) else {
+            return ViewEvents::default();
+        };
         let mut tree = std::mem::replace(
             &mut self.layout.tree,
             egui_tiles::Tree::empty(egui::Id::unique("image_views_swap")),
@@ -208,7 +273,7 @@ impl WorkbenchApp {
             let snapshots = renderer.snapshot_labels();
             let mut cx = PaneContext {
                 renderer: &*renderer,
-                render_state: &rs,
+                render_state: rs,
                 transform: &mut self.layout.transform,
                 events: &mut events,
                 linear_filter: self.render_scale < 1.0,
@@ -224,8 +289,14 @@ impl WorkbenchApp {
             tree.ui(&mut cx, ui);
         }
         self.layout.tree = tree;
+        events
+    }
 
-        // A/B metrics (whole pair and rectangle), twice a second per view.
+    /// A/B metrics (whole pair and rectangle), twice a second per view.
+    fn update_ab_metrics(&mut self, now: f64) {
+        let Some(renderer) = self.renderer.as_mut() else {
+            return;
+        };
         for p in self.layout.panes_mut() {
             let Some(ab) = p.spec.effective_ab() else {
                 p.rt.metrics = None;
@@ -268,7 +339,14 @@ impl WorkbenchApp {
                 }
             };
         }
-        // Pixel values under the pointer (camera-space views; P pins / unpins, a click pins).
+    }
+
+    /// Pixel values under the pointer (camera-space views; P pins / unpins, a click pins) and
+    /// the pinned pixel's story.
+    fn pointer_and_story(&mut self, ui: &egui::Ui, events: &ViewEvents, now: f64) {
+        let Some(renderer) = self.renderer.as_mut() else {
+            return;
+        };
         if self.pixel.show || self.story.show {
             if events.hovered && ui.input(|i| i.key_pressed(egui::Key::P)) {
                 self.pixel.pinned = !self.pixel.pinned;
@@ -297,56 +375,41 @@ impl WorkbenchApp {
         if let Err(e) = self.story.refresh(renderer, story_pixel, now) {
             self.errors.push(format!("pixel story: {e}"));
         }
-        // Clicking a block in the cut views lists its cut.
+    }
+
+    /// Clicking a block in a view of a method's cut blocks lists its cut.
+    fn pick_cut(&mut self, events: &ViewEvents) {
+        let Some(renderer) = self.renderer.as_mut() else {
+            return;
+        };
         if let Some(c) = events.click
-            && matches!(c.buffer, ViewBuffer::Method(v)
-                if v == crate::methods::tree_samplers::CUT_BLOCKS || v == crate::methods::tree_samplers::CUT_DEPTH)
+            && let ViewBuffer::Method(v) = c.buffer
         {
-            let (px, py) = c.texel;
-            let b = renderer.slc_buffers();
-            let block = (py / b.block) * b.grid.0 + px / b.block;
-            let (bx, by) = (px / b.block, py / b.block);
-            renderer.select_block(Some(block));
-            match (
-                renderer.read_cut(block),
-                renderer.read_tree(),
-                renderer.read_tree_links(),
-            ) {
-                (Ok(cut), Ok((nodes, flags)), Ok(links)) => {
-                    let topo = crate::base::sst_node::Topology::of((nodes.len() / 2) as u32, &links);
-                    self.cut_inspect = Some(CutInspect {
-                        depths: cut.iter().map(|&n| topo.depth(n.max(1))).collect(),
-                        block: (bx, by),
-                        rows: cut
-                            .iter()
-                            .map(|&n| {
-                                let node = nodes.get(n as usize).copied().unwrap_or(SstNode::EMPTY);
-                                (n, node, crate::base::sst_node::flag(&flags, n as usize))
-                            })
-                            .collect(),
-                        leaves: (nodes.len() / 2) as u32,
-                        root_flux: nodes.get(1).map_or(0.0, |r| luminance(r.intensity)),
-                    })
-                }
-                (Err(e), _, _) | (_, Err(e), _) | (_, _, Err(e)) => {
-                    self.errors.push(format!("reading the cut: {e}"))
-                }
+            match renderer.pick_block(v, c.texel) {
+                Ok(None) => {}
+                Ok(Some(picked)) => match (renderer.read_tree(), renderer.read_tree_links()) {
+                    (Ok((nodes, flags)), Ok(links)) => {
+                        let topo = crate::base::sst_node::Topology::of((nodes.len() / 2) as u32, &links);
+                        let cut = &picked.nodes;
+                        self.cut_inspect = Some(CutInspect {
+                            depths: cut.iter().map(|&n| topo.depth(n.max(1))).collect(),
+                            block: picked.block,
+                            rows: cut
+                                .iter()
+                                .map(|&n| {
+                                    let node = nodes.get(n as usize).copied().unwrap_or(SstNode::EMPTY);
+                                    (n, node, crate::base::sst_node::flag(&flags, n as usize))
+                                })
+                                .collect(),
+                            leaves: (nodes.len() / 2) as u32,
+                            root_flux: nodes.get(1).map_or(0.0, |r| luminance(r.intensity)),
+                        })
+                    }
+                    (Err(e), _) | (_, Err(e)) => self.errors.push(format!("reading the cut: {e}")),
+                },
+                Err(e) => self.errors.push(format!("reading the cut: {e}")),
             }
         }
-        if let Some(src) = events.snapshot {
-            let label = format!(
-                "{} · {} · frame {}",
-                self.settings.gi.method.name(),
-                src.name(),
-                renderer.sampling_frames()
-            );
-            if let Err(e) = renderer.take_snapshot(src, label) {
-                self.errors.push(format!("snapshot: {e}"));
-            }
-        }
-        self.pending_export = events.export.take();
-        self.events = events;
-        self.frames += 1;
     }
 
     /// One line of fixed height (so the layout never jumps with the length of the timings):

@@ -78,7 +78,7 @@ pub struct AppOptions {
     /// Start with these views (docked in a grid) instead of the saved layout.
     pub views: Vec<ViewBuffer>,
     /// The views when neither `views`, `view` nor a saved layout give them (the binary:
-    /// [`FIRST_SCREEN`]; empty: one view of the final image).
+    /// [`first_screen`]; empty: one view of the final image).
     pub default_views: Vec<ViewBuffer>,
     /// Ignore the saved layout.
     pub reset_layout: bool,
@@ -92,12 +92,18 @@ pub struct AppOptions {
 /// The workbench's first screen: the final image, the method's GI, the ground truth of the
 /// same VPLs (progressive) and the traversal steps. A layout with a ground-truth view starts
 /// the comparison.
-pub const FIRST_SCREEN: [ViewBuffer; 4] = [
-    ViewBuffer::Final,
-    ViewBuffer::Indirect,
-    ViewBuffer::GroundTruthIndirect,
-    ViewBuffer::Method(crate::methods::tree_samplers::STEPS),
-];
+/// The fourth is the default method's first view (SLC's traversal steps).
+pub fn first_screen() -> Vec<ViewBuffer> {
+    let mut v = vec![
+        ViewBuffer::Final,
+        ViewBuffer::Indirect,
+        ViewBuffer::GroundTruthIndirect,
+    ];
+    if let Some(first) = crate::methods::MethodId::default().info().views.first() {
+        v.push(ViewBuffer::Method(crate::methods::MethodView::new(first.name)));
+    }
+    v
+}
 
 /// The sun as the UI edits it (light 0 of the scene).
 #[derive(Clone, Debug, PartialEq)]
@@ -195,7 +201,7 @@ pub struct WorkbenchApp {
     frame_ms_smoothed: f64,
     adapter: String,
     tree_panel: TreePanel,
-    sampling_stats: Option<crate::methods::tree_samplers::pass::SamplingStats>,
+    sampling_stats: Option<crate::base::traversal::TraversalStats>,
     /// The current method's statistics line (`Method::status`).
     method_status: Option<String>,
     cut_inspect: Option<CutInspect>,

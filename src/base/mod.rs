@@ -16,3 +16,4 @@ pub mod sampling;
 pub mod settings_ui;
 pub mod sst_node;
 pub mod story;
+pub mod traversal;

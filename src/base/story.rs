@@ -143,3 +143,13 @@ pub struct CutStory {
     /// the renderer fills them in), empty on the perfect tree.
     pub links: Vec<[u32; 4]>,
 }
+
+/// A block's light cut, picked in a view of a method's cut blocks (`Method::pick_block`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BlockCut {
+    /// The block's index (row-major over the method's block grid) and its (x, y) in blocks.
+    pub index: u32,
+    pub block: (u32, u32),
+    /// The cut's node ids, in slot order, without empty slots.
+    pub nodes: Vec<u32>,
+}

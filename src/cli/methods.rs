@@ -27,6 +27,12 @@ pub fn run() -> anyhow::Result<()> {
         if m.story {
             println!("{:<14} pixel story: yes", "");
         }
+        if let Some(vm) = m.visibility {
+            let v: Vec<String> = vm.modes.iter().map(|(n, what)| format!("{n} ({what})")).collect();
+            println!("{:<14} visibility (--visibility): {}; none", "", v.join("; "));
+        } else if m.shadow_ray_switch {
+            println!("{:<14} visibility (--visibility): rays; none", "");
+        }
         if m.kind != crate::methods::Kind::DirectOnly {
             let brdf = if m.glossy { "Lambert, GGX" } else { "Lambert only" };
             let bounces = if m.one_bounce { "1 (RSM texels)" } else { "1..=8" };

@@ -6,6 +6,7 @@ pub mod bench_soak;
 pub mod compare;
 pub mod export_scene;
 pub mod fetch_scenes;
+pub mod method_flags;
 pub mod methods;
 pub mod render;
 mod render_sequence;
@@ -69,7 +70,7 @@ pub struct Cli {
 }
 
 /// The GUI's start-up options from the command line (no subcommand): the settings file, the
-/// views by name, the first screen ([`crate::app::FIRST_SCREEN`]) when no view is named and
+/// views by name, the first screen ([`crate::app::first_screen`]) when no view is named and
 /// no layout is saved.
 pub fn gui_options(cli: &Cli) -> anyhow::Result<crate::app::AppOptions> {
     use crate::settings::ViewBuffer;
@@ -109,7 +110,7 @@ pub fn gui_options(cli: &Cli) -> anyhow::Result<crate::app::AppOptions> {
         compare_gt: cli.compare_gt,
         timings: cli.timings,
         views,
-        default_views: crate::app::FIRST_SCREEN.to_vec(),
+        default_views: crate::app::first_screen(),
         reset_layout: cli.reset_layout,
         pin: cli.pin,
         lose_device_at_frame: cli.lose_device_at_frame,

@@ -408,7 +408,7 @@ fn run_settings(
             "  note: the temporal stage's history from the window's earlier frames is not in the record: its image is the stage's over the frames rendered here"
         );
     }
-    args.sampling.apply(&mut settings);
+    args.sampling.apply(&mut settings)?;
     args.sampling.check_visibility(&[method])?;
     // `tree.kind = lbvh` from a settings file or --set: the same refusal as --tree's.
     if let Some(msg) = method.refuses_tree(settings.tree.kind) {

@@ -49,7 +49,7 @@ pub struct SheetArgs {
 pub fn run(args: &SheetArgs) -> anyhow::Result<()> {
     let opened = open_scene(&SceneSource::from_arg(&args.scene)).map_err(|e| anyhow!("{e}"))?;
     let mut settings = args.settings.resolve(opened.exposure_ev)?;
-    args.sampling.apply(&mut settings);
+    args.sampling.apply(&mut settings)?;
     if let Some(v) = args.vpls {
         settings.vpl.count = v;
     }

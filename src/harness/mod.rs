@@ -10,9 +10,12 @@
 //! so every frame regenerates the same VPLs and tree; a checksum of the VPLs taken with the
 //! ground truth is compared after every configuration, so a mismatch cannot go unnoticed.
 
+mod csv;
 pub mod figures;
 pub mod plot;
 pub mod sequence;
+
+pub use csv::{Csv, csv_line, num};
 
 use crate::methods::tree_samplers::settings::SamplingSettings;
 use std::{
@@ -25,7 +28,7 @@ use anyhow::{Context, anyhow, bail};
 
 use crate::{
     base::display,
-    methods::tree_samplers::pass::SamplingStats,
+    base::traversal::TraversalStats,
     metrics,
     renderer::{
         Buffer, FrameInput, FrameMode, Renderer,
@@ -144,7 +147,7 @@ pub struct Measured {
     /// Per frame: RMSE over the pixels without a similar cut only (NaN when there are none).
     pub rmse_fallback: Vec<f64>,
     /// Sampler statistics summed over the diagnostic frames.
-    pub stats: Option<SamplingStats>,
+    pub stats: Option<TraversalStats>,
     /// The last diagnostic frame's GI.
     pub indirect: Option<ImageF32>,
     /// A diagnostic frame's traversal steps per traversal, per GI pixel (NaN without
@@ -595,24 +598,29 @@ impl Bench {
     /// the pixels without a similar cut.
     fn read_steps(&self) -> anyhow::Result<(u32, u32, Vec<f32>, Vec<bool>)> {
         let (w, h) = self.r.size();
-        let diag = self.r.read_f32_buffer(&self.r.slc_buffers().diag)?;
+        let Some(crate::base::traversal::TraversalPixels { steps, fallback }) =
+            self.r.read_traversal_pixels()?
+        else {
+            bail!(
+                "{} keeps no per-pixel traversal counts",
+                self.r.settings().gi.method.name()
+            );
+        };
         let pos = self.r.read(Buffer::Position)?;
         let n = (w * h) as usize;
-        if diag.len() < 4 * n || pos.pixels.len() < n {
+        if steps.len() < n || fallback.len() < n || pos.pixels.len() < n {
             bail!("diagnostics buffer smaller than the frame");
         }
         let v = (0..n)
             .map(|i| {
                 if pos.pixels[i][3] > 0.0 {
-                    diag[4 * i]
+                    steps[i]
                 } else {
                     f32::NAN
                 }
             })
             .collect();
-        let fb = (0..n)
-            .map(|i| pos.pixels[i][3] > 0.0 && diag[4 * i + 1] > 0.5)
-            .collect();
+        let fb = (0..n).map(|i| pos.pixels[i][3] > 0.0 && fallback[i]).collect();
         Ok((w, h, v, fb))
     }
 
@@ -641,58 +649,6 @@ impl Bench {
             .collect();
         crate::export::write_png(path, img.width, img.height, &rgba)
             .with_context(|| format!("cannot write {}", path.display()))
-    }
-}
-
-/// A CSV table: a header and rows of cells.
-pub struct Csv {
-    pub header: Vec<&'static str>,
-    pub rows: Vec<Vec<String>>,
-}
-
-impl Csv {
-    pub fn new(header: &[&'static str]) -> Self {
-        Self {
-            header: header.to_vec(),
-            rows: Vec::new(),
-        }
-    }
-    pub fn row(&mut self, cells: Vec<String>) {
-        debug_assert_eq!(cells.len(), self.header.len());
-        self.rows.push(cells);
-    }
-    pub fn write(&self, path: &Path) -> anyhow::Result<()> {
-        let mut s = self.header.join(",");
-        s.push('\n');
-        for r in &self.rows {
-            s.push_str(&csv_line(r));
-            s.push('\n');
-        }
-        std::fs::write(path, s).with_context(|| format!("cannot write {}", path.display()))
-    }
-}
-
-/// One CSV line: cells with `,` or `"` quoted, quotes doubled.
-pub fn csv_line(cells: &[String]) -> String {
-    cells
-        .iter()
-        .map(|c| {
-            if c.contains(',') || c.contains('"') {
-                format!("\"{}\"", c.replace('"', "\"\""))
-            } else {
-                c.clone()
-            }
-        })
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-/// A number for a CSV cell (full precision, "nan" for missing).
-pub fn num(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v}")
-    } else {
-        "nan".into()
     }
 }
 

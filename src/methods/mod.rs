@@ -112,6 +112,43 @@ pub struct Module {
     /// Its kernels dispatched with a workgroup size of their own (the registry test checks
     /// every other compute entry point has the standard sizes).
     pub own_workgroups: &'static [crate::gpu::passes::OwnWorkgroup],
+    /// Its command-line flags (`render`, `sheet`): shorthands for `--set` of its settings.
+    pub flags: &'static [MethodFlag],
+}
+
+/// A command-line flag a method module declares: it sets one of the module's settings by its
+/// TOML path, as `--set path=value` would (and is checked by the same validation).
+pub struct MethodFlag {
+    /// The long name without dashes (`cut-size`).
+    pub long: &'static str,
+    /// Its line in `--help`.
+    pub help: &'static str,
+    /// The settings path it sets (`methods.slc.cut_size`).
+    pub path: &'static str,
+    pub kind: FlagKind,
+}
+
+/// What a [`MethodFlag`] takes.
+pub enum FlagKind {
+    /// A number (its value name in `--help`), written as given.
+    Number(&'static str),
+    /// One of these words, each written as its settings value: (CLI word, TOML value).
+    Choice(&'static [(&'static str, &'static str)]),
+    /// A switch: present, it writes this TOML value.
+    Switch(&'static str),
+}
+
+/// Every module's flags, each once (the CLI's `render` and `sheet` offer them).
+pub fn flags() -> Vec<&'static MethodFlag> {
+    let mut v: Vec<&'static MethodFlag> = Vec::new();
+    for m in modules() {
+        for f in m.flags {
+            if !v.iter().any(|x| x.long == f.long) {
+                v.push(f);
+            }
+        }
+    }
+    v
 }
 
 /// A per-frame method's quality knob: what `results` sweeps for its RMSE-vs-GPU-time curve
@@ -154,6 +191,9 @@ pub struct MethodInfo {
     pub story: bool,
     /// True when it honours `gi.shadow_rays` (the GUI shows the switch).
     pub shadow_ray_switch: bool,
+    /// The ways it can shadow its lights while `gi.shadow_rays` is on, if it offers a choice
+    /// (`render --visibility`; None: BVH shadow rays only).
+    pub visibility: Option<&'static VisibilityModes>,
     /// True for the ground truth of the frame's own VPLs (the comparison's truth).
     pub truth_of_vpls: bool,
     /// True when it lights the scene from the RSM itself (one bounce: Virtual Area Lights
@@ -188,6 +228,56 @@ pub struct MethodInfo {
     /// culling without the filter); the contract checks that `bias` then says `Unbiased` and
     /// that the N-frame means converge to the truth.
     pub unbiased: Option<Unbiased>,
+}
+
+/// A method's visibility modes (`MethodInfo::visibility`): how its lights are shadowed while
+/// `gi.shadow_rays` is on. `render --visibility` lists every method's modes (and `none`, the
+/// shadow rays off) and refuses a mode the method does not offer.
+pub struct VisibilityModes {
+    /// (CLI name, what it does), its default first.
+    pub modes: &'static [(&'static str, &'static str)],
+    /// Sets the mode named `name` (one of `modes`) in the settings.
+    pub set: fn(&mut RenderSettings, &str),
+}
+
+/// Every visibility mode of the registry, each once (`none` and `rays` first).
+pub fn visibility_names() -> Vec<&'static str> {
+    let mut v = vec!["none", "rays"];
+    for m in REGISTRY {
+        for (name, _) in m.visibility.map_or(&[][..], |vm| vm.modes) {
+            if !v.contains(name) {
+                v.push(name);
+            }
+        }
+    }
+    v
+}
+
+/// Whether `method` offers visibility mode `name` (`none` and, for a method without a
+/// choice, `rays` always); the error says which it offers.
+pub fn offers_visibility(method: MethodId, name: &str) -> Result<(), String> {
+    let modes = method.info().visibility;
+    let offered: Vec<&str> = modes.map_or(vec!["rays"], |vm| vm.modes.iter().map(|(n, _)| *n).collect());
+    if name == "none" || offered.contains(&name) {
+        return Ok(());
+    }
+    Err(format!(
+        "{method} offers visibility {} (and none), not {name}",
+        offered.join(", ")
+    ))
+}
+
+/// Sets visibility mode `name` in the settings of every method that offers it (`none`: the
+/// shadow rays off; otherwise on).
+pub fn set_visibility(s: &mut RenderSettings, name: &str) {
+    s.gi.shadow_rays = name != "none";
+    for m in REGISTRY {
+        if let Some(vm) = m.visibility
+            && vm.modes.iter().any(|(n, _)| *n == name)
+        {
+            (vm.set)(s, name);
+        }
+    }
 }
 
 /// Declared numeric settings of one settings section (`MethodInfo::fields`).
@@ -410,6 +500,31 @@ pub trait Method: Any {
     /// it keeps none.
     fn stats(&mut self) -> Vec<(&'static str, f64)> {
         Vec::new()
+    }
+    /// The counters of its light-tree traversals in a recent diagnostic frame (non-blocking:
+    /// None until one is read back; the GUI's statistics, the figures' steps, `render`'s
+    /// summary). None for a method that does not walk the tree sample by sample.
+    fn traversal_stats(&mut self) -> Option<crate::base::traversal::TraversalStats> {
+        None
+    }
+    /// Per pixel of its last diagnostic frame (row-major at its GI resolution): traversal
+    /// steps per traversal and whether the pixel had no similar cut (fell back). None for a
+    /// method that keeps no such counts.
+    fn read_traversal_pixels(
+        &self,
+        _ctx: &GpuContext,
+    ) -> Result<Option<crate::base::traversal::TraversalPixels>, GpuError> {
+        Ok(None)
+    }
+    /// The light cut of the block under `texel` of its view `view` (a view whose texels are
+    /// the method's cut blocks: clicking one lists its cut). None where `view` shows no blocks.
+    fn pick_block(
+        &self,
+        _ctx: &GpuContext,
+        _view: MethodView,
+        _texel: (u32, u32),
+    ) -> Result<Option<crate::base::story::BlockCut>, GpuError> {
+        Ok(None)
     }
 }
 

@@ -111,34 +111,29 @@ impl Renderer {
         }
     }
 
-    /// The top of the traversal-steps heat map: the depth of the tree (root to leaves).
-    pub fn sampling_steps_scale(&self) -> f32 {
-        methods::tree_samplers::steps_scale(self.tree.levels())
-    }
-
     /// Outlines a block in the cut views (None: no outline).
     pub fn select_block(&mut self, block: Option<u32>) {
         self.selected_block = block;
     }
 
-    /// Reads the cut of block `b` (node ids in slot order, without empty slots).
-    pub fn read_cut(&self, b: u32) -> Result<Vec<u32>, GpuError> {
-        match self.tree_samplers() {
-            Some(t) => t.read_cut(&self.ctx, b),
-            None => Ok(Vec::new()),
-        }
-    }
-
-    /// Half-resolution GI of the last frame: its G-buffer position, normal and the sampler's
-    /// demodulated sums (None when half resolution is off).
-    pub fn read_half_resolution(&self) -> Result<Option<HalfReadback>, GpuError> {
-        let Some(h) = self.tree_samplers().and_then(|t| t.half_targets()) else {
+    /// The block under `texel` of the method view `view` and its cut (`Method::pick_block`),
+    /// outlined in the cut views from now on; None where the view shows no blocks.
+    pub fn pick_block(
+        &mut self,
+        view: MethodView,
+        texel: (u32, u32),
+    ) -> Result<Option<crate::base::story::BlockCut>, GpuError> {
+        let Some((_, owner)) = view.find() else {
             return Ok(None);
         };
-        let pos = readback::read_texture_f32(&self.ctx, &h.gbuffer.position, 0)?;
-        let nrm = readback::read_texture_f32(&self.ctx, &h.gbuffer.normal, 0)?;
-        let acc = readback::read_storage_buffer(&self.ctx, &h.accum)?;
-        Ok(Some((pos, nrm, bytemuck::cast_slice(&acc).to_vec())))
+        let Some(m) = self.method_instance(owner) else {
+            return Ok(None);
+        };
+        let picked = m.pick_block(&self.ctx, view, texel)?;
+        if let Some(b) = &picked {
+            self.selected_block = Some(b.index);
+        }
+        Ok(picked)
     }
 
     /// Frames the current method averaged in its image (None: it does not average).
@@ -154,22 +149,27 @@ impl Renderer {
             .unwrap_or(0)
     }
 
-    /// The last frame's sampling counters, waiting for them.
-    pub fn sampling_stats_blocking(&mut self) -> Option<SamplingStats> {
+    /// The current method's traversal counters of the last diagnostic frame, waiting for
+    /// them (`Method::traversal_stats`; None for a method that keeps none).
+    pub fn sampling_stats_blocking(&mut self) -> Option<TraversalStats> {
         let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
-        self.tree_samplers_mut()?.poll_stats()
+        self.sampling_stats()
     }
 
-    /// Counters of a recent frame of the tree samplers (non-blocking; None before the first).
-    pub fn sampling_stats(&mut self) -> Option<SamplingStats> {
-        self.tree_samplers_mut()?.poll_stats()
+    /// The current method's traversal counters of a recent frame (non-blocking; None before
+    /// the first).
+    pub fn sampling_stats(&mut self) -> Option<TraversalStats> {
+        let module = self.settings.gi.method.info().module.name;
+        let (_, m) = self.methods.iter_mut().find(|(n, _)| *n == module)?;
+        m.traversal_stats()
     }
 
-    /// The tree samplers' buffers (cuts, per-pixel diagnostics, counters) of the last frame.
-    pub fn slc_buffers(&self) -> &SlcBuffers {
-        match self.tree_samplers() {
-            Some(t) => t.buffers(),
-            None => unreachable!("the tree samplers are registered"),
+    /// The current method's per-pixel traversal steps and fallback flags of the last
+    /// diagnostic frame (`Method::read_traversal_pixels`; None for a method without them).
+    pub fn read_traversal_pixels(&self) -> Result<Option<crate::base::traversal::TraversalPixels>, GpuError> {
+        match self.method_instance(self.settings.gi.method) {
+            Some(m) => m.read_traversal_pixels(&self.ctx),
+            None => Ok(None),
         }
     }
 
@@ -278,17 +278,6 @@ impl Renderer {
     pub fn method_legend(&self, view: MethodView) -> Option<crate::base::colormap::Legend> {
         let (_, owner) = view.find()?;
         self.method_instance(owner)?.legend(view, self.tree.levels())
-    }
-
-    pub(super) fn tree_samplers(&self) -> Option<&TreeSamplers> {
-        let m = self.method_instance(methods::tree_samplers::SLC)?;
-        (m as &dyn std::any::Any).downcast_ref::<TreeSamplers>()
-    }
-
-    pub(super) fn tree_samplers_mut(&mut self) -> Option<&mut TreeSamplers> {
-        let module = methods::tree_samplers::MODULE.name;
-        let (_, m) = self.methods.iter_mut().find(|(n, _)| *n == module)?;
-        (m.as_mut() as &mut dyn std::any::Any).downcast_mut::<TreeSamplers>()
     }
 
     /// Progress of the progressive GI method: VPLs done (ground truth) or samples per pixel

@@ -29,13 +29,8 @@ use thiserror::Error;
 
 use crate::base::sst_node::SstNode;
 use crate::base::story::PixelTrace;
-use crate::methods::{
-    self, FrameCx, Method, MethodId, MethodView, ViewCx,
-    tree_samplers::{
-        TreeSamplers,
-        pass::{SamplingStats, SlcBuffers},
-    },
-};
+use crate::base::traversal::TraversalStats;
+use crate::methods::{self, FrameCx, Method, MethodId, MethodView, ViewCx};
 use crate::scene::{Camera, DirectionalLight, Scene};
 use context::{GpuContext, GpuError};
 use frame::{FrameTargets, ShadowTargets, ViewTarget};
@@ -116,9 +111,6 @@ pub enum FrameMode {
     /// Every `n`-th frame diagnostic (untimed), the others timed (the GUI).
     Interleaved(u32),
 }
-
-/// Half-resolution G-buffer position and normal, and the sampler's demodulated sums there.
-pub type HalfReadback = (ImageF32, ImageF32, Vec<[f32; 4]>);
 
 /// The comparison's truth kept beside a per-frame method (an instance of
 /// [`methods::comparison_truth`]): its own accumulation and composite targets.

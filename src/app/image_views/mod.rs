@@ -13,8 +13,8 @@ use serde::{Deserialize, Serialize};
 use toolbar::{draw_legend, view_toolbar};
 
 use super::viewport_texture::ViewportTexture;
+use crate::base::traversal::TraversalStats;
 use crate::gpu::views::{AbMode, AbSource, Channel, ViewSpec};
-use crate::methods::tree_samplers::pass::SamplingStats;
 use crate::renderer::Renderer;
 use crate::settings::{DisplaySettings, Tonemap, ViewBuffer};
 
@@ -271,7 +271,7 @@ pub struct PaneContext<'a> {
     pub events: &'a mut ViewEvents,
     /// Smooth an upscaled render (render scale < 1) unless magnified.
     pub linear_filter: bool,
-    pub stats: Option<SamplingStats>,
+    pub stats: Option<TraversalStats>,
     pub display: &'a DisplaySettings,
     pub snapshots: &'a [String],
     pub pinned: Option<(u32, u32)>,

@@ -2,7 +2,6 @@
 //! value enums of the flags, and how they become settings.
 
 use super::*;
-use crate::methods::tree_samplers::settings::SamplingSettings;
 
 /// `--method NAME`: a registered GI method by its CLI name (`crate::methods::REGISTRY`).
 pub fn parse_method(name: &str) -> Result<MethodId, String> {
@@ -21,66 +20,6 @@ pub fn method_help() -> String {
          `lightcut-workbench methods` describes them",
         names.join(", ")
     )
-}
-
-/// Cut blending for `--blending`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum BlendingArg {
-    Stochastic,
-    Off,
-}
-
-/// Fallback for `--fallback`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum FallbackArg {
-    Mock,
-    Average,
-    Root,
-    Recompute,
-}
-
-/// Glossy walk weights for `--glossy-weights`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum GlossyWeightsArg {
-    Geometric,
-    Material,
-    Defensive,
-}
-
-/// Child probability for `--child-probability`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ChildProbabilityArg {
-    /// eq. 5.5 with the distance to each child's mean position (the thesis).
-    Mean,
-    /// RTSLC's average of the closest- and farthest-point box distances.
-    MinMax,
-    /// 0.8 x the thesis's + 0.2 x the closest-point box distance's probability (the default).
-    Defensive,
-}
-
-/// Visibility for `--visibility`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum VisibilityArg {
-    /// Every VPL visible (no shadow test).
-    None,
-    /// A BVH shadow ray per evaluated VPL or sample.
-    Rays,
-    /// Imperfect shadow maps: one per VPL (the light-culling methods) or per light-tree leaf
-    /// (the tree samplers); the others refuse it.
-    Ism,
-}
-
-/// The VALs' visibility for `--val-visibility`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ValVisibilityArg {
-    /// One lookup in the VAL's imperfect shadow map (the paper's simple lookup).
-    Ism,
-    /// The PCSS-style lookup in its map (section 6; the default).
-    Pcss,
-    /// A BVH shadow ray to the VAL's centre (a point light's visibility).
-    Rays,
-    /// 16 BVH rays to points of each VAL's disk (its visible fraction: exact visibility).
-    Disk,
 }
 
 /// The temporal stage for `--temporal`.
@@ -112,52 +51,25 @@ pub enum BrdfArg {
     Ggx,
 }
 
-/// Settings of the tree samplers (override `--settings`).
+/// Settings flags of the frame and the methods (override `--settings`).
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct SamplingArgs {
-    /// Cut block edge k in pixels (1 = a cut per pixel).
-    #[arg(long)]
-    pub block: Option<u32>,
-    /// Nodes per cut = samples per pixel (SST: traversals from the root per pixel).
-    #[arg(long)]
-    pub cut_size: Option<u32>,
-    #[arg(long, value_enum)]
-    pub blending: Option<BlendingArg>,
-    #[arg(long, value_enum)]
-    pub fallback: Option<FallbackArg>,
-    /// Keep nodes behind the block centre's surface in the cuts (complete cuts).
-    #[arg(long)]
-    pub no_cull: bool,
-    /// Near-field refinement of SLC/SST: stop at a usable node only when the shaded point is
-    /// at least this many box diagonals from its box (0 = off, the thesis's rule; default 1).
-    #[arg(long)]
-    pub near_field: Option<f32>,
-    /// Metres by which SLC/SST substitute samples' shadow rays stop short of the drawn point
-    /// (the SST paper's scene-size epsilon; 0 = off, the thesis; default 0.05).
-    #[arg(long)]
-    pub substitute_offset: Option<f32>,
-    /// How a traversal step picks a child (SLC, SST, RTSLC).
-    #[arg(long, value_enum)]
-    pub child_probability: Option<ChildProbabilityArg>,
+    /// The methods' own flags (`--cut-size`, `--block`, ...: `MethodFlag`s of the registry).
+    #[command(flatten)]
+    pub method_flags: crate::cli::method_flags::MethodFlagArgs,
     /// No shadow rays for the ground truth and the tree samplers (every VPL / sample visible).
     #[arg(long)]
     pub no_shadow_rays: bool,
-    /// Visibility of the VPL methods and their ground truth: `rays` (BVH shadow rays),
-    /// `none` (every VPL visible: the unshadowed estimate, as Stochastic Light Culling's
-    /// figures 1 and 4; the same switch as `--no-shadow-rays`) or `ism` (the light-culling
-    /// methods look each VPL up in its imperfect shadow map, the tree samplers a light-tree
-    /// leaf's; the ground truth traces rays).
-    #[arg(long, value_enum)]
-    pub visibility: Option<VisibilityArg>,
-    /// How the VAL methods (`val`, `val-vpl`) shadow their VALs while shadow rays are on:
-    /// `ism` (a simple lookup in each VAL's imperfect shadow map), `pcss` (the PCSS-style
-    /// lookup), `rays` (a BVH ray to each VAL's centre) or `disk` (16 rays to each VAL's
-    /// disk: exact visibility). Other methods refuse it.
-    #[arg(long, value_enum)]
-    pub val_visibility: Option<ValVisibilityArg>,
-    /// GI at half resolution, joint-bilateral upsampled with the similarity S.
-    #[arg(long)]
-    pub half_res: bool,
+    /// How the method shadows its lights: `none` (every VPL visible, the unshadowed estimate;
+    /// the same as `--no-shadow-rays`), `rays` (BVH shadow rays: the only mode of a method
+    /// without a choice) or one of the method's own modes (`methods` lists each method's:
+    /// imperfect shadow maps for light culling, the tree samplers and the VALs; the VALs' PCSS
+    /// lookup and disk rays). A mode the method does not offer is refused.
+    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(crate::methods::visibility_names()))]
+    pub visibility: Option<String>,
+    /// The older name of `--visibility` for the VAL methods.
+    #[arg(long, hide = true, value_parser = clap::builder::PossibleValuesParser::new(crate::methods::visibility_names()))]
+    pub val_visibility: Option<String>,
     /// The temporal stage after a per-frame method: `off`, `reproject` (motion vectors,
     /// history rejection, exponential history) or `svgf` (also the variance-guided à-trous
     /// filter). Its parameters: `--set temporal.<field>=..` (docs/temporal.md).
@@ -182,11 +94,6 @@ pub struct SamplingArgs {
     /// refuse `ggx`.
     #[arg(long, value_enum)]
     pub brdf: Option<BrdfArg>,
-    /// With `--brdf ggx`, how SLC's and SST's glossy samples weigh the children of a step:
-    /// `geometric` (the diffuse weights), `material` (the SST paper's material term, section
-    /// 4.1) or `defensive` (default: the material term mixed with 25% geometric).
-    #[arg(long, value_enum)]
-    pub glossy_weights: Option<GlossyWeightsArg>,
     /// Least normal similarity of a usable SST node.
     #[arg(long)]
     pub v_min: Option<f32>,
@@ -209,10 +116,19 @@ pub struct SamplingArgs {
 }
 
 impl SamplingArgs {
+    /// `--visibility` (or its older name `--val-visibility`; not both).
+    fn visibility_mode(&self) -> anyhow::Result<Option<&str>> {
+        match (self.visibility.as_deref(), self.val_visibility.as_deref()) {
+            (Some(_), Some(_)) => Err(anyhow!(
+                "--val-visibility is the older name of --visibility; give one"
+            )),
+            (v, w) => Ok(v.or(w)),
+        }
+    }
+
     /// `--visibility ism` with a method that has no imperfect shadow maps is refused (it
     /// would trace rays without saying so).
     pub fn check_visibility(&self, methods: &[crate::methods::MethodId]) -> anyhow::Result<()> {
-        use crate::methods::light_culling::{ISM_METHODS, has_ism};
         // `--tree lbvh` with a method that needs the perfect tree is refused (it would run
         // on the perfect tree without saying so).
         if self.tree == Some(TreeArg::Lbvh)
@@ -222,100 +138,21 @@ impl SamplingArgs {
         {
             return Err(anyhow!("--{msg}"));
         }
-        if self.visibility == Some(VisibilityArg::Ism)
-            && let Some(m) = methods.iter().find(|&&m| crate::methods::val::is_val(m))
-        {
-            return Err(anyhow!(
-                "--visibility ism: {m} picks its maps with --val-visibility ism|pcss (--visibility \
-                 rays / none switch its shadows on / off)"
-            ));
-        }
-        if self.visibility == Some(VisibilityArg::Ism)
-            && let Some(m) = methods.iter().find(|&&m| !has_ism(m))
-        {
-            return Err(anyhow!(
-                "--visibility ism: {m} traces shadow rays; imperfect shadow maps serve {}",
-                ISM_METHODS.map(|m| m.to_string()).join(", ")
-            ));
-        }
-        if self.val_visibility.is_some()
-            && let Some(m) = methods.iter().find(|&&m| !crate::methods::val::is_val(m))
-        {
-            return Err(anyhow!(
-                "--val-visibility: {m} has no virtual area lights; it serves {}",
-                crate::methods::val::METHODS.map(|m| m.to_string()).join(", ")
-            ));
+        if let Some(v) = self.visibility_mode()? {
+            for &m in methods {
+                crate::methods::offers_visibility(m, v).map_err(|e| anyhow!("--visibility {v}: {e}"))?;
+            }
         }
         Ok(())
     }
 
-    pub fn apply(&self, s: &mut crate::settings::RenderSettings) {
-        use crate::methods::tree_samplers::settings::{ChildProbability, CutBlending, CutFallback};
-        if let Some(v) = self.block {
-            SamplingSettings::edit(s, |m| m.block_size = v);
-        }
-        if let Some(v) = self.cut_size {
-            SamplingSettings::edit(s, |m| m.cut_size = v);
-        }
-        if let Some(b) = self.blending {
-            SamplingSettings::edit(s, |m| {
-                m.blending = match b {
-                    BlendingArg::Stochastic => CutBlending::Stochastic,
-                    BlendingArg::Off => CutBlending::Off,
-                }
-            });
-        }
-        if let Some(f) = self.fallback {
-            SamplingSettings::edit(s, |m| {
-                m.fallback = match f {
-                    FallbackArg::Mock => CutFallback::MockCut,
-                    FallbackArg::Average => CutFallback::Average,
-                    FallbackArg::Root => CutFallback::Root,
-                    FallbackArg::Recompute => CutFallback::Recompute,
-                }
-            });
-        }
-        if self.no_cull {
-            SamplingSettings::edit(s, |m| m.cull_behind = false);
-        }
-        if let Some(v) = self.near_field {
-            SamplingSettings::edit(s, |m| m.near_field = v);
-        }
-        if let Some(v) = self.substitute_offset {
-            SamplingSettings::edit(s, |m| m.substitute_offset = v);
-        }
-        if let Some(c) = self.child_probability {
-            SamplingSettings::edit(s, |m| {
-                m.child_probability = match c {
-                    ChildProbabilityArg::Mean => ChildProbability::Mean,
-                    ChildProbabilityArg::MinMax => ChildProbability::MinMax,
-                    ChildProbabilityArg::Defensive => ChildProbability::Defensive,
-                }
-            });
-        }
+    pub fn apply(&self, s: &mut crate::settings::RenderSettings) -> anyhow::Result<()> {
+        self.method_flags.apply(s)?;
         if self.no_shadow_rays {
             s.gi.shadow_rays = false;
         }
-        if let Some(v) = self.visibility {
-            s.gi.shadow_rays = v != VisibilityArg::None;
-            if v != VisibilityArg::None {
-                crate::methods::light_culling::set_visibility(s, v == VisibilityArg::Ism);
-            }
-        }
-        if let Some(v) = self.val_visibility {
-            use crate::methods::val::settings::ValVisibility;
-            crate::methods::val::set_visibility(
-                s,
-                match v {
-                    ValVisibilityArg::Ism => ValVisibility::Ism,
-                    ValVisibilityArg::Pcss => ValVisibility::Pcss,
-                    ValVisibilityArg::Rays => ValVisibility::Rays,
-                    ValVisibilityArg::Disk => ValVisibility::Disk,
-                },
-            );
-        }
-        if self.half_res {
-            SamplingSettings::edit(s, |m| m.half_resolution = true);
+        if let Ok(Some(v)) = self.visibility_mode() {
+            crate::methods::set_visibility(s, v);
         }
         if let Some(t) = self.temporal {
             use crate::settings::TemporalMode;
@@ -330,16 +167,6 @@ impl SamplingArgs {
         }
         if self.no_roulette {
             s.vpl.roulette = false;
-        }
-        if let Some(g) = self.glossy_weights {
-            use crate::base::sampling::GlossyWeights;
-            SamplingSettings::edit(s, |m| {
-                m.glossy_weights = match g {
-                    GlossyWeightsArg::Geometric => GlossyWeights::Geometric,
-                    GlossyWeightsArg::Material => GlossyWeights::Material,
-                    GlossyWeightsArg::Defensive => GlossyWeights::Defensive,
-                }
-            });
         }
         if let Some(b) = self.brdf {
             s.gi.brdf = match b {
@@ -367,6 +194,7 @@ impl SamplingArgs {
             s.vpl.d_max = v;
         }
         s.frame.accumulate = self.frames > 1;
+        Ok(())
     }
 }
 

@@ -84,16 +84,7 @@ pub fn bounces(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             if n == 1 {
                 one_bounce_mean = gt_mean;
             }
-            let alive = if n > 1 {
-                let vpls = b.r.read_vpls()?;
-                let first = b.r.vpl_frame().first_bounce as usize;
-                vpls[first.min(vpls.len())..]
-                    .iter()
-                    .filter(|v| v.id != crate::gpu::gpu_data::VPL_NONE)
-                    .count()
-            } else {
-                0
-            };
+            let alive = if n > 1 { path_vpls_alive(b)? } else { 0 };
             let over_one = gt_mean / one_bounce_mean;
             gt_points.push((n as f64, over_one));
             for (k, &(method, label)) in list.iter().enumerate() {
@@ -148,19 +139,11 @@ pub fn bounces(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             } else {
                 format!("{label} (path flux mix {mix})")
             };
-            if xi == 0 {
-                series.push(plot::Series {
-                    name,
-                    color: k,
-                    points: pts,
-                });
-            } else {
-                series.push(plot::Series {
-                    name,
-                    color: k + list.len(),
-                    points: pts,
-                });
-            }
+            series.push(plot::Series {
+                name,
+                color: if xi == 0 { k } else { k + list.len() },
+                points: pts,
+            });
         }
         gt_series.push(plot::Series {
             name: format!("ground truth / one bounce (path flux mix {mix})"),
@@ -169,6 +152,31 @@ pub fn bounces(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         });
     }
     csv.write(&dir.join("bounces.csv"))?;
+    write_plots(b, dir, &series, &gt_series)?;
+    Ok(Report {
+        table,
+        checks: Vec::new(),
+    })
+}
+
+/// The bounces' VPLs that their light paths kept (bounces 2..=N; Russian roulette and misses
+/// leave slots empty).
+fn path_vpls_alive(b: &Bench) -> anyhow::Result<usize> {
+    let vpls = b.r.read_vpls()?;
+    let first = b.r.vpl_frame().first_bounce as usize;
+    Ok(vpls[first.min(vpls.len())..]
+        .iter()
+        .filter(|v| v.id != crate::gpu::gpu_data::VPL_NONE)
+        .count())
+}
+
+/// The relative RMSE and the gathered light against the bounces.
+fn write_plots(
+    b: &Bench,
+    dir: &Path,
+    series: &[plot::Series],
+    gt_series: &[plot::Series],
+) -> anyhow::Result<()> {
     plot::lines(
         &dir.join("bounces_rmse.png"),
         &format!(
@@ -177,7 +185,7 @@ pub fn bounces(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         ),
         "bounces (1 = the RSM's VPLs)",
         "RMSE / ground-truth mean",
-        &series,
+        series,
         false,
         true,
     )?;
@@ -189,12 +197,9 @@ pub fn bounces(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         ),
         "bounces",
         "image mean / one bounce",
-        &gt_series,
+        gt_series,
         false,
         false,
     )?;
-    Ok(Report {
-        table,
-        checks: Vec::new(),
-    })
+    Ok(())
 }

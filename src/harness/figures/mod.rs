@@ -405,127 +405,9 @@ inventory::submit! {
 /// for that time. Frame wall clock stays a separate column.
 pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let base_spp = SamplingSettings::of(&b.base).cut_size;
-    let mut csv = Csv::new(&[
-        "scene",
-        "method",
-        "spp",
-        "setting",
-        "value",
-        "gi_gpu_ms",
-        "gi_gpu_ms_std",
-        "sample_gpu_ms",
-        "gi_gpu_ms_min",
-        "sample_gpu_ms_min",
-        "frame_wall_ms",
-        "frame_wall_ms_std",
-        "rmse",
-        "rmse_std",
-        "ssim",
-        "ssim_std",
-        "mean_ratio",
-        "bias_rmse",
-        "noise_rmse",
-        "steps_per_traversal",
-        "steps_per_pixel",
-        "method_stats",
-    ]);
     let ms = methods(o);
-    let mut curves: Vec<Vec<SweepPoint>> = Vec::new();
-    for (method, label) in ms.iter() {
-        let Some(sweep) = method.info().sweep else {
-            curves.push(Vec::new());
-            continue;
-        };
-        let mut pts = Vec::new();
-        for v in o.sweep_values(*method, base_spp) {
-            let s = with(b, |s| {
-                s.gi.method = *method;
-                (sweep.apply)(s, v);
-            });
-            let m = b.measure(&s, o.size, o.per_config(), true)?;
-            let (t, ts) = m.gi_ms();
-            let (wall, wall_s) = m.frame_ms();
-            let (r, rs) = m.rmse();
-            let (q, qs) = m.ssim();
-            let value = knob(v, sweep.integer);
-            let stats: Vec<String> = m
-                .method_stats
-                .iter()
-                .map(|(k, x)| format!("{k}={x:.4}"))
-                .collect();
-            csv.row(vec![
-                b.scene.clone(),
-                label.to_string(),
-                if sweep.name == "spp" {
-                    value.clone()
-                } else {
-                    String::new()
-                },
-                sweep.name.to_string(),
-                value.clone(),
-                num(t),
-                num(ts),
-                num(m.pass_ms(&SAMPLE_PASSES).0),
-                num(m.pass_ms_min(&gi_passes())),
-                num(m.pass_ms_min(&SAMPLE_PASSES)),
-                num(wall),
-                num(wall_s),
-                num(r),
-                num(rs),
-                num(q),
-                num(qs),
-                num(m.mean_ratio().0),
-                num(m.bias_rmse),
-                num(m.noise_rmse),
-                num(m.steps_per_traversal()),
-                num(m.steps_per_pixel()),
-                stats.join(" "),
-            ]);
-            eprintln!(
-                "[{}] {label} {} {value}: GI {t:.2} ms GPU (frame {wall:.1} ms wall), RMSE {r:.4e} (bias {:.2e}, noise {:.2e}, mean ratio {:.3}), SSIM {q:.3}",
-                b.scene,
-                sweep.name,
-                m.bias_rmse,
-                m.noise_rmse,
-                m.mean_ratio().0
-            );
-            pts.push((t, r, q, v));
-        }
-        curves.push(pts);
-    }
-    csv.write(&dir.join("equal_time.csv"))?;
-    let series = |f: &dyn Fn(&SweepPoint) -> (f64, f64)| -> Vec<plot::Series> {
-        ms.iter()
-            .enumerate()
-            .map(|(i, (_, l))| plot::Series {
-                name: l.to_string(),
-                color: i,
-                points: curves[i].iter().map(f).collect(),
-            })
-            .collect()
-    };
-    let knobs: Vec<String> = ms
-        .iter()
-        .filter_map(|(m, l)| m.info().sweep.map(|sw| format!("{l}: {}", sw.name)))
-        .collect();
-    plot::lines(
-        &dir.join("equal_time_rmse.png"),
-        &format!("{}: RMSE vs GI GPU time (swept: {})", b.scene, knobs.join(", ")),
-        "GI time (ms, GPU timestamps of each method's passes)",
-        "RMSE of one frame's GI (W/(m² sr))",
-        &series(&|p| (p.0, p.1)),
-        true,
-        true,
-    )?;
-    plot::lines(
-        &dir.join("equal_time_ssim.png"),
-        &format!("{}: SSIM vs GI GPU time", b.scene),
-        "GI time (ms, GPU timestamps of each method's passes)",
-        "SSIM of one frame's GI",
-        &series(&|p| (p.0, p.2)),
-        true,
-        false,
-    )?;
+    let curves = sweep_curves(b, o, &ms, base_spp, dir)?;
+    plot_curves(b, dir, &ms, &curves)?;
     // The matched time: SLC's GI at the base cut size (else the first method's first point).
     let slc = ms.iter().position(|(m, _)| *m == SLC);
     let t_match = slc
@@ -573,18 +455,7 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
         let (r, ex) = interp_loglog(&rt, t_match);
         let (q, _) = interp_loglog(&qt, t_match);
         let (v, _) = interp_loglog(&st, t_match);
-        // The knob at that time, within the swept range (spp: rounded).
-        let (lo, hi) = st
-            .iter()
-            .fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.1), hi.max(p.1)));
-        let v = if v.is_finite() && lo <= hi {
-            let v = v.clamp(lo, hi);
-            if sweep.integer { v.round() } else { v }
-        } else if sweep.name == "spp" {
-            base_spp as f64
-        } else {
-            st.first().map_or(f64::NAN, |p| p.1)
-        };
+        let v = knob_at(sweep, &st, v, base_spp);
         let s = with(b, |s| {
             s.gi.method = *method;
             (sweep.apply)(s, v);
@@ -656,6 +527,165 @@ pub fn equal_time(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report>
         ));
     }
     Ok(Report { table, checks })
+}
+
+/// Every method over its sweep (`equal_time.csv`): per method its (GI ms, RMSE, SSIM, knob)
+/// points, empty for a method without a sweep.
+fn sweep_curves(
+    b: &mut Bench,
+    o: &Opts,
+    ms: &[(MethodId, &str)],
+    base_spp: u32,
+    dir: &Path,
+) -> anyhow::Result<Vec<Vec<SweepPoint>>> {
+    let mut csv = Csv::new(&[
+        "scene",
+        "method",
+        "spp",
+        "setting",
+        "value",
+        "gi_gpu_ms",
+        "gi_gpu_ms_std",
+        "sample_gpu_ms",
+        "gi_gpu_ms_min",
+        "sample_gpu_ms_min",
+        "frame_wall_ms",
+        "frame_wall_ms_std",
+        "rmse",
+        "rmse_std",
+        "ssim",
+        "ssim_std",
+        "mean_ratio",
+        "bias_rmse",
+        "noise_rmse",
+        "steps_per_traversal",
+        "steps_per_pixel",
+        "method_stats",
+    ]);
+    let mut curves: Vec<Vec<SweepPoint>> = Vec::new();
+    for (method, label) in ms {
+        let Some(sweep) = method.info().sweep else {
+            curves.push(Vec::new());
+            continue;
+        };
+        let mut pts = Vec::new();
+        for v in o.sweep_values(*method, base_spp) {
+            let s = with(b, |s| {
+                s.gi.method = *method;
+                (sweep.apply)(s, v);
+            });
+            let m = b.measure(&s, o.size, o.per_config(), true)?;
+            let (t, ts) = m.gi_ms();
+            let (wall, wall_s) = m.frame_ms();
+            let (r, rs) = m.rmse();
+            let (q, qs) = m.ssim();
+            let value = knob(v, sweep.integer);
+            let stats: Vec<String> = m
+                .method_stats
+                .iter()
+                .map(|(k, x)| format!("{k}={x:.4}"))
+                .collect();
+            csv.row(vec![
+                b.scene.clone(),
+                label.to_string(),
+                if sweep.name == "spp" {
+                    value.clone()
+                } else {
+                    String::new()
+                },
+                sweep.name.to_string(),
+                value.clone(),
+                num(t),
+                num(ts),
+                num(m.pass_ms(&SAMPLE_PASSES).0),
+                num(m.pass_ms_min(&gi_passes())),
+                num(m.pass_ms_min(&SAMPLE_PASSES)),
+                num(wall),
+                num(wall_s),
+                num(r),
+                num(rs),
+                num(q),
+                num(qs),
+                num(m.mean_ratio().0),
+                num(m.bias_rmse),
+                num(m.noise_rmse),
+                num(m.steps_per_traversal()),
+                num(m.steps_per_pixel()),
+                stats.join(" "),
+            ]);
+            eprintln!(
+                "[{}] {label} {} {value}: GI {t:.2} ms GPU (frame {wall:.1} ms wall), RMSE {r:.4e} (bias {:.2e}, noise {:.2e}, mean ratio {:.3}), SSIM {q:.3}",
+                b.scene,
+                sweep.name,
+                m.bias_rmse,
+                m.noise_rmse,
+                m.mean_ratio().0
+            );
+            pts.push((t, r, q, v));
+        }
+        curves.push(pts);
+    }
+    csv.write(&dir.join("equal_time.csv"))?;
+    Ok(curves)
+}
+
+/// RMSE and SSIM over GI GPU time, a curve per method.
+fn plot_curves(
+    b: &Bench,
+    dir: &Path,
+    ms: &[(MethodId, &str)],
+    curves: &[Vec<SweepPoint>],
+) -> anyhow::Result<()> {
+    let series = |f: &dyn Fn(&SweepPoint) -> (f64, f64)| -> Vec<plot::Series> {
+        ms.iter()
+            .enumerate()
+            .map(|(i, (_, l))| plot::Series {
+                name: l.to_string(),
+                color: i,
+                points: curves[i].iter().map(f).collect(),
+            })
+            .collect()
+    };
+    let knobs: Vec<String> = ms
+        .iter()
+        .filter_map(|(m, l)| m.info().sweep.map(|sw| format!("{l}: {}", sw.name)))
+        .collect();
+    plot::lines(
+        &dir.join("equal_time_rmse.png"),
+        &format!("{}: RMSE vs GI GPU time (swept: {})", b.scene, knobs.join(", ")),
+        "GI time (ms, GPU timestamps of each method's passes)",
+        "RMSE of one frame's GI (W/(m² sr))",
+        &series(&|p| (p.0, p.1)),
+        true,
+        true,
+    )?;
+    plot::lines(
+        &dir.join("equal_time_ssim.png"),
+        &format!("{}: SSIM vs GI GPU time", b.scene),
+        "GI time (ms, GPU timestamps of each method's passes)",
+        "SSIM of one frame's GI",
+        &series(&|p| (p.0, p.2)),
+        true,
+        false,
+    )?;
+    Ok(())
+}
+
+/// The knob's value at the matched time `v` (interpolated over the sweep's (time, value)
+/// points `st`), within the swept range (integers rounded); outside any measured time the
+/// base spp, else the first value.
+fn knob_at(sweep: &crate::methods::Sweep, st: &[(f64, f64)], v: f64, base_spp: u32) -> f64 {
+    let (lo, hi) = st
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.1), hi.max(p.1)));
+    if v.is_finite() && lo <= hi {
+        let v = v.clamp(lo, hi);
+        if sweep.integer { v.round() } else { v }
+    } else if sweep.name == "spp" {
+        base_spp as f64
+    } else {
+        st.first().map_or(f64::NAN, |p| p.1)
+    }
 }
 
 #[cfg(test)]

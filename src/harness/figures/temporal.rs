@@ -70,7 +70,7 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     if b.r.size() != o.size {
         b.r.resize(o.size.0, o.size.1)?;
     }
-    let mut per_frame = Csv::new(&[
+    let per_frame = Csv::new(&[
         "scene",
         "motion",
         "method",
@@ -85,7 +85,7 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "flicker_filtered",
         "static_pixels",
     ]);
-    let mut summary = Csv::new(&[
+    let summary = Csv::new(&[
         "scene",
         "motion",
         "method",
@@ -124,10 +124,14 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "flick.raw",
         "filt."
     );
+    let mut out = Out {
+        per_frame,
+        summary,
+        report,
+    };
     // Flicker bars (raw, filtered) per method, for the motions with static pixels.
     let mut flicker_bars: Vec<(String, Vec<plot::Bar>)> = Vec::new();
     for m in &motions {
-        let mut bars = Vec::new();
         let t0 = std::time::Instant::now();
         let truths = sequence::ground_truths(&mut b.r, &b.base, m, |_| {})?;
         b.gpu_wall += t0.elapsed();
@@ -140,121 +144,9 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 t0.elapsed().as_secs_f64()
             );
         }
-        let mut series = Vec::new();
-        for (ci, (method, short)) in methods.iter().enumerate() {
-            let s = stage(b, *method);
-            let (frames, rendering): (Vec<SeqFrame>, _) = sequence::measure(
-                &mut b.r,
-                &s,
-                m,
-                &truths,
-                b.gi_exposure,
-                b.base.display.tonemap,
-                |_, _| Ok(()),
-            )?;
-            b.gpu_wall += rendering;
-            for (i, f) in frames.iter().enumerate() {
-                per_frame.row(vec![
-                    b.scene.clone(),
-                    m.name.clone(),
-                    method.cli().into(),
-                    i.to_string(),
-                    num(f.rmse_raw),
-                    num(f.rmse_filtered),
-                    num(f.mean_ratio_raw),
-                    num(f.mean_ratio_filtered),
-                    num(f.ssim_raw),
-                    num(f.ssim_filtered),
-                    num(f.flicker_raw),
-                    num(f.flicker_filtered),
-                    f.static_pixels.to_string(),
-                ]);
-            }
-            let avg = |g: fn(&SeqFrame) -> f64| mean_finite(frames.iter().map(g));
-            let (rr, rf) = (avg(|f| f.rmse_raw), avg(|f| f.rmse_filtered));
-            // The image-mean ratios averaged over the frames as the RMSEs are (each frame's
-            // against its own truth: a mean of ratios, not the ratio of mean images).
-            let (mr, mf) = (avg(|f| f.mean_ratio_raw), avg(|f| f.mean_ratio_filtered));
-            // Flicker over the second half: the first frames are the history's warm-up (the
-            // filter's variance estimate settling), not frame-to-frame instability.
-            let late = |g: fn(&SeqFrame) -> f64| mean_finite(frames.iter().skip(frames.len() / 2).map(g));
-            let (fr, ff) = (late(|f| f.flicker_raw), late(|f| f.flicker_filtered));
-            summary.row(vec![
-                b.scene.clone(),
-                m.name.clone(),
-                method.cli().into(),
-                s.temporal.mode.cli().into(),
-                frames.len().to_string(),
-                num(rr),
-                num(rf),
-                num(rf / rr),
-                num(mr),
-                num(mf),
-                num(avg(|f| f.ssim_raw)),
-                num(avg(|f| f.ssim_filtered)),
-                num(fr),
-                num(ff),
-            ]);
-            report.table += &format!(
-                "{:<22} {:<10} {:>10.3e} {:>10.3e} {:>6.3} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4}\n",
-                m.name,
-                short,
-                rr,
-                rf,
-                rf / rr,
-                mr,
-                mf,
-                avg(|f| f.ssim_raw),
-                avg(|f| f.ssim_filtered),
-                fr,
-                ff
-            );
-            // The claim, for the thesis's method: its error and flicker drop.
-            if *method == SLC && m.name != "still" {
-                report.checks.push(check(
-                    b,
-                    &format!("temporal: {short} {} filtered/raw RMSE", m.name),
-                    rf / rr,
-                    1.0,
-                    false,
-                    format!(
-                        "mean over {} frames at {}x{}, vs each frame's ground truth",
-                        frames.len(),
-                        o.size.0,
-                        o.size.1
-                    ),
-                ));
-            }
-            if *method == SLC && fr.is_finite() && ff.is_finite() {
-                report.checks.push(check(
-                    b,
-                    &format!("temporal: {short} {} filtered/raw flicker", m.name),
-                    ff / fr,
-                    1.0,
-                    false,
-                    "sum |dI - dG| / sum G over static pixels of consecutive frames, second half".into(),
-                ));
-            }
-            if fr.is_finite() && ff.is_finite() {
-                // The method's name under its filtered bar, the raw one grey beside it.
-                for (label, v, c) in [(String::new(), fr, 8), (short.to_string(), ff, ci)] {
-                    bars.push(plot::Bar {
-                        label,
-                        value: v,
-                        spread: 0.0,
-                        color: c,
-                    });
-                }
-            }
-            series.push(plot::Series {
-                name: short.to_string(),
-                color: ci,
-                points: frames
-                    .iter()
-                    .enumerate()
-                    .map(|(i, f)| (i as f64, f.rmse_filtered / f.rmse_raw))
-                    .collect(),
-            });
+        let mut plots = MotionPlots::default();
+        for (ci, &(method, short)) in methods.iter().enumerate() {
+            one_method(b, o, m, &truths, (ci, method, short), &mut out, &mut plots)?;
         }
         let file = m.name.replace([' ', '+'], "_").replace("__", "_");
         plot::lines(
@@ -262,12 +154,12 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             &format!("{}: filtered / raw GI RMSE per frame ({})", b.scene, m.name),
             "frame",
             "RMSE ratio (vs each frame's ground truth)",
-            &series,
+            &plots.series,
             false,
             true,
         )?;
-        if !bars.is_empty() {
-            flicker_bars.push((file, bars));
+        if !plots.bars.is_empty() {
+            flicker_bars.push((file, plots.bars));
         }
     }
     for (file, bars) in &flicker_bars {
@@ -283,13 +175,166 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             true,
         )?;
     }
-    per_frame.write(&dir.join("temporal.csv"))?;
-    summary.write(&dir.join("temporal_summary.csv"))?;
+    out.per_frame.write(&dir.join("temporal.csv"))?;
+    out.summary.write(&dir.join("temporal_summary.csv"))?;
+    stage_timing(b, o, &methods, &motions[0], &mut out.report, dir)?;
+    b.r.resize(o.size.0, o.size.1)?;
+    Ok(out.report)
+}
 
-    // GPU time of the stage's passes along the path at the timing size.
+/// What the figure gathers over motions and methods.
+struct Out {
+    per_frame: Csv,
+    summary: Csv,
+    report: Report,
+}
+
+/// One motion's plots: per method its filtered / raw RMSE per frame and its flicker bars.
+#[derive(Default)]
+struct MotionPlots {
+    bars: Vec<plot::Bar>,
+    series: Vec<plot::Series>,
+}
+
+/// One method along one motion: its frames (CSV rows), their means (summary row, table line,
+/// the thesis method's checks) and its plot series.
+fn one_method(
+    b: &mut Bench,
+    o: &Opts,
+    m: &Motion,
+    truths: &[sequence::Truth],
+    (ci, method, short): (usize, MethodId, &str),
+    out: &mut Out,
+    plots: &mut MotionPlots,
+) -> anyhow::Result<()> {
+    let s = stage(b, method);
+    let (frames, rendering): (Vec<SeqFrame>, _) = sequence::measure(
+        &mut b.r,
+        &s,
+        m,
+        truths,
+        b.gi_exposure,
+        b.base.display.tonemap,
+        |_, _| Ok(()),
+    )?;
+    b.gpu_wall += rendering;
+    for (i, f) in frames.iter().enumerate() {
+        out.per_frame.row(vec![
+            b.scene.clone(),
+            m.name.clone(),
+            method.cli().into(),
+            i.to_string(),
+            num(f.rmse_raw),
+            num(f.rmse_filtered),
+            num(f.mean_ratio_raw),
+            num(f.mean_ratio_filtered),
+            num(f.ssim_raw),
+            num(f.ssim_filtered),
+            num(f.flicker_raw),
+            num(f.flicker_filtered),
+            f.static_pixels.to_string(),
+        ]);
+    }
+    let avg = |g: fn(&SeqFrame) -> f64| mean_finite(frames.iter().map(g));
+    let (rr, rf) = (avg(|f| f.rmse_raw), avg(|f| f.rmse_filtered));
+    // The image-mean ratios averaged over the frames as the RMSEs are (each frame's
+    // against its own truth: a mean of ratios, not the ratio of mean images).
+    let (mr, mf) = (avg(|f| f.mean_ratio_raw), avg(|f| f.mean_ratio_filtered));
+    // Flicker over the second half: the first frames are the history's warm-up (the
+    // filter's variance estimate settling), not frame-to-frame instability.
+    let late = |g: fn(&SeqFrame) -> f64| mean_finite(frames.iter().skip(frames.len() / 2).map(g));
+    let (fr, ff) = (late(|f| f.flicker_raw), late(|f| f.flicker_filtered));
+    out.summary.row(vec![
+        b.scene.clone(),
+        m.name.clone(),
+        method.cli().into(),
+        s.temporal.mode.cli().into(),
+        frames.len().to_string(),
+        num(rr),
+        num(rf),
+        num(rf / rr),
+        num(mr),
+        num(mf),
+        num(avg(|f| f.ssim_raw)),
+        num(avg(|f| f.ssim_filtered)),
+        num(fr),
+        num(ff),
+    ]);
+    out.report.table += &format!(
+        "{:<22} {:<10} {:>10.3e} {:>10.3e} {:>6.3} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4}\n",
+        m.name,
+        short,
+        rr,
+        rf,
+        rf / rr,
+        mr,
+        mf,
+        avg(|f| f.ssim_raw),
+        avg(|f| f.ssim_filtered),
+        fr,
+        ff
+    );
+    // The claim, for the thesis's method: its error and flicker drop.
+    if method == SLC && m.name != "still" {
+        out.report.checks.push(check(
+            b,
+            &format!("temporal: {short} {} filtered/raw RMSE", m.name),
+            rf / rr,
+            1.0,
+            false,
+            format!(
+                "mean over {} frames at {}x{}, vs each frame's ground truth",
+                frames.len(),
+                o.size.0,
+                o.size.1
+            ),
+        ));
+    }
+    if method == SLC && fr.is_finite() && ff.is_finite() {
+        out.report.checks.push(check(
+            b,
+            &format!("temporal: {short} {} filtered/raw flicker", m.name),
+            ff / fr,
+            1.0,
+            false,
+            "sum |dI - dG| / sum G over static pixels of consecutive frames, second half".into(),
+        ));
+    }
+    if fr.is_finite() && ff.is_finite() {
+        // The method's name under its filtered bar, the raw one grey beside it.
+        for (label, v, c) in [(String::new(), fr, 8), (short.to_string(), ff, ci)] {
+            plots.bars.push(plot::Bar {
+                label,
+                value: v,
+                spread: 0.0,
+                color: c,
+            });
+        }
+    }
+    plots.series.push(plot::Series {
+        name: short.to_string(),
+        color: ci,
+        points: frames
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (i as f64, f.rmse_filtered / f.rmse_raw))
+            .collect(),
+    });
+    Ok(())
+}
+
+/// GPU time of the stage's passes along the path at the timing size
+/// (`temporal_timing.csv`).
+fn stage_timing(
+    b: &mut Bench,
+    o: &Opts,
+    methods: &[(MethodId, &str)],
+    path: &Motion,
+    report: &mut Report,
+    dir: &Path,
+) -> anyhow::Result<()> {
     let tsize = o.temporal_timing_size;
     b.r.resize(tsize.0, tsize.1)?;
-    let path = motions[0].clone();
     let mut timing = Csv::new(&[
         "scene",
         "method",
@@ -309,10 +354,10 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         tsize.1,
         b.adapter
     );
-    for (method, short) in &methods {
+    for (method, short) in methods {
         let s = stage(b, *method);
         let t0 = std::time::Instant::now();
-        let timed = sequence::time(&mut b.r, &s, &path, o.timing_frames as usize, 2)?;
+        let timed = sequence::time(&mut b.r, &s, path, o.timing_frames as usize, 2)?;
         b.gpu_wall += t0.elapsed();
         if timed.is_empty() {
             report.table += "  timestamps not supported on this adapter\n";
@@ -359,6 +404,5 @@ pub fn temporal(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         report.table += " ms\n";
     }
     timing.write(&dir.join("temporal_timing.csv"))?;
-    b.r.resize(o.size.0, o.size.1)?;
-    Ok(report)
+    Ok(())
 }

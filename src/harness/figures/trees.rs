@@ -81,82 +81,25 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         if values.is_empty() {
             continue;
         }
-        // The matched point: the swept spp nearest the base spp, else the sweep's middle value.
-        let base = if sweep.name == "spp" {
-            values
-                .iter()
-                .copied()
-                .min_by(|a, b| {
-                    (a - base_spp as f64)
-                        .abs()
-                        .total_cmp(&(b - base_spp as f64).abs())
-                })
-                .unwrap_or(values[0])
-        } else {
-            values[values.len() / 2]
-        };
+        let base = matched_value(sweep, &values, base_spp);
         // Per tree: (total ms, RMSE) over the sweep, the base value's steps and build time.
         let mut curves: Vec<TreeCurve> = Vec::new();
         for (ki, kind) in TreeKind::ALL.into_iter().enumerate() {
-            let (mut pts, mut ratios) = (Vec::new(), Vec::new());
-            let (mut steps, mut build, mut t_base) = (f64::NAN, f64::NAN, f64::NAN);
-            for &v in &values {
-                let s = with(b, |s| {
-                    s.gi.method = method;
-                    s.tree.kind = kind;
-                    (sweep.apply)(s, v);
-                });
-                let m = b.measure(&s, o.size, o.per_config(), true)?;
-                let gi = m.gi_ms().0;
-                let tb = m.pass_ms(&TREE_BUILD_PASSES).0;
-                let (r, rs) = m.rmse();
-                let value = knob(v, sweep.integer);
-                csv.row(vec![
-                    b.scene.clone(),
-                    label.to_string(),
-                    kind.name().to_string(),
-                    sweep.name.to_string(),
-                    value.clone(),
-                    num(gi),
-                    num(tb),
-                    num(gi + tb),
-                    num(r),
-                    num(rs),
-                    num(m.ssim().0),
-                    num(m.mean_ratio().0),
-                    num(m.steps_per_traversal()),
-                    num(m.steps_per_pixel()),
-                ]);
-                eprintln!(
-                    "[{}] {label} on the {} tree, {} {value}: GI {gi:.3} + build {tb:.3} ms GPU, RMSE {r:.4e}, mean {:.3}x GT, {:.2} steps per traversal",
-                    b.scene,
-                    kind.name(),
-                    sweep.name,
-                    m.mean_ratio().0,
-                    m.steps_per_traversal()
-                );
-                if v == base {
-                    steps = m.steps_per_traversal();
-                    build = tb;
-                    t_base = gi + tb;
-                }
-                pts.push((gi + tb, r));
-                ratios.push((gi + tb, m.mean_ratio().0));
-            }
-            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            ratios.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let run = SweepRun {
+                method,
+                label,
+                kind,
+                sweep,
+                values: &values,
+                base,
+            };
+            let curve = tree_curve(b, o, &mut csv, &run)?;
             series.push(plot::Series {
                 name: format!("{label} {}", kind.name()),
                 color: 2 * mi + ki,
-                points: pts.clone(),
+                points: curve.points.clone(),
             });
-            curves.push(TreeCurve {
-                points: pts,
-                ratios,
-                steps,
-                build,
-                t_base,
-            });
+            curves.push(curve);
         }
         let t = curves[0].t_base;
         let (r_p, ex_p) = interp_loglog(&curves[0].points, t);
@@ -206,5 +149,101 @@ pub fn trees(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     Ok(Report {
         table,
         checks: Vec::new(),
+    })
+}
+
+/// The matched point of a sweep: the swept spp nearest the base spp, else the sweep's middle
+/// value.
+fn matched_value(sweep: &crate::methods::Sweep, values: &[f64], base_spp: u32) -> f64 {
+    if sweep.name == "spp" {
+        values
+            .iter()
+            .copied()
+            .min_by(|a, b| {
+                (a - base_spp as f64)
+                    .abs()
+                    .total_cmp(&(b - base_spp as f64).abs())
+            })
+            .unwrap_or(values[0])
+    } else {
+        values[values.len() / 2]
+    }
+}
+
+/// One method's sweep on one tree.
+struct SweepRun<'a> {
+    method: MethodId,
+    label: &'a str,
+    kind: TreeKind,
+    sweep: &'static crate::methods::Sweep,
+    values: &'a [f64],
+    /// The matched value (its steps, build and total time are the curve's).
+    base: f64,
+}
+
+/// Measures a method over its sweep on one tree (a CSV row per value): (total ms, RMSE) and
+/// (total ms, mean ratio), sorted by time, and the base value's steps, build and total time.
+fn tree_curve(b: &mut Bench, o: &Opts, csv: &mut Csv, run: &SweepRun<'_>) -> anyhow::Result<TreeCurve> {
+    let SweepRun {
+        method,
+        label,
+        kind,
+        sweep,
+        values,
+        base,
+    } = *run;
+    let (mut pts, mut ratios) = (Vec::new(), Vec::new());
+    let (mut steps, mut build, mut t_base) = (f64::NAN, f64::NAN, f64::NAN);
+    for &v in values {
+        let s = with(b, |s| {
+            s.gi.method = method;
+            s.tree.kind = kind;
+            (sweep.apply)(s, v);
+        });
+        let m = b.measure(&s, o.size, o.per_config(), true)?;
+        let gi = m.gi_ms().0;
+        let tb = m.pass_ms(&TREE_BUILD_PASSES).0;
+        let (r, rs) = m.rmse();
+        let value = knob(v, sweep.integer);
+        csv.row(vec![
+            b.scene.clone(),
+            label.to_string(),
+            kind.name().to_string(),
+            sweep.name.to_string(),
+            value.clone(),
+            num(gi),
+            num(tb),
+            num(gi + tb),
+            num(r),
+            num(rs),
+            num(m.ssim().0),
+            num(m.mean_ratio().0),
+            num(m.steps_per_traversal()),
+            num(m.steps_per_pixel()),
+        ]);
+        eprintln!(
+            "[{}] {label} on the {} tree, {} {value}: GI {gi:.3} + build {tb:.3} ms GPU, RMSE {r:.4e}, mean {:.3}x GT, {:.2} steps per traversal",
+            b.scene,
+            kind.name(),
+            sweep.name,
+            m.mean_ratio().0,
+            m.steps_per_traversal()
+        );
+        if v == base {
+            steps = m.steps_per_traversal();
+            build = tb;
+            t_base = gi + tb;
+        }
+        pts.push((gi + tb, r));
+        ratios.push((gi + tb, m.mean_ratio().0));
+    }
+    pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+    ratios.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(TreeCurve {
+        points: pts,
+        ratios,
+        steps,
+        build,
+        t_base,
     })
 }

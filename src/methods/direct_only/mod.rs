@@ -14,6 +14,7 @@ pub static MODULE: Module = Module {
     entry_shaders: &[],
     wgsl_twins: &[],
     own_workgroups: &[],
+    flags: &[],
 };
 
 pub static INFO: MethodInfo = MethodInfo {
@@ -30,6 +31,7 @@ pub static INFO: MethodInfo = MethodInfo {
     timed_passes: &[],
     story: false,
     shadow_ray_switch: false,
+    visibility: None,
     truth_of_vpls: false,
     one_bounce: false,
     glossy: true,

@@ -42,6 +42,7 @@ pub static MODULE: Module = Module {
     entry_shaders: ENTRY_SHADERS,
     wgsl_twins: pass::WGSL_TWINS,
     own_workgroups: &[],
+    flags: &[],
 };
 
 pub static INFO: MethodInfo = MethodInfo {
@@ -58,6 +59,7 @@ pub static INFO: MethodInfo = MethodInfo {
     timed_passes: &["ground_truth"],
     story: false,
     shadow_ray_switch: true,
+    visibility: None,
     truth_of_vpls: true,
     one_bounce: false,
     glossy: true,

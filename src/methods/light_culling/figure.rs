@@ -100,6 +100,36 @@ inventory::submit! {
     }
 }
 
+/// What every configuration of the study shares: the settings' light culling, its base
+/// bound, the swept bounds and the images' folder.
+struct Study {
+    base: LightCullingSettings,
+    base_eps: f64,
+    eps_values: Vec<f64>,
+    img: std::path::PathBuf,
+}
+
+/// The three variants: (method, ranges label).
+const MODES: [(MethodId, &str); 3] = [
+    (lcull::ID, "stochastic"),
+    (lcull::CLAMPED, "clamped"),
+    (lcull::TREE, "tree"),
+];
+
+/// Each variant's passes: ranges, culling, shading, filter (the CSV's four pass columns).
+fn passes_of(mode: usize) -> [&'static str; 4] {
+    if MODES[mode].0 == lcull::TREE {
+        [
+            "lcull_tree_leaves",
+            "lcull_tree_traverse",
+            "lcull_tree_shade",
+            "lcull_filter",
+        ]
+    } else {
+        ["lcull_ranges", "lcull_tiles", "lcull_shade", "lcull_filter"]
+    }
+}
+
 /// The study (module doc). Its VPL counts are `--vpl-exponents`, its error bounds the
 /// method's sweep (`--sweep light-culling=...`), its base bound the settings'.
 pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
@@ -112,135 +142,184 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         eps_values.push(base_eps);
     }
     eps_values.sort_by(f64::total_cmp);
-    let modes = [
-        (lcull::ID, "stochastic"),
-        (lcull::CLAMPED, "clamped"),
-        (lcull::TREE, "tree"),
-    ];
-    // Each variant's passes: ranges, culling, shading, filter (the CSV's four pass columns).
-    let passes_of = |mode: usize| -> [&'static str; 4] {
-        if modes[mode].0 == lcull::TREE {
-            [
-                "lcull_tree_leaves",
-                "lcull_tree_traverse",
-                "lcull_tree_shade",
-                "lcull_filter",
-            ]
-        } else {
-            ["lcull_ranges", "lcull_tiles", "lcull_shade", "lcull_filter"]
-        }
+    let st = Study {
+        base,
+        base_eps,
+        eps_values,
+        img: images(dir)?,
     };
-    let img = images(dir)?;
-    let mut rows: Vec<Row> = Vec::new();
-    let run = |b: &mut Bench, mode: usize, vis: Vis, vpls: u32, eps: f64| -> anyhow::Result<Row> {
-        let shadows = vis.shadows();
-        let s = with(b, |s| {
-            s.gi.method = modes[mode].0;
-            s.gi.shadow_rays = shadows;
-            s.vpl.count = vpls;
-            let _ = s.set_method(
-                lcull::ID,
-                &LightCullingSettings {
-                    epsilon_max: eps as f32,
-                    visibility: if matches!(vis, Vis::Ism | Vis::IsmUnculled) {
-                        CullingVisibility::Ism
-                    } else {
-                        CullingVisibility::Rays
-                    },
-                    ism_range_culling: vis != Vis::IsmUnculled,
-                    ..base.clone()
-                },
-            );
-        });
-        let m = b.measure(&s, o.size, o.per_config(), true)?;
-        // The true ground truth (shadow rays) for the image of the last diagnostic frame.
-        let truth = b.ground_truth(
-            &with(b, |t| {
-                t.vpl.count = vpls;
-                t.gi.shadow_rays = true;
-            }),
-            o.size,
-        )?;
-        let (rmse_true, mean_ratio_true) = m.indirect.as_ref().map_or((f64::NAN, f64::NAN), |x| {
-            let c = metrics::compare_without_flip(x, &truth, b.gi_exposure, b.base.display.tonemap);
-            (c.rmse, c.mean_ratio)
-        });
-        let (gi_ms, gi_std) = m.gi_ms();
-        eprintln!(
-            "[{}] {} {} VPLs eps {eps}, visibility {}: GI {gi_ms:.3} ms GPU, RMSE {:.4e}, mean {:.3}x",
-            b.scene,
-            modes[mode].1,
-            vpls,
-            vis.label(),
-            m.rmse().0,
-            m.mean_ratio().0
-        );
-        if vpls == b.base.vpl.count
-            && same_eps(eps, base_eps)
-            && !shadows
-            && let Some(x) = &m.indirect
-        {
-            let gt = b.ground_truth(&s, o.size)?;
-            let stem = format!("culling_{}", modes[mode].1);
-            b.write_gi_png(&img.join(format!("{stem}.png")), x)?;
-            b.write_error_png(&img.join(format!("{stem}_error.png")), x, &gt)?;
-        }
-        Ok(Row {
-            mode: modes[mode].1,
-            vis,
-            vpls,
-            eps,
-            gi_ms,
-            gi_std,
-            in_range: stat(&m, "vpls_in_range_per_pixel"),
-            rays: stat(&m, "shadow_rays_per_pixel"),
-            rmse: m.rmse().0,
-            bias: m.bias_rmse,
-            noise: m.noise_rmse,
-            mean_ratio: m.mean_ratio().0,
-            rmse_true,
-            mean_ratio_true,
-            passes: passes_of(mode)
-                .into_iter()
-                .map(|p| (p, m.pass_ms(&[p]).0))
-                .collect(),
-            ism_ms: if matches!(vis, Vis::Ism | Vis::IsmUnculled) {
-                m.pass_ms(&["lcull_ism"]).0
+    let rows = measure_rows(b, o, &st)?;
+    write_rows(b, dir, &rows)?;
+    write_plots(b, dir, &rows, base_eps, eps_label)?;
+    let at_base_eps = |r: &Row| same_eps(r.eps, base_eps);
+    let mut table = format!(
+        "Stochastic vs clamped light culling, and the bounding-sphere tree ({}x{}, eps_max {eps_label}, {} x {} interleaving, {} filter radius; tree: k = {}, filter radius {}; {}):\n",
+        o.size.0,
+        o.size.1,
+        st.base.interleave.n,
+        st.base.interleave.n,
+        st.base.interleave.filter_radius,
+        st.base.reservoir_k,
+        st.base.tree_filter_radius,
+        b.adapter
+    );
+    for r in rows.iter().filter(|r| at_base_eps(r)) {
+        table.push_str(&format!(
+            "  {:<10} {:<12} {:>6} VPLs: GI {:>9.3} ms GPU{}, {:>6.1} VPLs in range/pixel, RMSE {:.4e} (bias {:.2e}), mean ratio {:.3}, RMSE vs true GT {:.4e} (mean ratio {:.3})\n",
+            r.mode,
+            r.vis.label(),
+            r.vpls,
+            r.gi_ms,
+            if r.mode == "tree" {
+                format!(" (+ {:.3} ms light-tree build)", r.tree_build_ms)
+            } else if r.ism_ms > 0.0 {
+                format!(" (of which {:.3} ms the maps)", r.ism_ms)
             } else {
-                0.0
+                String::new()
             },
-            // The light tree's keys, sort and build (shared frame work, in no GI time).
-            tree_build_ms: m.pass_ms(&[&SORT_PASSES[..], &TREE_BUILD_PASSES[..]].concat()).0,
-        })
-    };
-    // Over the VPL count at the base bound, then over the bound at the base count; the maps
-    // with the stochastic ranges (with and without their range culling over the count).
+            r.in_range,
+            r.rmse,
+            r.bias,
+            r.mean_ratio,
+            r.rmse_true,
+            r.mean_ratio_true,
+        ));
+    }
+    let mut checks = Vec::new();
+    paper_table_1(b, o, &rows, base_eps, &mut table, &mut checks, dir)?;
+    figure_7(b, o, &rows, &st, &mut table, &mut checks);
+    equal_time(b, &rows, base_eps, &mut table);
+    Ok(Report { table, checks })
+}
+
+/// One configuration measured: a variant (`MODES[mode]`), a visibility, a VPL count and a
+/// bound; its error against the same visibility's truth and the true one; at the base count
+/// and bound without visibility, its images.
+fn run(
+    b: &mut Bench,
+    o: &Opts,
+    st: &Study,
+    mode: usize,
+    vis: Vis,
+    vpls: u32,
+    eps: f64,
+) -> anyhow::Result<Row> {
+    let shadows = vis.shadows();
+    let s = with(b, |s| {
+        s.gi.method = MODES[mode].0;
+        s.gi.shadow_rays = shadows;
+        s.vpl.count = vpls;
+        let _ = s.set_method(
+            lcull::ID,
+            &LightCullingSettings {
+                epsilon_max: eps as f32,
+                visibility: if matches!(vis, Vis::Ism | Vis::IsmUnculled) {
+                    CullingVisibility::Ism
+                } else {
+                    CullingVisibility::Rays
+                },
+                ism_range_culling: vis != Vis::IsmUnculled,
+                ..st.base.clone()
+            },
+        );
+    });
+    let m = b.measure(&s, o.size, o.per_config(), true)?;
+    // The true ground truth (shadow rays) for the image of the last diagnostic frame.
+    let truth = b.ground_truth(
+        &with(b, |t| {
+            t.vpl.count = vpls;
+            t.gi.shadow_rays = true;
+        }),
+        o.size,
+    )?;
+    let (rmse_true, mean_ratio_true) = m.indirect.as_ref().map_or((f64::NAN, f64::NAN), |x| {
+        let c = metrics::compare_without_flip(x, &truth, b.gi_exposure, b.base.display.tonemap);
+        (c.rmse, c.mean_ratio)
+    });
+    let (gi_ms, gi_std) = m.gi_ms();
+    eprintln!(
+        "[{}] {} {} VPLs eps {eps}, visibility {}: GI {gi_ms:.3} ms GPU, RMSE {:.4e}, mean {:.3}x",
+        b.scene,
+        MODES[mode].1,
+        vpls,
+        vis.label(),
+        m.rmse().0,
+        m.mean_ratio().0
+    );
+    if vpls == b.base.vpl.count
+        && same_eps(eps, st.base_eps)
+        && !shadows
+        && let Some(x) = &m.indirect
+    {
+        let gt = b.ground_truth(&s, o.size)?;
+        let stem = format!("culling_{}", MODES[mode].1);
+        b.write_gi_png(&st.img.join(format!("{stem}.png")), x)?;
+        b.write_error_png(&st.img.join(format!("{stem}_error.png")), x, &gt)?;
+    }
+    Ok(Row {
+        mode: MODES[mode].1,
+        vis,
+        vpls,
+        eps,
+        gi_ms,
+        gi_std,
+        in_range: stat(&m, "vpls_in_range_per_pixel"),
+        rays: stat(&m, "shadow_rays_per_pixel"),
+        rmse: m.rmse().0,
+        bias: m.bias_rmse,
+        noise: m.noise_rmse,
+        mean_ratio: m.mean_ratio().0,
+        rmse_true,
+        mean_ratio_true,
+        passes: passes_of(mode)
+            .into_iter()
+            .map(|p| (p, m.pass_ms(&[p]).0))
+            .collect(),
+        ism_ms: if matches!(vis, Vis::Ism | Vis::IsmUnculled) {
+            m.pass_ms(&["lcull_ism"]).0
+        } else {
+            0.0
+        },
+        // The light tree's keys, sort and build (shared frame work, in no GI time).
+        tree_build_ms: m.pass_ms(&[&SORT_PASSES[..], &TREE_BUILD_PASSES[..]].concat()).0,
+    })
+}
+
+/// Over the VPL count at the base bound, then over the bound at the base count.
+fn measure_rows(b: &mut Bench, o: &Opts, st: &Study) -> anyhow::Result<Vec<Row>> {
+    let mut rows: Vec<Row> = Vec::new();
+    // The maps with the stochastic ranges (with and without their range culling over the
+    // count).
     // More VPLs than the atlas holds maps: no ISM row (the count is named in the table).
-    let maps = base.ism.capacity();
+    let maps = st.base.ism.capacity();
     for &e in &o.vpl_exponents {
         for vis in [Vis::None, Vis::Rays, Vis::Ism, Vis::IsmUnculled] {
-            for mode in 0..modes.len() {
+            for mode in 0..MODES.len() {
                 if matches!(vis, Vis::Ism | Vis::IsmUnculled) && (mode != 0 || 1 << e > maps) {
                     continue;
                 }
-                rows.push(run(b, mode, vis, 1 << e, base_eps)?);
+                rows.push(run(b, o, st, mode, vis, 1 << e, st.base_eps)?);
             }
         }
     }
-    for &eps in &eps_values {
+    for &eps in &st.eps_values {
         for vis in [Vis::None, Vis::Rays, Vis::Ism] {
-            for mode in 0..modes.len() {
-                if same_eps(eps, base_eps) && o.vpl_exponents.iter().any(|&e| 1 << e == b.base.vpl.count) {
+            for mode in 0..MODES.len() {
+                if same_eps(eps, st.base_eps) && o.vpl_exponents.iter().any(|&e| 1 << e == b.base.vpl.count) {
                     continue; // measured above
                 }
                 if vis == Vis::Ism && (mode != 0 || b.base.vpl.count > maps) {
                     continue;
                 }
-                rows.push(run(b, mode, vis, b.base.vpl.count, eps)?);
+                rows.push(run(b, o, st, mode, vis, b.base.vpl.count, eps)?);
             }
         }
     }
+    Ok(rows)
+}
 
+/// `culling.csv`: a row per configuration.
+fn write_rows(b: &Bench, dir: &Path, rows: &[Row]) -> anyhow::Result<()> {
     let mut csv = Csv::new(&[
         "scene",
         "ranges",
@@ -268,7 +347,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         // The imperfect shadow maps' build (lcull_ism, in the GI time; 0 without maps).
         "ism_ms",
     ]);
-    for r in &rows {
+    for r in rows {
         let mut cells = vec![
             b.scene.clone(),
             r.mode.to_string(),
@@ -292,46 +371,52 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         csv.row(cells);
     }
     csv.write(&dir.join("culling.csv"))?;
+    Ok(())
+}
 
-    let series = |pick: &dyn Fn(&Row) -> Option<(f64, f64)>| -> Vec<plot::Series> {
-        let mut v = Vec::new();
-        for (c, (mode, vis)) in [
-            ("stochastic", Vis::None),
-            ("clamped", Vis::None),
-            ("tree", Vis::None),
-            ("stochastic", Vis::Rays),
-            ("clamped", Vis::Rays),
-            ("tree", Vis::Rays),
-            ("stochastic", Vis::Ism),
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            let mut points: Vec<(f64, f64)> = rows
-                .iter()
-                .filter(|r| r.mode == mode && r.vis == vis)
-                .filter_map(pick)
-                .filter(|p| p.0.is_finite() && p.1.is_finite() && p.0 > 0.0 && p.1 > 0.0)
-                .collect();
-            points.sort_by(|a, b| a.0.total_cmp(&b.0));
-            points.dedup_by(|a, b| a.0 == b.0);
-            if !points.is_empty() {
-                v.push(plot::Series {
-                    name: format!(
-                        "{mode}, {}",
-                        match vis {
-                            Vis::None => "no visibility",
-                            Vis::Rays => "shadow rays",
-                            _ => "ISMs",
-                        }
-                    ),
-                    color: c,
-                    points,
-                });
-            }
+/// The plot's series: per variant and visibility, the points `pick` takes from its rows.
+fn series(rows: &[Row], pick: &dyn Fn(&Row) -> Option<(f64, f64)>) -> Vec<plot::Series> {
+    let mut v = Vec::new();
+    for (c, (mode, vis)) in [
+        ("stochastic", Vis::None),
+        ("clamped", Vis::None),
+        ("tree", Vis::None),
+        ("stochastic", Vis::Rays),
+        ("clamped", Vis::Rays),
+        ("tree", Vis::Rays),
+        ("stochastic", Vis::Ism),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut points: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.mode == mode && r.vis == vis)
+            .filter_map(pick)
+            .filter(|p| p.0.is_finite() && p.1.is_finite() && p.0 > 0.0 && p.1 > 0.0)
+            .collect();
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        points.dedup_by(|a, b| a.0 == b.0);
+        if !points.is_empty() {
+            v.push(plot::Series {
+                name: format!(
+                    "{mode}, {}",
+                    match vis {
+                        Vis::None => "no visibility",
+                        Vis::Rays => "shadow rays",
+                        _ => "ISMs",
+                    }
+                ),
+                color: c,
+                points,
+            });
         }
-        v
-    };
+    }
+    v
+}
+
+/// Time and RMSE over the VPL count and over the bound.
+fn write_plots(b: &Bench, dir: &Path, rows: &[Row], base_eps: f64, eps_label: f32) -> anyhow::Result<()> {
     let at_base_eps = |r: &Row| same_eps(r.eps, base_eps);
     let at_base_n = |r: &Row| r.vpls == b.base.vpl.count;
     plot::lines(
@@ -342,7 +427,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         ),
         "VPLs",
         "ms (GPU timestamps of the culling passes)",
-        &series(&|r| at_base_eps(r).then_some((r.vpls as f64, r.gi_ms))),
+        &series(rows, &|r| at_base_eps(r).then_some((r.vpls as f64, r.gi_ms))),
         true,
         true,
     )?;
@@ -354,7 +439,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         ),
         "VPLs",
         "RMSE of one frame's GI",
-        &series(&|r| at_base_eps(r).then_some((r.vpls as f64, r.rmse))),
+        &series(rows, &|r| at_base_eps(r).then_some((r.vpls as f64, r.rmse))),
         true,
         true,
     )?;
@@ -363,7 +448,7 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         &format!("{}: RMSE over eps_max ({} VPLs)", b.scene, b.base.vpl.count),
         "eps_max",
         "RMSE of one frame's GI",
-        &series(&|r| at_base_n(r).then_some((r.eps, r.rmse))),
+        &series(rows, &|r| at_base_n(r).then_some((r.eps, r.rmse))),
         true,
         true,
     )?;
@@ -375,51 +460,32 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         ),
         "eps_max",
         "ms (GPU timestamps)",
-        &series(&|r| at_base_n(r).then_some((r.eps, r.gi_ms))),
+        &series(rows, &|r| at_base_n(r).then_some((r.eps, r.gi_ms))),
         true,
         true,
     )?;
+    Ok(())
+}
 
-    let mut table = format!(
-        "Stochastic vs clamped light culling, and the bounding-sphere tree ({}x{}, eps_max {eps_label}, {} x {} interleaving, {} filter radius; tree: k = {}, filter radius {}; {}):\n",
-        o.size.0,
-        o.size.1,
-        base.interleave.n,
-        base.interleave.n,
-        base.interleave.filter_radius,
-        base.reservoir_k,
-        base.tree_filter_radius,
-        b.adapter
-    );
-    for r in rows.iter().filter(|r| at_base_eps(r)) {
-        table.push_str(&format!(
-            "  {:<10} {:<12} {:>6} VPLs: GI {:>9.3} ms GPU{}, {:>6.1} VPLs in range/pixel, RMSE {:.4e} (bias {:.2e}), mean ratio {:.3}, RMSE vs true GT {:.4e} (mean ratio {:.3})\n",
-            r.mode,
-            r.vis.label(),
-            r.vpls,
-            r.gi_ms,
-            if r.mode == "tree" {
-                format!(" (+ {:.3} ms light-tree build)", r.tree_build_ms)
-            } else if r.ism_ms > 0.0 {
-                format!(" (of which {:.3} ms the maps)", r.ism_ms)
-            } else {
-                String::new()
-            },
-            r.in_range,
-            r.rmse,
-            r.bias,
-            r.mean_ratio,
-            r.rmse_true,
-            r.mean_ratio_true,
-        ));
-    }
-    // The paper's Table 1 beside our passes, at the largest VPL count without visibility.
-    let mut checks = Vec::new();
+/// The row of variant `mode`, visibility `vis` and `n` VPLs at the base bound.
+fn find<'a>(rows: &'a [Row], mode: &str, vis: Vis, n: u32, base_eps: f64) -> Option<&'a Row> {
+    rows.iter()
+        .find(|r| r.mode == mode && r.vis == vis && r.vpls == n && same_eps(r.eps, base_eps))
+}
+
+/// The paper's Table 1 beside our passes, at the largest VPL count without visibility
+/// (`culling_table1.csv`), and the stochastic / clamped time check.
+fn paper_table_1(
+    b: &Bench,
+    o: &Opts,
+    rows: &[Row],
+    base_eps: f64,
+    table: &mut String,
+    checks: &mut Vec<Check>,
+    dir: &Path,
+) -> anyhow::Result<()> {
+    let find = |mode: &str, vis: Vis, n: u32| find(rows, mode, vis, n, base_eps);
     let top = o.vpl_exponents.iter().max().map(|&e| 1u32 << e);
-    let find = |mode: &str, vis: Vis, n: u32| {
-        rows.iter()
-            .find(|r| r.mode == mode && r.vis == vis && r.vpls == n && at_base_eps(r))
-    };
     let mut t1 = Csv::new(&["scene", "vpls", "paper_pass", "our_passes", "our_ms", "paper_ms"]);
     if let Some(n) = top
         && let Some(r) = find("stochastic", Vis::None, n)
@@ -459,8 +525,14 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         }
     }
     t1.write(&dir.join("culling_table1.csv"))?;
-    // Figure 7: the maps' build with and without the range culling, at the largest count
-    // with maps; the paper's 16,384 AISMs in about 22 ms (R9 290X) beside it.
+    Ok(())
+}
+
+/// Figure 7: the maps' build with and without the range culling, at the largest count with
+/// maps; the paper's 16,384 AISMs in about 22 ms (R9 290X) beside it.
+fn figure_7(b: &Bench, o: &Opts, rows: &[Row], st: &Study, table: &mut String, checks: &mut Vec<Check>) {
+    let maps = st.base.ism.capacity();
+    let find = |mode: &str, vis: Vis, n: u32| find(rows, mode, vis, n, st.base_eps);
     let top_ism = o
         .vpl_exponents
         .iter()
@@ -475,9 +547,9 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     {
         table.push_str(&format!(
             "  Figure 7 ({n} VPLs, {}^2 maps of {} points, front-face culling {}): the maps' build {:.3} ms with range culling, {:.3} ms without (paper: 16,384 AISMs in about 22 ms with it, R9 290X); with the maps RMSE vs the true GT {:.4e} (mean ratio {:.3}), with shadow rays {:.4e} (mean ratio {:.3})\n",
-            base.ism.tile,
-            base.ism.points_per_light,
-            if base.ism.front_face_culling { "on" } else { "off" },
+            st.base.ism.tile,
+            st.base.ism.points_per_light,
+            if st.base.ism.front_face_culling { "on" } else { "off" },
             c.ism_ms,
             u.ism_ms,
             c.rmse_true,
@@ -500,11 +572,16 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     if o.vpl_exponents.iter().any(|&e| 1u32 << e > maps) {
         table.push_str(&format!(
             "  (no ISM rows above {maps} VPLs: the atlas holds {maps} maps of {}^2; raise methods.light-culling.ism.atlas)\n",
-            base.ism.tile
+            st.base.ism.tile
         ));
     }
-    // Figure 4: the clamped ranges at the stochastic ones' time (log-log interpolation over
-    // the eps_max sweep), error against the unshadowed truth.
+}
+
+/// Figure 4: the clamped ranges at the stochastic ones' time (log-log interpolation over the
+/// eps_max sweep), error against the unshadowed truth.
+fn equal_time(b: &Bench, rows: &[Row], base_eps: f64, table: &mut String) {
+    let at_base_eps = |r: &Row| same_eps(r.eps, base_eps);
+    let at_base_n = |r: &Row| r.vpls == b.base.vpl.count;
     for shadows in [false, true] {
         let vis = if shadows { Vis::Rays } else { Vis::None };
         let st = rows
@@ -528,7 +605,6 @@ pub fn culling(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             ));
         }
     }
-    Ok(Report { table, checks })
 }
 
 /// Whether two error bounds are the same setting (the base bound is an f32 widened to f64, a

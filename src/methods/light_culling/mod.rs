@@ -30,7 +30,6 @@ use crate::gpu::passes::interleave_filter::GpuFilterParams;
 use crate::gpu::passes::ism::{IsmPoints, IsmTargets};
 use crate::gpu::readback::{self, ImageF32};
 use crate::gpu::shaders::ShaderError;
-use crate::methods::tree_samplers::settings::SamplingSettings;
 use crate::reference::light_culling::{Interleave, TileGrid};
 use crate::settings::RenderSettings;
 use pass::{
@@ -96,6 +95,7 @@ pub static MODULE: Module = Module {
         entries: &[],
         size: [pass::TILE_WG, 1, 1],
     }],
+    flags: &[],
 };
 
 /// The pixel's tile list length (log heat map).
@@ -231,6 +231,7 @@ pub static INFO: MethodInfo = MethodInfo {
     ],
     story: false,
     shadow_ray_switch: true,
+    visibility: Some(&VISIBILITY),
     truth_of_vpls: false,
     one_bounce: false,
     glossy: true,
@@ -268,6 +269,7 @@ pub static CLAMPED_INFO: MethodInfo = MethodInfo {
     ],
     story: false,
     shadow_ray_switch: true,
+    visibility: Some(&VISIBILITY),
     truth_of_vpls: false,
     one_bounce: false,
     glossy: true,
@@ -304,6 +306,7 @@ pub static TREE_INFO: MethodInfo = MethodInfo {
     ],
     story: false,
     shadow_ray_switch: true,
+    visibility: Some(&VISIBILITY),
     truth_of_vpls: false,
     one_bounce: false,
     glossy: true,
@@ -383,44 +386,29 @@ pub static SWEEP: super::Sweep = super::Sweep {
     integer: false,
 };
 
-/// The methods that can look VPLs up in imperfect shadow maps (`render --visibility ism`):
-/// light culling's three variants and the tree samplers (a map per light-tree leaf).
-pub const ISM_METHODS: [MethodId; 6] = [
-    ID,
-    CLAMPED,
-    TREE,
-    super::tree_samplers::SLC,
-    super::tree_samplers::SST,
-    super::tree_samplers::RTSLC,
-];
-
-/// Whether `m` can use ISM visibility.
-pub fn has_ism(m: MethodId) -> bool {
-    ISM_METHODS.contains(&m)
-}
-
-/// Sets light culling's and the tree samplers' visibility (while `gi.shadow_rays` is on):
-/// maps or rays.
-pub fn set_visibility(s: &mut RenderSettings, ism: bool) {
-    SamplingSettings::edit(s, |m| {
-        m.visibility = if ism {
-            super::tree_samplers::settings::SamplerVisibility::Ism
+/// Light culling's visibility (`render --visibility`; `[methods.light-culling] visibility`).
+pub static VISIBILITY: super::VisibilityModes = super::VisibilityModes {
+    modes: &[
+        ("rays", "a BVH shadow ray per VPL in range"),
+        (
+            "ism",
+            "a lookup in each VPL's imperfect shadow map (sections 4.3-4.4)",
+        ),
+    ],
+    set: |s, name| {
+        // A malformed table is left for validation to name.
+        let Ok(mut lc) = s.method::<LightCullingSettings>(ID) else {
+            return;
+        };
+        lc.visibility = if name == "ism" {
+            settings::CullingVisibility::Ism
         } else {
-            super::tree_samplers::settings::SamplerVisibility::Rays
-        }
-    });
-    // A malformed table is left for validation to name.
-    let Ok(mut lc) = s.method::<LightCullingSettings>(ID) else {
-        return;
-    };
-    lc.visibility = if ism {
-        settings::CullingVisibility::Ism
-    } else {
-        settings::CullingVisibility::Rays
-    };
-    // Cannot fail: the struct serialises to a table.
-    let _ = s.set_method(ID, &lc);
-}
+            settings::CullingVisibility::Rays
+        };
+        // Cannot fail: the struct serialises to a table.
+        let _ = s.set_method(ID, &lc);
+    },
+};
 
 fn validate(s: &RenderSettings) -> Result<(), String> {
     let lc = s.method::<LightCullingSettings>(ID)?;

@@ -34,45 +34,7 @@ inventory::submit! {
 
 pub fn interpolation(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let li_base: LightcutInterpolationSettings = b.base.method(li::ID).map_err(|e| anyhow::anyhow!(e))?;
-    let lc_set = LightcutsSettings {
-        relative_error: li_base.relative_error,
-        max_cut: li_base.max_cut,
-    };
-    let configs: Vec<(&str, RenderSettings)> = vec![
-        (
-            "Lightcuts",
-            with(b, |s| {
-                s.gi.method = lightcuts::ID;
-                let _ = s.set_method(lightcuts::ID, &lc_set);
-            }),
-        ),
-        (
-            "LI full vis.",
-            with(b, |s| {
-                s.gi.method = li::ID;
-                let _ = s.set_method(
-                    li::ID,
-                    &LightcutInterpolationSettings {
-                        visibility: LiVisibility::Full,
-                        ..li_base.clone()
-                    },
-                );
-            }),
-        ),
-        (
-            "LI interp. vis.",
-            with(b, |s| {
-                s.gi.method = li::ID;
-                let _ = s.set_method(
-                    li::ID,
-                    &LightcutInterpolationSettings {
-                        visibility: LiVisibility::Interpolated,
-                        ..li_base.clone()
-                    },
-                );
-            }),
-        ),
-    ];
+    let configs = configs(b, &li_base);
     let mut ms = Vec::new();
     for (label, s) in &configs {
         let m = b.measure(s, o.size, o.per_config(), true)?;
@@ -193,22 +155,7 @@ pub fn interpolation(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Repo
             b.write_error_png(&img.join(format!("{stem}_error.png")), x, &gt)?;
         }
         if i > 0 {
-            let limit = if i == 1 {
-                PAPER_FULL_RATIO.1
-            } else {
-                PAPER_INTERP_RATIO.1
-            };
-            checks.push(check(
-                b,
-                &format!("{label} GI time / Lightcuts'"),
-                ratio,
-                limit,
-                false,
-                format!(
-                    "GI GPU time (timestamps of each method's timed passes), median of {} timed frames; the paper's worst diffuse scene as the limit",
-                    o.timing_frames
-                ),
-            ));
+            checks.push(time_check(b, o, i, label, ratio));
         }
     }
     csv.write(&dir.join("interpolation.csv"))?;
@@ -221,4 +168,69 @@ pub fn interpolation(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Repo
         true,
     )?;
     Ok(Report { table, checks })
+}
+
+/// The three configurations: Lightcuts at Lightcut Interpolation's threshold and cut, and
+/// the interpolation with full and with interpolated visibility.
+fn configs(b: &Bench, li_base: &LightcutInterpolationSettings) -> Vec<(&'static str, RenderSettings)> {
+    let lc_set = LightcutsSettings {
+        relative_error: li_base.relative_error,
+        max_cut: li_base.max_cut,
+    };
+    vec![
+        (
+            "Lightcuts",
+            with(b, |s| {
+                s.gi.method = lightcuts::ID;
+                let _ = s.set_method(lightcuts::ID, &lc_set);
+            }),
+        ),
+        (
+            "LI full vis.",
+            with(b, |s| {
+                s.gi.method = li::ID;
+                let _ = s.set_method(
+                    li::ID,
+                    &LightcutInterpolationSettings {
+                        visibility: LiVisibility::Full,
+                        ..li_base.clone()
+                    },
+                );
+            }),
+        ),
+        (
+            "LI interp. vis.",
+            with(b, |s| {
+                s.gi.method = li::ID;
+                let _ = s.set_method(
+                    li::ID,
+                    &LightcutInterpolationSettings {
+                        visibility: LiVisibility::Interpolated,
+                        ..li_base.clone()
+                    },
+                );
+            }),
+        ),
+    ]
+}
+
+/// The check of configuration `i`'s GI time against Lightcuts' (the paper's worst diffuse
+/// scene's ratio as the limit).
+fn time_check(b: &Bench, o: &Opts, i: usize, label: &str, ratio: f64) -> Check {
+    let limit = if i == 1 {
+        PAPER_FULL_RATIO.1
+    } else {
+        PAPER_INTERP_RATIO.1
+    };
+    check(
+        b,
+        &format!("{label} GI time / Lightcuts'"),
+        ratio,
+        limit,
+        false,
+        format!(
+            "GI GPU time (timestamps of each method's timed passes), median of {} timed frames; the paper's worst diffuse scene as the limit",
+            o.timing_frames
+        ),
+    )
 }

@@ -79,6 +79,7 @@ pub static MODULE: Module = Module {
         entries: pass::TILE_WG_ENTRIES,
         size: [pass::TILE_WG, 1, 1],
     }],
+    flags: &[],
 };
 
 /// The cache records over the grey final image (reach from red to green, paper Fig. 4 top).
@@ -162,6 +163,7 @@ pub static INFO: MethodInfo = MethodInfo {
     ],
     story: false,
     shadow_ray_switch: true,
+    visibility: None,
     truth_of_vpls: false,
     one_bounce: false,
     glossy: false,

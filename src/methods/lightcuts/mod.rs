@@ -69,6 +69,7 @@ pub static MODULE: Module = Module {
     entry_shaders: ENTRY_SHADERS,
     wgsl_twins: pass::WGSL_TWINS,
     own_workgroups: &[],
+    flags: &[],
 };
 
 /// Nodes in each pixel's cut (log heat map).
@@ -137,6 +138,7 @@ pub static INFO: MethodInfo = MethodInfo {
     timed_passes: &["lightcuts_build", "lightcuts"],
     story: false,
     shadow_ray_switch: true,
+    visibility: None,
     truth_of_vpls: false,
     one_bounce: false,
     glossy: true,

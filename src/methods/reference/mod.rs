@@ -47,6 +47,7 @@ pub static MODULE: Module = Module {
     entry_shaders: ENTRY_SHADERS,
     wgsl_twins: &[],
     own_workgroups: &[],
+    flags: &[],
 };
 
 pub static INFO: MethodInfo = MethodInfo {
@@ -63,6 +64,7 @@ pub static INFO: MethodInfo = MethodInfo {
     timed_passes: &["reference", "light_path_starts", "light_paths", "ground_truth"],
     story: false,
     shadow_ray_switch: false,
+    visibility: None,
     truth_of_vpls: false,
     one_bounce: false,
     glossy: true,

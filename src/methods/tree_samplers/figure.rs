@@ -33,40 +33,14 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "shadow_ray_share",
         "sample_pass_ms_min",
     ]);
-    // What each method spends: its sampling pass with shadow rays, and without them (the
-    // same traversals and evaluations, every sample visible).
-    let mut ms: Vec<Measured> = Vec::new();
-    let mut cost = Vec::new();
-    for (method, _) in tree_methods(o) {
-        let s = with(b, |s| s.gi.method = method);
-        let m = b.measure(&s, o.size, o.per_config(), false)?;
-        let mut no_rays = s.clone();
-        no_rays.gi.shadow_rays = false;
-        let open = b.measure(&no_rays, o.size, o.per_config(), false)?;
-        cost.push((
-            m.pass_ms(&SAMPLE_PASSES).0,
-            open.pass_ms(&SAMPLE_PASSES).0,
-            m.pass_ms_min(&SAMPLE_PASSES),
-        ));
-        ms.push(m);
-    }
-    let quant = |v: &[f32], q: f64| -> f64 {
-        let mut f: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
-        if f.is_empty() {
-            return f64::NAN;
-        }
-        f.sort_by(|a, b| a.total_cmp(b));
-        f[((f.len() - 1) as f64 * q).round() as usize] as f64
-    };
+    let spp = SamplingSettings::of(&b.base).cut_size;
+    let (ms, cost) = measure_samplers(b, o)?;
     let max = ms
         .iter()
         .filter_map(|m| m.steps.as_ref().map(|s| quant(&s.2, 0.99)))
         .fold(1.0f64, f64::max) as f32;
     let img = images(dir)?;
-    let mut table = format!(
-        "traversal steps ({} spp):\n",
-        SamplingSettings::of(&b.base).cut_size
-    );
+    let mut table = format!("traversal steps ({spp} spp):\n");
     let mut bars = Vec::new();
     let mut hist = Vec::new();
     for (i, ((m, (_, label)), (with_rays, no_rays, with_rays_min))) in
@@ -82,7 +56,7 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         csv.row(vec![
             b.scene.clone(),
             label.to_string(),
-            SamplingSettings::of(&b.base).cut_size.to_string(),
+            spp.to_string(),
             num(m.steps_per_traversal()),
             num(m.steps_per_pixel()),
             num(med),
@@ -118,33 +92,17 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
                 v,
                 max,
             )?;
-            // Distribution over pixels, in bins of 0.5 steps.
-            let bins = (max / 0.5).ceil().max(1.0) as usize + 1;
-            let mut c = vec![0usize; bins];
-            let mut n = 0usize;
-            for x in v.iter().filter(|x| x.is_finite()) {
-                c[((x / 0.5) as usize).min(bins - 1)] += 1;
-                n += 1;
-            }
             hist.push(plot::Series {
                 name: label.into(),
                 color: i,
-                points: c
-                    .iter()
-                    .enumerate()
-                    .map(|(k, c)| (k as f64 * 0.5 + 0.25, *c as f64 / n.max(1) as f64))
-                    .collect(),
+                points: histogram(v, max),
             });
         }
     }
     csv.write(&dir.join("steps.csv"))?;
     plot::bars(
         &dir.join("steps.png"),
-        &format!(
-            "{}: traversal steps per traversal ({} spp)",
-            b.scene,
-            SamplingSettings::of(&b.base).cut_size
-        ),
+        &format!("{}: traversal steps per traversal ({spp} spp)", b.scene),
         "steps",
         &bars,
         false,
@@ -159,10 +117,7 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         false,
     )?;
     let v: Vec<f64> = ms.iter().map(|m| m.steps_per_traversal()).collect();
-    let detail = format!(
-        "mean steps per traversal, {} spp each (= per pixel at equal samples)",
-        SamplingSettings::of(&b.base).cut_size
-    );
+    let detail = format!("mean steps per traversal, {spp} spp each (= per pixel at equal samples)");
     Ok(Report {
         table,
         checks: vec![
@@ -177,6 +132,57 @@ pub fn steps(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
             check(b, "traversal steps SLC / RTSLC", v[0] / v[1], 0.35, false, detail),
         ],
     })
+}
+
+/// A sampler's sampling pass (ms): with shadow rays, without, the fastest frame's with.
+type Cost = (f64, f64, f64);
+
+/// The samplers measured at the base settings, and per sampler its sampling pass's GPU time
+/// with shadow rays, without them (the same traversals and evaluations, every sample
+/// visible) and its fastest frame's.
+fn measure_samplers(b: &mut Bench, o: &Opts) -> anyhow::Result<(Vec<Measured>, Vec<Cost>)> {
+    let mut ms: Vec<Measured> = Vec::new();
+    let mut cost = Vec::new();
+    for (method, _) in tree_methods(o) {
+        let s = with(b, |s| s.gi.method = method);
+        let m = b.measure(&s, o.size, o.per_config(), false)?;
+        let mut no_rays = s.clone();
+        no_rays.gi.shadow_rays = false;
+        let open = b.measure(&no_rays, o.size, o.per_config(), false)?;
+        cost.push((
+            m.pass_ms(&SAMPLE_PASSES).0,
+            open.pass_ms(&SAMPLE_PASSES).0,
+            m.pass_ms_min(&SAMPLE_PASSES),
+        ));
+        ms.push(m);
+    }
+    Ok((ms, cost))
+}
+
+/// The `q`-quantile of the finite values (NaN without any).
+fn quant(v: &[f32], q: f64) -> f64 {
+    let mut f: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if f.is_empty() {
+        return f64::NAN;
+    }
+    f.sort_by(|a, b| a.total_cmp(b));
+    f[((f.len() - 1) as f64 * q).round() as usize] as f64
+}
+
+/// The distribution of the finite values over bins of 0.5 steps up to `max`: (bin centre,
+/// fraction of the values).
+fn histogram(v: &[f32], max: f32) -> Vec<(f64, f64)> {
+    let bins = (max / 0.5).ceil().max(1.0) as usize + 1;
+    let mut c = vec![0usize; bins];
+    let mut n = 0usize;
+    for x in v.iter().filter(|x| x.is_finite()) {
+        c[((x / 0.5) as usize).min(bins - 1)] += 1;
+        n += 1;
+    }
+    c.iter()
+        .enumerate()
+        .map(|(k, c)| (k as f64 * 0.5 + 0.25, *c as f64 / n.max(1) as f64))
+        .collect()
 }
 
 inventory::submit! {

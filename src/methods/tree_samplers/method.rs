@@ -256,6 +256,43 @@ impl Method for TreeSamplers {
         }
     }
 
+    fn traversal_stats(&mut self) -> Option<crate::base::traversal::TraversalStats> {
+        self.poll_stats()
+    }
+
+    /// The diagnostics buffer's steps (word 0) and fallback flag (word 1) per pixel.
+    fn read_traversal_pixels(
+        &self,
+        ctx: &GpuContext,
+    ) -> Result<Option<crate::base::traversal::TraversalPixels>, GpuError> {
+        let bytes = crate::gpu::readback::read_storage_buffer(ctx, &self.buffers.diag)?;
+        let diag: &[f32] = bytemuck::cast_slice(&bytes);
+        let steps = diag.chunks_exact(4).map(|d| d[0]).collect();
+        let fallback = diag.chunks_exact(4).map(|d| d[1] > 0.5).collect();
+        Ok(Some(crate::base::traversal::TraversalPixels { steps, fallback }))
+    }
+
+    /// The cut views show the blocks: a texel's block and its cut.
+    fn pick_block(
+        &self,
+        ctx: &GpuContext,
+        view: MethodView,
+        (px, py): (u32, u32),
+    ) -> Result<Option<crate::base::story::BlockCut>, GpuError> {
+        if view != CUT_BLOCKS && view != CUT_DEPTH {
+            return Ok(None);
+        }
+        let b = &self.buffers;
+        let k = b.block.max(1);
+        let (bx, by) = (px / k, py / k);
+        let index = by * b.grid.0 + bx;
+        Ok(Some(crate::base::story::BlockCut {
+            index,
+            block: (bx, by),
+            nodes: self.read_cut(ctx, index)?,
+        }))
+    }
+
     fn status(&mut self) -> Option<String> {
         let st = self.pass.stats.poll()?;
         Some(format!(

@@ -83,6 +83,7 @@ pub static MODULE: Module = Module {
     entry_shaders: ENTRY_SHADERS,
     wgsl_twins: pass::WGSL_TWINS,
     own_workgroups: &[],
+    flags: FLAGS,
 };
 
 /// Traversal steps per traversal, per pixel (heat map, thesis fig. 7.2).
@@ -177,6 +178,7 @@ pub static SLC_INFO: MethodInfo = MethodInfo {
     ],
     story: true,
     shadow_ray_switch: true,
+    visibility: Some(&VISIBILITY),
     truth_of_vpls: false,
     one_bounce: false,
     glossy: true,
@@ -189,7 +191,10 @@ pub static SLC_INFO: MethodInfo = MethodInfo {
     bias: slc_bias,
     unbiased: Some(super::Unbiased {
         how: "tree.v_min = 1, tree.sigma_max = 0 (only leaves usable: RTSLC's traversal), methods.slc.block_size = 1",
-        apply: |s| (s.tree.v_min, s.tree.sigma_max, SamplingSettings::of(s).block_size) = (1.0, 0.0, 1),
+        apply: |s| {
+            (s.tree.v_min, s.tree.sigma_max) = (1.0, 0.0);
+            SamplingSettings::edit(s, |m| m.block_size = 1);
+        },
     }),
 };
 
@@ -215,6 +220,7 @@ pub static SST_INFO: MethodInfo = MethodInfo {
     ],
     story: true,
     shadow_ray_switch: true,
+    visibility: Some(&VISIBILITY),
     truth_of_vpls: false,
     one_bounce: false,
     glossy: true,
@@ -254,6 +260,7 @@ pub static RTSLC_INFO: MethodInfo = MethodInfo {
     ],
     story: true,
     shadow_ray_switch: true,
+    visibility: Some(&VISIBILITY),
     truth_of_vpls: false,
     one_bounce: false,
     glossy: true,
@@ -361,6 +368,108 @@ fn validate(s: &RenderSettings) -> Result<(), String> {
     crate::base::field::check(SECTION, settings::FIELDS, sm)?;
     sm.interleave.validate(SECTION, settings::MAX_SLOT_INTERLEAVE)
 }
+
+/// Half-resolution G-buffer position and normal, and the sampler's demodulated sums there.
+pub type HalfReadback = (ImageF32, ImageF32, Vec<[f32; 4]>);
+
+/// The samplers' command-line flags (`render`, `sheet`): shorthands for `--set methods.slc.*`.
+pub static FLAGS: &[super::MethodFlag] = &[
+    super::MethodFlag {
+        long: "block",
+        help: "SLC / RTSLC: cut block edge k in pixels (1 = a cut per pixel)",
+        path: "methods.slc.block_size",
+        kind: super::FlagKind::Number("K"),
+    },
+    super::MethodFlag {
+        long: "cut-size",
+        help: "SLC / SST / RTSLC: nodes per cut = samples per pixel (SST: traversals from the root)",
+        path: "methods.slc.cut_size",
+        kind: super::FlagKind::Number("N"),
+    },
+    super::MethodFlag {
+        long: "blending",
+        help: "SLC / RTSLC: how a pixel picks a cut per slot (Algorithm 1, or its own block's)",
+        path: "methods.slc.blending",
+        kind: super::FlagKind::Choice(&[("stochastic", "Stochastic"), ("off", "Off")]),
+    },
+    super::MethodFlag {
+        long: "fallback",
+        help: "SLC / RTSLC: what a pixel without a similar cut does (thesis 5.1.4)",
+        path: "methods.slc.fallback",
+        kind: super::FlagKind::Choice(&[
+            ("mock", "MockCut"),
+            ("average", "Average"),
+            ("root", "Root"),
+            ("recompute", "Recompute"),
+        ]),
+    },
+    super::MethodFlag {
+        long: "no-cull",
+        help: "SLC / RTSLC: keep nodes behind the block centre's surface in the cuts (complete cuts)",
+        path: "methods.slc.cull_behind",
+        kind: super::FlagKind::Switch("false"),
+    },
+    super::MethodFlag {
+        long: "near-field",
+        help: "SLC / SST: stop at a usable node only when the shaded point is at least this many box \
+               diagonals from its box (0 = off, the thesis's rule; default 1)",
+        path: "methods.slc.near_field",
+        kind: super::FlagKind::Number("DIAGONALS"),
+    },
+    super::MethodFlag {
+        long: "substitute-offset",
+        help: "SLC / SST: metres by which substitute samples' shadow rays stop short of the drawn \
+               point (the SST paper's scene-size epsilon; 0 = off, the thesis; default 0.05)",
+        path: "methods.slc.substitute_offset",
+        kind: super::FlagKind::Number("METRES"),
+    },
+    super::MethodFlag {
+        long: "child-probability",
+        help: "SLC / SST / RTSLC: how a traversal step picks a child: mean (eq. 5.5, the thesis), \
+               min-max (RTSLC's box distances), defensive (default: 0.8 x the thesis's + 0.2 x \
+               the closest-point distance's)",
+        path: "methods.slc.child_probability",
+        kind: super::FlagKind::Choice(&[
+            ("mean", "Mean"),
+            ("min-max", "MinMax"),
+            ("defensive", "Defensive"),
+        ]),
+    },
+    super::MethodFlag {
+        long: "glossy-weights",
+        help: "SLC / SST with --brdf ggx: how glossy samples weigh a step's children: geometric, \
+               material (the SST paper's 4.1) or defensive (default: material with 25% geometric)",
+        path: "methods.slc.glossy_weights",
+        kind: super::FlagKind::Choice(&[
+            ("geometric", "Geometric"),
+            ("material", "Material"),
+            ("defensive", "Defensive"),
+        ]),
+    },
+    super::MethodFlag {
+        long: "half-res",
+        help: "SLC / SST / RTSLC: GI at half resolution, joint-bilateral upsampled with the similarity S",
+        path: "methods.slc.half_resolution",
+        kind: super::FlagKind::Switch("true"),
+    },
+];
+
+/// The samplers' visibility (`render --visibility`; `[methods.slc] visibility`).
+pub static VISIBILITY: super::VisibilityModes = super::VisibilityModes {
+    modes: &[
+        ("rays", "a BVH shadow ray per sample (the thesis)"),
+        ("ism", "an imperfect shadow map per light-tree leaf"),
+    ],
+    set: |s, name| {
+        SamplingSettings::edit(s, |m| {
+            m.visibility = if name == "ism" {
+                SamplerVisibility::Ism
+            } else {
+                SamplerVisibility::Rays
+            }
+        })
+    },
+};
 
 /// The tree samplers' settings table, as settings paths and messages name it.
 const SECTION: &str = "methods.slc";
@@ -470,6 +579,17 @@ impl TreeSamplers {
     /// Counters of a recent frame (non-blocking).
     pub fn poll_stats(&mut self) -> Option<SamplingStats> {
         self.pass.stats.poll()
+    }
+    /// Half-resolution GI of the last frame: its G-buffer position, normal and the sampler's
+    /// demodulated sums (None when half resolution is off).
+    pub fn read_half_resolution(&self, ctx: &GpuContext) -> Result<Option<HalfReadback>, GpuError> {
+        let Some(h) = self.half_targets() else {
+            return Ok(None);
+        };
+        let pos = readback::read_texture_f32(ctx, &h.gbuffer.position, 0)?;
+        let nrm = readback::read_texture_f32(ctx, &h.gbuffer.normal, 0)?;
+        let acc = readback::read_storage_buffer(ctx, &h.accum)?;
+        Ok(Some((pos, nrm, bytemuck::cast_slice(&acc).to_vec())))
     }
     /// The half-resolution targets of the last frame (None when half resolution is off).
     pub fn half_targets(&self) -> Option<&HalfTargets> {

@@ -73,24 +73,75 @@ inventory::submit! {
 pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     let base: ValSettings = b.base.method(val_method::ID).map_err(|e| anyhow::anyhow!(e))?;
     let img = images(dir)?;
-    let settings = |b: &Bench, method: MethodId, vals: u32, vis: ValVisibility, carried: bool| {
-        with(b, |s| {
-            s.gi.method = method;
-            s.gi.shadow_rays = true;
-            s.frame.fixed_seed = true;
-            s.frame.accumulate = false;
-            let _ = s.set_method(
-                val_method::ID,
-                &ValSettings {
-                    clusters: vals,
-                    visibility: vis,
-                    carry_over: carried,
-                    iterations: if carried { 1 } else { base.iterations },
-                    ..base.clone()
-                },
-            );
-        })
-    };
+    let rows = measure_rows(b, o, &base, &img)?;
+    write_rows(b, dir, &rows)?;
+    let mut table = format!(
+        "Virtual Area Lights ({}x{}, {} VPLs as seeds, splat {}, {} steps, {} x {} interleaving, {}^2 maps of {} cloud points, {}):\n",
+        o.size.0,
+        o.size.1,
+        b.base.vpl.count,
+        base.splat,
+        base.iterations,
+        base.interleave.n,
+        base.interleave.n,
+        base.ism.tile,
+        base.ism.points,
+        b.adapter
+    );
+    for r in &rows {
+        table.push_str(&format!(
+            "  {:<8} {:>4} VALs {:<13}: GI {:>8.3} ms GPU (clustering {:.3}, indirect {:.3}, ISMs {:.3}), frame {:.3} ms GPU, RMSE vs GT {:.4e} (mean {:.3}x), vs exact visibility {:.4e} (mean {:.3}x), {:.0} VALs lit\n",
+            r.method.to_string(),
+            r.vals,
+            format!("{}{}", r.vis.name(), if r.carried { " carried" } else { "" }),
+            r.gi_ms,
+            r.groups[0],
+            r.groups[1],
+            r.groups[2],
+            r.frame_gpu_ms,
+            r.rmse_gt,
+            r.mean_ratio_gt,
+            r.rmse_exact,
+            r.mean_ratio_exact,
+            r.lit
+        ));
+    }
+    let mut checks = Vec::new();
+    paper_table_1(b, o, &rows, &mut table, &mut checks, dir)?;
+    Ok(Report { table, checks })
+}
+
+/// A configuration's settings: fixed seeds (every run of a count shades the same
+/// interleaving subsets), no accumulation, shadow rays on.
+fn config_settings(
+    b: &Bench,
+    base: &ValSettings,
+    method: MethodId,
+    vals: u32,
+    vis: ValVisibility,
+    carried: bool,
+) -> RenderSettings {
+    with(b, |s| {
+        s.gi.method = method;
+        s.gi.shadow_rays = true;
+        s.frame.fixed_seed = true;
+        s.frame.accumulate = false;
+        let _ = s.set_method(
+            val_method::ID,
+            &ValSettings {
+                clusters: vals,
+                visibility: vis,
+                carry_over: carried,
+                iterations: if carried { 1 } else { base.iterations },
+                ..base.clone()
+            },
+        );
+    })
+}
+
+/// Every configuration measured, with its error against the ground truth and against the
+/// same clusters with exact visibility; the VAL runs' images.
+fn measure_rows(b: &mut Bench, o: &Opts, base: &ValSettings, img: &Path) -> anyhow::Result<Vec<Row>> {
     let mut rows: Vec<Row> = Vec::new();
     // (method, VALs, visibility, clusters carried over frames with one step each: the
     // paper's clustering, after the warm-up frames).
@@ -108,7 +159,7 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
     ];
     let mut exact: Vec<(MethodId, u32, ImageF32)> = Vec::new();
     for (method, vals, vis, carried) in configs {
-        let s = settings(b, method, vals, vis, carried);
+        let s = config_settings(b, base, method, vals, vis, carried);
         let m = b.measure(&s, o.size, o.per_config(), true)?;
         let Some(x) = m.indirect.clone() else {
             anyhow::bail!("{method} with {vals} VALs produced no image");
@@ -166,7 +217,11 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         }
         rows.push(row);
     }
+    Ok(rows)
+}
 
+/// `val.csv`: a row per configuration.
+fn write_rows(b: &Bench, dir: &Path, rows: &[Row]) -> anyhow::Result<()> {
     let mut csv = Csv::new(&[
         "scene",
         "method",
@@ -185,7 +240,7 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         "vals_lit",
         "mean_disk_radius_m",
     ]);
-    for r in &rows {
+    for r in rows {
         let mut cells = vec![
             b.scene.clone(),
             r.method.to_string(),
@@ -207,43 +262,22 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         csv.row(cells);
     }
     csv.write(&dir.join("val.csv"))?;
+    Ok(())
+}
 
+/// The paper's Table 1 beside ours (`val_table1.csv`) and the time and error checks.
+fn paper_table_1(
+    b: &Bench,
+    o: &Opts,
+    rows: &[Row],
+    table: &mut String,
+    checks: &mut Vec<Check>,
+    dir: &Path,
+) -> anyhow::Result<()> {
     let find = |m: MethodId, n: u32, v: ValVisibility| {
         rows.iter()
             .find(|r| r.method == m && r.vals == n && r.vis == v && !r.carried)
     };
-    let mut table = format!(
-        "Virtual Area Lights ({}x{}, {} VPLs as seeds, splat {}, {} steps, {} x {} interleaving, {}^2 maps of {} cloud points, {}):\n",
-        o.size.0,
-        o.size.1,
-        b.base.vpl.count,
-        base.splat,
-        base.iterations,
-        base.interleave.n,
-        base.interleave.n,
-        base.ism.tile,
-        base.ism.points,
-        b.adapter
-    );
-    for r in &rows {
-        table.push_str(&format!(
-            "  {:<8} {:>4} VALs {:<13}: GI {:>8.3} ms GPU (clustering {:.3}, indirect {:.3}, ISMs {:.3}), frame {:.3} ms GPU, RMSE vs GT {:.4e} (mean {:.3}x), vs exact visibility {:.4e} (mean {:.3}x), {:.0} VALs lit\n",
-            r.method.to_string(),
-            r.vals,
-            format!("{}{}", r.vis.name(), if r.carried { " carried" } else { "" }),
-            r.gi_ms,
-            r.groups[0],
-            r.groups[1],
-            r.groups[2],
-            r.frame_gpu_ms,
-            r.rmse_gt,
-            r.mean_ratio_gt,
-            r.rmse_exact,
-            r.mean_ratio_exact,
-            r.lit
-        ));
-    }
-    let mut checks = Vec::new();
     let mut t1 = Csv::new(&[
         "scene",
         "row",
@@ -327,5 +361,5 @@ pub fn val(b: &mut Bench, o: &Opts, dir: &Path) -> anyhow::Result<Report> {
         ));
     }
     t1.write(&dir.join("val_table1.csv"))?;
-    Ok(Report { table, checks })
+    Ok(())
 }

@@ -90,6 +90,7 @@ pub static MODULE: Module = Module {
         entries: &[pass::SEED_WG_ENTRY],
         size: [pass::SEED_WG, 1, 1],
     }],
+    flags: &[],
 };
 
 /// The clusters over light 0's RSM.
@@ -204,6 +205,7 @@ const fn info(
         timed_passes: TIMED,
         story: false,
         shadow_ray_switch: true,
+        visibility: Some(&VISIBILITY),
         truth_of_vpls: false,
         one_bounce: true,
         glossy: false,
@@ -283,13 +285,27 @@ pub static SWEEP: super::Sweep = super::Sweep {
     integer: true,
 };
 
-/// The VAL methods (`render --val-visibility`).
-pub const METHODS: [MethodId; 2] = [ID, VPL];
-
-/// Whether `m` is a VAL method.
-pub fn is_val(m: MethodId) -> bool {
-    METHODS.contains(&m)
-}
+/// The VALs' visibility (`render --visibility`; `[methods.val] visibility`).
+pub static VISIBILITY: super::VisibilityModes = super::VisibilityModes {
+    modes: &[
+        (
+            "pcss",
+            "the PCSS-style lookup in each VAL's imperfect shadow map (section 6)",
+        ),
+        ("ism", "one lookup in the VAL's map (the paper's simple lookup)"),
+        ("rays", "a BVH shadow ray to the VAL's centre"),
+        ("disk", "16 BVH rays to the VAL's disk (exact visibility)"),
+    ],
+    set: |s, name| {
+        let v = match name {
+            "ism" => ValVisibility::Ism,
+            "rays" => ValVisibility::Rays,
+            "disk" => ValVisibility::Disk,
+            _ => ValVisibility::Pcss,
+        };
+        set_visibility(s, v);
+    },
+};
 
 /// Sets the VALs' visibility (used while `gi.shadow_rays` is on).
 pub fn set_visibility(s: &mut RenderSettings, v: ValVisibility) {
