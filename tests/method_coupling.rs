@@ -27,6 +27,7 @@ const LIMITS: &[(&str, usize)] = &[
     // cut kernels (`lightcuts/kernels.rs`) and compare with Lightcuts in their figure.
     ("lightcuts", 7),
     ("reference", 0),
+    ("restir", 0),
     ("tree_samplers", 6),
     ("val", 0),
 ];
@@ -348,7 +349,7 @@ fn the_scan_finds_paths_groups_types_and_ids() {
 /// never grow; lower `SHAPE_LIMITS` when a change improves one). Its goal: every count 0.
 const SHAPE_LIMITS: &[(&str, usize)] = &[
     ("files over 700 lines", 0),
-    ("functions over 150 lines", 2),
+    ("functions over 150 lines", 0),
     ("too_many_arguments allows", 0),
     ("files in src/gpu and src/settings that name methods", 1),
     (

@@ -233,21 +233,8 @@ impl StoryPanel {
             super::cut_story::contents(ui, story, self.leaves);
             return;
         }
-        if let Some(m) = &self.method_overlay {
-            let (x, y) = self.pixel.unwrap_or_default();
-            ui.label(format!("Pixel ({x}, {y}) · last frame · {}", m.title));
-            ui.checkbox(&mut self.overlay, "draw it in the camera views")
-                .on_hover_text(&m.key);
-            ui.label(egui::RichText::new(&m.key).small());
-            egui::Grid::new("method_overlay_rows")
-                .striped(true)
-                .show(ui, |ui| {
-                    for (k, v) in &m.rows {
-                        ui.label(k);
-                        ui.label(v);
-                        ui.end_row();
-                    }
-                });
+        if self.method_overlay.is_some() {
+            self.overlay_contents(ui);
             return;
         }
         let Some(t) = self.trace.clone() else {
@@ -259,39 +246,7 @@ impl StoryPanel {
         ui.checkbox(&mut self.overlay, "draw the story in the camera views")
             .on_hover_text("points and shadow rays (green visible, red blocked, grey facing away); the selected sample's path boxes (blue) and end node's 1-sigma ellipse (yellow)");
         if t.mode == 0 || t.fell_back {
-            ui.separator();
-            ui.strong("The 4 surrounding block cuts (Algorithm 1)");
-            egui::Grid::new("story_blocks").striped(true).show(ui, |ui| {
-                for h in ["", "block", "bilinear", "similar (S)", "blend weight"] {
-                    ui.strong(h);
-                }
-                ui.end_row();
-                for i in 0..4 {
-                    ui.label(["top-left", "top-right", "bottom-left", "bottom-right"][i]);
-                    ui.label(t.blocks[i].to_string());
-                    ui.label(format!("{:.3}", t.bilinear[i]));
-                    ui.label(if t.bilinear[i] <= 0.0 {
-                        "–"
-                    } else if t.weights[i] > 0.0 {
-                        "yes"
-                    } else {
-                        "no"
-                    });
-                    let w = if t.weight_sum > 0.0 {
-                        t.weights[i] / t.weight_sum
-                    } else {
-                        0.0
-                    };
-                    ui.label(format!("{:.3}", w));
-                    ui.end_row();
-                }
-            });
-            if t.fell_back {
-                ui.label(
-                    egui::RichText::new(format!("no similar cut: fell back to the {}", t.mode_name()))
-                        .color(ui.visuals().warn_fg_color),
-                );
-            }
+            blocks_section(ui, &t);
         }
         ui.separator();
         let est = self.albedo / std::f32::consts::PI * t.estimate();
@@ -324,6 +279,37 @@ impl StoryPanel {
         let links = self.links.clone();
         let topo = Topology::of(leaves, &links);
         let level = |n: u32| topo.depth(n.max(1));
+        self.samples_table(ui, &t, &level);
+        self.selected_path(ui, &t, &level, leaves);
+        ui.separator();
+        ui.strong("Tree view: the paths over the levels");
+        self.tree_view(ui, &t);
+    }
+
+    /// A method's overlay story: its table, and the switch that draws it in the views.
+    fn overlay_contents(&mut self, ui: &mut egui::Ui) {
+        let Some(m) = &self.method_overlay else {
+            return;
+        };
+        let (x, y) = self.pixel.unwrap_or_default();
+        ui.label(format!("Pixel ({x}, {y}) · last frame · {}", m.title));
+        ui.checkbox(&mut self.overlay, "draw it in the camera views")
+            .on_hover_text(&m.key);
+        ui.label(egui::RichText::new(&m.key).small());
+        egui::Grid::new("method_overlay_rows")
+            .striped(true)
+            .show(ui, |ui| {
+                for (k, v) in &m.rows {
+                    ui.label(k);
+                    ui.label(v);
+                    ui.end_row();
+                }
+            });
+    }
+
+    /// The samples: slot, origin, start and end node, steps, stop, path probability,
+    /// shadow ray, contribution; clicking a slot selects it.
+    fn samples_table(&mut self, ui: &mut egui::Ui, t: &PixelTrace, level: &dyn Fn(u32) -> u32) {
         egui::ScrollArea::vertical()
             .id_salt("story_samples")
             .max_height(220.0)
@@ -385,6 +371,11 @@ impl StoryPanel {
                         }
                     });
             });
+    }
+
+    /// The selected sample's path: a row per step (level, node, p(child), usable, v, σ_z,
+    /// flux).
+    fn selected_path(&self, ui: &mut egui::Ui, t: &PixelTrace, level: &dyn Fn(u32) -> u32, leaves: u32) {
         if let Some(i) = self.selected
             && let Some(s) = t.samples.get(i)
         {
@@ -431,9 +422,6 @@ impl StoryPanel {
                 ));
             }
         }
-        ui.separator();
-        ui.strong("Tree view: the paths over the levels");
-        self.tree_view(ui, &t);
     }
 
     /// Levels top to bottom (root first), each node at its position within its level; the
@@ -527,5 +515,43 @@ fn ellipse(node: &SstNode, color: egui::Color32) -> Prim {
         center: node.position,
         axes: [t * sx, b * sy],
         color: rgba8(color),
+    }
+}
+
+/// The 4 surrounding block cuts of Algorithm 1 (their bilinear weights, similarity, blend
+/// weights) and whether the pixel fell back.
+fn blocks_section(ui: &mut egui::Ui, t: &PixelTrace) {
+    ui.separator();
+    ui.strong("The 4 surrounding block cuts (Algorithm 1)");
+    egui::Grid::new("story_blocks").striped(true).show(ui, |ui| {
+        for h in ["", "block", "bilinear", "similar (S)", "blend weight"] {
+            ui.strong(h);
+        }
+        ui.end_row();
+        for i in 0..4 {
+            ui.label(["top-left", "top-right", "bottom-left", "bottom-right"][i]);
+            ui.label(t.blocks[i].to_string());
+            ui.label(format!("{:.3}", t.bilinear[i]));
+            ui.label(if t.bilinear[i] <= 0.0 {
+                "–"
+            } else if t.weights[i] > 0.0 {
+                "yes"
+            } else {
+                "no"
+            });
+            let w = if t.weight_sum > 0.0 {
+                t.weights[i] / t.weight_sum
+            } else {
+                0.0
+            };
+            ui.label(format!("{:.3}", w));
+            ui.end_row();
+        }
+    });
+    if t.fell_back {
+        ui.label(
+            egui::RichText::new(format!("no similar cut: fell back to the {}", t.mode_name()))
+                .color(ui.visuals().warn_fg_color),
+        );
     }
 }

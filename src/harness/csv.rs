@@ -55,4 +55,3 @@ pub fn num(v: f64) -> String {
         "nan".into()
     }
 }
-

@@ -501,7 +501,7 @@ impl Bench {
         m.frame_kind = format!("{:?}", self.r.frame_mode());
         let mut base_slc = self.base.clone();
         base_slc.gi.method = crate::methods::tree_samplers::SLC;
-        if *s == base_slc && !m.passes.is_empty() {
+        if crate::methods::same_settings(s, &base_slc) && !m.passes.is_empty() {
             self.base_timings.push(BaseTiming {
                 figure: self.figure.clone(),
                 size,

@@ -232,6 +232,23 @@ pub fn own_settings(id: MethodId, s: &RenderSettings) -> Option<(String, toml::T
     Some((own.section, t))
 }
 
+/// Whether two settings configure the same frame: equal, each method's own table compared as
+/// the method reads it (a table that spells a default out equals one that leaves it out).
+pub fn same_settings(a: &RenderSettings, b: &RenderSettings) -> bool {
+    let norm = |s: &RenderSettings| {
+        let mut n = s.clone();
+        for m in REGISTRY {
+            if let Some((section, t)) = own_settings(m.id, s)
+                && let Some(key) = section.strip_prefix("methods.")
+            {
+                n.methods.insert_raw(key, t);
+            }
+        }
+        n
+    };
+    a == b || norm(a) == norm(b)
+}
+
 /// `over`'s keys written onto `base`, nested tables key by key.
 fn overlay(base: &mut toml::Table, over: &toml::Table) {
     for (k, v) in over {

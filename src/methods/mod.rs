@@ -23,6 +23,7 @@ pub mod lightcut_interpolation;
 pub mod lightcuts;
 pub mod overlay;
 pub mod reference;
+pub mod restir;
 pub mod tree_samplers;
 pub mod val;
 pub use ids::*;

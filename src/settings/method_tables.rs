@@ -88,10 +88,18 @@ impl MethodTables {
         }
     }
 
-    /// Stores `value` as the table `key`.
-    pub fn set<T: Serialize>(&mut self, key: &str, value: &T) -> Result<(), String> {
+    /// Stores `value` as the table `key`: the keys where it differs from `T`'s defaults (none:
+    /// no table), as a user would write it, so that settings equal in value compare equal
+    /// however they were reached.
+    pub fn set<T: Serialize + Default>(&mut self, key: &str, value: &T) -> Result<(), String> {
         let t = toml::Table::try_from(value).map_err(|e| format!("methods.{key}: {e}"))?;
-        self.insert_raw(key, t);
+        let d = toml::Table::try_from(T::default()).map_err(|e| format!("methods.{key}: {e}"))?;
+        let t = diff(&t, &d);
+        if t.is_empty() {
+            self.0.remove(key);
+        } else {
+            self.insert_raw(key, t);
+        }
         Ok(())
     }
 
@@ -104,6 +112,26 @@ impl MethodTables {
     pub fn remove(&mut self, key: &str) -> Option<toml::Table> {
         self.0.remove(key).map(|e| e.raw)
     }
+}
+
+/// The keys of `value` that differ from `default` (nested tables key by key).
+fn diff(value: &toml::Table, default: &toml::Table) -> toml::Table {
+    let mut out = toml::Table::new();
+    for (k, v) in value {
+        match (v, default.get(k)) {
+            (toml::Value::Table(a), Some(toml::Value::Table(b))) => {
+                let d = diff(a, b);
+                if !d.is_empty() {
+                    out.insert(k.clone(), toml::Value::Table(d));
+                }
+            }
+            (v, Some(dv)) if v == dv => {}
+            _ => {
+                out.insert(k.clone(), v.clone());
+            }
+        }
+    }
+    out
 }
 
 impl PartialEq for MethodTables {
@@ -162,6 +190,9 @@ mod tests {
         m.set("x", &Knobs { cap: 4 }).unwrap();
         assert_eq!(m.get::<Knobs>("x"), Ok(Knobs { cap: 4 }));
         assert_ne!(c, m);
+        // The defaults are no table: equal to never having set one.
+        m.set("x", &Knobs::default()).unwrap();
+        assert!(m.raw("x").is_none() && m == MethodTables::default());
         let mut bad = toml::Table::new();
         bad.insert("cap".into(), toml::Value::String("many".into()));
         m.insert_raw("x", bad);

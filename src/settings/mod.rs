@@ -102,7 +102,7 @@ impl RenderSettings {
     }
 
     /// Stores a method's settings as its `[methods.<cli name>]` table.
-    pub fn set_method<T: Serialize>(&mut self, id: MethodId, value: &T) -> Result<(), String> {
+    pub fn set_method<T: Serialize + Default>(&mut self, id: MethodId, value: &T) -> Result<(), String> {
         self.methods.set(id.cli(), value)
     }
 }
